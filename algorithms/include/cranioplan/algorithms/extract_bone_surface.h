@@ -1,0 +1,39 @@
+#pragma once
+// From a CT or label volume to a bone surface mesh.
+#include <limits>
+#include <string>
+
+#include "cranioplan/model/mesh.h"
+#include "cranioplan/model/volume.h"
+
+namespace cranioplan {
+
+struct ExtractBoneSurfaceParams {
+  /// Iso-value: Hounsfield units for CT (bone from about 200–400 HU), probability for masks.
+  /// NaN means the volume kind's default (300 HU for CT, 0.5 for masks).
+  double threshold = std::numeric_limits<double>::quiet_NaN();
+  /// Keep only the largest connected piece (true), or every piece of at least
+  /// `min_piece_triangles` triangles (false).
+  bool largest_piece_only = true;
+  long long min_piece_triangles = 1000;  ///< used when largest_piece_only is false; ≥ 1
+  /// Decimate to about this many triangles (quadric decimation); 0 keeps full resolution.
+  long long target_triangles = 0;
+};
+
+struct ExtractBoneSurfaceResult {
+  enum class Status { Ok, NoSurface };
+  Status status = Status::Ok;
+  std::string message;     ///< why there is no surface, e.g. threshold above every sample
+  SkullMesh mesh;          ///< closed, outward-oriented, in the volume's world coordinates (mm)
+  double threshold_used = 0.0;
+  long long pieces_found = 0;
+  long long pieces_kept = 0;
+  long long triangles_before_decimation = 0;
+  double seconds = 0.0;
+  bool usable() const { return status == Status::Ok; }
+};
+
+ExtractBoneSurfaceResult extract_bone_surface(const Volume& volume,
+                                              const ExtractBoneSurfaceParams& params = {});
+
+}  // namespace cranioplan

@@ -1,0 +1,57 @@
+#pragma once
+// The midsagittal plane: an initial plane from landmarks (or found automatically), refined with
+// Ceres from landmarks and surface symmetry.
+#include <string>
+
+#include "cranioplan/model/landmarks.h"
+#include "cranioplan/model/mesh.h"
+#include "cranioplan/model/plane.h"
+
+namespace cranioplan {
+
+struct PlaneFitParams {
+  bool refine = true;                 ///< run the Ceres refinement after the initial plane
+  bool use_surface_symmetry = true;   ///< add the surface-symmetry residuals (needs a mesh)
+  int sample_count = 4000;            ///< surface samples for symmetry, 100..100000
+  int outer_iterations = 15;          ///< correspondence updates (k-d tree), 1..50
+  double robust_scale_mm = 1.0;       ///< Cauchy loss scale for symmetry residuals, mm (>0)
+  double max_correspondence_mm = 10;  ///< reflected samples farther than this are ignored, mm
+  double inlier_threshold_mm = 1.5;   ///< |residual| below this counts as an inlier, mm
+  double landmark_weight = 1.0;       ///< weight of each landmark residual (≥ 0)
+  double convergence_deg = 1e-2;      ///< stop outer iterations when the normal turns less, deg
+  double convergence_mm = 1e-2;       ///< ... and the offset moves less than this, mm
+};
+
+struct PlaneFit {
+  enum class Status { Converged, MaxIterations, Failed };
+  Status status = Status::Failed;
+  std::string message;                ///< plain words: how it ended, or why it failed
+  Plane plane;                        ///< the refined plane (or the initial one without refining)
+  Plane initial;                      ///< the starting plane
+  std::string initial_method;         ///< "landmarks" or "automatic"
+  double symmetry_rms_mm = 0.0;       ///< RMS of point-to-plane symmetry residuals over inliers
+  double inlier_fraction = 0.0;       ///< fraction of samples whose residual is an inlier
+  int iterations = 0;                 ///< outer iterations (correspondence updates)
+  int solver_iterations = 0;          ///< Ceres iterations summed over outer iterations
+  std::string termination;            ///< Ceres termination of the last solve
+  double seconds = 0.0;
+  bool usable() const { return status != Status::Failed; }
+};
+
+/// Plane from nasion and orbit centres (required), plus optional midline points: the normal
+/// runs from the left to the right orbit; with midline points the plane is the least-squares
+/// fit to the midline points and the reflected-orbit condition.
+Plane initial_plane_from_landmarks(const Landmarks& landmarks);
+
+/// Plane found without landmarks: candidate normals along the principal axes of the vertices
+/// and along the coordinate axes, plane through the centroid, scored by how well the mirrored
+/// surface overlaps the original (median distance); the best candidate wins.
+Plane automatic_initial_plane(const SkullMesh& mesh);
+
+/// Initial plane (landmarks when they hold the required three, otherwise automatic), then the
+/// Ceres refinement. With `params.refine == false` returns the initial plane with its
+/// symmetry measures.
+PlaneFit fit_sagittal_plane(const SkullMesh& mesh, const Landmarks& landmarks,
+                            const PlaneFitParams& params = {});
+
+}  // namespace cranioplan

@@ -1,0 +1,28 @@
+#pragma once
+// Nearest-neighbour queries over a fixed set of points (a k-d tree; nanoflann stays private).
+#include <Eigen/Core>
+#include <memory>
+#include <vector>
+
+namespace cranioplan {
+
+class PointIndex {
+ public:
+  explicit PointIndex(std::vector<Eigen::Vector3d> points);
+  ~PointIndex();
+  PointIndex(PointIndex&&) noexcept;
+  PointIndex& operator=(PointIndex&&) noexcept;
+
+  /// Index of the nearest point and its squared distance (mm²). Requires a non-empty set.
+  int nearest(const Eigen::Vector3d& query, double* squared_distance = nullptr) const;
+  /// Indices of all points within `radius` mm.
+  std::vector<int> within_radius(const Eigen::Vector3d& query, double radius) const;
+  const std::vector<Eigen::Vector3d>& points() const;
+  size_t size() const { return points().size(); }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace cranioplan

@@ -1,0 +1,30 @@
+#pragma once
+// Reading surface meshes: STL (binary or ASCII, told apart by content), PLY, OBJ, OFF, VTP.
+#include <string>
+#include <vector>
+
+#include "cranioplan/model/mesh.h"
+
+namespace cranioplan {
+
+struct ReadMeshParams {
+  /// When true, any zero-area or repeated-vertex triangle makes the file an error instead of
+  /// being dropped with a warning.
+  bool strict = false;
+};
+
+struct MeshFile {
+  SkullMesh mesh;
+  std::string format;                 ///< "binary STL", "ASCII STL", "PLY", "OBJ", "OFF", "VTP"
+  long long triangles_in_file = 0;    ///< triangles (after fan triangulation of polygons)
+  long long degenerate_dropped = 0;   ///< zero-area triangles removed
+  long long nonmanifold_split = 0;    ///< triangles added on duplicated vertices
+  std::vector<std::string> warnings;  ///< one sentence each, naming the file
+};
+
+/// Reads a mesh; STL vertices are welded (identical coordinates become one vertex).
+/// Throws InputError naming the file and the problem: missing, empty, truncated, garbage,
+/// NaN/Inf coordinates, no usable triangle, unknown format.
+MeshFile read_mesh(const std::string& path, const ReadMeshParams& params = {});
+
+}  // namespace cranioplan

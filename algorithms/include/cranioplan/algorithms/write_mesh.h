@@ -1,0 +1,21 @@
+#pragma once
+#include <string>
+
+#include "cranioplan/model/mesh.h"
+
+namespace cranioplan {
+
+enum class MeshFormat { BinarySTL, BinaryPLY };
+
+/// The format a path's extension asks for (.stl or .ply, case-insensitive); throws InputError
+/// for other extensions.
+MeshFormat mesh_format_for_path(const std::string& path);
+
+/// Writes the mesh atomically (temporary file in the same folder, then rename). Throws
+/// InputError when the file cannot be written.
+void write_mesh(const SkullMesh& mesh, const std::string& path, MeshFormat format);
+inline void write_mesh(const SkullMesh& mesh, const std::string& path) {
+  write_mesh(mesh, path, mesh_format_for_path(path));
+}
+
+}  // namespace cranioplan

@@ -1,0 +1,140 @@
+#include "cranioplan/algorithms/extract_bone_surface.h"
+
+#include <vtkCellArray.h>
+#include <vtkFlyingEdges3D.h>
+#include <vtkFloatArray.h>
+#include <vtkIdList.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkQuadricDecimation.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "cranioplan/algorithms/mesh_components.h"
+
+namespace cranioplan {
+namespace {
+
+TriangleSoup soup_from_vtk(vtkPolyData* pd) {
+  TriangleSoup soup;
+  const vtkIdType np = pd->GetNumberOfPoints();
+  soup.vertices.resize(static_cast<size_t>(np));
+  for (vtkIdType i = 0; i < np; ++i) {
+    double p[3];
+    pd->GetPoint(i, p);
+    soup.vertices[static_cast<size_t>(i)] = {p[0], p[1], p[2]};
+  }
+  vtkNew<vtkIdList> ids;
+  vtkCellArray* polys = pd->GetPolys();
+  soup.triangles.reserve(static_cast<size_t>(polys->GetNumberOfCells()));
+  for (polys->InitTraversal(); polys->GetNextCell(ids);)
+    if (ids->GetNumberOfIds() == 3)
+      soup.triangles.emplace_back(ids->GetId(0), ids->GetId(1), ids->GetId(2));
+  return soup;
+}
+
+vtkNew<vtkPolyData> vtk_from_soup(const TriangleSoup& soup) {
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  pts->SetNumberOfPoints(static_cast<vtkIdType>(soup.vertices.size()));
+  for (size_t i = 0; i < soup.vertices.size(); ++i)
+    pts->SetPoint(static_cast<vtkIdType>(i), soup.vertices[i].data());
+  vtkNew<vtkCellArray> polys;
+  polys->AllocateExact(static_cast<vtkIdType>(soup.triangles.size()),
+                       static_cast<vtkIdType>(soup.triangles.size() * 3));
+  for (const auto& t : soup.triangles) {
+    const vtkIdType ids[3] = {t[0], t[1], t[2]};
+    polys->InsertNextCell(3, ids);
+  }
+  vtkNew<vtkPolyData> pd;
+  pd->SetPoints(pts);
+  pd->SetPolys(polys);
+  return pd;
+}
+
+}  // namespace
+
+ExtractBoneSurfaceResult extract_bone_surface(const Volume& volume,
+                                              const ExtractBoneSurfaceParams& params) {
+  const auto t0 = std::chrono::steady_clock::now();
+  ExtractBoneSurfaceResult result;
+  const double threshold =
+      std::isnan(params.threshold) ? volume.default_threshold() : params.threshold;
+  result.threshold_used = threshold;
+  const auto [lo_it, hi_it] = std::minmax_element(volume.data.begin(), volume.data.end());
+  if (volume.data.empty() || *hi_it < threshold || *lo_it >= threshold) {
+    result.status = ExtractBoneSurfaceResult::Status::NoSurface;
+    result.message = "threshold " + std::to_string(threshold) + " is outside the volume's range [" +
+                     std::to_string(volume.data.empty() ? 0.0 : *lo_it) + ", " +
+                     std::to_string(volume.data.empty() ? 0.0 : *hi_it) + "]: no surface";
+    return result;
+  }
+
+  // Pad by one sample below the threshold on every side so the surface is closed where bone
+  // touches the edge of the scan. Index space: sample (i,j,k) of the volume sits at (i,j,k).
+  const int nx = volume.dims[0] + 2, ny = volume.dims[1] + 2, nz = volume.dims[2] + 2;
+  const float pad = static_cast<float>(std::min<double>(*lo_it, threshold - 1.0));
+  vtkNew<vtkFloatArray> scalars;
+  scalars->SetNumberOfTuples(static_cast<vtkIdType>(nx) * ny * nz);
+  float* dst = scalars->GetPointer(0);
+  std::fill(dst, dst + static_cast<size_t>(nx) * ny * nz, pad);
+  for (int k = 0; k < volume.dims[2]; ++k)
+    for (int j = 0; j < volume.dims[1]; ++j)
+      std::copy_n(&volume.data[volume.index(0, j, k)], volume.dims[0],
+                  dst + ((static_cast<size_t>(k) + 1) * ny + j + 1) * nx + 1);
+  vtkNew<vtkImageData> image;
+  image->SetDimensions(nx, ny, nz);
+  image->SetOrigin(-1, -1, -1);
+  image->SetSpacing(1, 1, 1);
+  image->GetPointData()->SetScalars(scalars);
+
+  vtkNew<vtkFlyingEdges3D> fe;
+  fe->SetInputData(image);
+  fe->SetValue(0, threshold);
+  fe->ComputeNormalsOff();
+  fe->ComputeGradientsOff();
+  fe->ComputeScalarsOff();
+  fe->Update();
+  TriangleSoup soup = soup_from_vtk(fe->GetOutput());
+  for (auto& p : soup.vertices) p = volume.world(p);
+
+  const SoupComponents comps = soup_components(soup);
+  result.pieces_found = static_cast<long long>(comps.sizes.size());
+  int keep = 1;
+  if (!params.largest_piece_only) {
+    keep = 0;
+    while (keep < static_cast<int>(comps.sizes.size()) &&
+           comps.sizes[keep] >= std::max<long long>(1, params.min_piece_triangles))
+      ++keep;
+    keep = std::max(keep, 1);
+  }
+  result.pieces_kept = keep;
+  soup = keep_largest_pieces(soup, comps, keep);
+  result.triangles_before_decimation = static_cast<long long>(soup.triangles.size());
+
+  if (params.target_triangles > 0 &&
+      params.target_triangles < static_cast<long long>(soup.triangles.size())) {
+    vtkNew<vtkPolyData> pd = vtk_from_soup(soup);
+    vtkNew<vtkQuadricDecimation> dec;
+    dec->SetInputData(pd);
+    dec->SetTargetReduction(1.0 - static_cast<double>(params.target_triangles) /
+                                      static_cast<double>(soup.triangles.size()));
+    dec->VolumePreservationOn();
+    dec->Update();
+    soup = soup_from_vtk(dec->GetOutput());
+  }
+
+  if (signed_volume(soup) < 0)
+    for (auto& t : soup.triangles) std::swap(t[1], t[2]);
+  result.mesh = build_mesh(soup);
+  result.seconds =
+      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return result;
+}
+
+}  // namespace cranioplan

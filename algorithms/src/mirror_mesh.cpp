@@ -1,0 +1,12 @@
+#include "cranioplan/algorithms/mirror_mesh.h"
+
+namespace cranioplan {
+
+SkullMesh mirror_mesh(const SkullMesh& mesh, const Plane& plane) {
+  TriangleSoup soup = to_soup(mesh);
+  for (auto& p : soup.vertices) p = plane.reflect(p);
+  for (auto& t : soup.triangles) std::swap(t[1], t[2]);
+  return build_mesh(soup);
+}
+
+}  // namespace cranioplan

@@ -1,0 +1,424 @@
+#include "cranioplan/algorithms/read_mesh.h"
+
+#include <vtkCallbackCommand.h>
+#include <vtkCellArray.h>
+#include <vtkIdList.h>
+#include <vtkNew.h>
+#include <vtkPLYReader.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
+#include <vtkXMLPolyDataReader.h>
+
+#include <cmath>
+#include <cstdint>
+#include <cstdlib>
+#include <cstring>
+#include <sstream>
+
+#include "cranioplan/model/error.h"
+#include "file_bytes.h"
+
+namespace cranioplan {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Vertex welding of float coordinates: open-addressing hash on the exact bit patterns.
+class FloatWelder {
+ public:
+  explicit FloatWelder(size_t expected_points) {
+    size_t cap = 16;
+    while (cap < expected_points * 2) cap <<= 1;
+    slots_.assign(cap, -1);
+    mask_ = cap - 1;
+    keys_.reserve(expected_points * 3);
+  }
+  int insert(const float* xyz) {
+    uint32_t k[3];
+    for (int i = 0; i < 3; ++i) {
+      const float v = xyz[i] == 0.0f ? 0.0f : xyz[i];  // -0 and +0 weld together
+      std::memcpy(&k[i], &v, 4);
+    }
+    uint64_t h = (k[0] * 0x9E3779B97F4A7C15ull) ^ (k[1] * 0xC2B2AE3D27D4EB4Full) ^
+                 (k[2] * 0x165667B19E3779F9ull);
+    h ^= h >> 29;
+    size_t slot = static_cast<size_t>(h) & mask_;
+    while (true) {
+      const int idx = slots_[slot];
+      if (idx < 0) {
+        const int id = static_cast<int>(keys_.size() / 3);
+        keys_.insert(keys_.end(), k, k + 3);
+        slots_[slot] = id;
+        return id;
+      }
+      const uint32_t* e = &keys_[static_cast<size_t>(idx) * 3];
+      if (e[0] == k[0] && e[1] == k[1] && e[2] == k[2]) return idx;
+      slot = (slot + 1) & mask_;
+    }
+  }
+  std::vector<Eigen::Vector3d> points() const {
+    std::vector<Eigen::Vector3d> out(keys_.size() / 3);
+    for (size_t i = 0; i < out.size(); ++i) {
+      float f[3];
+      std::memcpy(f, &keys_[i * 3], 12);
+      out[i] = {f[0], f[1], f[2]};
+    }
+    return out;
+  }
+
+ private:
+  std::vector<int> slots_;
+  std::vector<uint32_t> keys_;
+  size_t mask_ = 0;
+};
+
+[[noreturn]] void fail(const std::string& path, const std::string& problem) {
+  throw InputError(path, problem);
+}
+
+void check_finite(const std::string& path, const Eigen::Vector3d& p, long long triangle) {
+  if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z()))
+    fail(path, "triangle " + format_count(triangle + 1) +
+                   " has a coordinate that is not a number (NaN or Inf)");
+}
+
+// ---------------------------------------------------------------------------------------------
+// STL
+bool looks_like_text(const std::string& bytes) {
+  const size_t n = std::min<size_t>(bytes.size(), 1024);
+  for (size_t i = 0; i < n; ++i) {
+    const unsigned char c = static_cast<unsigned char>(bytes[i]);
+    if (c == 0 || (c < 32 && c != '\n' && c != '\r' && c != '\t' && c != '\f' && c != '\v'))
+      return false;
+  }
+  size_t i = 0;
+  while (i < bytes.size() && std::isspace(static_cast<unsigned char>(bytes[i]))) ++i;
+  return bytes.compare(i, 5, "solid") == 0;
+}
+
+TriangleSoup parse_binary_stl(const std::string& path, const std::string& bytes, uint32_t n) {
+  FloatWelder welder(static_cast<size_t>(n) / 2 + 16);
+  TriangleSoup soup;
+  soup.triangles.resize(n);
+  const char* p = bytes.data() + 84;
+  for (uint32_t t = 0; t < n; ++t, p += 50) {
+    float xyz[9];
+    std::memcpy(xyz, p + 12, 36);
+    for (int c = 0; c < 9; ++c)
+      if (!std::isfinite(xyz[c]))
+        fail(path, "triangle " + format_count(t + 1LL) +
+                       " has a coordinate that is not a number (NaN or Inf)");
+    for (int v = 0; v < 3; ++v) soup.triangles[t][v] = welder.insert(xyz + 3 * v);
+  }
+  soup.vertices = welder.points();
+  return soup;
+}
+
+// A tokenizer over a null-terminated text buffer.
+struct TextCursor {
+  const char* p;
+  const char* end;
+  long long line = 1;
+  void skip_space() {
+    while (p < end && std::isspace(static_cast<unsigned char>(*p))) {
+      if (*p == '\n') ++line;
+      ++p;
+    }
+  }
+  std::string word() {
+    skip_space();
+    const char* s = p;
+    while (p < end && !std::isspace(static_cast<unsigned char>(*p))) ++p;
+    return std::string(s, p);
+  }
+  bool number(double& out) {
+    skip_space();
+    char* e = nullptr;
+    out = std::strtod(p, &e);
+    if (e == p) return false;
+    p = e;
+    return true;
+  }
+  bool at_end() {
+    skip_space();
+    return p >= end;
+  }
+};
+
+TriangleSoup parse_ascii_stl(const std::string& path, const std::string& bytes) {
+  TextCursor cur{bytes.c_str(), bytes.c_str() + bytes.size()};
+  auto expect = [&](const char* w) {
+    const std::string got = cur.word();
+    if (got != w)
+      fail(path, "ASCII STL: expected '" + std::string(w) + "' on line " +
+                     format_count(cur.line) + ", found '" + got.substr(0, 40) + "'");
+  };
+  cur.word();                                                     // "solid"
+  while (cur.p < cur.end && *cur.p != '\n') ++cur.p;              // the solid's name
+  std::vector<float> coords;
+  std::vector<Eigen::Vector3i> tris;
+  while (true) {
+    if (cur.at_end()) fail(path, "ASCII STL: file ends without 'endsolid'");
+    const std::string w = cur.word();
+    if (w == "endsolid") break;
+    if (w != "facet")
+      fail(path, "ASCII STL: expected 'facet' or 'endsolid' on line " + format_count(cur.line) +
+                     ", found '" + w.substr(0, 40) + "'");
+    expect("normal");
+    double d;
+    for (int i = 0; i < 3; ++i)
+      if (!cur.number(d)) fail(path, "ASCII STL: bad normal on line " + format_count(cur.line));
+    expect("outer");
+    expect("loop");
+    for (int v = 0; v < 3; ++v) {
+      expect("vertex");
+      for (int i = 0; i < 3; ++i) {
+        if (!cur.number(d))
+          fail(path, "ASCII STL: bad vertex coordinate on line " + format_count(cur.line));
+        if (!std::isfinite(d))
+          fail(path, "triangle " + format_count(static_cast<long long>(tris.size()) + 1) +
+                         " has a coordinate that is not a number (NaN or Inf)");
+        coords.push_back(static_cast<float>(d));
+      }
+    }
+    expect("endloop");
+    expect("endfacet");
+    tris.emplace_back(0, 0, 0);
+  }
+  FloatWelder welder(tris.size() / 2 + 16);
+  TriangleSoup soup;
+  soup.triangles.resize(tris.size());
+  for (size_t t = 0; t < tris.size(); ++t)
+    for (int v = 0; v < 3; ++v) soup.triangles[t][v] = welder.insert(&coords[(t * 3 + v) * 3]);
+  soup.vertices = welder.points();
+  return soup;
+}
+
+TriangleSoup read_stl(const std::string& path, const std::string& bytes, std::string& format) {
+  const size_t size = bytes.size();
+  uint32_t n = 0;
+  if (size >= 84) std::memcpy(&n, bytes.data() + 80, 4);
+  const unsigned long long expected = 84ull + 50ull * n;
+  if (size >= 84 && size >= expected && size - expected < 50 && !(n == 0 && looks_like_text(bytes))) {
+    if (n == 0) fail(path, "binary STL declares 0 triangles");
+    format = "binary STL";
+    return parse_binary_stl(path, bytes, n);
+  }
+  if (looks_like_text(bytes)) {
+    format = "ASCII STL";
+    return parse_ascii_stl(path, bytes);
+  }
+  if (size < 84) fail(path, "too short for an STL file (" + format_count(size) + " bytes)");
+  if (size < expected)
+    fail(path, "file ends after " + format_count((size - 84) / 50) + " of " + format_count(n) +
+                   " triangles");
+  fail(path, "not an STL file: binary triangle count " + format_count(n) +
+                 " does not match the file size of " + format_count(size) +
+                 " bytes, and it is not ASCII STL");
+}
+
+// ---------------------------------------------------------------------------------------------
+// OFF and OBJ (text, polygons are fan-triangulated)
+void add_polygon(const std::string& path, const std::vector<int>& poly, int nv,
+                 std::vector<Eigen::Vector3i>& tris, long long line) {
+  for (int idx : poly)
+    if (idx < 0 || idx >= nv)
+      fail(path, "face on line " + format_count(line) + " uses vertex " + std::to_string(idx) +
+                     " but the file has " + format_count(nv) + " vertices");
+  for (size_t k = 1; k + 1 < poly.size(); ++k) tris.emplace_back(poly[0], poly[k], poly[k + 1]);
+}
+
+TriangleSoup read_off(const std::string& path, const std::string& bytes) {
+  // Comments start with '#': blank them out of a copy for simple tokenizing.
+  std::string text = bytes;
+  for (size_t i = 0; i < text.size(); ++i)
+    if (text[i] == '#')
+      while (i < text.size() && text[i] != '\n') text[i++] = ' ';
+  TextCursor cur{text.c_str(), text.c_str() + text.size()};
+  const std::string magic = cur.word();
+  if (magic != "OFF") fail(path, "not an OFF file (first word is '" + magic.substr(0, 20) + "')");
+  double nv_d, nf_d, ne_d;
+  if (!cur.number(nv_d) || !cur.number(nf_d) || !cur.number(ne_d) || nv_d < 0 || nf_d < 0 ||
+      nv_d > 1e9 || nf_d > 1e9)
+    fail(path, "OFF header must give vertex, face and edge counts");
+  const long long nv = static_cast<long long>(nv_d), nf = static_cast<long long>(nf_d);
+  TriangleSoup soup;
+  soup.vertices.reserve(static_cast<size_t>(std::min<long long>(nv, 1 << 24)));
+  for (long long i = 0; i < nv; ++i) {
+    Eigen::Vector3d p;
+    for (int c = 0; c < 3; ++c)
+      if (!cur.number(p[c]))
+        fail(path, "file ends or is malformed at vertex " + format_count(i + 1) + " of " +
+                       format_count(nv));
+    soup.vertices.push_back(p);
+  }
+  std::vector<int> poly;
+  for (long long f = 0; f < nf; ++f) {
+    double k;
+    if (!cur.number(k) || k < 3 || k > 1e6)
+      fail(path, "file ends or is malformed at face " + format_count(f + 1) + " of " +
+                     format_count(nf));
+    poly.resize(static_cast<size_t>(k));
+    for (auto& idx : poly) {
+      double v;
+      if (!cur.number(v)) fail(path, "malformed face " + format_count(f + 1));
+      idx = static_cast<int>(v);
+    }
+    // Colour values may follow on the same line.
+    while (cur.p < cur.end && *cur.p != '\n') ++cur.p;
+    add_polygon(path, poly, static_cast<int>(nv), soup.triangles, cur.line);
+  }
+  return soup;
+}
+
+TriangleSoup read_obj(const std::string& path, const std::string& bytes) {
+  TriangleSoup soup;
+  std::istringstream in(bytes);
+  std::string line;
+  long long line_no = 0;
+  std::vector<int> poly;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.size() < 2) continue;
+    if (line[0] == 'v' && line[1] == ' ') {
+      Eigen::Vector3d p;
+      char* s = line.data() + 2;
+      for (int c = 0; c < 3; ++c) {
+        char* e = nullptr;
+        p[c] = std::strtod(s, &e);
+        if (e == s) fail(path, "malformed vertex on line " + format_count(line_no));
+        s = e;
+      }
+      soup.vertices.push_back(p);
+    } else if (line[0] == 'f' && line[1] == ' ') {
+      poly.clear();
+      std::istringstream fs(line.substr(2));
+      std::string tok;
+      while (fs >> tok) {
+        char* e = nullptr;
+        const long v = std::strtol(tok.c_str(), &e, 10);
+        if (e == tok.c_str() || v == 0)
+          fail(path, "malformed face on line " + format_count(line_no));
+        poly.push_back(v > 0 ? static_cast<int>(v - 1)
+                             : static_cast<int>(soup.vertices.size()) + static_cast<int>(v));
+      }
+      if (poly.size() < 3) fail(path, "face with fewer than 3 vertices on line " + format_count(line_no));
+      add_polygon(path, poly, static_cast<int>(soup.vertices.size()), soup.triangles, line_no);
+    }
+  }
+  return soup;
+}
+
+// ---------------------------------------------------------------------------------------------
+// PLY and VTP through VTK readers, with their error events turned into messages.
+struct VtkErrorCatcher {
+  std::string message;
+  static void callback(vtkObject*, unsigned long, void* client, void* call) {
+    auto* self = static_cast<VtkErrorCatcher*>(client);
+    if (self->message.empty() && call) self->message = static_cast<const char*>(call);
+  }
+};
+
+TriangleSoup soup_from_polydata(const std::string& path, vtkPolyData* pd) {
+  TriangleSoup soup;
+  if (!pd || !pd->GetPoints()) return soup;
+  const vtkIdType np = pd->GetNumberOfPoints();
+  soup.vertices.resize(static_cast<size_t>(np));
+  for (vtkIdType i = 0; i < np; ++i) {
+    double p[3];
+    pd->GetPoint(i, p);
+    soup.vertices[static_cast<size_t>(i)] = {p[0], p[1], p[2]};
+  }
+  std::vector<int> poly;
+  vtkCellArray* cells = pd->GetPolys();
+  vtkNew<vtkIdList> ids;
+  long long cell = 0;
+  for (cells->InitTraversal(); cells->GetNextCell(ids);) {
+    poly.assign(ids->begin(), ids->end());
+    if (poly.size() >= 3) add_polygon(path, poly, static_cast<int>(np), soup.triangles, ++cell);
+  }
+  vtkCellArray* strips = pd->GetStrips();
+  for (strips->InitTraversal(); strips->GetNextCell(ids);)
+    for (vtkIdType k = 0; k + 2 < ids->GetNumberOfIds(); ++k) {
+      const int a = static_cast<int>(ids->GetId(k)), b = static_cast<int>(ids->GetId(k + 1)),
+                c = static_cast<int>(ids->GetId(k + 2));
+      soup.triangles.push_back(k % 2 == 0 ? Eigen::Vector3i(a, b, c) : Eigen::Vector3i(b, a, c));
+    }
+  return soup;
+}
+
+template <class Reader>
+TriangleSoup read_with_vtk(const std::string& path, const char* what) {
+  vtkNew<Reader> reader;
+  VtkErrorCatcher catcher;
+  vtkNew<vtkCallbackCommand> cb;
+  cb->SetCallback(&VtkErrorCatcher::callback);
+  cb->SetClientData(&catcher);
+  reader->AddObserver(vtkCommand::ErrorEvent, cb);
+  reader->AddObserver(vtkCommand::WarningEvent, cb);
+  reader->SetFileName(path.c_str());
+  reader->Update();
+  if (!catcher.message.empty()) {
+    std::string m = catcher.message;
+    while (!m.empty() && (m.back() == '\n' || m.back() == ' ')) m.pop_back();
+    fail(path, std::string("not a readable ") + what + " file (" + m.substr(0, 200) + ")");
+  }
+  return soup_from_polydata(path, reader->GetOutput());
+}
+
+}  // namespace
+
+MeshFile read_mesh(const std::string& path, const ReadMeshParams& params) {
+  const std::string bytes = detail::read_file_bytes(path);
+  const std::string ext = detail::lower_extension(path);
+  MeshFile out;
+  TriangleSoup soup;
+  if (ext == ".stl") {
+    soup = read_stl(path, bytes, out.format);
+  } else if (ext == ".off") {
+    out.format = "OFF";
+    soup = read_off(path, bytes);
+  } else if (ext == ".obj") {
+    out.format = "OBJ";
+    soup = read_obj(path, bytes);
+  } else if (ext == ".ply") {
+    out.format = "PLY";
+    if (bytes.compare(0, 3, "ply") != 0) fail(path, "not a PLY file (it does not start with 'ply')");
+    soup = read_with_vtk<vtkPLYReader>(path, "PLY");
+  } else if (ext == ".vtp") {
+    out.format = "VTP";
+    if (bytes.find("<VTKFile") == std::string::npos)
+      fail(path, "not a VTP file (no <VTKFile> element)");
+    soup = read_with_vtk<vtkXMLPolyDataReader>(path, "VTP");
+  } else {
+    fail(path, "unknown mesh format '" + ext +
+                   "' (expected .stl, .ply, .obj, .off or .vtp)");
+  }
+  out.triangles_in_file = static_cast<long long>(soup.triangles.size());
+  if (soup.triangles.empty()) fail(path, "contains no triangles");
+  for (size_t t = 0; t < soup.triangles.size(); ++t)
+    for (int v = 0; v < 3; ++v)
+      check_finite(path, soup.vertices[soup.triangles[t][v]], static_cast<long long>(t));
+
+  BuildMeshStats stats;
+  out.mesh = build_mesh(soup, &stats);
+  out.degenerate_dropped = stats.degenerate_dropped;
+  out.nonmanifold_split = stats.nonmanifold_split;
+  if (out.mesh.n_faces() == 0)
+    fail(path, "all " + format_count(out.triangles_in_file) +
+                   " triangles have zero area; there is no surface to use");
+  if (stats.degenerate_dropped > 0) {
+    const std::string msg = format_count(stats.degenerate_dropped) + " of " +
+                            format_count(out.triangles_in_file) +
+                            " triangles have zero area or a repeated vertex";
+    if (params.strict) fail(path, msg);
+    out.warnings.push_back(path + ": " + msg + "; they were removed");
+  }
+  if (stats.nonmanifold_split > 0)
+    out.warnings.push_back(path + ": " + format_count(stats.nonmanifold_split) +
+                           " triangles share an edge with two or more others (non-manifold); "
+                           "they were kept on separate vertices");
+  return out;
+}
+
+}  // namespace cranioplan

@@ -1,0 +1,24 @@
+#pragma once
+// Private: one reader per volume format, and the sample conversion they share.
+#include <string>
+
+#include "cranioplan/model/volume.h"
+
+namespace cranioplan::detail {
+
+enum class SampleType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
+size_t sample_size(SampleType t);
+
+/// Converts `count` raw samples into floats. Throws InputError when fewer bytes are available.
+void convert_samples(const std::string& path, const char* data, size_t available, size_t count,
+                     SampleType type, bool big_endian, std::vector<float>& out);
+
+/// Marks the volume as a mask when all samples are 0 or 1.
+void classify_kind(Volume& v);
+
+Volume read_inv3(const std::string& path);
+Volume read_nrrd(const std::string& path);
+Volume read_nifti(const std::string& path);
+Volume read_dicom_folder(const std::string& path);
+
+}  // namespace cranioplan::detail

@@ -1,0 +1,81 @@
+#include "cli_bench.h"
+
+#include <sys/resource.h>
+#include <unistd.h>
+#include <vtkNew.h>
+#include <vtkPolyData.h>
+#include <vtkSTLReader.h>
+
+#include <algorithm>
+#include <chrono>
+#include <filesystem>
+#include <functional>
+
+#include "cranioplan/algorithms/fit_sagittal_plane.h"
+#include "cranioplan/algorithms/load_skull.h"
+#include "cranioplan/algorithms/mirror_mesh.h"
+#include "cranioplan/algorithms/read_mesh.h"
+#include "cranioplan/algorithms/register_icp.h"
+#include "cranioplan/algorithms/write_mesh.h"
+
+namespace cranioplan::cli {
+namespace {
+
+double median_seconds(int runs, const std::function<void()>& step) {
+  std::vector<double> t;
+  for (int i = 0; i < runs; ++i) {
+    const auto t0 = std::chrono::steady_clock::now();
+    step();
+    t.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count());
+  }
+  std::sort(t.begin(), t.end());
+  return t[t.size() / 2];
+}
+
+double peak_rss_mb() {
+  rusage usage{};
+  getrusage(RUSAGE_SELF, &usage);
+  return usage.ru_maxrss / 1024.0;  // Linux reports kilobytes
+}
+
+}  // namespace
+
+Json run_bench(const BenchOptions& options) {
+  const std::string input = options.input.empty() ? sample_case_path() : options.input;
+  const int runs = std::max(1, options.runs);
+  Json out;
+  out["input"] = input;
+  out["runs"] = runs;
+
+  LoadedSkull skull;
+  out["import_s"] = median_seconds(runs, [&] { skull = load_skull(input); });
+  out["triangles"] = skull.mesh.n_faces();
+  out["vertices"] = skull.mesh.n_vertices();
+
+  const std::filesystem::path tmp =
+      std::filesystem::temp_directory_path() / ("cranioplan-bench-" + std::to_string(::getpid()) + ".stl");
+  write_mesh(skull.mesh, tmp.string(), MeshFormat::BinarySTL);
+  out["stl_load_s"] = median_seconds(runs, [&] { read_mesh(tmp.string()); });
+  out["vtk_stl_reader_s"] = median_seconds(runs, [&] {
+    vtkNew<vtkSTLReader> reader;
+    reader->SetFileName(tmp.string().c_str());
+    reader->Update();
+  });
+  out["stl_speedup_vs_vtk"] = out["vtk_stl_reader_s"].get<double>() / out["stl_load_s"].get<double>();
+  std::filesystem::remove(tmp);
+
+  PlaneFit fit;
+  out["plane_s"] = median_seconds(runs, [&] { fit = fit_sagittal_plane(skull.mesh, Landmarks{}); });
+  SkullMesh mirrored;
+  out["mirror_s"] = median_seconds(runs, [&] { mirrored = mirror_mesh(skull.mesh, fit.plane); });
+  RegisterResult reg;
+  out["register_s"] = median_seconds(runs, [&] { reg = register_icp(mirrored, skull.mesh); });
+  out["plane_mirror_register_s"] =
+      out["plane_s"].get<double>() + out["mirror_s"].get<double>() + out["register_s"].get<double>();
+  out["symmetry_rms_mm"] = fit.symmetry_rms_mm;
+  out["register_rms_mm"] = reg.rms_mm;
+  out["peak_memory_mb"] = peak_rss_mb();
+  return out;
+}
+
+}  // namespace cranioplan::cli

@@ -1,0 +1,40 @@
+#include "cli_output.h"
+
+#include <iostream>
+
+namespace cranioplan::cli {
+namespace {
+void print_human(const Json& j, const std::string& prefix) {
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
+    const Json& v = it.value();
+    if (v.is_object()) {
+      print_human(v, key);
+    } else if (v.is_string()) {
+      std::cout << key << ": " << v.get<std::string>() << "\n";
+    } else {
+      std::cout << key << ": " << v.dump() << "\n";
+    }
+  }
+}
+}  // namespace
+
+void print_result(const Json& result, bool json) {
+  if (json)
+    std::cout << result.dump(2) << std::endl;
+  else
+    print_human(result, "");
+}
+
+void print_error(const std::string& message, int code, bool json) {
+  if (json)
+    std::cout << Json{{"error", message}, {"exit_code", code}}.dump(2) << std::endl;
+  std::cerr << "cranioplan-cli: " << message << std::endl;
+}
+
+void print_warnings(const std::vector<std::string>& warnings, bool json) {
+  if (json) return;  // included in the JSON result instead
+  for (const auto& w : warnings) std::cerr << "warning: " << w << "\n";
+}
+
+}  // namespace cranioplan::cli

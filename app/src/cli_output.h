@@ -1,0 +1,16 @@
+#pragma once
+// How cranioplan-cli prints: one JSON object with --json, otherwise "key: value" lines.
+#include <string>
+
+#include "cranioplan/sessions/plan_files.h"
+
+namespace cranioplan::cli {
+
+/// Exit codes of every subcommand.
+enum Exit : int { kOk = 0, kUnusable = 1, kUsage = 2, kBadInput = 3 };
+
+void print_result(const Json& result, bool json);
+void print_error(const std::string& message, int code, bool json);
+void print_warnings(const std::vector<std::string>& warnings, bool json);
+
+}  // namespace cranioplan::cli

@@ -1,0 +1,56 @@
+#pragma once
+// Triangle meshes of skulls and implants: OpenMesh with double-precision points, lengths in mm.
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+
+#include <Eigen/Core>
+#include <vector>
+
+namespace cranioplan {
+
+struct MeshTraits : public OpenMesh::DefaultTraits {
+  using Point = OpenMesh::Vec3d;
+  using Normal = OpenMesh::Vec3d;
+  VertexAttributes(OpenMesh::Attributes::Normal | OpenMesh::Attributes::Status);
+  FaceAttributes(OpenMesh::Attributes::Normal | OpenMesh::Attributes::Status);
+  EdgeAttributes(OpenMesh::Attributes::Status);
+  HalfedgeAttributes(OpenMesh::Attributes::PrevHalfedge | OpenMesh::Attributes::Status);
+};
+
+/// A skull, mirrored skull or implant surface. Points in mm, faces counter-clockwise seen from
+/// outside (outward normals).
+using SkullMesh = OpenMesh::TriMesh_ArrayKernelT<MeshTraits>;
+
+inline Eigen::Vector3d to_eigen(const OpenMesh::Vec3d& p) { return {p[0], p[1], p[2]}; }
+inline OpenMesh::Vec3d to_point(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }
+
+/// Indexed triangle soup: the plain form meshes take on their way in and out of files.
+struct TriangleSoup {
+  std::vector<Eigen::Vector3d> vertices;
+  std::vector<Eigen::Vector3i> triangles;
+};
+
+/// Result of building a SkullMesh from an indexed soup.
+struct BuildMeshStats {
+  long long degenerate_dropped = 0;   ///< triangles with repeated vertices or zero area
+  long long nonmanifold_split = 0;    ///< faces added with duplicated vertices (complex edges)
+};
+
+/// Builds a mesh from an indexed soup. Triangles with a repeated index or zero area are dropped;
+/// faces that would make a complex edge are added on duplicated vertices (as OpenMesh's readers
+/// do), so that no triangle of the input is lost. Unused vertices are not added.
+SkullMesh build_mesh(const TriangleSoup& soup, BuildMeshStats* stats = nullptr);
+
+/// The mesh as an indexed soup (vertex order = vertex handle order, garbage collected).
+TriangleSoup to_soup(const SkullMesh& mesh);
+
+/// Vertex positions as a 3×N matrix.
+Eigen::Matrix3Xd vertex_matrix(const SkullMesh& mesh);
+
+/// Signed volume (mm³) enclosed by the faces: positive for a closed, outward-oriented mesh.
+double signed_volume(const SkullMesh& mesh);
+double signed_volume(const TriangleSoup& soup);
+
+/// Reverses the orientation of every face (normals point the other way).
+void flip_orientation(SkullMesh& mesh);
+
+}  // namespace cranioplan

@@ -1,0 +1,167 @@
+#include "cranioplan/sessions/plan_files.h"
+
+#include <Eigen/LU>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "cranioplan/algorithms/atomic_write.h"
+#include "cranioplan/model/error.h"
+
+namespace cranioplan {
+
+Json to_json(const Eigen::Vector3d& v) { return Json::array({v.x(), v.y(), v.z()}); }
+
+Json to_json(const Plane& plane) {
+  return Json{{"normal", to_json(plane.normal)}, {"offset_mm", plane.offset}};
+}
+
+Json to_json(const RigidTransform& t) {
+  Json rows = Json::array();
+  for (int r = 0; r < 3; ++r) rows.push_back(to_json(Eigen::Vector3d(t.rotation.row(r))));
+  return Json{{"rotation", rows}, {"translation", to_json(t.translation)}};
+}
+
+Json to_json(const Landmarks& lm) {
+  Json j = Json::object();
+  if (lm.nasion) j["nasion"] = to_json(*lm.nasion);
+  if (lm.orbit_left) j["orbit_left"] = to_json(*lm.orbit_left);
+  if (lm.orbit_right) j["orbit_right"] = to_json(*lm.orbit_right);
+  if (!lm.midline.empty()) {
+    j["midline"] = Json::array();
+    for (const auto& p : lm.midline) j["midline"].push_back(to_json(p));
+  }
+  return j;
+}
+
+Json to_json(const MeshReport& r) {
+  return Json{{"vertices", r.vertices},
+              {"triangles", r.triangles},
+              {"bbox_min", to_json(r.bbox_min)},
+              {"bbox_max", to_json(r.bbox_max)},
+              {"area_mm2", r.area_mm2},
+              {"volume_mm3", r.volume_mm3},
+              {"boundary_edges", r.boundary_edges},
+              {"nonmanifold_edges", r.nonmanifold_edges},
+              {"pieces", r.pieces},
+              {"watertight", r.watertight}};
+}
+
+Json to_json(const PlaneFit& fit) {
+  static const char* names[] = {"converged", "max_iterations", "failed"};
+  return Json{{"normal", to_json(fit.plane.normal)},
+              {"offset_mm", fit.plane.offset},
+              {"symmetry_rms_mm", fit.symmetry_rms_mm},
+              {"inlier_fraction", fit.inlier_fraction},
+              {"iterations", fit.iterations},
+              {"solver_iterations", fit.solver_iterations},
+              {"status", names[static_cast<int>(fit.status)]},
+              {"message", fit.message},
+              {"termination", fit.termination},
+              {"initial_method", fit.initial_method},
+              {"initial", to_json(fit.initial)},
+              {"seconds", fit.seconds}};
+}
+
+Json to_json(const RegisterResult& r) {
+  static const char* names[] = {"converged", "max_iterations", "failed"};
+  Json j = to_json(r.transform);
+  j["rms_mm"] = r.rms_mm;
+  j["inlier_fraction"] = r.inlier_fraction;
+  j["iterations"] = r.iterations;
+  j["rotation_deg"] = r.transform.rotation_angle_deg();
+  j["status"] = names[static_cast<int>(r.status)];
+  j["message"] = r.message;
+  j["seconds"] = r.seconds;
+  return j;
+}
+
+Eigen::Vector3d vector_from_json(const Json& j, const std::string& source, const std::string& what) {
+  if (!j.is_array() || j.size() != 3)
+    throw InputError(source, "'" + what + "' must be an array of 3 numbers");
+  Eigen::Vector3d v;
+  for (int k = 0; k < 3; ++k) {
+    if (!j[k].is_number()) throw InputError(source, "'" + what + "' must hold numbers only");
+    v[k] = j[k].get<double>();
+  }
+  if (!v.allFinite()) throw InputError(source, "'" + what + "' holds a value that is not finite");
+  return v;
+}
+
+Plane plane_from_json(const Json& j, const std::string& source) {
+  if (!j.is_object() || !j.contains("normal") || !j.contains("offset_mm"))
+    throw InputError(source, "a plane needs 'normal' and 'offset_mm'");
+  const Eigen::Vector3d n = vector_from_json(j["normal"], source, "normal");
+  if (n.norm() < 1e-9) throw InputError(source, "plane 'normal' must not be zero");
+  if (!j["offset_mm"].is_number()) throw InputError(source, "'offset_mm' must be a number");
+  const double scale = n.norm();
+  return Plane{n / scale, j["offset_mm"].get<double>() / scale};
+}
+
+RigidTransform transform_from_json(const Json& j, const std::string& source) {
+  if (!j.is_object() || !j.contains("rotation") || !j.contains("translation"))
+    throw InputError(source, "a transform needs 'rotation' (3×3) and 'translation'");
+  RigidTransform t;
+  const Json& rows = j["rotation"];
+  if (!rows.is_array() || rows.size() != 3)
+    throw InputError(source, "'rotation' must be 3 rows of 3 numbers");
+  for (int r = 0; r < 3; ++r) t.rotation.row(r) = vector_from_json(rows[r], source, "rotation").transpose();
+  if ((t.rotation * t.rotation.transpose() - Eigen::Matrix3d::Identity()).norm() > 1e-4 ||
+      t.rotation.determinant() < 0)
+    throw InputError(source, "'rotation' is not a rotation matrix");
+  t.translation = vector_from_json(j["translation"], source, "translation");
+  return t;
+}
+
+Landmarks landmarks_from_json(const Json& j, const std::string& source) {
+  if (!j.is_object()) throw InputError(source, "landmarks must be a JSON object");
+  Landmarks lm;
+  if (j.contains("nasion")) lm.nasion = vector_from_json(j["nasion"], source, "nasion");
+  if (j.contains("orbit_left")) lm.orbit_left = vector_from_json(j["orbit_left"], source, "orbit_left");
+  if (j.contains("orbit_right"))
+    lm.orbit_right = vector_from_json(j["orbit_right"], source, "orbit_right");
+  if (j.contains("midline")) {
+    if (!j["midline"].is_array()) throw InputError(source, "'midline' must be a list of points");
+    for (const auto& p : j["midline"]) lm.midline.push_back(vector_from_json(p, source, "midline"));
+  }
+  if (!lm.has_required())
+    throw InputError(source, "landmarks need 'nasion', 'orbit_left' and 'orbit_right'");
+  if ((*lm.orbit_left - *lm.orbit_right).norm() < 1.0)
+    throw InputError(source, "'orbit_left' and 'orbit_right' are less than 1 mm apart");
+  return lm;
+}
+
+Json read_json_file(const std::string& path) {
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec)) throw InputError(path, "file not found");
+  if (std::filesystem::is_directory(path, ec)) throw InputError(path, "is a folder, not a file");
+  std::ifstream in(path);
+  if (!in) throw InputError(path, std::string("cannot open file: ") + std::strerror(errno));
+  std::stringstream buffer;
+  buffer << in.rdbuf();
+  const std::string text = buffer.str();
+  if (text.find_first_not_of(" \t\r\n") == std::string::npos) throw InputError(path, "file is empty");
+  try {
+    return Json::parse(text);
+  } catch (const nlohmann::json::parse_error& e) {
+    std::string what = e.what();
+    const size_t colon = what.find("] ");
+    throw InputError(path, "not valid JSON (" + (colon == std::string::npos ? what : what.substr(colon + 2)) + ")");
+  }
+}
+
+void write_json_file(const Json& j, const std::string& path) {
+  write_file_atomically(path, j.dump(2) + "\n");
+}
+
+Landmarks read_landmarks_file(const std::string& path) {
+  return landmarks_from_json(read_json_file(path), path);
+}
+
+Plane read_plane_file(const std::string& path) { return plane_from_json(read_json_file(path), path); }
+
+}  // namespace cranioplan
