@@ -12,6 +12,7 @@
 #include "cranioplan/algorithms/load_skull.h"
 #include "cranioplan/algorithms/mesh_report.h"
 #include "cranioplan/algorithms/mirror_mesh.h"
+#include "cranioplan/algorithms/read_volume.h"
 #include "cranioplan/algorithms/register_icp.h"
 #include "cranioplan/algorithms/write_mesh.h"
 #include "cranioplan/model/error.h"
@@ -187,6 +188,9 @@ int run(int argc, char** argv) {
       return kOk;
     }
     if (import_ct->parsed()) {
+      if (!is_volume_path(ct_path))
+        throw InputError(ct_path, "is not a volume (expected .inv3, .nrrd, .nhdr, .nii, .nii.gz "
+                                  "or a DICOM folder)");
       const LoadedSkull s = load_skull(ct_path, import.params());
       write_mesh(s.mesh, output);
       Json r = skull_json(s);

@@ -1,0 +1,171 @@
+#include "cranioplan/algorithms/read_mesh.h"
+
+#include <gtest/gtest.h>
+#include <vtkNew.h>
+#include <vtkPolyData.h>
+#include <vtkXMLPolyDataWriter.h>
+#include <vtkPoints.h>
+#include <vtkCellArray.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "cranioplan/algorithms/mesh_report.h"
+#include "cranioplan/algorithms/write_mesh.h"
+#include "cranioplan/model/error.h"
+#include "support/synthetic.h"
+#include "support/test_files.h"
+
+namespace cranioplan {
+namespace {
+
+using test::TempDir;
+
+std::string binary_stl(const std::vector<std::array<float, 9>>& tris, uint32_t declared) {
+  std::string s(80, ' ');
+  s.append(reinterpret_cast<const char*>(&declared), 4);
+  for (const auto& t : tris) {
+    s.append(12, '\0');
+    s.append(reinterpret_cast<const char*>(t.data()), 36);
+    s.append(2, '\0');
+  }
+  return s;
+}
+
+// Expects read_mesh to throw an InputError whose message names the file and contains `part`.
+void expect_bad(const std::string& path, const std::string& part) {
+  try {
+    read_mesh(path);
+    FAIL() << "expected an error for " << path;
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_EQ(msg.rfind(path, 0), 0u) << msg;
+    EXPECT_NE(msg.find(part), std::string::npos) << msg;
+  }
+}
+
+TEST(ReadMesh, BinaryStlRoundTripWeldsVertices) {
+  TempDir dir;
+  const SkullMesh head = test::make_symmetric_head(3);
+  write_mesh(head, dir.path("head.stl"));
+  const MeshFile f = read_mesh(dir.path("head.stl"));
+  EXPECT_EQ(f.format, "binary STL");
+  EXPECT_EQ(f.mesh.n_faces(), head.n_faces());
+  EXPECT_EQ(f.mesh.n_vertices(), head.n_vertices());  // welded back to shared vertices
+  EXPECT_TRUE(report_mesh(f.mesh).watertight);
+  EXPECT_NEAR(signed_volume(f.mesh), signed_volume(head), 1e-4 * signed_volume(head));
+}
+
+TEST(ReadMesh, BinaryStlWhoseHeaderStartsWithSolidIsStillBinary) {
+  TempDir dir;
+  std::string bytes = binary_stl({{0, 0, 0, 1, 0, 0, 0, 1, 0}}, 1);
+  std::memcpy(bytes.data(), "solid trap", 10);
+  test::write_bytes(dir.path("trap.stl"), bytes);
+  EXPECT_EQ(read_mesh(dir.path("trap.stl")).format, "binary STL");
+}
+
+TEST(ReadMesh, PlyRoundTrip) {
+  TempDir dir;
+  const SkullMesh head = test::make_symmetric_head(2);
+  write_mesh(head, dir.path("head.ply"));
+  const MeshFile f = read_mesh(dir.path("head.ply"));
+  ASSERT_EQ(f.mesh.n_vertices(), head.n_vertices());
+  for (auto vh : head.vertices())
+    EXPECT_LT((to_eigen(f.mesh.point(vh)) - to_eigen(head.point(vh))).norm(), 1e-4);  // VTK reads PLY as float
+  EXPECT_EQ(f.mesh.n_faces(), head.n_faces());
+}
+
+TEST(ReadMesh, AsciiStlObjOffAndVtp) {
+  TempDir dir;
+  test::write_bytes(dir.path("a.stl"),
+                    "solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n"
+                    "vertex 0 1 0\nendloop\nendfacet\nfacet normal 0 0 1\nouter loop\n"
+                    "vertex 1 0 0\nvertex 1 1 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n");
+  const MeshFile a = read_mesh(dir.path("a.stl"));
+  EXPECT_EQ(a.format, "ASCII STL");
+  EXPECT_EQ(a.mesh.n_faces(), 2u);
+  EXPECT_EQ(a.mesh.n_vertices(), 4u);
+
+  test::write_bytes(dir.path("q.obj"), "# quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1/1 2/2 3/3 4/4\n");
+  EXPECT_EQ(read_mesh(dir.path("q.obj")).mesh.n_faces(), 2u);
+
+  test::write_bytes(dir.path("q.off"), "OFF\n# comment\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n");
+  EXPECT_EQ(read_mesh(dir.path("q.off")).mesh.n_faces(), 2u);
+
+  vtkNew<vtkPoints> pts;
+  pts->InsertNextPoint(0, 0, 0);
+  pts->InsertNextPoint(1, 0, 0);
+  pts->InsertNextPoint(0, 1, 0);
+  vtkNew<vtkCellArray> polys;
+  const vtkIdType ids[3] = {0, 1, 2};
+  polys->InsertNextCell(3, ids);
+  vtkNew<vtkPolyData> pd;
+  pd->SetPoints(pts);
+  pd->SetPolys(polys);
+  vtkNew<vtkXMLPolyDataWriter> w;
+  w->SetInputData(pd);
+  w->SetFileName(dir.path("t.vtp").c_str());
+  w->Write();
+  EXPECT_EQ(read_mesh(dir.path("t.vtp")).mesh.n_faces(), 1u);
+}
+
+TEST(ReadMesh, BadInputsGiveOneClearMessage) {
+  TempDir dir;
+  expect_bad(dir.path("missing.stl"), "file not found");
+  test::write_bytes(dir.path("empty.stl"), "");
+  expect_bad(dir.path("empty.stl"), "file is empty");
+
+  const std::array<float, 9> tri{0, 0, 0, 1, 0, 0, 0, 1, 0};
+  std::string truncated = binary_stl({tri, tri, tri}, 40000);
+  test::write_bytes(dir.path("truncated.stl"), truncated);
+  expect_bad(dir.path("truncated.stl"), "file ends after 3 of 40,000 triangles");
+
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  test::write_bytes(dir.path("nan.stl"), binary_stl({tri, {0, 0, 0, nan, 0, 0, 0, 1, 0}}, 2));
+  expect_bad(dir.path("nan.stl"), "triangle 2 has a coordinate that is not a number");
+  const float inf = std::numeric_limits<float>::infinity();
+  test::write_bytes(dir.path("inf.stl"), binary_stl({{0, 0, 0, 1, inf, 0, 0, 1, 0}}, 1));
+  expect_bad(dir.path("inf.stl"), "not a number");
+
+  test::write_bytes(dir.path("flat.stl"), binary_stl({{0, 0, 0, 1, 0, 0, 2, 0, 0}}, 1));
+  expect_bad(dir.path("flat.stl"), "zero area");
+
+  std::string garbage(5000, '\0');
+  for (size_t i = 0; i < garbage.size(); ++i) garbage[i] = static_cast<char>((i * 7919) % 251);
+  for (const char* ext : {".stl", ".ply", ".obj", ".off", ".vtp"}) {
+    const std::string p = dir.path(std::string("garbage") + ext);
+    test::write_bytes(p, garbage);
+    EXPECT_THROW(read_mesh(p), InputError) << ext;
+  }
+  test::write_bytes(dir.path("x.xyz"), "1 2 3");
+  expect_bad(dir.path("x.xyz"), "unknown mesh format");
+  test::write_bytes(dir.path("bad.off"), "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
+  expect_bad(dir.path("bad.off"), "uses vertex 7");
+  test::write_bytes(dir.path("cut.stl"), "solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0\n");
+  expect_bad(dir.path("cut.stl"), "ASCII STL");
+  expect_bad(dir.path(""), "folder");
+}
+
+TEST(ReadMesh, SomeZeroAreaTrianglesAreDroppedWithAWarningOrRefusedWhenStrict) {
+  TempDir dir;
+  const std::string p = dir.path("mixed.stl");
+  test::write_bytes(p, binary_stl({{0, 0, 0, 1, 0, 0, 0, 1, 0}, {0, 0, 0, 1, 0, 0, 2, 0, 0}}, 2));
+  const MeshFile f = read_mesh(p);
+  EXPECT_EQ(f.mesh.n_faces(), 1u);
+  EXPECT_EQ(f.degenerate_dropped, 1);
+  ASSERT_EQ(f.warnings.size(), 1u);
+  EXPECT_NE(f.warnings[0].find("1 of 2 triangles have zero area"), std::string::npos);
+  ReadMeshParams strict;
+  strict.strict = true;
+  EXPECT_THROW(read_mesh(p, strict), InputError);
+}
+
+TEST(WriteMesh, RefusesUnknownExtensionAndMissingFolder) {
+  const SkullMesh head = test::make_symmetric_head(1);
+  EXPECT_THROW(write_mesh(head, "/tmp/x.obj"), InputError);
+  EXPECT_THROW(write_mesh(head, "/nonexistent-folder-xyz/x.stl"), InputError);
+}
+
+}  // namespace
+}  // namespace cranioplan

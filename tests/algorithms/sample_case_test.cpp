@@ -1,0 +1,50 @@
+// The whole foundation chain on the real sample case (Debian's invesalius-examples).
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "cranioplan/algorithms/fit_sagittal_plane.h"
+#include "cranioplan/algorithms/load_skull.h"
+#include "cranioplan/algorithms/mesh_report.h"
+#include "cranioplan/algorithms/mirror_mesh.h"
+#include "cranioplan/algorithms/register_icp.h"
+
+namespace cranioplan {
+namespace {
+
+TEST(SampleCase, ImportPlaneMirrorRegister) {
+  const std::string path = sample_case_path();
+  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not installed (scripts/install-deps)";
+  const LoadedSkull skull = load_skull(path);
+  const MeshReport rep = report_mesh(skull.mesh);
+  EXPECT_GT(rep.triangles, 300000);
+  EXPECT_EQ(rep.pieces, 1);
+  EXPECT_EQ(rep.boundary_edges, 0);  // closed by the padding, even where bone meets the scan edge
+  EXPECT_GT(rep.volume_mm3, 0);
+  // A head: 12–25 cm across in every direction.
+  const Eigen::Vector3d size = rep.bbox_max - rep.bbox_min;
+  EXPECT_GT(size.minCoeff(), 120.0);
+  EXPECT_LT(size.maxCoeff(), 250.0);
+
+  const PlaneFit fit = fit_sagittal_plane(skull.mesh, Landmarks{});
+  ASSERT_TRUE(fit.usable()) << fit.message;
+  // The scan is roughly aligned: the left-right axis is the image x axis.
+  EXPECT_GT(std::abs(fit.plane.normal.x()), 0.98);
+  EXPECT_LT(fit.symmetry_rms_mm, 1.2);
+  EXPECT_GT(fit.inlier_fraction, 0.6);
+  // The plane passes through the middle of the head.
+  const double mid = 0.5 * (rep.bbox_min.x() + rep.bbox_max.x());
+  EXPECT_LT(std::abs(fit.plane.offset / fit.plane.normal.x() - mid), 15.0);
+
+  const SkullMesh mirrored = mirror_mesh(skull.mesh, fit.plane);
+  EXPECT_GT(signed_volume(mirrored), 0);
+  const RegisterResult reg = register_icp(mirrored, skull.mesh);
+  ASSERT_TRUE(reg.usable()) << reg.message;
+  // The plane was already good: registration only corrects a little.
+  EXPECT_LT(reg.transform.rotation_angle_deg(), 2.0);
+  EXPECT_LT(reg.transform.translation.norm(), 3.0);
+  EXPECT_LT(reg.rms_mm, 1.2);
+}
+
+}  // namespace
+}  // namespace cranioplan

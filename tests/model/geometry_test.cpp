@@ -1,0 +1,55 @@
+#include <gtest/gtest.h>
+
+#include "cranioplan/model/error.h"
+#include "cranioplan/model/mesh.h"
+#include "cranioplan/model/plane.h"
+#include "cranioplan/model/rigid_transform.h"
+#include "support/synthetic.h"
+
+namespace cranioplan {
+
+TEST(Plane, ReflectIsAnInvolutionAndFixesThePlane) {
+  const Plane p = Plane::through({1, 2, 3}, {1, 1, 0});
+  const Eigen::Vector3d x(4, -5, 6);
+  EXPECT_LT((p.reflect(p.reflect(x)) - x).norm(), 1e-12);
+  EXPECT_NEAR(p.signed_distance(p.reflect(x)), -p.signed_distance(x), 1e-12);
+  const Eigen::Vector3d on = p.project(x);
+  EXPECT_LT((p.reflect(on) - on).norm(), 1e-12);
+  EXPECT_NEAR(p.angle_to_deg(p.flipped()), 0.0, 1e-9);
+}
+
+TEST(RigidTransform, InverseAndComposition) {
+  const RigidTransform t = RigidTransform::from_axis_angle({1, 2, 3}, 30, {4, 5, 6});
+  const Eigen::Vector3d x(1, -1, 2);
+  EXPECT_LT(((t.inverse() * t).apply(x) - x).norm(), 1e-12);
+  EXPECT_NEAR(t.rotation_angle_deg(), 30.0, 1e-9);
+}
+
+TEST(Mesh, BuildDropsDegenerateTrianglesAndCountsThem) {
+  TriangleSoup s;
+  s.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {2, 0, 0}};
+  s.triangles = {{0, 1, 2}, {0, 1, 3}, {0, 0, 2}};  // second collinear, third repeated index
+  BuildMeshStats stats;
+  const SkullMesh m = build_mesh(s, &stats);
+  EXPECT_EQ(m.n_faces(), 1u);
+  EXPECT_EQ(m.n_vertices(), 3u);
+  EXPECT_EQ(stats.degenerate_dropped, 2);
+}
+
+TEST(Mesh, SignedVolumeOfHeadIsPositiveAndFlipNegates) {
+  SkullMesh head = test::make_symmetric_head(3);
+  const double v = signed_volume(head);
+  EXPECT_GT(v, 0.0);
+  flip_orientation(head);
+  EXPECT_NEAR(signed_volume(head), -v, 1e-6 * v);
+}
+
+TEST(Error, InputErrorNamesFileFirstAndCountsReadably) {
+  const InputError e("skull.stl", "file ends after 1,203 of 40,000 triangles");
+  EXPECT_STREQ(e.what(), "skull.stl: file ends after 1,203 of 40,000 triangles");
+  EXPECT_EQ(format_count(40000), "40,000");
+  EXPECT_EQ(format_count(-1234567), "-1,234,567");
+  EXPECT_EQ(format_count(999), "999");
+}
+
+}  // namespace cranioplan

@@ -1,0 +1,31 @@
+#pragma once
+// Shapes whose truth is known by construction, for known-answer tests.
+#include "cranioplan/model/landmarks.h"
+#include "cranioplan/model/mesh.h"
+#include "cranioplan/model/plane.h"
+#include "cranioplan/model/rigid_transform.h"
+#include "cranioplan/model/volume.h"
+
+namespace cranioplan::test {
+
+/// A closed, outward-oriented head-like surface, mirror-symmetric across x = 0 exactly (the
+/// vertex set is symmetric), about 140 × 180 × 150 mm, with a nose ridge at +y and a flattened
+/// back, so no other plane is a symmetry plane. `subdivisions` 4 gives 5,120 triangles,
+/// 5 gives 20,480.
+SkullMesh make_symmetric_head(int subdivisions = 5);
+
+/// Landmarks of make_symmetric_head(): nasion on the midline, orbit centres mirrored.
+Landmarks head_landmarks();
+
+/// Removes every face whose centroid lies within `radius` of `center`.
+SkullMesh cut_hole(const SkullMesh& mesh, const Eigen::Vector3d& center, double radius);
+
+SkullMesh transformed(const SkullMesh& mesh, const RigidTransform& t);
+Landmarks transformed(const Landmarks& lm, const RigidTransform& t);
+Plane transformed(const Plane& p, const RigidTransform& t);
+
+/// A volume holding a solid ball (values 1 inside, 0 outside; or HU 1000 / -1000 as CT).
+Volume make_ball_volume(const Eigen::Vector3d& center_world, double radius, int n, double spacing,
+                        bool as_ct);
+
+}  // namespace cranioplan::test

@@ -1,0 +1,32 @@
+#pragma once
+// Temporary folders and small file writers for IO tests.
+#include <string>
+
+#include "cranioplan/model/volume.h"
+
+namespace cranioplan::test {
+
+/// A fresh folder under the system temp folder, removed when the object dies.
+class TempDir {
+ public:
+  TempDir();
+  ~TempDir();
+  std::string path(const std::string& name) const;
+
+ private:
+  std::string root_;
+};
+
+void write_bytes(const std::string& path, const std::string& bytes);
+std::string read_bytes(const std::string& path);
+std::string gzip(const std::string& bytes);
+
+/// Writes an int16 NRRD of the volume with its directions and origin; gzip or raw.
+void write_nrrd(const Volume& v, const std::string& path, bool gzip_encoding);
+/// Writes a float32 NIfTI-1 with the volume's affine as sform (NIfTI's RAS-world = ours).
+void write_nifti(const Volume& v, const std::string& path);
+
+/// Runs a command line; returns its exit code and fills stdout.
+int run_command(const std::string& command, std::string* out = nullptr);
+
+}  // namespace cranioplan::test
