@@ -1,11 +1,15 @@
 #include "cranioplan/model/mesh.h"
 
 #include <Eigen/Geometry>
+#include <OpenMesh/Core/System/omstream.hh>
 #include <array>
 
 namespace cranioplan {
 
 SkullMesh build_mesh(const TriangleSoup& soup, BuildMeshStats* stats) {
+  // Complex faces are counted in the stats and reported by the callers in plain words;
+  // OpenMesh's own log lines on stderr would only confuse.
+  omerr().disable();
   BuildMeshStats local;
   SkullMesh mesh;
   const int nv = static_cast<int>(soup.vertices.size());
