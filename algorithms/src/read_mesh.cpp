@@ -368,25 +368,25 @@ TriangleSoup read_with_vtk(const std::string& path, const char* what) {
 
 }  // namespace
 
-MeshFile read_mesh(const std::string& path, const ReadMeshParams& params) {
+TriangleSoup read_mesh_soup(const std::string& path, std::string* format_out) {
   const std::string bytes = detail::read_file_bytes(path);
   const std::string ext = detail::lower_extension(path);
-  MeshFile out;
+  std::string format;
   TriangleSoup soup;
   if (ext == ".stl") {
-    soup = read_stl(path, bytes, out.format);
+    soup = read_stl(path, bytes, format);
   } else if (ext == ".off") {
-    out.format = "OFF";
+    format = "OFF";
     soup = read_off(path, bytes);
   } else if (ext == ".obj") {
-    out.format = "OBJ";
+    format = "OBJ";
     soup = read_obj(path, bytes);
   } else if (ext == ".ply") {
-    out.format = "PLY";
+    format = "PLY";
     if (bytes.compare(0, 3, "ply") != 0) fail(path, "not a PLY file (it does not start with 'ply')");
     soup = read_with_vtk<vtkPLYReader>(path, "PLY");
   } else if (ext == ".vtp") {
-    out.format = "VTP";
+    format = "VTP";
     if (bytes.find("<VTKFile") == std::string::npos)
       fail(path, "not a VTP file (no <VTKFile> element)");
     soup = read_with_vtk<vtkXMLPolyDataReader>(path, "VTP");
@@ -394,11 +394,19 @@ MeshFile read_mesh(const std::string& path, const ReadMeshParams& params) {
     fail(path, "unknown mesh format '" + ext +
                    "' (expected .stl, .ply, .obj, .off or .vtp)");
   }
-  out.triangles_in_file = static_cast<long long>(soup.triangles.size());
   if (soup.triangles.empty()) fail(path, "contains no triangles");
-  for (size_t t = 0; t < soup.triangles.size(); ++t)
-    for (int v = 0; v < 3; ++v)
-      check_finite(path, soup.vertices[soup.triangles[t][v]], static_cast<long long>(t));
+  if (format != "binary STL" && format != "ASCII STL")  // STL parsers check as they read
+    for (size_t t = 0; t < soup.triangles.size(); ++t)
+      for (int v = 0; v < 3; ++v)
+        check_finite(path, soup.vertices[soup.triangles[t][v]], static_cast<long long>(t));
+  if (format_out) *format_out = format;
+  return soup;
+}
+
+MeshFile read_mesh(const std::string& path, const ReadMeshParams& params) {
+  MeshFile out;
+  const TriangleSoup soup = read_mesh_soup(path, &out.format);
+  out.triangles_in_file = static_cast<long long>(soup.triangles.size());
 
   BuildMeshStats stats;
   out.mesh = build_mesh(soup, &stats);

@@ -22,6 +22,11 @@ struct MeshFile {
   std::vector<std::string> warnings;  ///< one sentence each, naming the file
 };
 
+/// The file as an indexed triangle soup (polygons fan-triangulated, STL vertices welded,
+/// coordinates checked to be finite), before the halfedge mesh is built: the same product as
+/// VTK's readers give. `format` receives the format's name. Throws InputError like read_mesh.
+TriangleSoup read_mesh_soup(const std::string& path, std::string* format = nullptr);
+
 /// Reads a mesh; STL vertices are welded (identical coordinates become one vertex).
 /// Throws InputError naming the file and the problem: missing, empty, truncated, garbage,
 /// NaN/Inf coordinates, no usable triangle, unknown format.

@@ -26,7 +26,7 @@ struct RegisterParams {
   double max_correspondence_mm = 8.0;  ///< pairs farther apart are ignored, mm (>0)
   double trim_fraction = 0.85;         ///< keep this best fraction of pairs, (0, 1]
   double huber_mm = 1.0;               ///< Huber weight scale for residuals, mm (>0)
-  double convergence_mm = 1e-5;        ///< stop when an update moves points less than this, mm
+  double convergence_mm = 0.01;        ///< stop when an update moves no sample more than this, mm
   std::optional<RegionOfInterest> roi; ///< only moving samples inside it (after transform)
 };
 
