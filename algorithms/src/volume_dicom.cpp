@@ -1,6 +1,6 @@
 // DICOM series: every slice file of one folder, read by VTK's DICOM reader. World coordinates
-// follow ImagePositionPatient and ImageOrientationPatient (LPS, mm); Hounsfield units from the
-// rescale slope and intercept.
+// follow ImagePositionPatient and ImageOrientationPatient (LPS, mm); values in Hounsfield units
+// (VTK's reader applies the rescale slope and intercept).
 #include <vtkCallbackCommand.h>
 #include <vtkDICOMImageReader.h>
 #include <vtkDataArray.h>
@@ -66,13 +66,11 @@ Volume read_dicom_folder(const std::string& path) {
   v.directions.col(2) = slice_dir * spacing[2];
   v.origin = first + col_dir * spacing[1] * (dims[1] - 1);
   vtkDataArray* s = img->GetPointData()->GetScalars();
-  const double slope = reader->GetRescaleSlope() != 0 ? reader->GetRescaleSlope() : 1.0;
-  const double intercept = reader->GetRescaleOffset();
   v.data.resize(v.size());
   if (static_cast<size_t>(s->GetNumberOfTuples()) < v.size())
     throw InputError(path, "DICOM series holds fewer samples than its slices announce");
   for (size_t i = 0; i < v.size(); ++i)
-    v.data[i] = static_cast<float>(s->GetComponent(static_cast<vtkIdType>(i), 0) * slope + intercept);
+    v.data[i] = static_cast<float>(s->GetComponent(static_cast<vtkIdType>(i), 0));  // VTK applied the rescale
   v.description = "DICOM series " + std::to_string(dims[0]) + "×" + std::to_string(dims[1]) + "×" +
                   std::to_string(dims[2]);
   v.kind = VolumeKind::CT;

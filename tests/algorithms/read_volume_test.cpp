@@ -8,6 +8,7 @@
 #include "cranioplan/algorithms/extract_bone_surface.h"
 #include "cranioplan/model/error.h"
 #include "support/synthetic.h"
+#include "support/dicom_writer.h"
 #include "support/test_files.h"
 
 namespace cranioplan {
@@ -106,6 +107,37 @@ TEST(ReadVolume, SkullFixMaskHonoursObliqueDirections) {
   EXPECT_EQ(v.dims[0], 512);
   EXPECT_NEAR(v.directions(2, 1), -0.0705786695, 1e-9);  // oblique: off-diagonal kept
   EXPECT_NEAR(v.origin.x(), -120.2, 1e-9);
+}
+
+}  // namespace
+}  // namespace cranioplan
+
+namespace cranioplan {
+namespace {
+
+TEST(ReadVolume, DicomSeriesFolderGivesWorldCoordinatesAndHounsfieldUnits) {
+  test::TempDir dir;
+  const Eigen::Vector3d center(-20, 35, 110);
+  Volume v = test::make_ball_volume(center, 9.0, 30, 1.0, true);
+  // Anisotropic and off-centre, like a real scan: 0.8 × 0.8 × 1.25 mm.
+  v.directions = Eigen::Vector3d(0.8, 0.8, 1.25).asDiagonal();
+  v.origin = center - v.directions * Eigen::Vector3d(12.0, 17.0, 14.5);
+  for (int k = 0; k < 30; ++k)
+    for (int j = 0; j < 30; ++j)
+      for (int i = 0; i < 30; ++i)
+        v.data[v.index(i, j, k)] =
+            (v.world(Eigen::Vector3d(i, j, k)) - center).norm() <= 9.0 ? 1000.0f : -1000.0f;
+  std::filesystem::create_directories(dir.path("series"));
+  test::write_dicom_series(v, dir.path("series"));
+  const Volume r = read_volume(dir.path("series"));
+  EXPECT_EQ(r.dims, v.dims);
+  EXPECT_NEAR(*std::max_element(r.data.begin(), r.data.end()), 1000.0f, 1e-3);
+  EXPECT_NEAR(*std::min_element(r.data.begin(), r.data.end()), -1000.0f, 1e-3);
+  EXPECT_LT((r.spacing() - v.spacing()).norm(), 1e-4);
+  const auto surface = extract_bone_surface(r);
+  ASSERT_TRUE(surface.usable());
+  EXPECT_LT((mesh_centroid(surface.mesh) - center).norm(), 0.3);
+  EXPECT_GT(signed_volume(surface.mesh), 0.0);
 }
 
 }  // namespace
