@@ -122,8 +122,12 @@ Volume read_inv3(const std::string& path) {
   Volume v;
   // shape is (slices, rows, columns) = (k, j, i); spacing is (x, y, z).
   v.dims = {static_cast<int>(shape[2]), static_cast<int>(shape[1]), static_cast<int>(shape[0])};
-  v.directions = Eigen::Vector3d(spacing[0], spacing[1], spacing[2]).asDiagonal();
-  v.origin.setZero();
+  // InVesalius stores the rows of each slice flipped with respect to DICOM (row 0 is the
+  // patient's front): flip j so that the frame is right-handed and patient-true (LPS-like:
+  // x to the patient's left, y to the back, z up). Without the flip every mesh would be the
+  // mirror image of the patient, and so would an implant designed on it.
+  v.directions = Eigen::Vector3d(spacing[0], -spacing[1], spacing[2]).asDiagonal();
+  v.origin = Eigen::Vector3d(0.0, spacing[1] * (shape[1] - 1), 0.0);
   convert_samples(path + " (" + filename + ")", data_it->second.data(), data_it->second.size(),
                   v.size(), type, false, v.data);
   if (data_it->second.size() != v.size() * sample_size(type))

@@ -7,6 +7,9 @@
 #include "cranioplan/algorithms/load_skull.h"
 #include "cranioplan/algorithms/mesh_report.h"
 #include "cranioplan/algorithms/mirror_mesh.h"
+#include "cranioplan/algorithms/read_volume.h"
+
+#include <Eigen/LU>
 #include "cranioplan/algorithms/register_icp.h"
 
 namespace cranioplan {
@@ -15,6 +18,10 @@ namespace {
 TEST(SampleCase, ImportPlaneMirrorRegister) {
   const std::string path = sample_case_path();
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not installed (scripts/install-deps)";
+  const Volume volume = read_volume(path);
+  // InVesalius stores rows flipped: the reader must give a right-handed, patient-true frame.
+  EXPECT_GT(volume.directions.determinant(), 0.0);
+  EXPECT_LT(volume.directions(1, 1), 0.0);
   const LoadedSkull skull = load_skull(path);
   const MeshReport rep = report_mesh(skull.mesh);
   EXPECT_GT(rep.triangles, 300000);
