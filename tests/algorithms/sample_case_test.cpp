@@ -19,8 +19,9 @@ TEST(SampleCase, ImportPlaneMirrorRegister) {
   const std::string path = sample_case_path();
   if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not installed (scripts/install-deps)";
   const Volume volume = read_volume(path);
-  // InVesalius stores rows flipped: the reader must give a right-handed, patient-true frame.
-  EXPECT_GT(volume.directions.determinant(), 0.0);
+  // InVesalius stores rows flipped: the reader's index-to-world map must undo that mirror
+  // (negative determinant), so the world coordinates are patient-true.
+  EXPECT_LT(volume.directions.determinant(), 0.0);
   EXPECT_LT(volume.directions(1, 1), 0.0);
   const LoadedSkull skull = load_skull(path);
   const MeshReport rep = report_mesh(skull.mesh);
