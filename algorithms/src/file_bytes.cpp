@@ -1,5 +1,5 @@
 #include "file_bytes.h"
-#include "cranioplan/algorithms/atomic_write.h"
+#include "cranioplan/algorithms/file_io.h"
 
 #include <zlib.h>
 
@@ -17,25 +17,6 @@
 namespace cranioplan::detail {
 
 namespace fs = std::filesystem;
-
-std::string read_file_bytes(const std::string& path) {
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (ec || !fs::exists(st)) throw InputError(path, "file not found");
-  if (fs::is_directory(st)) throw InputError(path, "is a folder, not a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, std::string("cannot open file: ") + std::strerror(errno));
-  std::string bytes;
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  if (size < 0) throw InputError(path, "cannot determine the file size");
-  in.seekg(0, std::ios::beg);
-  bytes.resize(static_cast<size_t>(size));
-  if (size > 0 && !in.read(bytes.data(), size))
-    throw InputError(path, "read error after " + format_count(in.gcount()) + " bytes");
-  if (bytes.empty()) throw InputError(path, "file is empty");
-  return bytes;
-}
 
 std::string gunzip(const std::string& path, const char* data, size_t size, size_t expected_size) {
   z_stream zs{};
@@ -102,6 +83,25 @@ std::string lower_extension(const std::string& path) {
 namespace cranioplan {
 
 namespace fs = std::filesystem;
+
+std::string read_file_bytes(const std::string& path) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (ec || !fs::exists(st)) throw InputError(path, "file not found");
+  if (fs::is_directory(st)) throw InputError(path, "is a folder, not a file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, std::string("cannot open file: ") + std::strerror(errno));
+  std::string bytes;
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size < 0) throw InputError(path, "cannot determine the file size");
+  in.seekg(0, std::ios::beg);
+  bytes.resize(static_cast<size_t>(size));
+  if (size > 0 && !in.read(bytes.data(), size))
+    throw InputError(path, "read error after " + format_count(in.gcount()) + " bytes");
+  if (bytes.empty()) throw InputError(path, "file is empty");
+  return bytes;
+}
 
 void write_file_atomically(const std::string& path, const std::string& bytes) {
   const fs::path target(path);

@@ -1,12 +1,8 @@
 #pragma once
-// Private helpers of the readers: whole-file reads and gzip inflation with messages that name
-// the file.
+// Private helpers of the readers: gzip inflation and extensions.
 #include <string>
 
 namespace cranioplan::detail {
-
-/// The file's bytes. Throws InputError for a missing file, a folder, an unreadable or empty file.
-std::string read_file_bytes(const std::string& path);
 
 /// Inflates gzip (or zlib) data. `expected_size` (when > 0) bounds the output: more data than
 /// that is an error, which stops a corrupt stream from filling memory.

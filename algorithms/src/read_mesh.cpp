@@ -16,6 +16,7 @@
 #include <cstring>
 #include <sstream>
 
+#include "cranioplan/algorithms/file_io.h"
 #include "cranioplan/model/error.h"
 #include "file_bytes.h"
 
@@ -369,7 +370,7 @@ TriangleSoup read_with_vtk(const std::string& path, const char* what) {
 }  // namespace
 
 TriangleSoup read_mesh_soup(const std::string& path, std::string* format_out) {
-  const std::string bytes = detail::read_file_bytes(path);
+  const std::string bytes = read_file_bytes(path);
   const std::string ext = detail::lower_extension(path);
   std::string format;
   TriangleSoup soup;

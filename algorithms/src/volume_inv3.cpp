@@ -4,6 +4,7 @@
 #include <cstring>
 #include <map>
 
+#include "cranioplan/algorithms/file_io.h"
 #include "cranioplan/model/error.h"
 #include "file_bytes.h"
 #include "volume_formats.h"

@@ -7,6 +7,7 @@
 #include <map>
 #include <sstream>
 
+#include "cranioplan/algorithms/file_io.h"
 #include "cranioplan/model/error.h"
 #include "file_bytes.h"
 #include "volume_formats.h"

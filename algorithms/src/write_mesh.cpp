@@ -5,7 +5,7 @@
 #include <cstring>
 
 #include "cranioplan/model/error.h"
-#include "cranioplan/algorithms/atomic_write.h"
+#include "cranioplan/algorithms/file_io.h"
 #include "file_bytes.h"
 
 namespace cranioplan {

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "cranioplan/algorithms/atomic_write.h"
+#include "cranioplan/algorithms/file_io.h"
 #include "cranioplan/model/error.h"
 
 namespace cranioplan {

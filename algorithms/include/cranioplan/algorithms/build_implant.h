@@ -1,0 +1,55 @@
+#pragma once
+// From markers to an implant: the paper's Delaunay 3D, and a closed fitted shell.
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "cranioplan/model/marker.h"
+#include "cranioplan/model/mesh.h"
+
+namespace cranioplan {
+
+enum class ImplantMethod { Shell, Delaunay3D };
+const char* to_string(ImplantMethod m);
+
+struct ImplantParams {
+  ImplantMethod method = ImplantMethod::Shell;
+  // shell
+  double resolution_mm = 1.0;  ///< target edge length of the shell, mm (0.2..10)
+  /// Thickness when there are no inner markers, mm; NaN: the bone thickness measured around
+  /// the rim (6 mm when no skull is given).
+  double thickness_mm = std::numeric_limits<double>::quiet_NaN();
+  bool snap_rim_to_skull = true;  ///< rim points between edge markers are put onto the bone
+  double max_rim_snap_mm = 3.0;   ///< rim points farther than this from bone stay where they are
+  // delaunay3d (VTK's vtkDelaunay3D parameters)
+  double delaunay_alpha = 0.0;        ///< 0: convex hull; >0: alpha shape radius, mm
+  double delaunay_tolerance = 0.001;  ///< point merge tolerance, fraction of the bounding box
+  double delaunay_offset = 2.5;       ///< bounding triangulation size multiplier
+};
+
+struct ImplantResult {
+  enum class Status { Built, TooFewMarkers, Failed };
+  Status status = Status::Failed;
+  std::string message;
+  SkullMesh mesh;               ///< closed and outward-oriented for the shell method
+  bool watertight = false;
+  double thickness_used_mm = 0.0;     ///< shell without inner markers: the offset applied
+  double rim_marker_error_mm = 0.0;   ///< largest distance from an edge marker to its rim
+  int rim_points = 0;                 ///< samples along each rim
+  double seconds = 0.0;
+  bool usable() const { return status == Status::Built; }
+};
+
+/// Builds an implant from markers (types 0–3). `skull` is the original skull: the shell's rims
+/// are snapped onto it and the default thickness is measured on it; may be null.
+///
+/// Shell: a plane is fitted to the outer markers and oriented away from the skull's centre; the
+/// outer and inner surfaces are thin-plate spline height fields over it, passing through their
+/// markers; both are sampled on rings that shrink from the rim (the edge markers in angular
+/// order, densified to `resolution_mm`) to the centre, and a side wall joins the two rims.
+/// The defect must be a graph over that plane and its rim star-shaped around the rim's centre,
+/// which holds for cranial defects up to about a hemisphere.
+ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh* skull,
+                            const ImplantParams& params = {});
+
+}  // namespace cranioplan

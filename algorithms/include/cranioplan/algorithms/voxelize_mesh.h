@@ -1,0 +1,44 @@
+#pragma once
+// Solid voxelisation of closed meshes on axis-aligned grids: the common ground of accuracy
+// metrics, overlap (penetration) checks and defect injection.
+#include <Eigen/Core>
+#include <array>
+#include <cstdint>
+#include <vector>
+
+#include "cranioplan/model/mesh.h"
+#include "cranioplan/model/volume.h"
+
+namespace cranioplan {
+
+/// An axis-aligned grid: voxel (i,j,k) has its centre at origin + spacing·(i,j,k).
+struct VoxelGrid {
+  Eigen::Vector3d origin = Eigen::Vector3d::Zero();  ///< centre of voxel (0,0,0), mm
+  double spacing = 0.5;                              ///< mm (>0)
+  std::array<int, 3> dims{0, 0, 0};
+
+  size_t size() const { return static_cast<size_t>(dims[0]) * dims[1] * dims[2]; }
+  size_t index(int i, int j, int k) const {
+    return (static_cast<size_t>(k) * dims[1] + j) * dims[0] + i;
+  }
+  Eigen::Vector3d center(int i, int j, int k) const {
+    return origin + spacing * Eigen::Vector3d(i, j, k);
+  }
+  double voxel_volume() const { return spacing * spacing * spacing; }
+
+  /// The grid that covers [lo, hi] with `pad` extra voxels on every side.
+  static VoxelGrid covering(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double spacing,
+                            int pad = 2);
+};
+
+/// Bounding box of a mesh's vertices.
+std::pair<Eigen::Vector3d, Eigen::Vector3d> mesh_bounds(const SkullMesh& mesh);
+
+/// 1 for voxels whose centre lies inside the mesh, else 0. The mesh should be closed; inside is
+/// decided by the parity of crossings along z through the voxel centre.
+std::vector<uint8_t> voxelize_mesh(const SkullMesh& mesh, const VoxelGrid& grid);
+
+/// The mask as a Volume (values 0/1), for surface extraction.
+Volume mask_volume(const std::vector<uint8_t>& mask, const VoxelGrid& grid);
+
+}  // namespace cranioplan

@@ -1,0 +1,427 @@
+#include "cranioplan/algorithms/build_implant.h"
+
+#include <vtkCellArray.h>
+#include <vtkDataSetSurfaceFilter.h>
+#include <vtkDelaunay3D.h>
+#include <vtkIdList.h>
+#include <vtkNew.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkTriangleFilter.h>
+#include <vtkUnstructuredGrid.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "cranioplan/algorithms/mesh_report.h"
+#include "cranioplan/algorithms/surface_locator.h"
+#include "cranioplan/algorithms/thin_plate_spline.h"
+
+namespace cranioplan {
+
+const char* to_string(ImplantMethod m) {
+  return m == ImplantMethod::Shell ? "shell" : "delaunay3d";
+}
+
+namespace {
+
+constexpr double kTwoPi = 2.0 * M_PI;
+
+// The local frame of the defect: origin, two tangent axes and the outward normal.
+struct Frame {
+  Eigen::Vector3d origin, e1, e2, n;
+  Eigen::Vector2d uv(const Eigen::Vector3d& p) const { return {(p - origin).dot(e1), (p - origin).dot(e2)}; }
+  double h(const Eigen::Vector3d& p) const { return (p - origin).dot(n); }
+  Eigen::Vector3d lift(const Eigen::Vector2d& q, double height) const {
+    return origin + q.x() * e1 + q.y() * e2 + height * n;
+  }
+};
+
+// A point of a ring: its position in the plane, its polar angle (unwrapped) and its vertex.
+struct RingPoint {
+  double angle;
+  int vertex;
+};
+using Ring = std::vector<RingPoint>;
+
+// A closed polygon in polar form around a centre: points sorted by angle.
+struct PolarPolygon {
+  Eigen::Vector2d center;
+  std::vector<double> angle;           // ascending in [-π, π)
+  std::vector<Eigen::Vector2d> point;  // same order
+  std::vector<double> extra;           // a value carried along (height correction)
+
+  static double angle_of(const Eigen::Vector2d& c, const Eigen::Vector2d& p) {
+    return std::atan2(p.y() - c.y(), p.x() - c.x());
+  }
+  void sort() {
+    std::vector<size_t> order(angle.size());
+    for (size_t i = 0; i < order.size(); ++i) order[i] = i;
+    std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return angle[a] < angle[b]; });
+    PolarPolygon s{center, {}, {}, {}};
+    for (size_t i : order) {
+      s.angle.push_back(angle[i]);
+      s.point.push_back(point[i]);
+      s.extra.push_back(extra.empty() ? 0.0 : extra[i]);
+    }
+    *this = s;
+  }
+  // Where the ray from the centre at angle `a` crosses the polygon, and the carried value
+  // interpolated there.
+  std::pair<Eigen::Vector2d, double> at(double a) const {
+    const size_t n = angle.size();
+    a = std::remainder(a, kTwoPi);
+    size_t hi = std::upper_bound(angle.begin(), angle.end(), a) - angle.begin();
+    const size_t i0 = (hi + n - 1) % n, i1 = hi % n;
+    const Eigen::Vector2d p0 = point[i0], p1 = point[i1];
+    const Eigen::Vector2d dir(std::cos(a), std::sin(a));
+    // center + t·dir = p0 + s·(p1 − p0)
+    Eigen::Matrix2d M;
+    M.col(0) = dir;
+    M.col(1) = p0 - p1;
+    const Eigen::Vector2d rhs = p0 - center;
+    double s = 0.0;
+    if (std::abs(M.determinant()) > 1e-12) s = std::clamp(M.inverse().row(1).dot(rhs), 0.0, 1.0);
+    return {p0 + s * (p1 - p0), extra[i0] + s * (extra[i1] - extra[i0])};
+  }
+};
+
+// Triangles between two closed rings sorted by angle (unwrapped from a common start).
+void zipper(const Ring& a, const Ring& b, std::vector<Eigen::Vector3i>& tris) {
+  const size_t na = a.size(), nb = b.size();
+  size_t i = 0, j = 0;
+  auto ang = [](const Ring& r, size_t k) { return k < r.size() ? r[k].angle : r[0].angle + kTwoPi; };
+  while (i < na || j < nb) {
+    if (j >= nb || (i < na && ang(a, i + 1) <= ang(b, j + 1))) {
+      tris.emplace_back(a[i % na].vertex, a[(i + 1) % na].vertex, b[j % nb].vertex);
+      ++i;
+    } else {
+      tris.emplace_back(a[i % na].vertex, b[(j + 1) % nb].vertex, b[j % nb].vertex);
+      ++j;
+    }
+  }
+}
+
+Ring make_ring(const std::vector<double>& angles, int first_vertex, double start) {
+  Ring r;
+  for (size_t k = 0; k < angles.size(); ++k) {
+    double a = angles[k];
+    while (a < start) a += kTwoPi;
+    while (a >= start + kTwoPi) a -= kTwoPi;
+    r.push_back({a, first_vertex + static_cast<int>(k)});
+  }
+  std::stable_sort(r.begin(), r.end(), [](const RingPoint& x, const RingPoint& y) { return x.angle < y.angle; });
+  return r;
+}
+
+double measure_bone_thickness(const std::vector<Eigen::Vector3d>& edge_points,
+                              const SurfaceLocator& skull) {
+  std::vector<double> t;
+  for (const auto& p : edge_points) {
+    const auto c = skull.closest(p);
+    const Eigen::Vector3d n = skull.face_normal(c.face);
+    const auto hit = skull.first_hit(c.point - 0.2 * n, c.point - 25.0 * n);
+    if (hit) t.push_back(hit->distance + 0.2);
+  }
+  if (t.empty()) return 6.0;
+  std::nth_element(t.begin(), t.begin() + t.size() / 2, t.end());
+  return std::clamp(t[t.size() / 2], 1.5, 15.0);
+}
+
+ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* skull,
+                          const ImplantParams& params) {
+  ImplantResult result;
+  std::vector<Eigen::Vector3d> outer, outer_edges, inner, inner_edges;
+  for (const auto& m : markers) {
+    (is_outer(m.type) ? outer : inner).push_back(m.position);
+    if (m.type == MarkerType::OuterEdge) outer_edges.push_back(m.position);
+    if (m.type == MarkerType::InnerEdge) inner_edges.push_back(m.position);
+  }
+  if (outer_edges.size() < 3) {
+    result.status = ImplantResult::Status::TooFewMarkers;
+    result.message = "the shell needs at least 3 outer edge markers (" +
+                     std::to_string(outer_edges.size()) + " given)";
+    return result;
+  }
+  const bool has_inner = inner_edges.size() >= 3;
+  std::unique_ptr<SurfaceLocator> bone;
+  if (skull && skull->n_faces() > 0) bone = std::make_unique<SurfaceLocator>(*skull);
+
+  // Frame: plane of the outer markers, normal pointing away from the skull's centre.
+  Frame f;
+  f.origin = Eigen::Vector3d::Zero();
+  for (const auto& p : outer) f.origin += p;
+  f.origin /= static_cast<double>(outer.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const auto& p : outer) cov += (p - f.origin) * (p - f.origin).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  f.n = eig.eigenvectors().col(0);
+  if (skull && skull->n_vertices() > 0) {
+    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+    for (auto vh : skull->vertices()) centre += to_eigen(skull->point(vh));
+    centre /= static_cast<double>(skull->n_vertices());
+    if (f.n.dot(f.origin - centre) < 0) f.n = -f.n;
+  }
+  f.e1 = eig.eigenvectors().col(2);
+  f.e2 = f.n.cross(f.e1);
+
+  auto fit = [&](const std::vector<Eigen::Vector3d>& pts, ThinPlateSpline& tps) {
+    std::vector<Eigen::Vector2d> uv;
+    std::vector<double> h;
+    for (const auto& p : pts) {
+      uv.push_back(f.uv(p));
+      h.push_back(f.h(p));
+    }
+    return tps.fit(uv, h);
+  };
+  ThinPlateSpline outer_tps, inner_tps;
+  if (!fit(outer, outer_tps)) {
+    result.message = "the outer markers lie on a line: no surface can be fitted";
+    return result;
+  }
+  if (has_inner && !fit(inner, inner_tps)) {
+    result.message = "the inner markers lie on a line: no surface can be fitted";
+    return result;
+  }
+  auto outer_normal = [&](const Eigen::Vector2d& q) {
+    const Eigen::Vector2d g = outer_tps.gradient(q);
+    return Eigen::Vector3d(f.n - g.x() * f.e1 - g.y() * f.e2).normalized();
+  };
+  result.thickness_used_mm =
+      has_inner ? 0.0
+                : (!std::isnan(params.thickness_mm) ? params.thickness_mm
+                   : bone                            ? measure_bone_thickness(outer_edges, *bone)
+                                                     : 6.0);
+
+  // Rim polygons around the centre of the outer edge markers.
+  Eigen::Vector2d center = Eigen::Vector2d::Zero();
+  for (const auto& p : outer_edges) center += f.uv(p);
+  center /= static_cast<double>(outer_edges.size());
+  auto polygon = [&](const std::vector<Eigen::Vector3d>& edges) {
+    PolarPolygon poly{center, {}, {}, {}};
+    for (const auto& p : edges) {
+      poly.point.push_back(f.uv(p));
+      poly.angle.push_back(PolarPolygon::angle_of(center, f.uv(p)));
+      poly.extra.push_back(0.0);
+    }
+    poly.sort();
+    return poly;
+  };
+  const PolarPolygon outer_poly = polygon(outer_edges);
+  const PolarPolygon inner_poly = has_inner ? polygon(inner_edges) : outer_poly;
+
+  // Rim sample angles: every edge marker's, densified to the resolution along the outer rim.
+  const double res = std::clamp(params.resolution_mm, 0.2, 10.0);
+  std::vector<double> marker_angles = outer_poly.angle;
+  if (has_inner) marker_angles.insert(marker_angles.end(), inner_poly.angle.begin(), inner_poly.angle.end());
+  std::sort(marker_angles.begin(), marker_angles.end());
+  marker_angles.erase(std::unique(marker_angles.begin(), marker_angles.end(),
+                                  [](double a, double b) { return std::abs(a - b) < 1e-9; }),
+                      marker_angles.end());
+  std::vector<double> angles;
+  std::vector<char> is_marker_angle;
+  for (size_t k = 0; k < marker_angles.size(); ++k) {
+    const double a0 = marker_angles[k];
+    const double a1 = k + 1 < marker_angles.size() ? marker_angles[k + 1] : marker_angles[0] + kTwoPi;
+    const double len = std::max((outer_poly.at(a1).first - outer_poly.at(a0).first).norm(),
+                                (inner_poly.at(a1).first - inner_poly.at(a0).first).norm());
+    const int steps = std::max(1, static_cast<int>(std::ceil(len / res)));
+    for (int s = 0; s < steps; ++s) {
+      angles.push_back(a0 + (a1 - a0) * s / steps);
+      is_marker_angle.push_back(s == 0);
+    }
+  }
+  const size_t n_rim = angles.size();
+  result.rim_points = static_cast<int>(n_rim);
+
+  // Rim points in 3D, snapped onto the bone between markers.
+  auto rim_points = [&](const PolarPolygon& poly, const ThinPlateSpline* tps) {
+    std::vector<Eigen::Vector3d> pts(n_rim);
+    for (size_t k = 0; k < n_rim; ++k) {
+      const Eigen::Vector2d q = poly.at(angles[k]).first;
+      if (tps) {
+        pts[k] = f.lift(q, (*tps)(q));
+      } else {  // no inner markers: the outer rim offset inwards along the surface normal
+        pts[k] = f.lift(q, outer_tps(q)) - result.thickness_used_mm * outer_normal(q);
+      }
+      const bool exact = is_marker_angle[k] && tps != nullptr;
+      if (bone && params.snap_rim_to_skull && !exact) {
+        const auto c = bone->closest(pts[k]);
+        if (c.distance <= params.max_rim_snap_mm) pts[k] = c.point;
+      }
+    }
+    return pts;
+  };
+  const std::vector<Eigen::Vector3d> outer_rim = rim_points(outer_poly, &outer_tps);
+  const std::vector<Eigen::Vector3d> inner_rim =
+      rim_points(inner_poly, has_inner ? &inner_tps : nullptr);
+
+  // The surfaces' interiors: rings shrinking from the rim to the centre. The rim's height
+  // correction (snapping) fades in as s⁴ towards the rim.
+  auto rim_polygon = [&](const std::vector<Eigen::Vector3d>& rim, const ThinPlateSpline* tps) {
+    PolarPolygon poly{center, {}, {}, {}};
+    for (const auto& p : rim) {
+      const Eigen::Vector2d q = f.uv(p);
+      poly.point.push_back(q);
+      poly.angle.push_back(PolarPolygon::angle_of(center, q));
+      const double base = tps ? (*tps)(q) : f.h(p);
+      poly.extra.push_back(f.h(p) - base);
+    }
+    poly.sort();
+    return poly;
+  };
+  double radius = 0.0;
+  for (const auto& p : outer_rim) radius = std::max(radius, (f.uv(p) - center).norm());
+  const int n_rings = std::max(2, static_cast<int>(std::ceil(radius / res)));
+  const double start = angles.front() - 1e-6;
+
+  TriangleSoup soup;
+  auto build_cap = [&](const std::vector<Eigen::Vector3d>& rim, const ThinPlateSpline* tps,
+                       bool offset_from_outer) {
+    const PolarPolygon poly = rim_polygon(rim, offset_from_outer ? &outer_tps : tps);
+    auto surface_point = [&](const Eigen::Vector2d& q, double correction) {
+      if (!offset_from_outer) return f.lift(q, (*tps)(q) + correction);
+      return Eigen::Vector3d(f.lift(q, outer_tps(q) + correction) -
+                             result.thickness_used_mm * outer_normal(q));
+    };
+    std::vector<Eigen::Vector3i> tris;
+    const int center_vertex = static_cast<int>(soup.vertices.size());
+    soup.vertices.push_back(surface_point(center, 0.0));
+    Ring previous;
+    for (int k = 1; k < n_rings; ++k) {
+      const double s = static_cast<double>(k) / n_rings;
+      const int count = std::max(6, static_cast<int>(std::lround(static_cast<double>(n_rim) * s)));
+      std::vector<double> ring_angles;
+      const int first = static_cast<int>(soup.vertices.size());
+      for (int j = 0; j < count; ++j) {
+        const double a = start + kTwoPi * (j + 0.5) / count;
+        const auto [boundary, correction] = poly.at(a);
+        soup.vertices.push_back(surface_point(center + s * (boundary - center), std::pow(s, 4) * correction));
+        ring_angles.push_back(a);
+      }
+      Ring ring = make_ring(ring_angles, first, start);
+      if (k == 1) {
+        for (size_t j = 0; j < ring.size(); ++j)
+          tris.emplace_back(center_vertex, ring[j].vertex, ring[(j + 1) % ring.size()].vertex);
+      } else {
+        zipper(previous, ring, tris);
+      }
+      previous = std::move(ring);
+    }
+    const int rim_first = static_cast<int>(soup.vertices.size());
+    std::vector<double> rim_angles;
+    for (const auto& p : rim) {
+      soup.vertices.push_back(p);
+      rim_angles.push_back(PolarPolygon::angle_of(center, f.uv(p)));
+    }
+    zipper(previous, make_ring(rim_angles, rim_first, start), tris);
+    // Orient every triangle counter-clockwise in the plane (normal along +n).
+    for (auto& t : tris) {
+      const Eigen::Vector2d a = f.uv(soup.vertices[t[0]]), b = f.uv(soup.vertices[t[1]]),
+                            c = f.uv(soup.vertices[t[2]]);
+      const double area = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
+      if (area < 0) std::swap(t[1], t[2]);
+    }
+    return std::make_pair(tris, rim_first);
+  };
+  auto [outer_tris, outer_rim_first] = build_cap(outer_rim, &outer_tps, false);
+  auto [inner_tris, inner_rim_first] =
+      build_cap(inner_rim, has_inner ? &inner_tps : nullptr, !has_inner);
+  soup.triangles = outer_tris;
+  for (auto t : inner_tris) soup.triangles.emplace_back(t[0], t[2], t[1]);  // facing inwards
+  // Side wall between rim k of both surfaces, facing away from the centre.
+  const Eigen::Vector3d axis_point = f.lift(center, 0.0);
+  for (size_t k = 0; k < n_rim; ++k) {
+    const int o0 = outer_rim_first + static_cast<int>(k);
+    const int o1 = outer_rim_first + static_cast<int>((k + 1) % n_rim);
+    const int i0 = inner_rim_first + static_cast<int>(k);
+    const int i1 = inner_rim_first + static_cast<int>((k + 1) % n_rim);
+    for (Eigen::Vector3i t : {Eigen::Vector3i(o0, i0, o1), Eigen::Vector3i(o1, i0, i1)}) {
+      const Eigen::Vector3d &a = soup.vertices[t[0]], &b = soup.vertices[t[1]], &c = soup.vertices[t[2]];
+      Eigen::Vector3d out = (a + b + c) / 3.0 - axis_point;
+      out -= out.dot(f.n) * f.n;
+      if ((b - a).cross(c - a).dot(out) < 0) std::swap(t[1], t[2]);
+      soup.triangles.push_back(t);
+    }
+  }
+  if (signed_volume(soup) < 0)  // inner surface above the outer one: markers swapped
+    for (auto& t : soup.triangles) std::swap(t[1], t[2]);
+  result.mesh = build_mesh(soup);
+
+  for (const auto& m : markers) {
+    if (!is_edge(m.type)) continue;
+    const std::vector<Eigen::Vector3d>& rim = m.type == MarkerType::OuterEdge ? outer_rim : inner_rim;
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& p : rim) best = std::min(best, (p - m.position).norm());
+    if (m.type == MarkerType::OuterEdge || has_inner)
+      result.rim_marker_error_mm = std::max(result.rim_marker_error_mm, best);
+  }
+  result.watertight = report_mesh(result.mesh).watertight;
+  result.status = ImplantResult::Status::Built;
+  result.message = has_inner ? "shell through outer and inner markers"
+                             : "shell through outer markers, inner surface offset by the thickness";
+  return result;
+}
+
+ImplantResult build_delaunay(const std::vector<Marker>& markers, const ImplantParams& params) {
+  ImplantResult result;
+  if (markers.size() < 4) {
+    result.status = ImplantResult::Status::TooFewMarkers;
+    result.message = "Delaunay 3D needs at least 4 markers (" + std::to_string(markers.size()) + " given)";
+    return result;
+  }
+  vtkNew<vtkPoints> pts;
+  pts->SetDataTypeToDouble();
+  for (const auto& m : markers) pts->InsertNextPoint(m.position.data());
+  vtkNew<vtkPolyData> cloud;
+  cloud->SetPoints(pts);
+  vtkNew<vtkDelaunay3D> del;
+  del->SetInputData(cloud);
+  del->SetAlpha(params.delaunay_alpha);
+  del->SetTolerance(params.delaunay_tolerance);
+  del->SetOffset(params.delaunay_offset);
+  vtkNew<vtkDataSetSurfaceFilter> surface;
+  surface->SetInputConnection(del->GetOutputPort());
+  vtkNew<vtkTriangleFilter> tri;
+  tri->SetInputConnection(surface->GetOutputPort());
+  tri->Update();
+  vtkPolyData* pd = tri->GetOutput();
+  TriangleSoup soup;
+  for (vtkIdType i = 0; i < pd->GetNumberOfPoints(); ++i) {
+    double p[3];
+    pd->GetPoint(i, p);
+    soup.vertices.emplace_back(p[0], p[1], p[2]);
+  }
+  vtkNew<vtkIdList> ids;
+  for (pd->GetPolys()->InitTraversal(); pd->GetPolys()->GetNextCell(ids);)
+    if (ids->GetNumberOfIds() == 3)
+      soup.triangles.emplace_back(ids->GetId(0), ids->GetId(1), ids->GetId(2));
+  if (soup.triangles.empty()) {
+    result.message = "Delaunay 3D produced no surface (markers coplanar, or alpha too small)";
+    return result;
+  }
+  if (signed_volume(soup) < 0)
+    for (auto& t : soup.triangles) std::swap(t[1], t[2]);
+  result.mesh = build_mesh(soup);
+  result.watertight = report_mesh(result.mesh).watertight;
+  result.status = ImplantResult::Status::Built;
+  result.message = result.watertight ? "Delaunay 3D surface (watertight)"
+                                     : "Delaunay 3D surface (not watertight)";
+  return result;
+}
+
+}  // namespace
+
+ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh* skull,
+                            const ImplantParams& params) {
+  const auto t0 = std::chrono::steady_clock::now();
+  ImplantResult r = params.method == ImplantMethod::Shell ? build_shell(markers, skull, params)
+                                                          : build_delaunay(markers, params);
+  r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return r;
+}
+
+}  // namespace cranioplan

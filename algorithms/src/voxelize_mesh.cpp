@@ -1,0 +1,84 @@
+#include "cranioplan/algorithms/voxelize_mesh.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace cranioplan {
+
+VoxelGrid VoxelGrid::covering(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                              double spacing, int pad) {
+  VoxelGrid g;
+  g.spacing = spacing;
+  g.origin = lo - Eigen::Vector3d::Constant(pad * spacing);
+  for (int a = 0; a < 3; ++a)
+    g.dims[a] = static_cast<int>(std::ceil((hi[a] - lo[a]) / spacing)) + 1 + 2 * pad;
+  return g;
+}
+
+std::pair<Eigen::Vector3d, Eigen::Vector3d> mesh_bounds(const SkullMesh& mesh) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (auto vh : mesh.vertices()) {
+    lo = lo.cwiseMin(to_eigen(mesh.point(vh)));
+    hi = hi.cwiseMax(to_eigen(mesh.point(vh)));
+  }
+  return {lo, hi};
+}
+
+std::vector<uint8_t> voxelize_mesh(const SkullMesh& mesh, const VoxelGrid& grid) {
+  std::vector<uint8_t> mask(grid.size(), 0);
+  const int nx = grid.dims[0], ny = grid.dims[1], nz = grid.dims[2];
+  // Crossing heights (in voxel units along z) per (i, j) column.
+  std::vector<std::vector<float>> columns(static_cast<size_t>(nx) * ny);
+  // A tiny irrational shift keeps column lines off vertices and edges of regular meshes.
+  const double jitter_x = 1.3e-6 * M_PI, jitter_y = 1.7e-6 * M_E;
+  for (auto fh : mesh.faces()) {
+    Eigen::Vector3d p[3];
+    int k = 0;
+    for (auto vh : mesh.fv_range(fh)) p[k++] = (to_eigen(mesh.point(vh)) - grid.origin) / grid.spacing;
+    const double x0 = std::min({p[0].x(), p[1].x(), p[2].x()}), x1 = std::max({p[0].x(), p[1].x(), p[2].x()});
+    const double y0 = std::min({p[0].y(), p[1].y(), p[2].y()}), y1 = std::max({p[0].y(), p[1].y(), p[2].y()});
+    const int i0 = std::max(0, static_cast<int>(std::ceil(x0 - jitter_x)));
+    const int i1 = std::min(nx - 1, static_cast<int>(std::floor(x1 - jitter_x)));
+    const int j0 = std::max(0, static_cast<int>(std::ceil(y0 - jitter_y)));
+    const int j1 = std::min(ny - 1, static_cast<int>(std::floor(y1 - jitter_y)));
+    const double det = (p[1].x() - p[0].x()) * (p[2].y() - p[0].y()) -
+                       (p[2].x() - p[0].x()) * (p[1].y() - p[0].y());
+    if (std::abs(det) < 1e-14) continue;  // parallel to z: no crossing
+    for (int j = j0; j <= j1; ++j)
+      for (int i = i0; i <= i1; ++i) {
+        const double x = i + jitter_x, y = j + jitter_y;
+        // Barycentric coordinates of (x, y) in the projected triangle.
+        const double b1 = ((x - p[0].x()) * (p[2].y() - p[0].y()) - (p[2].x() - p[0].x()) * (y - p[0].y())) / det;
+        const double b2 = ((p[1].x() - p[0].x()) * (y - p[0].y()) - (x - p[0].x()) * (p[1].y() - p[0].y())) / det;
+        if (b1 < 0 || b2 < 0 || b1 + b2 > 1) continue;
+        const double z = p[0].z() + b1 * (p[1].z() - p[0].z()) + b2 * (p[2].z() - p[0].z());
+        columns[static_cast<size_t>(j) * nx + i].push_back(static_cast<float>(z));
+      }
+  }
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      auto& c = columns[static_cast<size_t>(j) * nx + i];
+      if (c.size() < 2) continue;
+      std::sort(c.begin(), c.end());
+      for (size_t s = 0; s + 1 < c.size(); s += 2) {
+        const int k0 = std::max(0, static_cast<int>(std::ceil(c[s])));
+        const int k1 = std::min(nz - 1, static_cast<int>(std::floor(c[s + 1])));
+        for (int kk = k0; kk <= k1; ++kk) mask[grid.index(i, j, kk)] = 1;
+      }
+    }
+  return mask;
+}
+
+Volume mask_volume(const std::vector<uint8_t>& mask, const VoxelGrid& grid) {
+  Volume v;
+  v.dims = grid.dims;
+  v.directions = Eigen::Matrix3d::Identity() * grid.spacing;
+  v.origin = grid.origin;
+  v.kind = VolumeKind::Mask;
+  v.data.assign(mask.begin(), mask.end());
+  return v;
+}
+
+}  // namespace cranioplan
