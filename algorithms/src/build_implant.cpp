@@ -117,14 +117,18 @@ Ring make_ring(const std::vector<double>& angles, int first_vertex, double start
   return r;
 }
 
+// Bone thickness around the defect: a few millimetres outside each outer edge marker (away
+// from the defect's centre, on the intact outer table), along the inward surface normal to the
+// inner table. The median, clamped to 1.5–15 mm.
 double measure_bone_thickness(const std::vector<Eigen::Vector3d>& edge_points,
-                              const SurfaceLocator& skull) {
+                              const Eigen::Vector3d& defect_center, const SurfaceLocator& skull) {
   std::vector<double> t;
   for (const auto& p : edge_points) {
-    const auto c = skull.closest(p);
+    const Eigen::Vector3d away = (p - defect_center).normalized();
+    const auto c = skull.closest(p + 5.0 * away);
     const Eigen::Vector3d n = skull.face_normal(c.face);
-    const auto hit = skull.first_hit(c.point - 0.2 * n, c.point - 25.0 * n);
-    if (hit) t.push_back(hit->distance + 0.2);
+    const auto hit = skull.first_hit(c.point - 0.05 * n, c.point - 25.0 * n);
+    if (hit) t.push_back(hit->distance + 0.05);
   }
   if (t.empty()) return 6.0;
   std::nth_element(t.begin(), t.begin() + t.size() / 2, t.end());
@@ -193,7 +197,7 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
   result.thickness_used_mm =
       has_inner ? 0.0
                 : (!std::isnan(params.thickness_mm) ? params.thickness_mm
-                   : bone                            ? measure_bone_thickness(outer_edges, *bone)
+                   : bone                            ? measure_bone_thickness(outer_edges, f.origin, *bone)
                                                      : 6.0);
 
   // Rim polygons around the centre of the outer edge markers.

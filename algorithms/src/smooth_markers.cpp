@@ -6,6 +6,9 @@
 #include "cranioplan/algorithms/surface_locator.h"
 
 namespace cranioplan {
+namespace {
+constexpr double kCoincident2 = 1e-18;  // (1 nm)², in mm²
+}  // namespace
 
 SmoothResult smooth_markers(const std::vector<Marker>& markers, const SmoothParams& params,
                             const SurfaceLocator* project_onto) {
@@ -31,7 +34,10 @@ SmoothResult smooth_markers(const std::vector<Marker>& markers, const SmoothPara
       for (size_t j = 0; j < markers.size(); ++j) {
         if (j == i || is_outer(markers[j].type) != outer) continue;
         const double d2 = (current[j] - current[i]).squaredNorm();
-        if (d2 <= 0.0 || d2 > r2) continue;  // 0 < dist <= radius
+        // 0 < dist <= radius. Markers closer than 1 nm count as coincident: two markers that
+        // smoothing moves onto the same place must not be in or out by a rounding error, or
+        // the result would depend on the order of the markers.
+        if (d2 <= kCoincident2 || d2 > r2) continue;
         const double w = is_edge(markers[j].type) ? params.edge_weight : 1.0;
         sum += w * current[j];
         weight += w;

@@ -7,6 +7,7 @@
 #include <sstream>
 
 #include "cli_bench.h"
+#include "cli_implant_commands.h"
 #include "cli_output.h"
 #include "cranioplan/algorithms/fit_sagittal_plane.h"
 #include "cranioplan/algorithms/load_skull.h"
@@ -162,6 +163,8 @@ int run(int argc, char** argv) {
   bench->add_option("--runs", bench_options.runs, "repetitions per step (median reported)")
       ->check(CLI::Range(1, 100));
 
+  const std::vector<Subcommand> implant_commands = add_implant_commands(app, json);
+
   for (auto* sub : app.get_subcommands([](CLI::App*) { return true; }))
     sub->add_flag("--json", json, "print one JSON object on stdout");
 
@@ -284,6 +287,8 @@ int run(int argc, char** argv) {
       print_result(run_bench(bench_options), json);
       return kOk;
     }
+    for (const auto& c : implant_commands)
+      if (c.app->parsed()) return c.run();
   } catch (const CLI::ValidationError& e) {
     print_error(e.what(), kUsage, json);
     return kUsage;

@@ -80,6 +80,39 @@ Json to_json(const RegisterResult& r) {
   return j;
 }
 
+Json to_json(const QualityReport& q) {
+  return Json{{"watertight", q.watertight},
+              {"manifold", q.manifold},
+              {"outward", q.outward},
+              {"self_intersections", q.self_intersections},
+              {"pieces", q.pieces},
+              {"volume_mm3", q.volume_mm3},
+              {"area_mm2", q.area_mm2},
+              {"thickness_min_mm", q.thickness_min_mm},
+              {"thickness_median_mm", q.thickness_median_mm},
+              {"thickness_max_mm", q.thickness_max_mm},
+              {"rim_gap_mm", q.rim_gap_mm},
+              {"penetration_mm3", q.penetration_mm3},
+              {"printable", q.printable},
+              {"reasons", q.reasons}};
+}
+
+Json to_json(const CompareResult& c) {
+  Json j{{"dice", c.dice}};
+  if (c.boundary_dice >= 0) j["boundary_dice"] = c.boundary_dice;
+  auto finite = [](double x) { return std::isfinite(x) ? Json(x) : Json(nullptr); };
+  j["hausdorff_mm"] = finite(c.hausdorff_mm);
+  j["hd95_mm"] = finite(c.hd95_mm);
+  j["mean_surface_mm"] = finite(c.mean_surface_mm);
+  j["volume_a_mm3"] = c.volume_a_mm3;
+  j["volume_b_mm3"] = c.volume_b_mm3;
+  j["voxels_a"] = c.voxels_a;
+  j["voxels_b"] = c.voxels_b;
+  j["voxels_both"] = c.voxels_both;
+  j["seconds"] = c.seconds;
+  return j;
+}
+
 Eigen::Vector3d vector_from_json(const Json& j, const std::string& source, const std::string& what) {
   if (!j.is_array() || j.size() != 3)
     throw InputError(source, "'" + what + "' must be an array of 3 numbers");

@@ -4,6 +4,9 @@
 #include <cmath>
 #include <map>
 
+#include "cranioplan/algorithms/extract_bone_surface.h"
+#include "cranioplan/algorithms/voxelize_mesh.h"
+
 namespace cranioplan::test {
 namespace {
 
@@ -42,8 +45,10 @@ TriangleSoup icosphere(int subdivisions) {
   return s;
 }
 
+}  // namespace
+
 // Radius of the head along unit direction u; even in u.x, so the head is symmetric in x.
-Eigen::Vector3d head_point(const Eigen::Vector3d& u) {
+Eigen::Vector3d head_surface_point(const Eigen::Vector3d& u) {
   const double x2 = u.x() * u.x();
   double r = 1.0 + 0.12 * u.y() + 0.08 * u.z() * u.z() - 0.06 * u.y() * u.z() + 0.05 * x2 * u.z();
   // Nose ridge at the front, on the midline, slightly below the equator.
@@ -54,17 +59,15 @@ Eigen::Vector3d head_point(const Eigen::Vector3d& u) {
   return Eigen::Vector3d(70.0 * u.x(), 85.0 * u.y(), 72.0 * u.z()) * r;
 }
 
-}  // namespace
-
 SkullMesh make_symmetric_head(int subdivisions) {
   TriangleSoup s = icosphere(subdivisions);
-  for (auto& v : s.vertices) v = head_point(v);
+  for (auto& v : s.vertices) v = head_surface_point(v);
   return build_mesh(s);
 }
 
 Landmarks head_landmarks() {
   Landmarks lm;
-  lm.nasion = head_point(Eigen::Vector3d(0, 0.95, 0.05).normalized());
+  lm.nasion = head_surface_point(Eigen::Vector3d(0, 0.95, 0.05).normalized());
   lm.orbit_left = Eigen::Vector3d(-32, 78, 5);
   lm.orbit_right = Eigen::Vector3d(32, 78, 5);
   return lm;
@@ -115,6 +118,64 @@ Volume make_ball_volume(const Eigen::Vector3d& center_world, double radius, int 
         v.data[v.index(i, j, k)] = as_ct ? (in ? 1000.0f : -1000.0f) : (in ? 1.0f : 0.0f);
       }
   return v;
+}
+
+SkullMesh make_thick_head(double inner_scale, double voxel_mm) {
+  const SkullMesh outer = make_symmetric_head(5);
+  SkullMesh inner = outer;
+  for (auto vh : inner.vertices()) inner.set_point(vh, inner.point(vh) * inner_scale);
+  const auto [lo, hi] = mesh_bounds(outer);
+  const VoxelGrid grid = VoxelGrid::covering(lo, hi, voxel_mm);
+  std::vector<uint8_t> shell = voxelize_mesh(outer, grid);
+  const std::vector<uint8_t> cavity = voxelize_mesh(inner, grid);
+  for (size_t i = 0; i < shell.size(); ++i) shell[i] = shell[i] && !cavity[i];
+  // The shell's boundary has two pieces, the outer and the inner wall: keep both.
+  ExtractBoneSurfaceParams both;
+  both.largest_piece_only = false;
+  both.min_piece_triangles = 1;
+  return extract_bone_surface(mask_volume(shell, grid), both).mesh;
+}
+
+std::vector<Marker> round_defect_markers(const Eigen::Vector3d& center, double radius,
+                                         double inner_scale, int edge_count, int surface_rings) {
+  // Directions around the defect's axis; along each, the angle at which a surface leaves the
+  // sphere is found by bisection.
+  const Eigen::Vector3d axis = center.normalized();
+  const Eigen::Vector3d t1 = axis.unitOrthogonal(), t2 = axis.cross(t1);
+  auto direction = [&](double beta, double phi) {
+    return Eigen::Vector3d(std::cos(beta) * axis +
+                           std::sin(beta) * (std::cos(phi) * t1 + std::sin(phi) * t2));
+  };
+  auto rim_angle = [&](double scale, double phi) {
+    double lo = 0.0, hi = 1.5;
+    for (int it = 0; it < 60; ++it) {
+      const double mid = 0.5 * (lo + hi);
+      ((scale * head_surface_point(direction(mid, phi)) - center).norm() < radius ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+  };
+  std::vector<Marker> markers;
+  int id = 1;
+  for (int layer = 0; layer < 2; ++layer) {
+    const double scale = layer == 0 ? 1.0 : inner_scale;
+    const MarkerType edge = layer == 0 ? MarkerType::OuterEdge : MarkerType::InnerEdge;
+    const MarkerType surface = layer == 0 ? MarkerType::OuterSurface : MarkerType::InnerSurface;
+    for (int e = 0; e < edge_count; ++e) {
+      const double phi = 2.0 * M_PI * e / edge_count;
+      markers.push_back({id++, edge, scale * head_surface_point(direction(rim_angle(scale, phi), phi)),
+                         MarkerSurface::Original});
+    }
+    for (int ring = 1; ring <= surface_rings; ++ring) {
+      const int count = std::max(1, edge_count * ring / (surface_rings + 1));
+      for (int e = 0; e < count; ++e) {
+        const double phi = 2.0 * M_PI * (e + 0.5) / count;
+        const double beta = rim_angle(scale, phi) * ring / (surface_rings + 1);
+        markers.push_back({id++, surface, scale * head_surface_point(direction(beta, phi)),
+                           MarkerSurface::Mirrored});
+      }
+    }
+  }
+  return markers;
 }
 
 }  // namespace cranioplan::test

@@ -1,6 +1,7 @@
 #pragma once
 // Shapes whose truth is known by construction, for known-answer tests.
 #include "cranioplan/model/landmarks.h"
+#include "cranioplan/model/marker.h"
 #include "cranioplan/model/mesh.h"
 #include "cranioplan/model/plane.h"
 #include "cranioplan/model/rigid_transform.h"
@@ -27,5 +28,24 @@ Plane transformed(const Plane& p, const RigidTransform& t);
 /// A volume holding a solid ball (values 1 inside, 0 outside; or HU 1000 / -1000 as CT).
 Volume make_ball_volume(const Eigen::Vector3d& center_world, double radius, int n, double spacing,
                         bool as_ct);
+
+}  // namespace cranioplan::test
+
+namespace cranioplan::test {
+
+/// Point of the head surface of make_symmetric_head() along unit direction u (exact surface).
+Eigen::Vector3d head_surface_point(const Eigen::Vector3d& u);
+
+/// A closed skull-like shell: the volume between the head surface and the same surface scaled
+/// by `inner_scale`, meshed from a voxel mask of `voxel_mm`. Symmetric across x = 0 up to the
+/// voxelisation.
+SkullMesh make_thick_head(double inner_scale = 0.93, double voxel_mm = 0.5);
+
+/// Markers of a round defect cut by a sphere (centre `center`, radius `radius`) out of
+/// make_thick_head(): `edge_count` outer and inner edge markers on the rim, and surface markers
+/// on rings inside taken from the intact surfaces (what a mirrored healthy side supplies).
+std::vector<Marker> round_defect_markers(const Eigen::Vector3d& center, double radius,
+                                         double inner_scale = 0.93, int edge_count = 16,
+                                         int surface_rings = 3);
 
 }  // namespace cranioplan::test

@@ -4,6 +4,9 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "cranioplan/algorithms/build_implant.h"
+#include "cranioplan/algorithms/check_implant.h"
+#include "cranioplan/algorithms/compare_implants.h"
 #include "cranioplan/algorithms/extract_bone_surface.h"
 #include "cranioplan/algorithms/fit_sagittal_plane.h"
 #include "cranioplan/algorithms/mesh_report.h"
@@ -23,6 +26,8 @@ Json to_json(const Landmarks& lm);
 Json to_json(const MeshReport& r);
 Json to_json(const PlaneFit& fit);
 Json to_json(const RegisterResult& r);
+Json to_json(const QualityReport& q);
+Json to_json(const CompareResult& c);
 
 /// Readers of the same forms; `source` names the file in error messages. Throw InputError.
 Eigen::Vector3d vector_from_json(const Json& j, const std::string& source, const std::string& what);

@@ -1,0 +1,119 @@
+#include "cranioplan/algorithms/check_implant.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <limits>
+
+#include "cranioplan/algorithms/mesh_report.h"
+#include "cranioplan/algorithms/self_intersections.h"
+#include "cranioplan/algorithms/surface_locator.h"
+#include "cranioplan/algorithms/voxelize_mesh.h"
+
+namespace cranioplan {
+namespace {
+std::string fmt(const char* f, double a, double b) {
+  char buf[200];
+  std::snprintf(buf, sizeof(buf), f, a, b);
+  return buf;
+}
+}  // namespace
+
+QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
+                            const QualityParams& params) {
+  QualityReport q;
+  const MeshReport rep = report_mesh(implant);
+  q.watertight = rep.watertight;
+  q.manifold = rep.nonmanifold_edges == 0;
+  q.volume_mm3 = rep.volume_mm3;
+  q.area_mm2 = rep.area_mm2;
+  q.outward = rep.volume_mm3 > 0;
+  q.pieces = rep.pieces;
+  q.self_intersections = count_self_intersections(implant);
+  if (implant.n_faces() == 0) {
+    q.reasons.push_back("the implant has no triangles");
+    return q;
+  }
+
+  // Principal axes of the implant's vertices: the thinnest one is across the plate.
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (auto vh : implant.vertices()) c += to_eigen(implant.point(vh));
+  c /= static_cast<double>(implant.n_vertices());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (auto vh : implant.vertices()) {
+    const Eigen::Vector3d d = to_eigen(implant.point(vh)) - c;
+    cov += d * d.transpose();
+  }
+  const Eigen::Vector3d axis = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
+
+  const SurfaceLocator self(implant);
+  std::vector<double> thickness;
+  std::vector<int> wall_vertices;
+  for (auto fh : implant.faces()) {
+    Eigen::Vector3d p[3];
+    int ids[3], k = 0;
+    for (auto vh : implant.fv_range(fh)) {
+      ids[k] = vh.idx();
+      p[k++] = to_eigen(implant.point(vh));
+    }
+    Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]);
+    if (n.norm() == 0) continue;
+    n.normalize();
+    if (std::abs(n.dot(axis)) >= std::cos(M_PI / 4)) {
+      const Eigen::Vector3d centre = (p[0] + p[1] + p[2]) / 3.0;
+      const auto hit = self.first_hit(centre - 1e-4 * n, centre - 200.0 * n);
+      if (hit) thickness.push_back(hit->distance + 1e-4);
+    } else {
+      wall_vertices.insert(wall_vertices.end(), ids, ids + 3);
+    }
+  }
+  if (!thickness.empty()) {
+    std::sort(thickness.begin(), thickness.end());
+    q.thickness_min_mm = thickness.front();
+    q.thickness_median_mm = thickness[thickness.size() / 2];
+    q.thickness_max_mm = thickness.back();
+  }
+  if (skull && skull->n_faces() > 0) {
+    const SurfaceLocator bone(*skull);
+    // The gap along the rim: in each 5° sector around the implant's axis, the side-wall vertex
+    // nearest the bone; the rim gap is the worst sector.
+    std::sort(wall_vertices.begin(), wall_vertices.end());
+    wall_vertices.erase(std::unique(wall_vertices.begin(), wall_vertices.end()), wall_vertices.end());
+    const Eigen::Vector3d e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
+    std::vector<double> sector(72, std::numeric_limits<double>::infinity());
+    for (int v : wall_vertices) {
+      const Eigen::Vector3d p = to_eigen(implant.point(SkullMesh::VertexHandle(v)));
+      const double a = std::atan2((p - c).dot(e2), (p - c).dot(e1));
+      const int s = std::clamp(static_cast<int>((a + M_PI) / (2 * M_PI) * 72), 0, 71);
+      sector[s] = std::min(sector[s], bone.closest(p).distance);
+    }
+    q.rim_gap_mm = 0.0;
+    for (double g : sector)
+      if (std::isfinite(g)) q.rim_gap_mm = std::max(q.rim_gap_mm, g);
+    const auto [lo, hi] = mesh_bounds(implant);
+    const VoxelGrid grid = VoxelGrid::covering(lo, hi, std::clamp(params.overlap_voxel_mm, 0.05, 2.0));
+    const auto a = voxelize_mesh(implant, grid), b = voxelize_mesh(*skull, grid);
+    long long both = 0;
+    for (size_t i = 0; i < a.size(); ++i) both += a[i] && b[i];
+    q.penetration_mm3 = static_cast<double>(both) * grid.voxel_volume();
+  }
+
+  if (!q.watertight) q.reasons.push_back("not watertight (" + std::to_string(rep.boundary_edges) + " boundary edges)");
+  if (!q.manifold) q.reasons.push_back(std::to_string(rep.nonmanifold_edges) + " non-manifold edges");
+  if (!q.outward) q.reasons.push_back("faces point inwards (negative volume)");
+  if (q.self_intersections > 0)
+    q.reasons.push_back(std::to_string(q.self_intersections) + " pairs of triangles cross each other");
+  if (thickness.empty()) q.reasons.push_back("thickness could not be measured");
+  else if (q.thickness_min_mm < params.min_thickness_mm)
+    q.reasons.push_back(fmt("thinnest part %.2f mm is below %.2f mm", q.thickness_min_mm, params.min_thickness_mm));
+  if (q.rim_gap_mm > params.max_rim_gap_mm)
+    q.reasons.push_back(fmt("gap of %.2f mm between the rim and the bone (limit %.2f mm)", q.rim_gap_mm, params.max_rim_gap_mm));
+  if (q.penetration_mm3 > params.max_penetration_mm3)
+    q.reasons.push_back(fmt("%.1f mm³ overlap the skull (limit %.1f mm³)", q.penetration_mm3, params.max_penetration_mm3));
+  q.printable = q.reasons.empty();
+  return q;
+}
+
+}  // namespace cranioplan
