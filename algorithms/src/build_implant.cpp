@@ -30,12 +30,27 @@ namespace {
 
 constexpr double kTwoPi = 2.0 * M_PI;
 
-// The local frame of the defect: origin, two tangent axes and the outward normal.
+// The parametrisation of the defect's surfaces as height fields h(u, v).
+// Planar: (u, v) in the plane of the outer markers, h along its normal n.
+// Radial: rays from a centre inside the skull; (u, v) is the gnomonic projection of the ray
+// around the axis n (scaled to mm at the markers' radius), h the distance from the centre.
+// Radial handles large, strongly curved defects: rays from inside never cross.
 struct Frame {
+  bool radial = false;
   Eigen::Vector3d origin, e1, e2, n;
-  Eigen::Vector2d uv(const Eigen::Vector3d& p) const { return {(p - origin).dot(e1), (p - origin).dot(e2)}; }
-  double h(const Eigen::Vector3d& p) const { return (p - origin).dot(n); }
+  double scale = 1.0;
+  Eigen::Vector2d uv(const Eigen::Vector3d& p) const {
+    const Eigen::Vector3d d = p - origin;
+    if (!radial) return {d.dot(e1), d.dot(e2)};
+    const double t = std::max(d.dot(n), 1e-3 * d.norm());
+    return Eigen::Vector2d(d.dot(e1), d.dot(e2)) * (scale / t);
+  }
+  double h(const Eigen::Vector3d& p) const { return radial ? (p - origin).norm() : (p - origin).dot(n); }
+  Eigen::Vector3d up(const Eigen::Vector2d& q) const {
+    return radial ? Eigen::Vector3d((n + (q.x() / scale) * e1 + (q.y() / scale) * e2).normalized()) : n;
+  }
   Eigen::Vector3d lift(const Eigen::Vector2d& q, double height) const {
+    if (radial) return origin + height * up(q);
     return origin + q.x() * e1 + q.y() * e2 + height * n;
   }
 };
@@ -89,31 +104,36 @@ struct PolarPolygon {
   }
 };
 
-// Triangles between two closed rings sorted by angle (unwrapped from a common start).
+// Triangles between two closed rings sorted by angle (unwrapped from a common start), `a`
+// inside `b`; counter-clockwise like the rings.
 void zipper(const Ring& a, const Ring& b, std::vector<Eigen::Vector3i>& tris) {
   const size_t na = a.size(), nb = b.size();
   size_t i = 0, j = 0;
   auto ang = [](const Ring& r, size_t k) { return k < r.size() ? r[k].angle : r[0].angle + kTwoPi; };
   while (i < na || j < nb) {
     if (j >= nb || (i < na && ang(a, i + 1) <= ang(b, j + 1))) {
-      tris.emplace_back(a[i % na].vertex, a[(i + 1) % na].vertex, b[j % nb].vertex);
+      tris.emplace_back(a[i % na].vertex, b[j % nb].vertex, a[(i + 1) % na].vertex);
       ++i;
     } else {
-      tris.emplace_back(a[i % na].vertex, b[(j + 1) % nb].vertex, b[j % nb].vertex);
+      tris.emplace_back(a[i % na].vertex, b[j % nb].vertex, b[(j + 1) % nb].vertex);
       ++j;
     }
   }
 }
 
-Ring make_ring(const std::vector<double>& angles, int first_vertex, double start) {
+// A ring from polar angles. Interior rings are sorted by angle; the rim keeps its own order
+// (the side wall follows it), with its angles made non-decreasing so the zipper can walk it.
+Ring make_ring(const std::vector<double>& angles, int first_vertex, double start, bool keep_order) {
   Ring r;
   for (size_t k = 0; k < angles.size(); ++k) {
     double a = angles[k];
     while (a < start) a += kTwoPi;
     while (a >= start + kTwoPi) a -= kTwoPi;
+    if (keep_order && !r.empty()) a = std::max(a, r.back().angle);
     r.push_back({a, first_vertex + static_cast<int>(k)});
   }
-  std::stable_sort(r.begin(), r.end(), [](const RingPoint& x, const RingPoint& y) { return x.angle < y.angle; });
+  if (!keep_order)
+    std::stable_sort(r.begin(), r.end(), [](const RingPoint& x, const RingPoint& y) { return x.angle < y.angle; });
   return r;
 }
 
@@ -154,23 +174,40 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
   std::unique_ptr<SurfaceLocator> bone;
   if (skull && skull->n_faces() > 0) bone = std::make_unique<SurfaceLocator>(*skull);
 
-  // Frame: plane of the outer markers, normal pointing away from the skull's centre.
-  Frame f;
-  f.origin = Eigen::Vector3d::Zero();
-  for (const auto& p : outer) f.origin += p;
-  f.origin /= static_cast<double>(outer.size());
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (const auto& p : outer) cov += (p - f.origin) * (p - f.origin).transpose();
-  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-  f.n = eig.eigenvectors().col(0);
+  Eigen::Vector3d marker_centroid = Eigen::Vector3d::Zero();
+  for (const auto& p : outer) marker_centroid += p;
+  marker_centroid /= static_cast<double>(outer.size());
+  Eigen::Vector3d skull_centre = marker_centroid;
   if (skull && skull->n_vertices() > 0) {
-    Eigen::Vector3d centre = Eigen::Vector3d::Zero();
-    for (auto vh : skull->vertices()) centre += to_eigen(skull->point(vh));
-    centre /= static_cast<double>(skull->n_vertices());
-    if (f.n.dot(f.origin - centre) < 0) f.n = -f.n;
+    skull_centre.setZero();
+    for (auto vh : skull->vertices()) skull_centre += to_eigen(skull->point(vh));
+    skull_centre /= static_cast<double>(skull->n_vertices());
   }
-  f.e1 = eig.eigenvectors().col(2);
-  f.e2 = f.n.cross(f.e1);
+  Frame f;
+  if (params.radial_center || (skull && skull->n_vertices() > 0 && params.frame == ImplantFrame::Radial)) {
+    f.radial = true;
+    f.origin = params.radial_center ? *params.radial_center : skull_centre;
+    Eigen::Vector3d axis = Eigen::Vector3d::Zero();
+    f.scale = 0.0;
+    for (const auto& p : outer_edges) {
+      axis += (p - f.origin).normalized();
+      f.scale += (p - f.origin).norm();
+    }
+    f.n = axis.normalized();
+    f.scale /= static_cast<double>(outer_edges.size());
+    f.e1 = f.n.unitOrthogonal();
+    f.e2 = f.n.cross(f.e1);
+  } else {
+    // The plane of the outer markers, normal pointing away from the skull's centre.
+    f.origin = marker_centroid;
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (const auto& p : outer) cov += (p - f.origin) * (p - f.origin).transpose();
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+    f.n = eig.eigenvectors().col(0);
+    if (f.n.dot(f.origin - skull_centre) < 0) f.n = -f.n;
+    f.e1 = eig.eigenvectors().col(2);
+    f.e2 = f.n.cross(f.e1);
+  }
 
   auto fit = [&](const std::vector<Eigen::Vector3d>& pts, ThinPlateSpline& tps) {
     std::vector<Eigen::Vector2d> uv;
@@ -190,20 +227,26 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
     result.message = "the inner markers lie on a line: no surface can be fitted";
     return result;
   }
+  // Outward normal of the outer surface: from the spline's gradient (planar), or the ray
+  // direction (radial; the surfaces of a skull are nearly perpendicular to rays from inside).
   auto outer_normal = [&](const Eigen::Vector2d& q) {
+    if (f.radial) return f.up(q);
     const Eigen::Vector2d g = outer_tps.gradient(q);
     return Eigen::Vector3d(f.n - g.x() * f.e1 - g.y() * f.e2).normalized();
   };
   result.thickness_used_mm =
       has_inner ? 0.0
                 : (!std::isnan(params.thickness_mm) ? params.thickness_mm
-                   : bone                            ? measure_bone_thickness(outer_edges, f.origin, *bone)
+                   : bone                            ? measure_bone_thickness(outer_edges, marker_centroid, *bone)
                                                      : 6.0);
 
   // Rim polygons around the centre of the outer edge markers.
+  // Polar centre: the ray axis (radial; the rim is ordered around it), or the rim's centroid.
   Eigen::Vector2d center = Eigen::Vector2d::Zero();
-  for (const auto& p : outer_edges) center += f.uv(p);
-  center /= static_cast<double>(outer_edges.size());
+  if (!f.radial) {
+    for (const auto& p : outer_edges) center += f.uv(p);
+    center /= static_cast<double>(outer_edges.size());
+  }
   auto polygon = [&](const std::vector<Eigen::Vector3d>& edges) {
     PolarPolygon poly{center, {}, {}, {}};
     for (const auto& p : edges) {
@@ -254,14 +297,25 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
       const bool exact = is_marker_angle[k] && tps != nullptr;
       if (bone && params.snap_rim_to_skull && !exact) {
         const auto c = bone->closest(pts[k]);
-        if (c.distance <= params.max_rim_snap_mm) pts[k] = c.point;
+        // The snapped point must keep its place in the rim's angular order (else the cap
+        // folds) and not land on its predecessor (else the wall gets a zero-area face).
+        const double a = angles[k];
+        const double gap = 0.45 * std::min(std::remainder(angles[(k + 1) % n_rim] - a, kTwoPi),
+                                           std::remainder(a - angles[(k + n_rim - 1) % n_rim], kTwoPi));
+        const double moved = std::abs(std::remainder(PolarPolygon::angle_of(center, f.uv(c.point)) - a, kTwoPi));
+        const bool collides = k > 0 && (c.point - pts[k - 1]).norm() < 0.05;
+        if (c.distance <= params.max_rim_snap_mm && moved < gap && !collides) pts[k] = c.point;
       }
     }
     return pts;
   };
   const std::vector<Eigen::Vector3d> outer_rim = rim_points(outer_poly, &outer_tps);
-  const std::vector<Eigen::Vector3d> inner_rim =
-      rim_points(inner_poly, has_inner ? &inner_tps : nullptr);
+  std::vector<Eigen::Vector3d> inner_rim = rim_points(inner_poly, has_inner ? &inner_tps : nullptr);
+  // Where both rims meet the same bone point the side wall would have no height: keep at
+  // least 0.3 mm between them, inwards along the outer surface's normal.
+  for (size_t k = 0; k < n_rim; ++k)
+    if ((inner_rim[k] - outer_rim[k]).norm() < 0.3)
+      inner_rim[k] = outer_rim[k] - 0.3 * outer_normal(f.uv(outer_rim[k]));
 
   // The surfaces' interiors: rings shrinking from the rim to the centre. The rim's height
   // correction (snapping) fades in as s⁴ towards the rim.
@@ -306,7 +360,7 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
         soup.vertices.push_back(surface_point(center + s * (boundary - center), std::pow(s, 4) * correction));
         ring_angles.push_back(a);
       }
-      Ring ring = make_ring(ring_angles, first, start);
+      Ring ring = make_ring(ring_angles, first, start, false);
       if (k == 1) {
         for (size_t j = 0; j < ring.size(); ++j)
           tris.emplace_back(center_vertex, ring[j].vertex, ring[(j + 1) % ring.size()].vertex);
@@ -321,14 +375,18 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
       soup.vertices.push_back(p);
       rim_angles.push_back(PolarPolygon::angle_of(center, f.uv(p)));
     }
-    zipper(previous, make_ring(rim_angles, rim_first, start), tris);
-    // Orient every triangle counter-clockwise in the plane (normal along +n).
-    for (auto& t : tris) {
+    zipper(previous, make_ring(rim_angles, rim_first, start, true), tris);
+    // The zipper winds every triangle the same way; turn the whole cap, if need be, so it
+    // runs counter-clockwise in the parametrisation (normal outwards). Triangles are never
+    // turned one by one: that would break the mesh where a sharp notch of the rim folds one.
+    double signed_area = 0.0;
+    for (const auto& t : tris) {
       const Eigen::Vector2d a = f.uv(soup.vertices[t[0]]), b = f.uv(soup.vertices[t[1]]),
                             c = f.uv(soup.vertices[t[2]]);
-      const double area = (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
-      if (area < 0) std::swap(t[1], t[2]);
+      signed_area += (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
     }
+    if (signed_area < 0)
+      for (auto& t : tris) std::swap(t[1], t[2]);
     return std::make_pair(tris, rim_first);
   };
   auto [outer_tris, outer_rim_first] = build_cap(outer_rim, &outer_tps, false);
@@ -336,20 +394,15 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
       build_cap(inner_rim, has_inner ? &inner_tps : nullptr, !has_inner);
   soup.triangles = outer_tris;
   for (auto t : inner_tris) soup.triangles.emplace_back(t[0], t[2], t[1]);  // facing inwards
-  // Side wall between rim k of both surfaces, facing away from the centre.
-  const Eigen::Vector3d axis_point = f.lift(center, 0.0);
+  // Side wall between rim k of both surfaces. The outer cap runs its rim o_k → o_k+1 and the
+  // inner cap (facing inwards) i_k+1 → i_k, so the wall takes the opposite directions.
   for (size_t k = 0; k < n_rim; ++k) {
     const int o0 = outer_rim_first + static_cast<int>(k);
     const int o1 = outer_rim_first + static_cast<int>((k + 1) % n_rim);
     const int i0 = inner_rim_first + static_cast<int>(k);
     const int i1 = inner_rim_first + static_cast<int>((k + 1) % n_rim);
-    for (Eigen::Vector3i t : {Eigen::Vector3i(o0, i0, o1), Eigen::Vector3i(o1, i0, i1)}) {
-      const Eigen::Vector3d &a = soup.vertices[t[0]], &b = soup.vertices[t[1]], &c = soup.vertices[t[2]];
-      Eigen::Vector3d out = (a + b + c) / 3.0 - axis_point;
-      out -= out.dot(f.n) * f.n;
-      if ((b - a).cross(c - a).dot(out) < 0) std::swap(t[1], t[2]);
-      soup.triangles.push_back(t);
-    }
+    soup.triangles.emplace_back(o1, o0, i0);
+    soup.triangles.emplace_back(o1, i0, i1);
   }
   if (signed_volume(soup) < 0)  // inner surface above the outer one: markers swapped
     for (auto& t : soup.triangles) std::swap(t[1], t[2]);

@@ -1,9 +1,15 @@
 #include "cli_implant_commands.h"
 
+#include <algorithm>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <chrono>
 #include <memory>
 #include <sstream>
 
 #include "cli_output.h"
+#include "cranioplan/algorithms/autoplan.h"
 #include "cranioplan/algorithms/build_implant.h"
 #include "cranioplan/algorithms/check_implant.h"
 #include "cranioplan/algorithms/compare_implants.h"
@@ -46,6 +52,40 @@ Json implant_json(const ImplantResult& r) {
               {"rim_marker_error_mm", r.rim_marker_error_mm},
               {"rim_points", r.rim_points},
               {"seconds", r.seconds}};
+}
+
+Json autoplan_json(const AutoplanResult& r) {
+  Json j{{"status", r.planned() ? "planned" : r.status == AutoplanResult::Status::NoDefect ? "no_defect" : "failed"},
+         {"message", r.message},
+         {"plane", to_json(r.plane.plane)},
+         {"transform", to_json(r.registration.transform)},
+         {"registration_rms_mm", r.registration.rms_mm}};
+  if (r.defect.found()) {
+    j["defect"] = Json{{"area_mm2", r.defect.area_mm2}, {"axis", to_json(r.defect.axis)},
+                       {"rim_points", r.defect.outer_rim.size()}};
+    j["method"] = to_string(r.method_used);
+    j["mirror_coverage"] = r.mirror_coverage;
+    j["markers"] = r.markers.size();
+  }
+  if (r.planned()) {
+    j["implant"] = implant_json(r.implant);
+    j["quality"] = to_json(r.quality);
+  }
+  Json times = Json::object();
+  double total = 0.0;
+  for (const auto& [name, sec] : r.stage_seconds) {
+    times[name] = sec;
+    total += sec;
+  }
+  times["total"] = total;
+  j["seconds"] = times;
+  return j;
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
 }  // namespace
@@ -207,6 +247,90 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
       j["defective"] = o->output;
       j["implant"] = o->implant;
       print_result(j, json);
+      return kOk;
+    }});
+  }
+  {  // autoplan
+    struct Opts {
+      std::string skull, landmarks, output, markers_out, method = "auto";
+      AutoplanParams params;
+    };
+    auto o = std::make_shared<Opts>();
+    auto* cmd = app.add_subcommand("autoplan", "Plan an implant automatically from a defective skull");
+    cmd->add_option("SKULL", o->skull, "defective skull (mesh or volume)")->required();
+    cmd->add_option("--landmarks", o->landmarks, "landmarks JSON for the midsagittal plane");
+    cmd->add_option("--method", o->method, "auto, mirror or rim-only")->check(CLI::IsMember({"auto", "mirror", "rim-only"}));
+    cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
+    cmd->add_option("--markers-out", o->markers_out, "proposed markers to write (.json or .csv)");
+    out.push_back({cmd, [o, &json] {
+      const Landmarks lm = o->landmarks.empty() ? Landmarks{} : read_landmarks_file(o->landmarks);
+      const SkullMesh skull = load_skull(o->skull).mesh;
+      o->params.method = o->method == "mirror" ? PlanMethod::Mirror : o->method == "rim-only" ? PlanMethod::RimOnly : PlanMethod::Auto;
+      const AutoplanResult r = autoplan(skull, lm, o->params);
+      Json j = autoplan_json(r);
+      if (!o->markers_out.empty() && !r.markers.empty()) write_markers_file(r.markers, o->markers_out);
+      if (!r.planned()) {
+        print_result(j, json);
+        return kUnusable;
+      }
+      write_mesh(r.implant.mesh, o->output);
+      j["output"] = o->output;
+      print_result(j, json);
+      return kOk;
+    }});
+  }
+
+  {  // evaluate
+    struct Opts {
+      std::string dir;
+    };
+    auto o = std::make_shared<Opts>();
+    auto* cmd = app.add_subcommand("evaluate", "Autoplan every NNN_defective_skull.* against its NNN_implant.*");
+    cmd->add_option("CASES_DIR", o->dir, "folder of cases (meshes or NRRD/NIfTI masks)")->required();
+    out.push_back({cmd, [o, &json] {
+      namespace fs = std::filesystem;
+      if (!fs::is_directory(o->dir)) throw InputError(o->dir, "is not a folder");
+      std::map<std::string, std::pair<std::string, std::string>> cases;  // id → (defective, implant)
+      for (const auto& e : fs::directory_iterator(o->dir)) {
+        const std::string name = e.path().filename().string();
+        const size_t us = name.find('_');
+        if (us == std::string::npos) continue;
+        const std::string id = name.substr(0, us), rest = name.substr(us + 1);
+        if (rest.rfind("defective_skull.", 0) == 0) cases[id].first = e.path().string();
+        if (rest.rfind("implant.", 0) == 0) cases[id].second = e.path().string();
+      }
+      Json rows = Json::array();
+      std::vector<double> dsc, bdsc, hd95, secs;
+      for (const auto& [id, files] : cases) {
+        if (files.first.empty() || files.second.empty()) continue;
+        const auto t0 = std::chrono::steady_clock::now();
+        const SkullMesh skull = load_skull(files.first).mesh;
+        const AutoplanResult r = autoplan(skull, Landmarks{}, AutoplanParams{});
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        Json row{{"case", id}, {"status", r.planned() ? "planned" : "failed"}, {"message", r.message}, {"seconds", seconds}};
+        if (r.planned()) {
+          const SkullMesh truth = load_any(files.second);
+          const CompareResult c = compare_implants(r.implant.mesh, truth, &skull);
+          row["method"] = to_string(r.method_used);
+          row["dice"] = c.dice;
+          row["boundary_dice"] = c.boundary_dice;
+          row["hd95_mm"] = c.hd95_mm;
+          dsc.push_back(c.dice);
+          bdsc.push_back(c.boundary_dice);
+          hd95.push_back(c.hd95_mm);
+        }
+        secs.push_back(seconds);
+        if (!json)
+          std::cout << id << "  " << row.value("method", "-") << "  DSC " << row.value("dice", 0.0) << "  bDSC "
+                    << row.value("boundary_dice", 0.0) << "  HD95 " << row.value("hd95_mm", 0.0) << " mm  "
+                    << seconds << " s  " << r.message << std::endl;
+        rows.push_back(row);
+      }
+      if (rows.empty()) throw InputError(o->dir, "holds no NNN_defective_skull.* with an NNN_implant.* beside it");
+      const Json summary{{"cases", rows.size()}, {"median_dice", median(dsc)}, {"median_boundary_dice", median(bdsc)},
+                         {"median_hd95_mm", median(hd95)}, {"median_seconds", median(secs)}};
+      if (json) print_result(Json{{"cases", rows}, {"median", summary}}, true);
+      else print_result(Json{{"median", summary}}, false);
       return kOk;
     }});
   }

@@ -1,6 +1,7 @@
 #pragma once
 // From markers to an implant: the paper's Delaunay 3D, and a closed fitted shell.
 #include <limits>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -10,6 +11,9 @@
 namespace cranioplan {
 
 enum class ImplantMethod { Shell, Delaunay3D };
+/// How the shell parametrises the defect: over the plane of the outer markers, or along rays
+/// from a centre inside the skull (large and strongly curved defects).
+enum class ImplantFrame { Radial, Planar };
 const char* to_string(ImplantMethod m);
 
 struct ImplantParams {
@@ -21,6 +25,9 @@ struct ImplantParams {
   double thickness_mm = std::numeric_limits<double>::quiet_NaN();
   bool snap_rim_to_skull = true;  ///< rim points between edge markers are put onto the bone
   double max_rim_snap_mm = 3.0;   ///< rim points farther than this from bone stay where they are
+  /// Radial needs a skull (its centroid is the centre) or `radial_center`; otherwise planar.
+  ImplantFrame frame = ImplantFrame::Radial;
+  std::optional<Eigen::Vector3d> radial_center;  ///< centre of the rays (inside the skull)
   // delaunay3d (VTK's vtkDelaunay3D parameters)
   double delaunay_alpha = 0.0;        ///< 0: convex hull; >0: alpha shape radius, mm
   double delaunay_tolerance = 0.001;  ///< point merge tolerance, fraction of the bounding box
@@ -43,12 +50,12 @@ struct ImplantResult {
 /// Builds an implant from markers (types 0–3). `skull` is the original skull: the shell's rims
 /// are snapped onto it and the default thickness is measured on it; may be null.
 ///
-/// Shell: a plane is fitted to the outer markers and oriented away from the skull's centre; the
-/// outer and inner surfaces are thin-plate spline height fields over it, passing through their
-/// markers; both are sampled on rings that shrink from the rim (the edge markers in angular
-/// order, densified to `resolution_mm`) to the centre, and a side wall joins the two rims.
-/// The defect must be a graph over that plane and its rim star-shaped around the rim's centre,
-/// which holds for cranial defects up to about a hemisphere.
+/// Shell: the outer and inner surfaces are thin-plate spline height fields, passing through
+/// their markers, over a parametrisation of the defect (radial from the skull's centre by
+/// default, or planar); both are sampled on rings that shrink from the rim (the edge markers in
+/// angular order, densified to `resolution_mm`) to the centre, and a side wall joins the two
+/// rims. The rim must be star-shaped around its centre in that parametrisation, which holds for
+/// cranial defects seen from inside the skull.
 ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh* skull,
                             const ImplantParams& params = {});
 

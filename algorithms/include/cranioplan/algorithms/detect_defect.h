@@ -1,0 +1,45 @@
+#pragma once
+// Where is the defect? Rays from inside the skull: the directions in which no bone is met form
+// openings; the skull base (or the cut of a scan) is the largest, a defect the next one that is
+// large enough. Works whether or not the defect crosses the midline.
+#include <string>
+#include <vector>
+
+#include "cranioplan/model/mesh.h"
+
+namespace cranioplan {
+
+class SurfaceLocator;
+
+struct DetectDefectParams {
+  int directions = 20000;          ///< rays cast (Fibonacci sphere), 2,000..200,000
+  double min_area_mm2 = 300.0;     ///< smaller openings are not defects (at the rim's radius)
+  double support_width_mm = 12.0;  ///< width of the ring of intact bone sampled around the rim
+  /// Rays whose inner and outer bone are farther apart than this met other bone on the way
+  /// (e.g. the orbital roof): not used for the rim or the support ring, mm.
+  double max_thickness_mm = 15.0;
+};
+
+struct DefectRegion {
+  enum class Status { Found, NoDefect };
+  Status status = Status::NoDefect;
+  std::string message;
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();  ///< where the rays start (inside the skull)
+  Eigen::Vector3d axis = Eigen::Vector3d::Zero();    ///< mean direction of the opening (unit)
+  double area_mm2 = 0.0;                             ///< opening area at the rim's radius
+  std::vector<Eigen::Vector3d> hole_directions;      ///< unit rays through the opening
+  /// The rim: the last bone met along rays next to the opening, outer and inner table, in
+  /// order around the axis (same count, paired).
+  std::vector<Eigen::Vector3d> outer_rim, inner_rim;
+  /// Intact bone in a ring around the rim (outer and inner table), for fitting the surfaces.
+  std::vector<Eigen::Vector3d> outer_support, inner_support;
+  double seconds = 0.0;
+  bool found() const { return status == Status::Found; }
+};
+
+/// `center`: a point inside the cranial cavity (e.g. the skull's centroid moved onto the
+/// midsagittal plane).
+DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator,
+                           const Eigen::Vector3d& center, const DetectDefectParams& params = {});
+
+}  // namespace cranioplan

@@ -1,0 +1,198 @@
+#include "cranioplan/algorithms/detect_defect.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <numeric>
+#include <optional>
+
+#include "cranioplan/algorithms/point_index.h"
+#include "cranioplan/algorithms/surface_locator.h"
+
+namespace cranioplan {
+namespace {
+
+std::vector<Eigen::Vector3d> fibonacci_sphere(int n) {
+  std::vector<Eigen::Vector3d> d(n);
+  const double golden = M_PI * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < n; ++i) {
+    const double z = 1.0 - 2.0 * (i + 0.5) / n, r = std::sqrt(1.0 - z * z), a = golden * i;
+    d[i] = {r * std::cos(a), r * std::sin(a), z};
+  }
+  return d;
+}
+
+}  // namespace
+
+DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator,
+                           const Eigen::Vector3d& center, const DetectDefectParams& params) {
+  const auto t0 = std::chrono::steady_clock::now();
+  DefectRegion region;
+  region.center = center;
+  double reach = 0.0;
+  for (auto vh : skull.vertices()) reach = std::max(reach, (to_eigen(skull.point(vh)) - center).norm());
+  reach += 10.0;
+
+  const int n = std::clamp(params.directions, 2000, 200000);
+  const std::vector<Eigen::Vector3d> dirs = fibonacci_sphere(n);
+  std::vector<std::optional<Eigen::Vector3d>> inner(n), outer(n);
+  std::vector<char> paired(n, 0);  // both tables met, no more than a skull's thickness apart
+  for (int i = 0; i < n; ++i) {
+    const auto in = locator.first_hit(center, center + reach * dirs[i]);
+    if (!in) continue;
+    inner[i] = in->point;
+    const auto out = locator.first_hit(center + reach * dirs[i], center);
+    if (!out) continue;
+    outer[i] = out->point;
+    paired[i] = (*outer[i] - *inner[i]).norm() <= params.max_thickness_mm;
+  }
+  // Neighbours on the sphere: the 6 nearest directions.
+  const PointIndex index(dirs);
+  const double spacing = std::sqrt(4.0 * M_PI / n);  // radians between neighbouring rays
+  std::vector<std::vector<int>> nbrs(n);
+  for (int i = 0; i < n; ++i)
+    for (int j : index.within_radius(dirs[i], 1.6 * spacing))
+      if (j != i) nbrs[i].push_back(j);
+
+  // Openings: connected directions without bone.
+  std::vector<int> label(n, -1);
+  std::vector<std::vector<int>> comps;
+  for (int i = 0; i < n; ++i) {
+    if (inner[i] || label[i] >= 0) continue;
+    std::vector<int> comp{i}, stack{i};
+    label[i] = static_cast<int>(comps.size());
+    while (!stack.empty()) {
+      const int v = stack.back();
+      stack.pop_back();
+      for (int w : nbrs[v])
+        if (!inner[w] && label[w] < 0) {
+          label[w] = label[i];
+          comp.push_back(w);
+          stack.push_back(w);
+        }
+    }
+    comps.push_back(std::move(comp));
+  }
+  std::vector<size_t> order(comps.size());
+  std::iota(order.begin(), order.end(), 0);
+  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return comps[a].size() > comps[b].size(); });
+
+  // The largest opening is the skull base or the scan's cut; the defect is the largest of the
+  // others whose area, at the radius of its rim, is large enough.
+  for (size_t r = 1; r < order.size(); ++r) {
+    const std::vector<int>& comp = comps[order[r]];
+    std::vector<int> rim;
+    for (int i : comp)
+      for (int j : nbrs[i])
+        if (paired[j]) rim.push_back(j);
+    std::sort(rim.begin(), rim.end());
+    rim.erase(std::unique(rim.begin(), rim.end()), rim.end());
+    if (rim.empty()) continue;
+    double radius = 0.0;
+    for (int j : rim) radius += (*outer[j] - center).norm();
+    radius /= static_cast<double>(rim.size());
+    const double area = static_cast<double>(comp.size()) * 4.0 * M_PI / n * radius * radius;
+    if (area < params.min_area_mm2) break;  // sorted by size: the rest are smaller
+
+    region.status = DefectRegion::Status::Found;
+    region.area_mm2 = area;
+    Eigen::Vector3d axis = Eigen::Vector3d::Zero();
+    for (int i : comp) {
+      axis += dirs[i];
+      region.hole_directions.push_back(dirs[i]);
+    }
+    region.axis = axis.normalized();
+    // The rim, in order around the axis: in each angular sector the rim ray nearest the axis
+    // (the innermost bone), so the rim is a simple loop even where the ray grid is ragged.
+    const Eigen::Vector3d e1 = region.axis.unitOrthogonal(), e2 = region.axis.cross(e1);
+    const int sectors = std::clamp(static_cast<int>(rim.size()) / 2, 8, 360);
+    std::vector<int> best(sectors, -1);
+    for (int j : rim) {
+      const double a = std::atan2(dirs[j].dot(e2), dirs[j].dot(e1));
+      const int sct = std::clamp(static_cast<int>((a + M_PI) / (2 * M_PI) * sectors), 0, sectors - 1);
+      if (best[sct] < 0 || dirs[j].dot(region.axis) > dirs[best[sct]].dot(region.axis)) best[sct] = j;
+    }
+    // Refine each rim ray towards its nearest opening ray by bisection, so the rim sits where
+    // the bone ends rather than up to a ray spacing inside it.
+    auto cast = [&](const Eigen::Vector3d& d, Eigen::Vector3d& in_pt, Eigen::Vector3d& out_pt) {
+      const auto in = locator.first_hit(center, center + reach * d);
+      if (!in) return false;
+      const auto out = locator.first_hit(center + reach * d, center);
+      if (!out || (out->point - in->point).norm() > params.max_thickness_mm) return false;
+      in_pt = in->point;
+      out_pt = out->point;
+      return true;
+    };
+    for (int j : best) {
+      if (j < 0) continue;
+      int open_nbr = -1;
+      for (int w : nbrs[j])
+        if (label[w] == static_cast<int>(order[r]) &&
+            (open_nbr < 0 || dirs[w].dot(dirs[j]) > dirs[open_nbr].dot(dirs[j])))
+          open_nbr = w;
+      Eigen::Vector3d bone_dir = dirs[j], in_pt = *inner[j], out_pt = *outer[j];
+      if (open_nbr >= 0) {
+        Eigen::Vector3d open_dir = dirs[open_nbr];
+        for (int it = 0; it < 6; ++it) {
+          const Eigen::Vector3d mid = (bone_dir + open_dir).normalized();
+          Eigen::Vector3d i2, o2;
+          if (cast(mid, i2, o2)) {
+            bone_dir = mid;
+            in_pt = i2;
+            out_pt = o2;
+          } else {
+            open_dir = mid;
+          }
+        }
+      }
+      region.outer_rim.push_back(out_pt);
+      region.inner_rim.push_back(in_pt);
+    }
+    // Refinement moves rays sideways a little: restore the angular order around the axis.
+    std::vector<size_t> by_angle(region.outer_rim.size());
+    std::iota(by_angle.begin(), by_angle.end(), 0);
+    auto polar = [&](const Eigen::Vector3d& p) {
+      const Eigen::Vector3d d = p - center;
+      return std::atan2(d.dot(e2), d.dot(e1));
+    };
+    std::sort(by_angle.begin(), by_angle.end(),
+              [&](size_t a, size_t b) { return polar(region.outer_rim[a]) < polar(region.outer_rim[b]); });
+    std::vector<Eigen::Vector3d> sorted_outer, sorted_inner;
+    for (size_t k : by_angle) {
+      sorted_outer.push_back(region.outer_rim[k]);
+      sorted_inner.push_back(region.inner_rim[k]);
+    }
+    region.outer_rim = std::move(sorted_outer);
+    region.inner_rim = std::move(sorted_inner);
+    // Support ring: grow outwards from the rim, ring by ring, over the support width.
+    std::vector<int> frontier = rim;
+    std::vector<char> seen(n, 0);
+    for (int i : comp) seen[i] = 1;
+    for (int j : rim) seen[j] = 1;
+    const int rings = std::max(1, static_cast<int>(std::ceil(params.support_width_mm / (spacing * radius))));
+    std::vector<int> support = rim;
+    for (int ring = 0; ring < rings; ++ring) {
+      std::vector<int> next;
+      for (int v : frontier)
+        for (int w : nbrs[v])
+          if (!seen[w] && paired[w]) {
+            seen[w] = 1;
+            next.push_back(w);
+          }
+      support.insert(support.end(), next.begin(), next.end());
+      frontier = std::move(next);
+    }
+    for (int j : support) {
+      region.outer_support.push_back(*outer[j]);
+      region.inner_support.push_back(*inner[j]);
+    }
+    region.message = "opening of " + std::to_string(static_cast<long long>(area)) + " mm² found";
+    break;
+  }
+  if (!region.found()) region.message = "no defect found (no opening in the skull besides its base)";
+  region.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return region;
+}
+
+}  // namespace cranioplan
