@@ -29,6 +29,8 @@ const char* to_string(ImplantMethod m) {
 namespace {
 
 constexpr double kTwoPi = 2.0 * M_PI;
+// Markers closer than this (mm, in the parametrisation) to an earlier one are not fitted.
+constexpr double kMinMarkerSeparation = 1.0;
 
 // The parametrisation of the defect's surfaces as height fields h(u, v).
 // Planar: (u, v) in the plane of the outer markers, h along its normal n.
@@ -158,12 +160,16 @@ double measure_bone_thickness(const std::vector<Eigen::Vector3d>& edge_points,
 ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* skull,
                           const ImplantParams& params) {
   ImplantResult result;
+  // Edge markers first: where a surface marker lies next to an edge marker, the edge wins.
   std::vector<Eigen::Vector3d> outer, outer_edges, inner, inner_edges;
   for (const auto& m : markers) {
-    (is_outer(m.type) ? outer : inner).push_back(m.position);
     if (m.type == MarkerType::OuterEdge) outer_edges.push_back(m.position);
     if (m.type == MarkerType::InnerEdge) inner_edges.push_back(m.position);
   }
+  outer = outer_edges;
+  inner = inner_edges;
+  for (const auto& m : markers)
+    if (!is_edge(m.type)) (is_outer(m.type) ? outer : inner).push_back(m.position);
   if (outer_edges.size() < 3) {
     result.status = ImplantResult::Status::TooFewMarkers;
     result.message = "the shell needs at least 3 outer edge markers (" +
@@ -209,21 +215,23 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
     f.e2 = f.n.cross(f.e1);
   }
 
-  auto fit = [&](const std::vector<Eigen::Vector3d>& pts, ThinPlateSpline& tps) {
+  auto fit = [&](const std::vector<Eigen::Vector3d>& pts, size_t edges, ThinPlateSpline& tps) {
     std::vector<Eigen::Vector2d> uv;
     std::vector<double> h;
     for (const auto& p : pts) {
       uv.push_back(f.uv(p));
       h.push_back(f.h(p));
     }
-    return tps.fit(uv, h);
+    std::vector<double> smoothing(uv.size(), 0.0);
+    for (size_t i = edges; i < smoothing.size(); ++i) smoothing[i] = params.surface_smoothing;
+    return tps.fit(uv, h, smoothing, kMinMarkerSeparation, edges);
   };
   ThinPlateSpline outer_tps, inner_tps;
-  if (!fit(outer, outer_tps)) {
+  if (!fit(outer, outer_edges.size(), outer_tps)) {
     result.message = "the outer markers lie on a line: no surface can be fitted";
     return result;
   }
-  if (has_inner && !fit(inner, inner_tps)) {
+  if (has_inner && !fit(inner, inner_edges.size(), inner_tps)) {
     result.message = "the inner markers lie on a line: no surface can be fitted";
     return result;
   }

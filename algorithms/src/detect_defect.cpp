@@ -45,7 +45,8 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
     const auto out = locator.first_hit(center + reach * dirs[i], center);
     if (!out) continue;
     outer[i] = out->point;
-    paired[i] = (*outer[i] - *inner[i]).norm() <= params.max_thickness_mm;
+    const double t = (*outer[i] - *inner[i]).norm();
+    paired[i] = t >= params.min_thickness_mm && t <= params.max_thickness_mm;
   }
   // Neighbours on the sphere: the 6 nearest directions.
   const PointIndex index(dirs);
@@ -78,9 +79,21 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return comps[a].size() > comps[b].size(); });
 
-  // The largest opening is the skull base or the scan's cut; the defect is the largest of the
-  // others whose area, at the radius of its rim, is large enough.
-  for (size_t r = 1; r < order.size(); ++r) {
+  // The skull base (or the scan's cut) is the opening that holds the most inferior ray: CT
+  // volumes are in patient coordinates with z pointing up (DICOM, NRRD, NIfTI, InVesalius).
+  // Without such an opening the largest one is taken as the base. The defect is the largest
+  // of the others whose area, at the radius of its rim, is large enough.
+  size_t base = 0;
+  for (size_t r = 0; r < order.size(); ++r) {
+    double lowest = 1.0;
+    for (int i : comps[order[r]]) lowest = std::min(lowest, dirs[i].z());
+    if (lowest < -std::cos(M_PI / 6)) {
+      base = r;
+      break;
+    }
+  }
+  for (size_t r = 0; r < order.size(); ++r) {
+    if (r == base) continue;
     const std::vector<int>& comp = comps[order[r]];
     std::vector<int> rim;
     for (int i : comp)
@@ -114,26 +127,29 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
       if (best[sct] < 0 || dirs[j].dot(region.axis) > dirs[best[sct]].dot(region.axis)) best[sct] = j;
     }
     // Refine each rim ray towards its nearest opening ray by bisection, so the rim sits where
-    // the bone ends rather than up to a ray spacing inside it.
+    // the bone ends rather than up to a ray spacing inside it. Rays must still cross bone of
+    // a plausible thickness on both tables (they share the ray).
     auto cast = [&](const Eigen::Vector3d& d, Eigen::Vector3d& in_pt, Eigen::Vector3d& out_pt) {
       const auto in = locator.first_hit(center, center + reach * d);
       if (!in) return false;
       const auto out = locator.first_hit(center + reach * d, center);
-      if (!out || (out->point - in->point).norm() > params.max_thickness_mm) return false;
+      if (!out) return false;
+      const double t = (out->point - in->point).norm();
+      if (t < params.min_thickness_mm || t > params.max_thickness_mm) return false;
       in_pt = in->point;
       out_pt = out->point;
       return true;
     };
     for (int j : best) {
       if (j < 0) continue;
+      Eigen::Vector3d in_pt = *inner[j], out_pt = *outer[j];
       int open_nbr = -1;
       for (int w : nbrs[j])
         if (label[w] == static_cast<int>(order[r]) &&
             (open_nbr < 0 || dirs[w].dot(dirs[j]) > dirs[open_nbr].dot(dirs[j])))
           open_nbr = w;
-      Eigen::Vector3d bone_dir = dirs[j], in_pt = *inner[j], out_pt = *outer[j];
       if (open_nbr >= 0) {
-        Eigen::Vector3d open_dir = dirs[open_nbr];
+        Eigen::Vector3d bone_dir = dirs[j], open_dir = dirs[open_nbr];
         for (int it = 0; it < 6; ++it) {
           const Eigen::Vector3d mid = (bone_dir + open_dir).normalized();
           Eigen::Vector3d i2, o2;

@@ -29,7 +29,11 @@ struct AutoplanParams {
   double edge_spacing_mm = 4.0;          ///< proposed edge markers along the rim, mm
   double surface_spacing_mm = 6.0;       ///< proposed surface and support markers, mm
   SmoothParams smooth{10.0, 2.0, 1};     ///< applied to mirror surface markers (projected back)
-  ImplantParams implant;
+  ImplantParams implant = [] {
+    ImplantParams p;
+    p.surface_smoothing = 0.003;
+    return p;
+  }();
 };
 
 struct AutoplanResult {

@@ -24,6 +24,10 @@ struct ImplantParams {
   /// the rim (6 mm when no skull is given).
   double thickness_mm = std::numeric_limits<double>::quiet_NaN();
   bool snap_rim_to_skull = true;  ///< rim points between edge markers are put onto the bone
+  /// Surface markers are approximated rather than interpolated with this spline smoothing
+  /// weight (dimensionless, ≥ 0; 0: the surfaces pass through them). Edge markers are always
+  /// met exactly. Automatic plans use a little, to ride over noise in sampled bone.
+  double surface_smoothing = 0.0;
   double max_rim_snap_mm = 3.0;   ///< rim points farther than this from bone stay where they are
   /// Radial needs a skull (its centroid is the centre) or `radial_center`; otherwise planar.
   ImplantFrame frame = ImplantFrame::Radial;

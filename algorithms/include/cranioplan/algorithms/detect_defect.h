@@ -1,7 +1,8 @@
 #pragma once
 // Where is the defect? Rays from inside the skull: the directions in which no bone is met form
-// openings; the skull base (or the cut of a scan) is the largest, a defect the next one that is
-// large enough. Works whether or not the defect crosses the midline.
+// openings; the skull base (or the cut of a scan) is the one straight down (−z: skulls are in
+// patient coordinates, superior up, as CT volumes give them), a defect the largest other one
+// that is large enough. Works whether or not the defect crosses the midline.
 #include <string>
 #include <vector>
 
@@ -18,6 +19,9 @@ struct DetectDefectParams {
   /// Rays whose inner and outer bone are farther apart than this met other bone on the way
   /// (e.g. the orbital roof): not used for the rim or the support ring, mm.
   double max_thickness_mm = 15.0;
+  /// Rays that only graze bone (at the cut face of a defect) pass through less than this; the
+  /// rim is placed where rays still cross this much bone, mm.
+  double min_thickness_mm = 1.5;
 };
 
 struct DefectRegion {
