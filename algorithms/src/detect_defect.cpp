@@ -81,9 +81,9 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
 
   // The skull base (or the scan's cut) is the opening that holds the most inferior ray: CT
   // volumes are in patient coordinates with z pointing up (DICOM, NRRD, NIfTI, InVesalius).
-  // Without such an opening the largest one is taken as the base. The defect is the largest
-  // of the others whose area, at the radius of its rim, is large enough.
-  size_t base = 0;
+  // Without such an opening the skull is closed below (no base opening). The defect is the
+  // largest of the others whose area, at the radius of its rim, is large enough.
+  size_t base = order.size();
   for (size_t r = 0; r < order.size(); ++r) {
     double lowest = 1.0;
     for (int i : comps[order[r]]) lowest = std::min(lowest, dirs[i].z());
