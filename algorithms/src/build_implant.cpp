@@ -14,6 +14,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
+#include <functional>
 #include <cmath>
 
 #include "cranioplan/algorithms/mesh_report.h"
@@ -215,26 +216,34 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
     f.e2 = f.n.cross(f.e1);
   }
 
-  auto fit = [&](const std::vector<Eigen::Vector3d>& pts, size_t edges, ThinPlateSpline& tps) {
+  // The outer surface: a spline of heights through the outer markers. The inner surface: the
+  // outer one less a thickness field, a spline through the inner markers' depths below the
+  // outer surface. Thickness varies slowly, so its spline stays calm across the opening where
+  // a spline of the inner heights themselves, pulled by noisy samples at the rim, can buckle.
+  auto fit = [&](const std::vector<Eigen::Vector3d>& pts, size_t edges, ThinPlateSpline& tps,
+                 const ThinPlateSpline* below) {
     std::vector<Eigen::Vector2d> uv;
     std::vector<double> h;
     for (const auto& p : pts) {
       uv.push_back(f.uv(p));
-      h.push_back(f.h(p));
+      h.push_back(below ? (*below)(f.uv(p)) - f.h(p) : f.h(p));
     }
     std::vector<double> smoothing(uv.size(), 0.0);
     for (size_t i = edges; i < smoothing.size(); ++i) smoothing[i] = params.surface_smoothing;
     return tps.fit(uv, h, smoothing, kMinMarkerSeparation, edges);
   };
-  ThinPlateSpline outer_tps, inner_tps;
-  if (!fit(outer, outer_edges.size(), outer_tps)) {
+  ThinPlateSpline outer_tps, thickness_tps;
+  if (!fit(outer, outer_edges.size(), outer_tps, nullptr)) {
     result.message = "the outer markers lie on a line: no surface can be fitted";
     return result;
   }
-  if (has_inner && !fit(inner, inner_edges.size(), inner_tps)) {
+  if (has_inner && !fit(inner, inner_edges.size(), thickness_tps, &outer_tps)) {
     result.message = "the inner markers lie on a line: no surface can be fitted";
     return result;
   }
+  using Height = std::function<double(const Eigen::Vector2d&)>;
+  const Height outer_height = [&](const Eigen::Vector2d& q) { return outer_tps(q); };
+  const Height inner_height = [&](const Eigen::Vector2d& q) { return outer_tps(q) - thickness_tps(q); };
   // Outward normal of the outer surface: from the spline's gradient (planar), or the ray
   // direction (radial; the surfaces of a skull are nearly perpendicular to rays from inside).
   auto outer_normal = [&](const Eigen::Vector2d& q) {
@@ -293,7 +302,7 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
   result.rim_points = static_cast<int>(n_rim);
 
   // Rim points in 3D, snapped onto the bone between markers.
-  auto rim_points = [&](const PolarPolygon& poly, const ThinPlateSpline* tps) {
+  auto rim_points = [&](const PolarPolygon& poly, const Height* tps) {
     std::vector<Eigen::Vector3d> pts(n_rim);
     for (size_t k = 0; k < n_rim; ++k) {
       const Eigen::Vector2d q = poly.at(angles[k]).first;
@@ -317,8 +326,8 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
     }
     return pts;
   };
-  const std::vector<Eigen::Vector3d> outer_rim = rim_points(outer_poly, &outer_tps);
-  std::vector<Eigen::Vector3d> inner_rim = rim_points(inner_poly, has_inner ? &inner_tps : nullptr);
+  const std::vector<Eigen::Vector3d> outer_rim = rim_points(outer_poly, &outer_height);
+  std::vector<Eigen::Vector3d> inner_rim = rim_points(inner_poly, has_inner ? &inner_height : nullptr);
   // Where both rims meet the same bone point the side wall would have no height: keep at
   // least 0.3 mm between them, inwards along the outer surface's normal.
   for (size_t k = 0; k < n_rim; ++k)
@@ -327,7 +336,7 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
 
   // The surfaces' interiors: rings shrinking from the rim to the centre. The rim's height
   // correction (snapping) fades in as s⁴ towards the rim.
-  auto rim_polygon = [&](const std::vector<Eigen::Vector3d>& rim, const ThinPlateSpline* tps) {
+  auto rim_polygon = [&](const std::vector<Eigen::Vector3d>& rim, const Height* tps) {
     PolarPolygon poly{center, {}, {}, {}};
     for (const auto& p : rim) {
       const Eigen::Vector2d q = f.uv(p);
@@ -345,9 +354,9 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
   const double start = angles.front() - 1e-6;
 
   TriangleSoup soup;
-  auto build_cap = [&](const std::vector<Eigen::Vector3d>& rim, const ThinPlateSpline* tps,
+  auto build_cap = [&](const std::vector<Eigen::Vector3d>& rim, const Height* tps,
                        bool offset_from_outer) {
-    const PolarPolygon poly = rim_polygon(rim, offset_from_outer ? &outer_tps : tps);
+    const PolarPolygon poly = rim_polygon(rim, offset_from_outer ? &outer_height : tps);
     auto surface_point = [&](const Eigen::Vector2d& q, double correction) {
       if (!offset_from_outer) return f.lift(q, (*tps)(q) + correction);
       return Eigen::Vector3d(f.lift(q, outer_tps(q) + correction) -
@@ -397,9 +406,9 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
       for (auto& t : tris) std::swap(t[1], t[2]);
     return std::make_pair(tris, rim_first);
   };
-  auto [outer_tris, outer_rim_first] = build_cap(outer_rim, &outer_tps, false);
+  auto [outer_tris, outer_rim_first] = build_cap(outer_rim, &outer_height, false);
   auto [inner_tris, inner_rim_first] =
-      build_cap(inner_rim, has_inner ? &inner_tps : nullptr, !has_inner);
+      build_cap(inner_rim, has_inner ? &inner_height : nullptr, !has_inner);
   soup.triangles = outer_tris;
   for (auto t : inner_tris) soup.triangles.emplace_back(t[0], t[2], t[1]);  // facing inwards
   // Side wall between rim k of both surfaces. The outer cap runs its rim o_k → o_k+1 and the
