@@ -142,7 +142,7 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
 
   ImplantParams implant = params.implant;
   implant.radial_center = r.defect.center;  // the rays that found the opening
-  r.implant = build_implant(r.markers, &skull, implant);
+  r.implant = build_implant(r.markers, &skull, &bone, implant);
   timer.stage("implant");
   if (!r.implant.usable()) {
     r.message = "implant: " + r.implant.message;

@@ -159,7 +159,7 @@ double measure_bone_thickness(const std::vector<Eigen::Vector3d>& edge_points,
 }
 
 ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* skull,
-                          const ImplantParams& params) {
+                          const SurfaceLocator* skull_locator, const ImplantParams& params) {
   ImplantResult result;
   // Edge markers first: where a surface marker lies next to an edge marker, the edge wins.
   std::vector<Eigen::Vector3d> outer, outer_edges, inner, inner_edges;
@@ -178,8 +178,9 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
     return result;
   }
   const bool has_inner = inner_edges.size() >= 3;
-  std::unique_ptr<SurfaceLocator> bone;
-  if (skull && skull->n_faces() > 0) bone = std::make_unique<SurfaceLocator>(*skull);
+  std::unique_ptr<SurfaceLocator> own_locator;
+  if (!skull_locator && skull && skull->n_faces() > 0) own_locator = std::make_unique<SurfaceLocator>(*skull);
+  const SurfaceLocator* bone = skull_locator ? skull_locator : own_locator.get();
 
   Eigen::Vector3d marker_centroid = Eigen::Vector3d::Zero();
   for (const auto& p : outer) marker_centroid += p;
@@ -491,9 +492,15 @@ ImplantResult build_delaunay(const std::vector<Marker>& markers, const ImplantPa
 
 ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh* skull,
                             const ImplantParams& params) {
+  return build_implant(markers, skull, nullptr, params);
+}
+
+ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh* skull,
+                            const SurfaceLocator* skull_locator, const ImplantParams& params) {
   const auto t0 = std::chrono::steady_clock::now();
-  ImplantResult r = params.method == ImplantMethod::Shell ? build_shell(markers, skull, params)
-                                                          : build_delaunay(markers, params);
+  ImplantResult r = params.method == ImplantMethod::Shell
+                        ? build_shell(markers, skull, skull_locator, params)
+                        : build_delaunay(markers, params);
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }

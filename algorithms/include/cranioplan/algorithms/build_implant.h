@@ -63,4 +63,11 @@ struct ImplantResult {
 ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh* skull,
                             const ImplantParams& params = {});
 
+class SurfaceLocator;
+/// The same with the skull's locator built once by the caller: an interactive editor rebuilds
+/// the implant on every marker edit, and building the locator of a 500k-triangle skull costs
+/// more than the implant.
+ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh* skull,
+                            const SurfaceLocator* skull_locator, const ImplantParams& params);
+
 }  // namespace cranioplan
