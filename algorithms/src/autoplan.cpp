@@ -10,9 +10,12 @@ namespace cranioplan {
 
 const char* to_string(PlanMethod m) {
   switch (m) {
-    case PlanMethod::Auto: return "auto";
-    case PlanMethod::Mirror: return "mirror";
-    case PlanMethod::RimOnly: return "rim-only";
+    case PlanMethod::Auto:
+      return "auto";
+    case PlanMethod::Mirror:
+      return "mirror";
+    case PlanMethod::RimOnly:
+      return "rim-only";
   }
   return "auto";
 }
@@ -77,7 +80,8 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
   const SkullMesh mirrored = mirror_mesh(skull, r.plane.plane);
   timer.stage("mirror");
   r.registration = register_icp(mirrored, skull, params.registration);
-  r.mirrored = r.registration.usable() ? transform_mesh(mirrored, r.registration.transform) : mirrored;
+  r.mirrored =
+      r.registration.usable() ? transform_mesh(mirrored, r.registration.transform) : mirrored;
   timer.stage("register");
 
   const SurfaceLocator bone(skull);
@@ -105,30 +109,37 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
       mirror_outer.push_back(out->point);
     }
   }
-  r.mirror_coverage = r.defect.hole_directions.empty()
-                          ? 0.0
-                          : static_cast<double>(mirror_outer.size()) / r.defect.hole_directions.size();
+  r.mirror_coverage = r.defect.hole_directions.empty() ? 0.0
+                                                       : static_cast<double>(mirror_outer.size()) /
+                                                             r.defect.hole_directions.size();
   r.method_used = params.method == PlanMethod::Auto
-                      ? (r.mirror_coverage >= params.min_mirror_coverage ? PlanMethod::Mirror : PlanMethod::RimOnly)
+                      ? (r.mirror_coverage >= params.min_mirror_coverage ? PlanMethod::Mirror
+                                                                         : PlanMethod::RimOnly)
                       : params.method;
 
   // Proposed markers: edges along both rims, support from the intact ring, surface markers
   // from the mirror.
   int id = 1;
   for (size_t i : along(r.defect.outer_rim, params.edge_spacing_mm)) {
-    r.markers.push_back({id++, MarkerType::OuterEdge, r.defect.outer_rim[i], MarkerSurface::Original});
-    r.markers.push_back({id++, MarkerType::InnerEdge, r.defect.inner_rim[i], MarkerSurface::Original});
+    r.markers.push_back(
+        {id++, MarkerType::OuterEdge, r.defect.outer_rim[i], MarkerSurface::Original});
+    r.markers.push_back(
+        {id++, MarkerType::InnerEdge, r.defect.inner_rim[i], MarkerSurface::Original});
   }
   for (size_t i : thin_out(r.defect.outer_support, params.surface_spacing_mm))
-    r.markers.push_back({id++, MarkerType::OuterSurface, r.defect.outer_support[i], MarkerSurface::Original});
+    r.markers.push_back(
+        {id++, MarkerType::OuterSurface, r.defect.outer_support[i], MarkerSurface::Original});
   for (size_t i : thin_out(r.defect.inner_support, params.surface_spacing_mm))
-    r.markers.push_back({id++, MarkerType::InnerSurface, r.defect.inner_support[i], MarkerSurface::Original});
+    r.markers.push_back(
+        {id++, MarkerType::InnerSurface, r.defect.inner_support[i], MarkerSurface::Original});
   if (r.method_used == PlanMethod::Mirror) {
     std::vector<Marker> mirror_markers;
     for (size_t i : thin_out(mirror_outer, params.surface_spacing_mm))
-      mirror_markers.push_back({id++, MarkerType::OuterSurface, mirror_outer[i], MarkerSurface::Mirrored});
+      mirror_markers.push_back(
+          {id++, MarkerType::OuterSurface, mirror_outer[i], MarkerSurface::Mirrored});
     for (size_t i : thin_out(mirror_inner, params.surface_spacing_mm))
-      mirror_markers.push_back({id++, MarkerType::InnerSurface, mirror_inner[i], MarkerSurface::Mirrored});
+      mirror_markers.push_back(
+          {id++, MarkerType::InnerSurface, mirror_inner[i], MarkerSurface::Mirrored});
     // The paper's smoother on the mirror's markers with the rim fixed, back onto the mirror.
     std::vector<Marker> to_smooth;
     for (const auto& m : r.markers)
@@ -152,7 +163,8 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
   timer.stage("quality");
   r.status = AutoplanResult::Status::Planned;
   char buf[200];
-  std::snprintf(buf, sizeof(buf), "%s; %s (mirror covers %.0f%% of the opening)", r.defect.message.c_str(),
+  std::snprintf(buf, sizeof(buf), "%s; %s (mirror covers %.0f%% of the opening)",
+                r.defect.message.c_str(),
                 r.method_used == PlanMethod::Mirror ? "mirror-guided" : "rim-only fitting",
                 100.0 * r.mirror_coverage);
   r.message = buf;

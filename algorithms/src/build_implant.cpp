@@ -14,8 +14,8 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <chrono>
-#include <functional>
 #include <cmath>
+#include <functional>
 
 #include "cranioplan/algorithms/mesh_report.h"
 #include "cranioplan/algorithms/surface_locator.h"
@@ -48,9 +48,12 @@ struct Frame {
     const double t = std::max(d.dot(n), 1e-3 * d.norm());
     return Eigen::Vector2d(d.dot(e1), d.dot(e2)) * (scale / t);
   }
-  double h(const Eigen::Vector3d& p) const { return radial ? (p - origin).norm() : (p - origin).dot(n); }
+  double h(const Eigen::Vector3d& p) const {
+    return radial ? (p - origin).norm() : (p - origin).dot(n);
+  }
   Eigen::Vector3d up(const Eigen::Vector2d& q) const {
-    return radial ? Eigen::Vector3d((n + (q.x() / scale) * e1 + (q.y() / scale) * e2).normalized()) : n;
+    return radial ? Eigen::Vector3d((n + (q.x() / scale) * e1 + (q.y() / scale) * e2).normalized())
+                  : n;
   }
   Eigen::Vector3d lift(const Eigen::Vector2d& q, double height) const {
     if (radial) return origin + height * up(q);
@@ -112,7 +115,9 @@ struct PolarPolygon {
 void zipper(const Ring& a, const Ring& b, std::vector<Eigen::Vector3i>& tris) {
   const size_t na = a.size(), nb = b.size();
   size_t i = 0, j = 0;
-  auto ang = [](const Ring& r, size_t k) { return k < r.size() ? r[k].angle : r[0].angle + kTwoPi; };
+  auto ang = [](const Ring& r, size_t k) {
+    return k < r.size() ? r[k].angle : r[0].angle + kTwoPi;
+  };
   while (i < na || j < nb) {
     if (j >= nb || (i < na && ang(a, i + 1) <= ang(b, j + 1))) {
       tris.emplace_back(a[i % na].vertex, b[j % nb].vertex, a[(i + 1) % na].vertex);
@@ -136,7 +141,8 @@ Ring make_ring(const std::vector<double>& angles, int first_vertex, double start
     r.push_back({a, first_vertex + static_cast<int>(k)});
   }
   if (!keep_order)
-    std::stable_sort(r.begin(), r.end(), [](const RingPoint& x, const RingPoint& y) { return x.angle < y.angle; });
+    std::stable_sort(r.begin(), r.end(),
+                     [](const RingPoint& x, const RingPoint& y) { return x.angle < y.angle; });
   return r;
 }
 
@@ -179,7 +185,8 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
   }
   const bool has_inner = inner_edges.size() >= 3;
   std::unique_ptr<SurfaceLocator> own_locator;
-  if (!skull_locator && skull && skull->n_faces() > 0) own_locator = std::make_unique<SurfaceLocator>(*skull);
+  if (!skull_locator && skull && skull->n_faces() > 0)
+    own_locator = std::make_unique<SurfaceLocator>(*skull);
   const SurfaceLocator* bone = skull_locator ? skull_locator : own_locator.get();
 
   Eigen::Vector3d marker_centroid = Eigen::Vector3d::Zero();
@@ -192,7 +199,8 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
     skull_centre /= static_cast<double>(skull->n_vertices());
   }
   Frame f;
-  if (params.radial_center || (skull && skull->n_vertices() > 0 && params.frame == ImplantFrame::Radial)) {
+  if (params.radial_center ||
+      (skull && skull->n_vertices() > 0 && params.frame == ImplantFrame::Radial)) {
     f.radial = true;
     f.origin = params.radial_center ? *params.radial_center : skull_centre;
     Eigen::Vector3d axis = Eigen::Vector3d::Zero();
@@ -244,7 +252,9 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
   }
   using Height = std::function<double(const Eigen::Vector2d&)>;
   const Height outer_height = [&](const Eigen::Vector2d& q) { return outer_tps(q); };
-  const Height inner_height = [&](const Eigen::Vector2d& q) { return outer_tps(q) - thickness_tps(q); };
+  const Height inner_height = [&](const Eigen::Vector2d& q) {
+    return outer_tps(q) - thickness_tps(q);
+  };
   // Outward normal of the outer surface: from the spline's gradient (planar), or the ray
   // direction (radial; the surfaces of a skull are nearly perpendicular to rays from inside).
   auto outer_normal = [&](const Eigen::Vector2d& q) {
@@ -255,8 +265,8 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
   result.thickness_used_mm =
       has_inner ? 0.0
                 : (!std::isnan(params.thickness_mm) ? params.thickness_mm
-                   : bone                            ? measure_bone_thickness(outer_edges, marker_centroid, *bone)
-                                                     : 6.0);
+                   : bone ? measure_bone_thickness(outer_edges, marker_centroid, *bone)
+                          : 6.0);
 
   // Rim polygons around the centre of the outer edge markers.
   // Polar centre: the ray axis (radial; the rim is ordered around it), or the rim's centroid.
@@ -281,7 +291,8 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
   // Rim sample angles: every edge marker's, densified to the resolution along the outer rim.
   const double res = std::clamp(params.resolution_mm, 0.2, 10.0);
   std::vector<double> marker_angles = outer_poly.angle;
-  if (has_inner) marker_angles.insert(marker_angles.end(), inner_poly.angle.begin(), inner_poly.angle.end());
+  if (has_inner)
+    marker_angles.insert(marker_angles.end(), inner_poly.angle.begin(), inner_poly.angle.end());
   std::sort(marker_angles.begin(), marker_angles.end());
   marker_angles.erase(std::unique(marker_angles.begin(), marker_angles.end(),
                                   [](double a, double b) { return std::abs(a - b) < 1e-9; }),
@@ -290,7 +301,8 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
   std::vector<char> is_marker_angle;
   for (size_t k = 0; k < marker_angles.size(); ++k) {
     const double a0 = marker_angles[k];
-    const double a1 = k + 1 < marker_angles.size() ? marker_angles[k + 1] : marker_angles[0] + kTwoPi;
+    const double a1 =
+        k + 1 < marker_angles.size() ? marker_angles[k + 1] : marker_angles[0] + kTwoPi;
     const double len = std::max((outer_poly.at(a1).first - outer_poly.at(a0).first).norm(),
                                 (inner_poly.at(a1).first - inner_poly.at(a0).first).norm());
     const int steps = std::max(1, static_cast<int>(std::ceil(len / res)));
@@ -318,9 +330,11 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
         // The snapped point must keep its place in the rim's angular order (else the cap
         // folds) and not land on its predecessor (else the wall gets a zero-area face).
         const double a = angles[k];
-        const double gap = 0.45 * std::min(std::remainder(angles[(k + 1) % n_rim] - a, kTwoPi),
-                                           std::remainder(a - angles[(k + n_rim - 1) % n_rim], kTwoPi));
-        const double moved = std::abs(std::remainder(PolarPolygon::angle_of(center, f.uv(c.point)) - a, kTwoPi));
+        const double gap =
+            0.45 * std::min(std::remainder(angles[(k + 1) % n_rim] - a, kTwoPi),
+                            std::remainder(a - angles[(k + n_rim - 1) % n_rim], kTwoPi));
+        const double moved =
+            std::abs(std::remainder(PolarPolygon::angle_of(center, f.uv(c.point)) - a, kTwoPi));
         const bool collides = k > 0 && (c.point - pts[k - 1]).norm() < 0.05;
         if (c.distance <= params.max_rim_snap_mm && moved < gap && !collides) pts[k] = c.point;
       }
@@ -328,7 +342,8 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
     return pts;
   };
   const std::vector<Eigen::Vector3d> outer_rim = rim_points(outer_poly, &outer_height);
-  std::vector<Eigen::Vector3d> inner_rim = rim_points(inner_poly, has_inner ? &inner_height : nullptr);
+  std::vector<Eigen::Vector3d> inner_rim =
+      rim_points(inner_poly, has_inner ? &inner_height : nullptr);
   // Where both rims meet the same bone point the side wall would have no height: keep at
   // least 0.3 mm between them, inwards along the outer surface's normal.
   for (size_t k = 0; k < n_rim; ++k)
@@ -375,7 +390,8 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
       for (int j = 0; j < count; ++j) {
         const double a = start + kTwoPi * (j + 0.5) / count;
         const auto [boundary, correction] = poly.at(a);
-        soup.vertices.push_back(surface_point(center + s * (boundary - center), std::pow(s, 4) * correction));
+        soup.vertices.push_back(
+            surface_point(center + s * (boundary - center), std::pow(s, 4) * correction));
         ring_angles.push_back(a);
       }
       Ring ring = make_ring(ring_angles, first, start, false);
@@ -428,7 +444,8 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
 
   for (const auto& m : markers) {
     if (!is_edge(m.type)) continue;
-    const std::vector<Eigen::Vector3d>& rim = m.type == MarkerType::OuterEdge ? outer_rim : inner_rim;
+    const std::vector<Eigen::Vector3d>& rim =
+        m.type == MarkerType::OuterEdge ? outer_rim : inner_rim;
     double best = std::numeric_limits<double>::infinity();
     for (const auto& p : rim) best = std::min(best, (p - m.position).norm());
     if (m.type == MarkerType::OuterEdge || has_inner)
@@ -445,7 +462,8 @@ ImplantResult build_delaunay(const std::vector<Marker>& markers, const ImplantPa
   ImplantResult result;
   if (markers.size() < 4) {
     result.status = ImplantResult::Status::TooFewMarkers;
-    result.message = "Delaunay 3D needs at least 4 markers (" + std::to_string(markers.size()) + " given)";
+    result.message =
+        "Delaunay 3D needs at least 4 markers (" + std::to_string(markers.size()) + " given)";
     return result;
   }
   vtkNew<vtkPoints> pts;

@@ -46,7 +46,8 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
     const Eigen::Vector3d d = to_eigen(implant.point(vh)) - c;
     cov += d * d.transpose();
   }
-  const Eigen::Vector3d axis = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
+  const Eigen::Vector3d axis =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
 
   const SurfaceLocator self(implant);
   std::vector<double> thickness;
@@ -80,7 +81,8 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
     // The gap along the rim: in each 5° sector around the implant's axis, the side-wall vertex
     // nearest the bone; the rim gap is the worst sector.
     std::sort(wall_vertices.begin(), wall_vertices.end());
-    wall_vertices.erase(std::unique(wall_vertices.begin(), wall_vertices.end()), wall_vertices.end());
+    wall_vertices.erase(std::unique(wall_vertices.begin(), wall_vertices.end()),
+                        wall_vertices.end());
     const Eigen::Vector3d e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
     std::vector<double> sector(72, std::numeric_limits<double>::infinity());
     for (int v : wall_vertices) {
@@ -93,25 +95,34 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
     for (double g : sector)
       if (std::isfinite(g)) q.rim_gap_mm = std::max(q.rim_gap_mm, g);
     const auto [lo, hi] = mesh_bounds(implant);
-    const VoxelGrid grid = VoxelGrid::covering(lo, hi, std::clamp(params.overlap_voxel_mm, 0.05, 2.0));
+    const VoxelGrid grid =
+        VoxelGrid::covering(lo, hi, std::clamp(params.overlap_voxel_mm, 0.05, 2.0));
     const auto a = voxelize_mesh(implant, grid), b = voxelize_mesh(*skull, grid);
     long long both = 0;
     for (size_t i = 0; i < a.size(); ++i) both += a[i] && b[i];
     q.penetration_mm3 = static_cast<double>(both) * grid.voxel_volume();
   }
 
-  if (!q.watertight) q.reasons.push_back("not watertight (" + std::to_string(rep.boundary_edges) + " boundary edges)");
-  if (!q.manifold) q.reasons.push_back(std::to_string(rep.nonmanifold_edges) + " non-manifold edges");
+  if (!q.watertight)
+    q.reasons.push_back("not watertight (" + std::to_string(rep.boundary_edges) +
+                        " boundary edges)");
+  if (!q.manifold)
+    q.reasons.push_back(std::to_string(rep.nonmanifold_edges) + " non-manifold edges");
   if (!q.outward) q.reasons.push_back("faces point inwards (negative volume)");
   if (q.self_intersections > 0)
-    q.reasons.push_back(std::to_string(q.self_intersections) + " pairs of triangles cross each other");
-  if (thickness.empty()) q.reasons.push_back("thickness could not be measured");
+    q.reasons.push_back(std::to_string(q.self_intersections) +
+                        " pairs of triangles cross each other");
+  if (thickness.empty())
+    q.reasons.push_back("thickness could not be measured");
   else if (q.thickness_min_mm < params.min_thickness_mm)
-    q.reasons.push_back(fmt("thinnest part %.2f mm is below %.2f mm", q.thickness_min_mm, params.min_thickness_mm));
+    q.reasons.push_back(
+        fmt("thinnest part %.2f mm is below %.2f mm", q.thickness_min_mm, params.min_thickness_mm));
   if (q.rim_gap_mm > params.max_rim_gap_mm)
-    q.reasons.push_back(fmt("gap of %.2f mm between the rim and the bone (limit %.2f mm)", q.rim_gap_mm, params.max_rim_gap_mm));
+    q.reasons.push_back(fmt("gap of %.2f mm between the rim and the bone (limit %.2f mm)",
+                            q.rim_gap_mm, params.max_rim_gap_mm));
   if (q.penetration_mm3 > params.max_penetration_mm3)
-    q.reasons.push_back(fmt("%.1f mm³ overlap the skull (limit %.1f mm³)", q.penetration_mm3, params.max_penetration_mm3));
+    q.reasons.push_back(fmt("%.1f mm³ overlap the skull (limit %.1f mm³)", q.penetration_mm3,
+                            params.max_penetration_mm3));
   q.printable = q.reasons.empty();
   return q;
 }

@@ -107,7 +107,8 @@ CompareResult compare_implants(const SkullMesh& a, const SkullMesh& b,
     r.mean_surface_mm = sum / static_cast<double>(d.size());
     std::sort(d.begin(), d.end());
     r.hausdorff_mm = d.back();
-    r.hd95_mm = d[std::min(d.size() - 1, static_cast<size_t>(std::ceil(0.95 * static_cast<double>(d.size()))) - 1)];
+    r.hd95_mm = d[std::min(
+        d.size() - 1, static_cast<size_t>(std::ceil(0.95 * static_cast<double>(d.size()))) - 1)];
   }
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;

@@ -31,7 +31,8 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
   DefectRegion region;
   region.center = center;
   double reach = 0.0;
-  for (auto vh : skull.vertices()) reach = std::max(reach, (to_eigen(skull.point(vh)) - center).norm());
+  for (auto vh : skull.vertices())
+    reach = std::max(reach, (to_eigen(skull.point(vh)) - center).norm());
   reach += 10.0;
 
   const int n = std::clamp(params.directions, 2000, 200000);
@@ -77,7 +78,8 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
   }
   std::vector<size_t> order(comps.size());
   std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(), [&](size_t a, size_t b) { return comps[a].size() > comps[b].size(); });
+  std::sort(order.begin(), order.end(),
+            [&](size_t a, size_t b) { return comps[a].size() > comps[b].size(); });
 
   // The skull base (or the scan's cut) is the opening that holds the most inferior ray: CT
   // volumes are in patient coordinates with z pointing up (DICOM, NRRD, NIfTI, InVesalius).
@@ -123,8 +125,10 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
     std::vector<int> best(sectors, -1);
     for (int j : rim) {
       const double a = std::atan2(dirs[j].dot(e2), dirs[j].dot(e1));
-      const int sct = std::clamp(static_cast<int>((a + M_PI) / (2 * M_PI) * sectors), 0, sectors - 1);
-      if (best[sct] < 0 || dirs[j].dot(region.axis) > dirs[best[sct]].dot(region.axis)) best[sct] = j;
+      const int sct =
+          std::clamp(static_cast<int>((a + M_PI) / (2 * M_PI) * sectors), 0, sectors - 1);
+      if (best[sct] < 0 || dirs[j].dot(region.axis) > dirs[best[sct]].dot(region.axis))
+        best[sct] = j;
     }
     // Refine each rim ray towards its nearest opening ray by bisection, so the rim sits where
     // the bone ends rather than up to a ray spacing inside it. Rays must still cross bone of
@@ -172,8 +176,9 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
       const Eigen::Vector3d d = p - center;
       return std::atan2(d.dot(e2), d.dot(e1));
     };
-    std::sort(by_angle.begin(), by_angle.end(),
-              [&](size_t a, size_t b) { return polar(region.outer_rim[a]) < polar(region.outer_rim[b]); });
+    std::sort(by_angle.begin(), by_angle.end(), [&](size_t a, size_t b) {
+      return polar(region.outer_rim[a]) < polar(region.outer_rim[b]);
+    });
     std::vector<Eigen::Vector3d> sorted_outer, sorted_inner;
     for (size_t k : by_angle) {
       sorted_outer.push_back(region.outer_rim[k]);
@@ -186,7 +191,8 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
     std::vector<char> seen(n, 0);
     for (int i : comp) seen[i] = 1;
     for (int j : rim) seen[j] = 1;
-    const int rings = std::max(1, static_cast<int>(std::ceil(params.support_width_mm / (spacing * radius))));
+    const int rings =
+        std::max(1, static_cast<int>(std::ceil(params.support_width_mm / (spacing * radius))));
     std::vector<int> support = rim;
     for (int ring = 0; ring < rings; ++ring) {
       std::vector<int> next;
@@ -206,7 +212,8 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
     region.message = "opening of " + std::to_string(static_cast<long long>(area)) + " mm² found";
     break;
   }
-  if (!region.found()) region.message = "no defect found (no opening in the skull besides its base)";
+  if (!region.found())
+    region.message = "no defect found (no opening in the skull besides its base)";
   region.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return region;
 }

@@ -1,8 +1,8 @@
 #include "cranioplan/algorithms/extract_bone_surface.h"
 
 #include <vtkCellArray.h>
-#include <vtkFlyingEdges3D.h>
 #include <vtkFloatArray.h>
+#include <vtkFlyingEdges3D.h>
 #include <vtkIdList.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
@@ -132,8 +132,7 @@ ExtractBoneSurfaceResult extract_bone_surface(const Volume& volume,
   if (signed_volume(soup) < 0)
     for (auto& t : soup.triangles) std::swap(t[1], t[2]);
   result.mesh = build_mesh(soup);
-  result.seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;
 }
 

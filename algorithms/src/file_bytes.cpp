@@ -1,6 +1,6 @@
 #include "file_bytes.h"
-#include "cranioplan/algorithms/file_io.h"
 
+#include <unistd.h>
 #include <zlib.h>
 
 #include <algorithm>
@@ -10,8 +10,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
-#include <unistd.h>
 
+#include "cranioplan/algorithms/file_io.h"
 #include "cranioplan/model/error.h"
 
 namespace cranioplan::detail {

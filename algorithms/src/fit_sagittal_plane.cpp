@@ -73,12 +73,12 @@ std::vector<Eigen::Vector3d> midline_points(const Landmarks& lm) {
   return pts;
 }
 
-void add_landmark_residuals(ceres::Problem& problem, const Landmarks& lm, double weight,
-                            double* n, double* d) {
+void add_landmark_residuals(ceres::Problem& problem, const Landmarks& lm, double weight, double* n,
+                            double* d) {
   if (weight <= 0) return;
   if (lm.orbit_left && lm.orbit_right)
-    problem.AddResidualBlock(OrbitCost::Create(*lm.orbit_left, *lm.orbit_right, weight), nullptr,
-                             n, d);
+    problem.AddResidualBlock(OrbitCost::Create(*lm.orbit_left, *lm.orbit_right, weight), nullptr, n,
+                             d);
   for (const auto& p : midline_points(lm))
     problem.AddResidualBlock(MidlineCost::Create(p, weight), nullptr, n, d);
 }
@@ -244,10 +244,12 @@ PlaneFit fit_sagittal_plane(const SkullMesh& mesh, const Landmarks& landmarks,
           problem.AddResidualBlock(SymmetryCost::Create(c.p, c.c, c.m), loss, n, &d);
         used = corr.size();
       }
-      if (problem.NumResidualBlocks() == 0 || (use_surface && used < 10 && !landmarks.has_required())) {
+      if (problem.NumResidualBlocks() == 0 ||
+          (use_surface && used < 10 && !landmarks.has_required())) {
         fit.status = PlaneFit::Status::Failed;
-        fit.message = "too few symmetric correspondences: the initial plane is far from the "
-                      "midline (give nasion and orbit landmarks)";
+        fit.message =
+            "too few symmetric correspondences: the initial plane is far from the "
+            "midline (give nasion and orbit landmarks)";
         break;
       }
       problem.SetManifold(n, new ceres::SphereManifold<3>());
@@ -270,8 +272,8 @@ PlaneFit fit_sagittal_plane(const SkullMesh& mesh, const Landmarks& landmarks,
       fit.plane = after;
     }
     if (fit.status != PlaneFit::Status::Failed) {
-      fit.status = converged || !use_surface ? PlaneFit::Status::Converged
-                                             : PlaneFit::Status::MaxIterations;
+      fit.status =
+          converged || !use_surface ? PlaneFit::Status::Converged : PlaneFit::Status::MaxIterations;
       fit.message = converged || !use_surface
                         ? "converged"
                         : "stopped after " + std::to_string(fit.iterations) +
@@ -283,9 +285,9 @@ PlaneFit fit_sagittal_plane(const SkullMesh& mesh, const Landmarks& landmarks,
   // Keep the normal's orientation from the initial plane (left → right for landmarks).
   if (fit.plane.normal.dot(fit.initial.normal) < 0) fit.plane = fit.plane.flipped();
   if (use_surface) {
-    const SymmetryMeasure m = measure_symmetry(samples, *index, all.normals, fit.plane,
-                                               params.max_correspondence_mm,
-                                               params.inlier_threshold_mm);
+    const SymmetryMeasure m =
+        measure_symmetry(samples, *index, all.normals, fit.plane, params.max_correspondence_mm,
+                         params.inlier_threshold_mm);
     fit.symmetry_rms_mm = m.rms;
     fit.inlier_fraction = m.inlier_fraction;
   }

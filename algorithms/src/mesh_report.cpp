@@ -40,7 +40,8 @@ MeshReport report_mesh(const SkullMesh& mesh) {
   for (auto& t : soup.triangles) {
     for (int k = 0; k < 3; ++k) t[k] = id[t[k]];
     for (int k = 0; k < 3; ++k) {
-      const unsigned long long a = static_cast<unsigned>(t[k]), b = static_cast<unsigned>(t[(k + 1) % 3]);
+      const unsigned long long a = static_cast<unsigned>(t[k]),
+                               b = static_cast<unsigned>(t[(k + 1) % 3]);
       ++edge_count[std::min(a, b) << 32 | std::max(a, b)];
     }
   }

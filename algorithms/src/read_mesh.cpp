@@ -151,11 +151,11 @@ TriangleSoup parse_ascii_stl(const std::string& path, const std::string& bytes) 
   auto expect = [&](const char* w) {
     const std::string got = cur.word();
     if (got != w)
-      fail(path, "ASCII STL: expected '" + std::string(w) + "' on line " +
-                     format_count(cur.line) + ", found '" + got.substr(0, 40) + "'");
+      fail(path, "ASCII STL: expected '" + std::string(w) + "' on line " + format_count(cur.line) +
+                     ", found '" + got.substr(0, 40) + "'");
   };
-  cur.word();                                                     // "solid"
-  while (cur.p < cur.end && *cur.p != '\n') ++cur.p;              // the solid's name
+  cur.word();                                         // "solid"
+  while (cur.p < cur.end && *cur.p != '\n') ++cur.p;  // the solid's name
   std::vector<float> coords;
   std::vector<Eigen::Vector3i> tris;
   while (true) {
@@ -200,7 +200,8 @@ TriangleSoup read_stl(const std::string& path, const std::string& bytes, std::st
   uint32_t n = 0;
   if (size >= 84) std::memcpy(&n, bytes.data() + 80, 4);
   const unsigned long long expected = 84ull + 50ull * n;
-  if (size >= 84 && size >= expected && size - expected < 50 && !(n == 0 && looks_like_text(bytes))) {
+  if (size >= 84 && size >= expected && size - expected < 50 &&
+      !(n == 0 && looks_like_text(bytes))) {
     if (n == 0) fail(path, "binary STL declares 0 triangles");
     format = "binary STL";
     return parse_binary_stl(path, bytes, n);
@@ -257,8 +258,8 @@ TriangleSoup read_off(const std::string& path, const std::string& bytes) {
   for (long long f = 0; f < nf; ++f) {
     double k;
     if (!cur.number(k) || k < 3 || k > 1e6)
-      fail(path, "file ends or is malformed at face " + format_count(f + 1) + " of " +
-                     format_count(nf));
+      fail(path,
+           "file ends or is malformed at face " + format_count(f + 1) + " of " + format_count(nf));
     poly.resize(static_cast<size_t>(k));
     for (auto& idx : poly) {
       double v;
@@ -303,7 +304,8 @@ TriangleSoup read_obj(const std::string& path, const std::string& bytes) {
         poly.push_back(v > 0 ? static_cast<int>(v - 1)
                              : static_cast<int>(soup.vertices.size()) + static_cast<int>(v));
       }
-      if (poly.size() < 3) fail(path, "face with fewer than 3 vertices on line " + format_count(line_no));
+      if (poly.size() < 3)
+        fail(path, "face with fewer than 3 vertices on line " + format_count(line_no));
       add_polygon(path, poly, static_cast<int>(soup.vertices.size()), soup.triangles, line_no);
     }
   }
@@ -384,7 +386,8 @@ TriangleSoup read_mesh_soup(const std::string& path, std::string* format_out) {
     soup = read_obj(path, bytes);
   } else if (ext == ".ply") {
     format = "PLY";
-    if (bytes.compare(0, 3, "ply") != 0) fail(path, "not a PLY file (it does not start with 'ply')");
+    if (bytes.compare(0, 3, "ply") != 0)
+      fail(path, "not a PLY file (it does not start with 'ply')");
     soup = read_with_vtk<vtkPLYReader>(path, "PLY");
   } else if (ext == ".vtp") {
     format = "VTP";
@@ -392,8 +395,7 @@ TriangleSoup read_mesh_soup(const std::string& path, std::string* format_out) {
       fail(path, "not a VTP file (no <VTKFile> element)");
     soup = read_with_vtk<vtkXMLPolyDataReader>(path, "VTP");
   } else {
-    fail(path, "unknown mesh format '" + ext +
-                   "' (expected .stl, .ply, .obj, .off or .vtp)");
+    fail(path, "unknown mesh format '" + ext + "' (expected .stl, .ply, .obj, .off or .vtp)");
   }
   if (soup.triangles.empty()) fail(path, "contains no triangles");
   if (format != "binary STL" && format != "ASCII STL")  // STL parsers check as they read

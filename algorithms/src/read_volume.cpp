@@ -16,13 +16,17 @@ namespace detail {
 size_t sample_size(SampleType t) {
   switch (t) {
     case SampleType::Int8:
-    case SampleType::UInt8: return 1;
+    case SampleType::UInt8:
+      return 1;
     case SampleType::Int16:
-    case SampleType::UInt16: return 2;
+    case SampleType::UInt16:
+      return 2;
     case SampleType::Int32:
     case SampleType::UInt32:
-    case SampleType::Float32: return 4;
-    case SampleType::Float64: return 8;
+    case SampleType::Float32:
+      return 4;
+    case SampleType::Float64:
+      return 8;
   }
   return 1;
 }
@@ -53,14 +57,30 @@ void convert_samples(const std::string& path, const char* data, size_t available
                                format_count(static_cast<long long>(available)) + " bytes");
   const bool swap = big_endian;  // this program runs on little-endian machines
   switch (type) {
-    case SampleType::Int8: convert_typed<int8_t>(data, count, false, out); break;
-    case SampleType::UInt8: convert_typed<uint8_t>(data, count, false, out); break;
-    case SampleType::Int16: convert_typed<int16_t>(data, count, swap, out); break;
-    case SampleType::UInt16: convert_typed<uint16_t>(data, count, swap, out); break;
-    case SampleType::Int32: convert_typed<int32_t>(data, count, swap, out); break;
-    case SampleType::UInt32: convert_typed<uint32_t>(data, count, swap, out); break;
-    case SampleType::Float32: convert_typed<float>(data, count, swap, out); break;
-    case SampleType::Float64: convert_typed<double>(data, count, swap, out); break;
+    case SampleType::Int8:
+      convert_typed<int8_t>(data, count, false, out);
+      break;
+    case SampleType::UInt8:
+      convert_typed<uint8_t>(data, count, false, out);
+      break;
+    case SampleType::Int16:
+      convert_typed<int16_t>(data, count, swap, out);
+      break;
+    case SampleType::UInt16:
+      convert_typed<uint16_t>(data, count, swap, out);
+      break;
+    case SampleType::Int32:
+      convert_typed<int32_t>(data, count, swap, out);
+      break;
+    case SampleType::UInt32:
+      convert_typed<uint32_t>(data, count, swap, out);
+      break;
+    case SampleType::Float32:
+      convert_typed<float>(data, count, swap, out);
+      break;
+    case SampleType::Float64:
+      convert_typed<double>(data, count, swap, out);
+      break;
   }
   for (size_t i = 0; i < out.size(); ++i)
     if (!std::isfinite(out[i]))

@@ -17,7 +17,8 @@ bool RegionOfInterest::contains(const Eigen::Vector3d& p) const {
 
 SkullMesh transform_mesh(const SkullMesh& mesh, const RigidTransform& transform) {
   SkullMesh out = mesh;
-  for (auto vh : out.vertices()) out.set_point(vh, to_point(transform.apply(to_eigen(out.point(vh)))));
+  for (auto vh : out.vertices())
+    out.set_point(vh, to_point(transform.apply(to_eigen(out.point(vh)))));
   return out;
 }
 
@@ -130,11 +131,14 @@ RegisterResult register_icp(const SkullMesh& moving, const SkullMesh& fixed,
     }
   }
   // Re-orthonormalise the accumulated rotation.
-  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(T.rotation, Eigen::ComputeFullU | Eigen::ComputeFullV);
+  const Eigen::JacobiSVD<Eigen::Matrix3d> svd(T.rotation,
+                                              Eigen::ComputeFullU | Eigen::ComputeFullV);
   T.rotation = svd.matrixU() * svd.matrixV().transpose();
   result.transform = T;
-  result.status = converged ? RegisterResult::Status::Converged : RegisterResult::Status::MaxIterations;
-  result.message = converged ? "converged" : "stopped at the iteration limit (still moving slightly)";
+  result.status =
+      converged ? RegisterResult::Status::Converged : RegisterResult::Status::MaxIterations;
+  result.message =
+      converged ? "converged" : "stopped at the iteration limit (still moving slightly)";
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;
 }

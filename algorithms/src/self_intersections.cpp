@@ -66,7 +66,8 @@ long long count_self_intersections(const SkullMesh& mesh) {
             // Test each pair once: in the cell holding the corner where their boxes start.
             const Eigen::Array3i owner = cell_of(lo[i].cwiseMax(lo[j]));
             if (owner[0] != x || owner[1] != y || owner[2] != z) continue;
-            if ((lo[i].array() > hi[j].array()).any() || (lo[j].array() > hi[i].array()).any()) continue;
+            if ((lo[i].array() > hi[j].array()).any() || (lo[j].array() > hi[i].array()).any())
+              continue;
             const auto &ti = soup.triangles[i], &tj = soup.triangles[j];
             bool shared = false;
             for (int p = 0; p < 3; ++p)

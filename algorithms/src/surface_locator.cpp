@@ -28,7 +28,8 @@ SurfaceLocator::SurfaceLocator(const SkullMesh& mesh) : impl_(std::make_unique<I
   points->SetNumberOfPoints(static_cast<vtkIdType>(mesh.n_vertices()));
   for (auto vh : mesh.vertices()) points->SetPoint(vh.idx(), mesh.point(vh).data());
   vtkNew<vtkCellArray> polys;
-  polys->AllocateExact(static_cast<vtkIdType>(mesh.n_faces()), static_cast<vtkIdType>(mesh.n_faces()) * 3);
+  polys->AllocateExact(static_cast<vtkIdType>(mesh.n_faces()),
+                       static_cast<vtkIdType>(mesh.n_faces()) * 3);
   impl_->normals.reserve(mesh.n_faces());
   for (auto fh : mesh.faces()) {
     vtkIdType ids[3];
@@ -40,7 +41,8 @@ SurfaceLocator::SurfaceLocator(const SkullMesh& mesh) : impl_(std::make_unique<I
     }
     polys->InsertNextCell(3, ids);
     const Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]);
-    impl_->normals.push_back(n.norm() > 0 ? Eigen::Vector3d(n.normalized()) : Eigen::Vector3d::Zero());
+    impl_->normals.push_back(n.norm() > 0 ? Eigen::Vector3d(n.normalized())
+                                          : Eigen::Vector3d::Zero());
   }
   impl_->polydata = vtkSmartPointer<vtkPolyData>::New();
   impl_->polydata->SetPoints(points);

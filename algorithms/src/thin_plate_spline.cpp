@@ -60,7 +60,8 @@ bool ThinPlateSpline::fit(const std::vector<Eigen::Vector2d>& sites,
   Eigen::MatrixXd A = Eigen::MatrixXd::Zero(n + 3, n + 3);
   Eigen::VectorXd b = Eigen::VectorXd::Zero(n + 3);
   for (int i = 0; i < n; ++i) {
-    for (int j = i + 1; j < n; ++j) A(i, j) = A(j, i) = kernel((sites_[i] - sites_[j]).squaredNorm());
+    for (int j = i + 1; j < n; ++j)
+      A(i, j) = A(j, i) = kernel((sites_[i] - sites_[j]).squaredNorm());
     A(i, i) = lambdas[i];
     A(i, n) = A(n, i) = 1.0;
     A(i, n + 1) = A(n + 1, i) = sites_[i].x();
@@ -81,7 +82,8 @@ bool ThinPlateSpline::fit(const std::vector<Eigen::Vector2d>& sites,
 double ThinPlateSpline::operator()(const Eigen::Vector2d& p) const {
   const Eigen::Vector2d q = (p - shift_) / scale_;
   double h = trend_.dot(monomials(q)) + affine_[0] + affine_[1] * q.x() + affine_[2] * q.y();
-  for (size_t i = 0; i < sites_.size(); ++i) h += weights_[static_cast<int>(i)] * kernel((q - sites_[i]).squaredNorm());
+  for (size_t i = 0; i < sites_.size(); ++i)
+    h += weights_[static_cast<int>(i)] * kernel((q - sites_[i]).squaredNorm());
   return h;
 }
 

@@ -70,7 +70,8 @@ Volume read_dicom_folder(const std::string& path) {
   if (static_cast<size_t>(s->GetNumberOfTuples()) < v.size())
     throw InputError(path, "DICOM series holds fewer samples than its slices announce");
   for (size_t i = 0; i < v.size(); ++i)
-    v.data[i] = static_cast<float>(s->GetComponent(static_cast<vtkIdType>(i), 0));  // VTK applied the rescale
+    v.data[i] = static_cast<float>(
+        s->GetComponent(static_cast<vtkIdType>(i), 0));  // VTK applied the rescale
   v.description = "DICOM series " + std::to_string(dims[0]) + "×" + std::to_string(dims[1]) + "×" +
                   std::to_string(dims[2]);
   v.kind = VolumeKind::CT;

@@ -80,7 +80,8 @@ Volume read_inv3(const std::string& path) {
   const std::string* plist_text = nullptr;
   std::string dir;
   for (const auto& [name, content] : files) {
-    if (name == "main.plist" || (name.size() > 11 && name.substr(name.size() - 11) == "/main.plist")) {
+    if (name == "main.plist" ||
+        (name.size() > 11 && name.substr(name.size() - 11) == "/main.plist")) {
       plist_text = &content;
       dir = name.substr(0, name.size() - 10);
     }
@@ -102,20 +103,28 @@ Volume read_inv3(const std::string& path) {
     throw InputError(path, "main.plist: matrix shape and spacing must have 3 values each");
   for (int a = 0; a < 3; ++a) {
     if (shape[a] < 1 || shape[a] > 1e5)
-      throw InputError(path, "main.plist: matrix shape value " + std::to_string(shape[a]) +
-                                 " is out of range");
+      throw InputError(
+          path, "main.plist: matrix shape value " + std::to_string(shape[a]) + " is out of range");
     if (!(spacing[a] > 0) || spacing[a] > 1e3)
       throw InputError(path, "main.plist: spacing must be positive");
   }
   SampleType type;
-  if (dtype == "int16") type = SampleType::Int16;
-  else if (dtype == "uint16") type = SampleType::UInt16;
-  else if (dtype == "uint8") type = SampleType::UInt8;
-  else if (dtype == "int8") type = SampleType::Int8;
-  else if (dtype == "int32") type = SampleType::Int32;
-  else if (dtype == "float32") type = SampleType::Float32;
-  else if (dtype == "float64") type = SampleType::Float64;
-  else throw InputError(path, "main.plist: unsupported matrix dtype '" + dtype + "'");
+  if (dtype == "int16")
+    type = SampleType::Int16;
+  else if (dtype == "uint16")
+    type = SampleType::UInt16;
+  else if (dtype == "uint8")
+    type = SampleType::UInt8;
+  else if (dtype == "int8")
+    type = SampleType::Int8;
+  else if (dtype == "int32")
+    type = SampleType::Int32;
+  else if (dtype == "float32")
+    type = SampleType::Float32;
+  else if (dtype == "float64")
+    type = SampleType::Float64;
+  else
+    throw InputError(path, "main.plist: unsupported matrix dtype '" + dtype + "'");
 
   const auto data_it = files.find(dir + filename);
   if (data_it == files.end())
@@ -142,8 +151,10 @@ Volume read_inv3(const std::string& path) {
       modality_at == std::string::npos ? "" : plist.element_text(modality_at, "string");
   v.description = "InVesalius project '" +
                   (name_at == std::string::npos ? "" : plist.element_text(name_at, "string")) + "'";
-  if (modality == "CT" || modality.empty()) v.kind = VolumeKind::CT;
-  else classify_kind(v);
+  if (modality == "CT" || modality.empty())
+    v.kind = VolumeKind::CT;
+  else
+    classify_kind(v);
   return v;
 }
 

@@ -59,17 +59,33 @@ Volume read_nifti(const std::string& path) {
       throw InputError(path, "4D and higher NIfTI volumes are not supported");
   SampleType type;
   switch (h.get<int16_t>(70)) {
-    case 2: type = SampleType::UInt8; break;
-    case 4: type = SampleType::Int16; break;
-    case 8: type = SampleType::Int32; break;
-    case 16: type = SampleType::Float32; break;
-    case 64: type = SampleType::Float64; break;
-    case 256: type = SampleType::Int8; break;
-    case 512: type = SampleType::UInt16; break;
-    case 768: type = SampleType::UInt32; break;
+    case 2:
+      type = SampleType::UInt8;
+      break;
+    case 4:
+      type = SampleType::Int16;
+      break;
+    case 8:
+      type = SampleType::Int32;
+      break;
+    case 16:
+      type = SampleType::Float32;
+      break;
+    case 64:
+      type = SampleType::Float64;
+      break;
+    case 256:
+      type = SampleType::Int8;
+      break;
+    case 512:
+      type = SampleType::UInt16;
+      break;
+    case 768:
+      type = SampleType::UInt32;
+      break;
     default:
-      throw InputError(path, "NIfTI datatype " + std::to_string(h.get<int16_t>(70)) +
-                                 " is not supported");
+      throw InputError(
+          path, "NIfTI datatype " + std::to_string(h.get<int16_t>(70)) + " is not supported");
   }
   float pixdim[8];
   for (int i = 0; i < 8; ++i) pixdim[i] = h.get<float>(76 + 4 * i);

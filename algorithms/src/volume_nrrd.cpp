@@ -24,19 +24,19 @@ std::string trim(const std::string& s) {
 
 SampleType parse_type(const std::string& path, std::string t) {
   static const std::map<std::string, SampleType> types = {
-      {"signed char", SampleType::Int8},   {"int8", SampleType::Int8},
-      {"int8_t", SampleType::Int8},        {"uchar", SampleType::UInt8},
+      {"signed char", SampleType::Int8},    {"int8", SampleType::Int8},
+      {"int8_t", SampleType::Int8},         {"uchar", SampleType::UInt8},
       {"unsigned char", SampleType::UInt8}, {"uint8", SampleType::UInt8},
-      {"uint8_t", SampleType::UInt8},      {"short", SampleType::Int16},
-      {"short int", SampleType::Int16},    {"signed short", SampleType::Int16},
-      {"int16", SampleType::Int16},        {"int16_t", SampleType::Int16},
-      {"ushort", SampleType::UInt16},      {"unsigned short", SampleType::UInt16},
-      {"uint16", SampleType::UInt16},      {"uint16_t", SampleType::UInt16},
-      {"int", SampleType::Int32},          {"signed int", SampleType::Int32},
-      {"int32", SampleType::Int32},        {"int32_t", SampleType::Int32},
-      {"uint", SampleType::UInt32},        {"unsigned int", SampleType::UInt32},
-      {"uint32", SampleType::UInt32},      {"uint32_t", SampleType::UInt32},
-      {"float", SampleType::Float32},      {"double", SampleType::Float64}};
+      {"uint8_t", SampleType::UInt8},       {"short", SampleType::Int16},
+      {"short int", SampleType::Int16},     {"signed short", SampleType::Int16},
+      {"int16", SampleType::Int16},         {"int16_t", SampleType::Int16},
+      {"ushort", SampleType::UInt16},       {"unsigned short", SampleType::UInt16},
+      {"uint16", SampleType::UInt16},       {"uint16_t", SampleType::UInt16},
+      {"int", SampleType::Int32},           {"signed int", SampleType::Int32},
+      {"int32", SampleType::Int32},         {"int32_t", SampleType::Int32},
+      {"uint", SampleType::UInt32},         {"unsigned int", SampleType::UInt32},
+      {"uint32", SampleType::UInt32},       {"uint32_t", SampleType::UInt32},
+      {"float", SampleType::Float32},       {"double", SampleType::Float64}};
   std::transform(t.begin(), t.end(), t.begin(),
                  [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   const auto it = types.find(t);
@@ -101,7 +101,8 @@ Volume read_nrrd(const std::string& path) {
     auto it = fields.find(k);
     return it == fields.end() ? std::string() : it->second;
   };
-  const std::string data_file = !field("data file").empty() ? field("data file") : field("datafile");
+  const std::string data_file =
+      !field("data file").empty() ? field("data file") : field("datafile");
   if (!header_done && data_file.empty())
     throw InputError(path, "NRRD header does not end with a blank line before the data");
   if (field("dimension") != "3")

@@ -6,8 +6,8 @@
 
 namespace cranioplan {
 
-VoxelGrid VoxelGrid::covering(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
-                              double spacing, int pad) {
+VoxelGrid VoxelGrid::covering(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double spacing,
+                              int pad) {
   VoxelGrid g;
   g.spacing = spacing;
   g.origin = lo - Eigen::Vector3d::Constant(pad * spacing);
@@ -36,9 +36,12 @@ std::vector<uint8_t> voxelize_mesh(const SkullMesh& mesh, const VoxelGrid& grid)
   for (auto fh : mesh.faces()) {
     Eigen::Vector3d p[3];
     int k = 0;
-    for (auto vh : mesh.fv_range(fh)) p[k++] = (to_eigen(mesh.point(vh)) - grid.origin) / grid.spacing;
-    const double x0 = std::min({p[0].x(), p[1].x(), p[2].x()}), x1 = std::max({p[0].x(), p[1].x(), p[2].x()});
-    const double y0 = std::min({p[0].y(), p[1].y(), p[2].y()}), y1 = std::max({p[0].y(), p[1].y(), p[2].y()});
+    for (auto vh : mesh.fv_range(fh))
+      p[k++] = (to_eigen(mesh.point(vh)) - grid.origin) / grid.spacing;
+    const double x0 = std::min({p[0].x(), p[1].x(), p[2].x()}),
+                 x1 = std::max({p[0].x(), p[1].x(), p[2].x()});
+    const double y0 = std::min({p[0].y(), p[1].y(), p[2].y()}),
+                 y1 = std::max({p[0].y(), p[1].y(), p[2].y()});
     const int i0 = std::max(0, static_cast<int>(std::ceil(x0 - jitter_x)));
     const int i1 = std::min(nx - 1, static_cast<int>(std::floor(x1 - jitter_x)));
     const int j0 = std::max(0, static_cast<int>(std::ceil(y0 - jitter_y)));
@@ -50,8 +53,10 @@ std::vector<uint8_t> voxelize_mesh(const SkullMesh& mesh, const VoxelGrid& grid)
       for (int i = i0; i <= i1; ++i) {
         const double x = i + jitter_x, y = j + jitter_y;
         // Barycentric coordinates of (x, y) in the projected triangle.
-        const double b1 = ((x - p[0].x()) * (p[2].y() - p[0].y()) - (p[2].x() - p[0].x()) * (y - p[0].y())) / det;
-        const double b2 = ((p[1].x() - p[0].x()) * (y - p[0].y()) - (x - p[0].x()) * (p[1].y() - p[0].y())) / det;
+        const double b1 =
+            ((x - p[0].x()) * (p[2].y() - p[0].y()) - (p[2].x() - p[0].x()) * (y - p[0].y())) / det;
+        const double b2 =
+            ((p[1].x() - p[0].x()) * (y - p[0].y()) - (x - p[0].x()) * (p[1].y() - p[0].y())) / det;
         if (b1 < 0 || b2 < 0 || b1 + b2 > 1) continue;
         const double z = p[0].z() + b1 * (p[1].z() - p[0].z()) + b2 * (p[2].z() - p[0].z());
         columns[static_cast<size_t>(j) * nx + i].push_back(static_cast<float>(z));

@@ -4,8 +4,8 @@
 #include <cstdint>
 #include <cstring>
 
-#include "cranioplan/model/error.h"
 #include "cranioplan/algorithms/file_io.h"
+#include "cranioplan/model/error.h"
 #include "file_bytes.h"
 
 namespace cranioplan {
@@ -65,7 +65,7 @@ MeshFormat mesh_format_for_path(const std::string& path) {
 
 void write_mesh(const SkullMesh& mesh, const std::string& path, MeshFormat format) {
   write_file_atomically(path,
-                                format == MeshFormat::BinarySTL ? encode_stl(mesh) : encode_ply(mesh));
+                        format == MeshFormat::BinarySTL ? encode_stl(mesh) : encode_ply(mesh));
 }
 
 }  // namespace cranioplan

@@ -13,11 +13,11 @@
 
 #include "cranioplan/algorithms/autoplan.h"
 #include "cranioplan/algorithms/fit_sagittal_plane.h"
-#include "cranioplan/algorithms/surface_locator.h"
 #include "cranioplan/algorithms/load_skull.h"
 #include "cranioplan/algorithms/mirror_mesh.h"
 #include "cranioplan/algorithms/read_mesh.h"
 #include "cranioplan/algorithms/register_icp.h"
+#include "cranioplan/algorithms/surface_locator.h"
 #include "cranioplan/algorithms/write_mesh.h"
 
 namespace cranioplan::cli {
@@ -54,8 +54,8 @@ Json run_bench(const BenchOptions& options) {
   out["triangles"] = skull.mesh.n_faces();
   out["vertices"] = skull.mesh.n_vertices();
 
-  const std::filesystem::path tmp =
-      std::filesystem::temp_directory_path() / ("cranioplan-bench-" + std::to_string(::getpid()) + ".stl");
+  const std::filesystem::path tmp = std::filesystem::temp_directory_path() /
+                                    ("cranioplan-bench-" + std::to_string(::getpid()) + ".stl");
   write_mesh(skull.mesh, tmp.string(), MeshFormat::BinarySTL);
   out["stl_load_s"] = median_seconds(runs, [&] { read_mesh(tmp.string()); });
   out["stl_parse_weld_s"] = median_seconds(runs, [&] { read_mesh_soup(tmp.string()); });
@@ -78,8 +78,8 @@ Json run_bench(const BenchOptions& options) {
   out["mirror_s"] = median_seconds(runs, [&] { mirrored = mirror_mesh(skull.mesh, fit.plane); });
   RegisterResult reg;
   out["register_s"] = median_seconds(runs, [&] { reg = register_icp(mirrored, skull.mesh); });
-  out["plane_mirror_register_s"] =
-      out["plane_s"].get<double>() + out["mirror_s"].get<double>() + out["register_s"].get<double>();
+  out["plane_mirror_register_s"] = out["plane_s"].get<double>() + out["mirror_s"].get<double>() +
+                                   out["register_s"].get<double>();
   out["symmetry_rms_mm"] = fit.symmetry_rms_mm;
   out["register_rms_mm"] = reg.rms_mm;
 

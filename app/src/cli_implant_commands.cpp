@@ -1,10 +1,10 @@
 #include "cli_implant_commands.h"
 
 #include <algorithm>
+#include <chrono>
 #include <filesystem>
 #include <iostream>
 #include <map>
-#include <chrono>
 #include <memory>
 #include <sstream>
 
@@ -33,15 +33,6 @@ SkullMesh load_any(const std::string& path) {
   return load_skull(path, p).mesh;
 }
 
-Eigen::Vector3d parse_xyz(const std::string& text, const std::string& option) {
-  std::stringstream in(text);
-  Eigen::Vector3d p;
-  char c1 = 0, c2 = 0;
-  if (!(in >> p.x() >> c1 >> p.y() >> c2 >> p.z()) || c1 != ',' || c2 != ',' || !p.allFinite())
-    throw CLI::ValidationError(option, "expected x,y,z in mm, got '" + text + "'");
-  return p;
-}
-
 Json implant_json(const ImplantResult& r) {
   static const char* names[] = {"built", "too_few_markers", "failed"};
   return Json{{"status", names[static_cast<int>(r.status)]},
@@ -55,13 +46,16 @@ Json implant_json(const ImplantResult& r) {
 }
 
 Json autoplan_json(const AutoplanResult& r) {
-  Json j{{"status", r.planned() ? "planned" : r.status == AutoplanResult::Status::NoDefect ? "no_defect" : "failed"},
+  Json j{{"status", r.planned()                                    ? "planned"
+                    : r.status == AutoplanResult::Status::NoDefect ? "no_defect"
+                                                                   : "failed"},
          {"message", r.message},
          {"plane", to_json(r.plane.plane)},
          {"transform", to_json(r.registration.transform)},
          {"registration_rms_mm", r.registration.rms_mm}};
   if (r.defect.found()) {
-    j["defect"] = Json{{"area_mm2", r.defect.area_mm2}, {"axis", to_json(r.defect.axis)},
+    j["defect"] = Json{{"area_mm2", r.defect.area_mm2},
+                       {"axis", to_json(r.defect.axis)},
                        {"rim_points", r.defect.outer_rim.size()}};
     j["method"] = to_string(r.method_used);
     j["mirror_coverage"] = r.mirror_coverage;
@@ -101,27 +95,35 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
     auto o = std::make_shared<Opts>();
     auto* cmd = app.add_subcommand("smooth", "The paper's Laplacian smoother on surface markers");
     cmd->add_option("MARKERS", o->markers, "markers (.json or .csv)")->required();
-    cmd->add_option("--radius", o->params.radius_mm, "neighbourhood radius (mm)")->required()->check(CLI::PositiveNumber);
-    cmd->add_option("--edge-weight", o->params.edge_weight, "weight of edge markers (>= 1)")->required()->check(CLI::Range(1.0, 1e6));
-    cmd->add_option("--iterations", o->params.iterations, "iterations (default 1)")->check(CLI::Range(1, 1000));
-    cmd->add_option("--project-onto", o->mirrored, "put smoothed surface markers back onto this mesh (the mirrored skull)");
+    cmd->add_option("--radius", o->params.radius_mm, "neighbourhood radius (mm)")
+        ->required()
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--edge-weight", o->params.edge_weight, "weight of edge markers (>= 1)")
+        ->required()
+        ->check(CLI::Range(1.0, 1e6));
+    cmd->add_option("--iterations", o->params.iterations, "iterations (default 1)")
+        ->check(CLI::Range(1, 1000));
+    cmd->add_option("--project-onto", o->mirrored,
+                    "put smoothed surface markers back onto this mesh (the mirrored skull)");
     cmd->add_option("-o,--output", o->output, "markers to write (.json or .csv)")->required();
     out.push_back({cmd, [o, &json] {
-      const auto markers = read_markers_file(o->markers);
-      std::unique_ptr<SurfaceLocator> surface;
-      SkullMesh mirrored;
-      if (!o->mirrored.empty()) {
-        mirrored = load_skull(o->mirrored).mesh;
-        surface = std::make_unique<SurfaceLocator>(mirrored);
-      }
-      const SmoothResult r = smooth_markers(markers, o->params, surface.get());
-      const bool ok = r.status == SmoothResult::Status::Smoothed;
-      if (ok) write_markers_file(r.markers, o->output);
-      print_result(Json{{"status", ok ? "smoothed" : "too_few_markers"}, {"message", r.message},
-                        {"markers", r.markers.size()}, {"max_move_mm", r.max_move_mm}},
-                   json);
-      return ok ? kOk : kUnusable;
-    }});
+                     const auto markers = read_markers_file(o->markers);
+                     std::unique_ptr<SurfaceLocator> surface;
+                     SkullMesh mirrored;
+                     if (!o->mirrored.empty()) {
+                       mirrored = load_skull(o->mirrored).mesh;
+                       surface = std::make_unique<SurfaceLocator>(mirrored);
+                     }
+                     const SmoothResult r = smooth_markers(markers, o->params, surface.get());
+                     const bool ok = r.status == SmoothResult::Status::Smoothed;
+                     if (ok) write_markers_file(r.markers, o->output);
+                     print_result(Json{{"status", ok ? "smoothed" : "too_few_markers"},
+                                       {"message", r.message},
+                                       {"markers", r.markers.size()},
+                                       {"max_move_mm", r.max_move_mm}},
+                                  json);
+                     return ok ? kOk : kUnusable;
+                   }});
   }
 
   {  // implant
@@ -133,45 +135,53 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
     auto o = std::make_shared<Opts>();
     auto* cmd = app.add_subcommand("implant", "Build an implant from markers");
     cmd->add_option("--skull", o->skull, "the original (defective) skull")->required();
-    cmd->add_option("--mirrored", o->mirrored, "the registered mirrored skull (surface markers are snapped onto it)");
+    cmd->add_option("--mirrored", o->mirrored,
+                    "the registered mirrored skull (surface markers are snapped onto it)");
     cmd->add_option("--markers", o->markers, "markers (.json or .csv)")->required();
-    cmd->add_option("--method", o->method, "shell (default) or delaunay3d")->check(CLI::IsMember({"shell", "delaunay3d"}));
-    cmd->add_option("--resolution", o->params.resolution_mm, "shell edge length (mm)")->check(CLI::Range(0.2, 10.0));
-    cmd->add_option("--thickness", o->params.thickness_mm, "thickness without inner markers (mm; default: bone around the rim)")->check(CLI::Range(0.5, 30.0));
-    cmd->add_flag("--no-rim-snap", o->no_snap, "keep the rim between markers where the spline puts it");
+    cmd->add_option("--method", o->method, "shell (default) or delaunay3d")
+        ->check(CLI::IsMember({"shell", "delaunay3d"}));
+    cmd->add_option("--resolution", o->params.resolution_mm, "shell edge length (mm)")
+        ->check(CLI::Range(0.2, 10.0));
+    cmd->add_option("--thickness", o->params.thickness_mm,
+                    "thickness without inner markers (mm; default: bone around the rim)")
+        ->check(CLI::Range(0.5, 30.0));
+    cmd->add_flag("--no-rim-snap", o->no_snap,
+                  "keep the rim between markers where the spline puts it");
     cmd->add_option("--alpha", o->params.delaunay_alpha, "delaunay3d alpha (mm; 0 = convex hull)");
     cmd->add_option("--tolerance", o->params.delaunay_tolerance, "delaunay3d tolerance");
     cmd->add_option("--offset", o->params.delaunay_offset, "delaunay3d offset");
     cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
     out.push_back({cmd, [o, &json] {
-      const std::vector<Marker> raw = read_markers_file(o->markers);
-      const SkullMesh skull = load_skull(o->skull).mesh;
-      const SurfaceLocator skull_surface(skull);
-      SkullMesh mirrored;
-      std::unique_ptr<SurfaceLocator> mirrored_surface;
-      if (!o->mirrored.empty()) {
-        mirrored = load_skull(o->mirrored).mesh;
-        mirrored_surface = std::make_unique<SurfaceLocator>(mirrored);
-      }
-      const SnapMarkersResult snapped = snap_markers(raw, skull_surface, mirrored_surface.get());
-      if (snapped.status != SnapMarkersResult::Status::Snapped)
-        throw InputError(o->markers, snapped.message);
-      o->params.method = o->method == "shell" ? ImplantMethod::Shell : ImplantMethod::Delaunay3D;
-      o->params.snap_rim_to_skull = !o->no_snap;
-      const ImplantResult r = build_implant(snapped.markers, &skull, o->params);
-      Json j = implant_json(r);
-      j["method"] = o->method;
-      j["marker_snap_max_mm"] = snapped.max_distance_mm;
-      if (!r.usable()) {
-        print_result(j, json);
-        return kUnusable;
-      }
-      write_mesh(r.mesh, o->output);
-      j["output"] = o->output;
-      j["quality"] = to_json(check_implant(r.mesh, &skull));
-      print_result(j, json);
-      return kOk;
-    }});
+                     const std::vector<Marker> raw = read_markers_file(o->markers);
+                     const SkullMesh skull = load_skull(o->skull).mesh;
+                     const SurfaceLocator skull_surface(skull);
+                     SkullMesh mirrored;
+                     std::unique_ptr<SurfaceLocator> mirrored_surface;
+                     if (!o->mirrored.empty()) {
+                       mirrored = load_skull(o->mirrored).mesh;
+                       mirrored_surface = std::make_unique<SurfaceLocator>(mirrored);
+                     }
+                     const SnapMarkersResult snapped =
+                         snap_markers(raw, skull_surface, mirrored_surface.get());
+                     if (snapped.status != SnapMarkersResult::Status::Snapped)
+                       throw InputError(o->markers, snapped.message);
+                     o->params.method =
+                         o->method == "shell" ? ImplantMethod::Shell : ImplantMethod::Delaunay3D;
+                     o->params.snap_rim_to_skull = !o->no_snap;
+                     const ImplantResult r = build_implant(snapped.markers, &skull, o->params);
+                     Json j = implant_json(r);
+                     j["method"] = o->method;
+                     j["marker_snap_max_mm"] = snapped.max_distance_mm;
+                     if (!r.usable()) {
+                       print_result(j, json);
+                       return kUnusable;
+                     }
+                     write_mesh(r.mesh, o->output);
+                     j["output"] = o->output;
+                     j["quality"] = to_json(check_implant(r.mesh, &skull));
+                     print_result(j, json);
+                     return kOk;
+                   }});
   }
 
   {  // qa
@@ -185,15 +195,17 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
     cmd->add_option("--skull", o->skull, "the (defective) skull it is made for");
     cmd->add_option("--min-thickness", o->params.min_thickness_mm, "thinnest printable (mm)");
     cmd->add_option("--max-rim-gap", o->params.max_rim_gap_mm, "largest acceptable rim gap (mm)");
-    cmd->add_option("--max-penetration", o->params.max_penetration_mm3, "largest acceptable overlap (mm³)");
+    cmd->add_option("--max-penetration", o->params.max_penetration_mm3,
+                    "largest acceptable overlap (mm³)");
     out.push_back({cmd, [o, &json] {
-      const SkullMesh implant = load_skull(o->implant).mesh;
-      SkullMesh skull;
-      if (!o->skull.empty()) skull = load_skull(o->skull).mesh;
-      const QualityReport q = check_implant(implant, o->skull.empty() ? nullptr : &skull, o->params);
-      print_result(to_json(q), json);
-      return q.printable ? kOk : kUnusable;
-    }});
+                     const SkullMesh implant = load_skull(o->implant).mesh;
+                     SkullMesh skull;
+                     if (!o->skull.empty()) skull = load_skull(o->skull).mesh;
+                     const QualityReport q =
+                         check_implant(implant, o->skull.empty() ? nullptr : &skull, o->params);
+                     print_result(to_json(q), json);
+                     return q.printable ? kOk : kUnusable;
+                   }});
   }
 
   {  // compare
@@ -205,16 +217,19 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
     auto* cmd = app.add_subcommand("compare", "Dice, boundary Dice, HD, HD95 between two implants");
     cmd->add_option("IMPLANT", o->a, "implant (mesh or NRRD/NIfTI mask)")->required();
     cmd->add_option("REFERENCE", o->b, "reference implant (mesh or mask)")->required();
-    cmd->add_option("--defective-skull", o->skull, "defective skull for boundary Dice (mesh or mask)");
-    cmd->add_option("--spacing", o->params.spacing_mm, "voxel size of the common grid (mm)")->check(CLI::Range(0.1, 2.0));
+    cmd->add_option("--defective-skull", o->skull,
+                    "defective skull for boundary Dice (mesh or mask)");
+    cmd->add_option("--spacing", o->params.spacing_mm, "voxel size of the common grid (mm)")
+        ->check(CLI::Range(0.1, 2.0));
     out.push_back({cmd, [o, &json] {
-      const SkullMesh a = load_any(o->a), b = load_any(o->b);
-      SkullMesh skull;
-      if (!o->skull.empty()) skull = load_any(o->skull);
-      const CompareResult r = compare_implants(a, b, o->skull.empty() ? nullptr : &skull, o->params);
-      print_result(to_json(r), json);
-      return kOk;
-    }});
+                     const SkullMesh a = load_any(o->a), b = load_any(o->b);
+                     SkullMesh skull;
+                     if (!o->skull.empty()) skull = load_any(o->skull);
+                     const CompareResult r =
+                         compare_implants(a, b, o->skull.empty() ? nullptr : &skull, o->params);
+                     print_result(to_json(r), json);
+                     return kOk;
+                   }});
   }
 
   {  // inject-defect
@@ -223,32 +238,40 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
       InjectDefectParams params;
     };
     auto o = std::make_shared<Opts>();
-    auto* cmd = app.add_subcommand("inject-defect", "Cut a defect out of a healthy skull, keeping the ground truth");
+    auto* cmd = app.add_subcommand("inject-defect",
+                                   "Cut a defect out of a healthy skull, keeping the ground truth");
     cmd->add_option("SKULL", o->skull, "healthy skull (closed mesh or volume)")->required();
     cmd->add_option("--center", o->center, "defect centre x,y,z (mm)")->required();
-    cmd->add_option("--size", o->params.size_mm, "sphere diameter or cube edge (mm)")->required()->check(CLI::PositiveNumber);
-    cmd->add_option("--shape", o->shape, "sphere or cube")->check(CLI::IsMember({"sphere", "cube"}));
-    cmd->add_option("--voxel", o->params.voxel_mm, "resolution of the cut (mm)")->check(CLI::Range(0.1, 2.0));
+    cmd->add_option("--size", o->params.size_mm, "sphere diameter or cube edge (mm)")
+        ->required()
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--shape", o->shape, "sphere or cube")
+        ->check(CLI::IsMember({"sphere", "cube"}));
+    cmd->add_option("--voxel", o->params.voxel_mm, "resolution of the cut (mm)")
+        ->check(CLI::Range(0.1, 2.0));
     cmd->add_option("-o,--output", o->output, "defective skull to write")->required();
     cmd->add_option("--implant", o->implant, "ground-truth implant to write")->required();
     out.push_back({cmd, [o, &json] {
-      o->params.center = parse_xyz(o->center, "--center");
-      o->params.shape = o->shape == "cube" ? InjectDefectParams::Shape::Cube : InjectDefectParams::Shape::Sphere;
-      const SkullMesh skull = load_skull(o->skull).mesh;
-      const InjectDefectResult r = inject_defect(skull, o->params);
-      Json j{{"status", r.usable() ? "injected" : "no_bone_in_defect"}, {"message", r.message},
-             {"removed_volume_mm3", r.removed_volume_mm3}, {"seconds", r.seconds}};
-      if (!r.usable()) {
-        print_result(j, json);
-        return kUnusable;
-      }
-      write_mesh(r.defective, o->output);
-      write_mesh(r.implant, o->implant);
-      j["defective"] = o->output;
-      j["implant"] = o->implant;
-      print_result(j, json);
-      return kOk;
-    }});
+                     o->params.center = parse_point(o->center, "--center");
+                     o->params.shape = o->shape == "cube" ? InjectDefectParams::Shape::Cube
+                                                          : InjectDefectParams::Shape::Sphere;
+                     const SkullMesh skull = load_skull(o->skull).mesh;
+                     const InjectDefectResult r = inject_defect(skull, o->params);
+                     Json j{{"status", r.usable() ? "injected" : "no_bone_in_defect"},
+                            {"message", r.message},
+                            {"removed_volume_mm3", r.removed_volume_mm3},
+                            {"seconds", r.seconds}};
+                     if (!r.usable()) {
+                       print_result(j, json);
+                       return kUnusable;
+                     }
+                     write_mesh(r.defective, o->output);
+                     write_mesh(r.implant, o->implant);
+                     j["defective"] = o->output;
+                     j["implant"] = o->implant;
+                     print_result(j, json);
+                     return kOk;
+                   }});
   }
   {  // autoplan
     struct Opts {
@@ -256,28 +279,34 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
       AutoplanParams params;
     };
     auto o = std::make_shared<Opts>();
-    auto* cmd = app.add_subcommand("autoplan", "Plan an implant automatically from a defective skull");
+    auto* cmd =
+        app.add_subcommand("autoplan", "Plan an implant automatically from a defective skull");
     cmd->add_option("SKULL", o->skull, "defective skull (mesh or volume)")->required();
     cmd->add_option("--landmarks", o->landmarks, "landmarks JSON for the midsagittal plane");
-    cmd->add_option("--method", o->method, "auto, mirror or rim-only")->check(CLI::IsMember({"auto", "mirror", "rim-only"}));
+    cmd->add_option("--method", o->method, "auto, mirror or rim-only")
+        ->check(CLI::IsMember({"auto", "mirror", "rim-only"}));
     cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
     cmd->add_option("--markers-out", o->markers_out, "proposed markers to write (.json or .csv)");
     out.push_back({cmd, [o, &json] {
-      const Landmarks lm = o->landmarks.empty() ? Landmarks{} : read_landmarks_file(o->landmarks);
-      const SkullMesh skull = load_skull(o->skull).mesh;
-      o->params.method = o->method == "mirror" ? PlanMethod::Mirror : o->method == "rim-only" ? PlanMethod::RimOnly : PlanMethod::Auto;
-      const AutoplanResult r = autoplan(skull, lm, o->params);
-      Json j = autoplan_json(r);
-      if (!o->markers_out.empty() && !r.markers.empty()) write_markers_file(r.markers, o->markers_out);
-      if (!r.planned()) {
-        print_result(j, json);
-        return kUnusable;
-      }
-      write_mesh(r.implant.mesh, o->output);
-      j["output"] = o->output;
-      print_result(j, json);
-      return kOk;
-    }});
+                     const Landmarks lm =
+                         o->landmarks.empty() ? Landmarks{} : read_landmarks_file(o->landmarks);
+                     const SkullMesh skull = load_skull(o->skull).mesh;
+                     o->params.method = o->method == "mirror"     ? PlanMethod::Mirror
+                                        : o->method == "rim-only" ? PlanMethod::RimOnly
+                                                                  : PlanMethod::Auto;
+                     const AutoplanResult r = autoplan(skull, lm, o->params);
+                     Json j = autoplan_json(r);
+                     if (!o->markers_out.empty() && !r.markers.empty())
+                       write_markers_file(r.markers, o->markers_out);
+                     if (!r.planned()) {
+                       print_result(j, json);
+                       return kUnusable;
+                     }
+                     write_mesh(r.implant.mesh, o->output);
+                     j["output"] = o->output;
+                     print_result(j, json);
+                     return kOk;
+                   }});
   }
 
   {  // evaluate
@@ -285,54 +314,70 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
       std::string dir;
     };
     auto o = std::make_shared<Opts>();
-    auto* cmd = app.add_subcommand("evaluate", "Autoplan every NNN_defective_skull.* against its NNN_implant.*");
-    cmd->add_option("CASES_DIR", o->dir, "folder of cases (meshes or NRRD/NIfTI masks)")->required();
-    out.push_back({cmd, [o, &json] {
-      namespace fs = std::filesystem;
-      if (!fs::is_directory(o->dir)) throw InputError(o->dir, "is not a folder");
-      std::map<std::string, std::pair<std::string, std::string>> cases;  // id → (defective, implant)
-      for (const auto& e : fs::directory_iterator(o->dir)) {
-        const std::string name = e.path().filename().string();
-        const size_t us = name.find('_');
-        if (us == std::string::npos) continue;
-        const std::string id = name.substr(0, us), rest = name.substr(us + 1);
-        if (rest.rfind("defective_skull.", 0) == 0) cases[id].first = e.path().string();
-        if (rest.rfind("implant.", 0) == 0) cases[id].second = e.path().string();
-      }
-      Json rows = Json::array();
-      std::vector<double> dsc, bdsc, hd95, secs;
-      for (const auto& [id, files] : cases) {
-        if (files.first.empty() || files.second.empty()) continue;
-        const auto t0 = std::chrono::steady_clock::now();
-        const SkullMesh skull = load_skull(files.first).mesh;
-        const AutoplanResult r = autoplan(skull, Landmarks{}, AutoplanParams{});
-        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-        Json row{{"case", id}, {"status", r.planned() ? "planned" : "failed"}, {"message", r.message}, {"seconds", seconds}};
-        if (r.planned()) {
-          const SkullMesh truth = load_any(files.second);
-          const CompareResult c = compare_implants(r.implant.mesh, truth, &skull);
-          row["method"] = to_string(r.method_used);
-          row["dice"] = c.dice;
-          row["boundary_dice"] = c.boundary_dice;
-          row["hd95_mm"] = c.hd95_mm;
-          dsc.push_back(c.dice);
-          bdsc.push_back(c.boundary_dice);
-          hd95.push_back(c.hd95_mm);
-        }
-        secs.push_back(seconds);
-        if (!json)
-          std::cout << id << "  " << row.value("method", "-") << "  DSC " << row.value("dice", 0.0) << "  bDSC "
-                    << row.value("boundary_dice", 0.0) << "  HD95 " << row.value("hd95_mm", 0.0) << " mm  "
-                    << seconds << " s  " << r.message << std::endl;
-        rows.push_back(row);
-      }
-      if (rows.empty()) throw InputError(o->dir, "holds no NNN_defective_skull.* with an NNN_implant.* beside it");
-      const Json summary{{"cases", rows.size()}, {"median_dice", median(dsc)}, {"median_boundary_dice", median(bdsc)},
-                         {"median_hd95_mm", median(hd95)}, {"median_seconds", median(secs)}};
-      if (json) print_result(Json{{"cases", rows}, {"median", summary}}, true);
-      else print_result(Json{{"median", summary}}, false);
-      return kOk;
-    }});
+    auto* cmd = app.add_subcommand(
+        "evaluate", "Autoplan every NNN_defective_skull.* against its NNN_implant.*");
+    cmd->add_option("CASES_DIR", o->dir, "folder of cases (meshes or NRRD/NIfTI masks)")
+        ->required();
+    out.push_back(
+        {cmd, [o, &json] {
+           namespace fs = std::filesystem;
+           if (!fs::is_directory(o->dir)) throw InputError(o->dir, "is not a folder");
+           std::map<std::string, std::pair<std::string, std::string>>
+               cases;  // id → (defective, implant)
+           for (const auto& e : fs::directory_iterator(o->dir)) {
+             const std::string name = e.path().filename().string();
+             const size_t us = name.find('_');
+             if (us == std::string::npos) continue;
+             const std::string id = name.substr(0, us), rest = name.substr(us + 1);
+             if (rest.rfind("defective_skull.", 0) == 0) cases[id].first = e.path().string();
+             if (rest.rfind("implant.", 0) == 0) cases[id].second = e.path().string();
+           }
+           Json rows = Json::array();
+           std::vector<double> dsc, bdsc, hd95, secs;
+           for (const auto& [id, files] : cases) {
+             if (files.first.empty() || files.second.empty()) continue;
+             const auto t0 = std::chrono::steady_clock::now();
+             const SkullMesh skull = load_skull(files.first).mesh;
+             const AutoplanResult r = autoplan(skull, Landmarks{}, AutoplanParams{});
+             const double seconds =
+                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+             Json row{{"case", id},
+                      {"status", r.planned() ? "planned" : "failed"},
+                      {"message", r.message},
+                      {"seconds", seconds}};
+             if (r.planned()) {
+               const SkullMesh truth = load_any(files.second);
+               const CompareResult c = compare_implants(r.implant.mesh, truth, &skull);
+               row["method"] = to_string(r.method_used);
+               row["dice"] = c.dice;
+               row["boundary_dice"] = c.boundary_dice;
+               row["hd95_mm"] = c.hd95_mm;
+               dsc.push_back(c.dice);
+               bdsc.push_back(c.boundary_dice);
+               hd95.push_back(c.hd95_mm);
+             }
+             secs.push_back(seconds);
+             if (!json)
+               std::cout << id << "  " << row.value("method", "-") << "  DSC "
+                         << row.value("dice", 0.0) << "  bDSC " << row.value("boundary_dice", 0.0)
+                         << "  HD95 " << row.value("hd95_mm", 0.0) << " mm  " << seconds << " s  "
+                         << r.message << std::endl;
+             rows.push_back(row);
+           }
+           if (rows.empty())
+             throw InputError(o->dir,
+                              "holds no NNN_defective_skull.* with an NNN_implant.* beside it");
+           const Json summary{{"cases", rows.size()},
+                              {"median_dice", median(dsc)},
+                              {"median_boundary_dice", median(bdsc)},
+                              {"median_hd95_mm", median(hd95)},
+                              {"median_seconds", median(secs)}};
+           if (json)
+             print_result(Json{{"cases", rows}, {"median", summary}}, true);
+           else
+             print_result(Json{{"median", summary}}, false);
+           return kOk;
+         }});
   }
   return out;
 }

@@ -1,7 +1,6 @@
 // cranioplan-cli: the planning pipeline without a window. Exit codes: 0 success, 1 the
 // computation gave no usable result (its status says why), 2 usage error, 3 bad input file.
 #include <CLI/CLI.hpp>
-
 #include <filesystem>
 #include <iostream>
 #include <sstream>
@@ -46,15 +45,6 @@ void add_import_options(CLI::App* cmd, ImportOptions& o) {
   cmd->add_option("--all-pieces-above", o.all_pieces_above,
                   "keep every piece of at least N triangles instead of only the largest")
       ->check(CLI::NonNegativeNumber);
-}
-
-Eigen::Vector3d parse_point(const std::string& text, const std::string& option) {
-  std::stringstream in(text);
-  Eigen::Vector3d p;
-  char c1 = 0, c2 = 0;
-  if (!(in >> p.x() >> c1 >> p.y() >> c2 >> p.z()) || c1 != ',' || c2 != ',' || !p.allFinite())
-    throw CLI::ValidationError(option, "expected x,y,z in mm, got '" + text + "'");
-  return p;
 }
 
 Json skull_json(const LoadedSkull& s) {
@@ -109,7 +99,8 @@ int run(int argc, char** argv) {
 
   // import-ct
   std::string ct_path;
-  auto* import_ct = app.add_subcommand("import-ct", "Turn a CT or label volume into a bone surface");
+  auto* import_ct =
+      app.add_subcommand("import-ct", "Turn a CT or label volume into a bone surface");
   import_ct->add_option("VOLUME", ct_path, ".inv3, .nrrd/.nhdr, .nii/.nii.gz or a DICOM folder")
       ->required();
   import_ct->add_option("-o,--output", output, "mesh to write (.stl or .ply)")->required();
@@ -120,7 +111,8 @@ int run(int argc, char** argv) {
   bool no_refine = false;
   auto* plane = app.add_subcommand("plane", "Fit the midsagittal plane");
   plane->add_option("MESH", plane_mesh, "skull mesh or volume")->required();
-  plane->add_option("--landmarks", landmarks_path, "landmarks JSON (nasion, orbit_left, orbit_right, midline)");
+  plane->add_option("--landmarks", landmarks_path,
+                    "landmarks JSON (nasion, orbit_left, orbit_right, midline)");
   plane->add_flag("--no-refine", no_refine, "only the initial plane, without the Ceres refinement");
   plane->add_option("-o,--output", output, "plane JSON to write");
   add_import_options(plane, import);
@@ -136,12 +128,14 @@ int run(int argc, char** argv) {
   // register
   std::string moving_path, fixed_path, roi_center, roi_half_size;
   double roi_radius = 0.0;
-  auto* reg = app.add_subcommand("register", "Rigidly register MOVING onto FIXED (point-to-plane ICP)");
+  auto* reg =
+      app.add_subcommand("register", "Rigidly register MOVING onto FIXED (point-to-plane ICP)");
   reg->add_option("MOVING", moving_path, "mesh to move")->required();
   reg->add_option("FIXED", fixed_path, "mesh to move onto")->required();
   reg->add_option("-o,--output", output, "write MOVING after the transform");
   reg->add_option("--roi-center", roi_center, "region of interest centre x,y,z (mm)");
-  reg->add_option("--roi-radius", roi_radius, "spherical region radius (mm)")->check(CLI::PositiveNumber);
+  reg->add_option("--roi-radius", roi_radius, "spherical region radius (mm)")
+      ->check(CLI::PositiveNumber);
   reg->add_option("--roi-half-size", roi_half_size, "box region half extents x,y,z (mm)");
   add_import_options(reg, import);
 
@@ -192,8 +186,9 @@ int run(int argc, char** argv) {
     }
     if (import_ct->parsed()) {
       if (!is_volume_path(ct_path))
-        throw InputError(ct_path, "is not a volume (expected .inv3, .nrrd, .nhdr, .nii, .nii.gz "
-                                  "or a DICOM folder)");
+        throw InputError(ct_path,
+                         "is not a volume (expected .inv3, .nrrd, .nhdr, .nii, .nii.gz "
+                         "or a DICOM folder)");
       const LoadedSkull s = load_skull(ct_path, import.params());
       write_mesh(s.mesh, output);
       Json r = skull_json(s);
@@ -203,7 +198,8 @@ int run(int argc, char** argv) {
       return kOk;
     }
     if (plane->parsed()) {
-      const Landmarks lm = landmarks_path.empty() ? Landmarks{} : read_landmarks_file(landmarks_path);
+      const Landmarks lm =
+          landmarks_path.empty() ? Landmarks{} : read_landmarks_file(landmarks_path);
       const LoadedSkull s = load_skull(plane_mesh, import.params());
       PlaneFitParams params;
       params.refine = !no_refine;
@@ -257,12 +253,15 @@ int run(int argc, char** argv) {
       return kOk;
     }
     if (pipeline->parsed()) {
-      const std::string input = use_sample || pipeline_input.empty() ? sample_case_path() : pipeline_input;
+      const std::string input =
+          use_sample || pipeline_input.empty() ? sample_case_path() : pipeline_input;
       std::filesystem::create_directories(output);
       const Pipeline p = run_pipeline(input, import, landmarks_path);
       const std::filesystem::path dir(output);
       write_mesh(p.skull.mesh, (dir / "skull.stl").string());
-      Json r{{"input", input}, {"skull", skull_json(p.skull)}, {"mesh", to_json(report_mesh(p.skull.mesh))}};
+      Json r{{"input", input},
+             {"skull", skull_json(p.skull)},
+             {"mesh", to_json(report_mesh(p.skull.mesh))}};
       r["plane"] = to_json(p.plane);
       if (!p.plane.usable()) {
         print_result(r, json);

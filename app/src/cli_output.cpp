@@ -1,6 +1,8 @@
 #include "cli_output.h"
 
+#include <CLI/CLI.hpp>
 #include <iostream>
+#include <sstream>
 
 namespace cranioplan::cli {
 namespace {
@@ -27,14 +29,22 @@ void print_result(const Json& result, bool json) {
 }
 
 void print_error(const std::string& message, int code, bool json) {
-  if (json)
-    std::cout << Json{{"error", message}, {"exit_code", code}}.dump(2) << std::endl;
+  if (json) std::cout << Json{{"error", message}, {"exit_code", code}}.dump(2) << std::endl;
   std::cerr << "cranioplan-cli: " << message << std::endl;
 }
 
 void print_warnings(const std::vector<std::string>& warnings, bool json) {
   if (json) return;  // included in the JSON result instead
   for (const auto& w : warnings) std::cerr << "warning: " << w << "\n";
+}
+
+Eigen::Vector3d parse_point(const std::string& text, const std::string& option) {
+  std::stringstream in(text);
+  Eigen::Vector3d p;
+  char c1 = 0, c2 = 0;
+  if (!(in >> p.x() >> c1 >> p.y() >> c2 >> p.z()) || c1 != ',' || c2 != ',' || !p.allFinite())
+    throw CLI::ValidationError(option, "expected x,y,z in mm, got '" + text + "'");
+  return p;
 }
 
 }  // namespace cranioplan::cli

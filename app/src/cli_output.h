@@ -13,4 +13,7 @@ void print_result(const Json& result, bool json);
 void print_error(const std::string& message, int code, bool json);
 void print_warnings(const std::vector<std::string>& warnings, bool json);
 
+/// "x,y,z" in mm; throws CLI::ValidationError naming the option otherwise.
+Eigen::Vector3d parse_point(const std::string& text, const std::string& option);
+
 }  // namespace cranioplan::cli

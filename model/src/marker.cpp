@@ -4,10 +4,14 @@ namespace cranioplan {
 
 const char* to_string(MarkerType t) {
   switch (t) {
-    case MarkerType::OuterEdge: return "outer edge";
-    case MarkerType::InnerEdge: return "inner edge";
-    case MarkerType::OuterSurface: return "outer surface";
-    case MarkerType::InnerSurface: return "inner surface";
+    case MarkerType::OuterEdge:
+      return "outer edge";
+    case MarkerType::InnerEdge:
+      return "inner edge";
+    case MarkerType::OuterSurface:
+      return "outer surface";
+    case MarkerType::InnerSurface:
+      return "inner surface";
   }
   return "unknown";
 }

@@ -109,8 +109,10 @@ SkullMesh build_mesh(const TriangleSoup& soup, BuildMeshStats* stats) {
         ok = !(other / 3 != f && accepted[other / 3] && corner[next_corner(other)] == v);
       }
     }
-    if (ok) accepted[f] = 1;
-    else deferred.push_back(static_cast<int>(f));
+    if (ok)
+      accepted[f] = 1;
+    else
+      deferred.push_back(static_cast<int>(f));
   }
   if (!deferred.empty()) lists = std::make_unique<OutgoingLists>(corner, nv, accepted);
 
@@ -132,7 +134,8 @@ SkullMesh build_mesh(const TriangleSoup& soup, BuildMeshStats* stats) {
           // Face i leaves v towards w and face j arrives at v from w: they share edge v–w.
           const size_t hi = static_cast<size_t>(lists->out[a + i]);
           const size_t hj = static_cast<size_t>(lists->out[a + j]);
-          if (i != j && corner[next_corner(hi)] == corner[prev_corner(hj)]) parent[root(i)] = root(j);
+          if (i != j && corner[next_corner(hi)] == corner[prev_corner(hj)])
+            parent[root(i)] = root(j);
         }
       copy.assign(n, -1);
       const int keep = root(0);

@@ -16,7 +16,8 @@ MarkerSurface surface_from_text(const std::string& text, const std::string& sour
                                 const std::string& where) {
   if (text == "original") return MarkerSurface::Original;
   if (text == "mirrored") return MarkerSurface::Mirrored;
-  throw InputError(source, where + ": surface must be \"original\" or \"mirrored\", not \"" + text + "\"");
+  throw InputError(source,
+                   where + ": surface must be \"original\" or \"mirrored\", not \"" + text + "\"");
 }
 
 void check_unique(const std::vector<Marker>& markers, const std::string& source) {
@@ -27,7 +28,8 @@ void check_unique(const std::vector<Marker>& markers, const std::string& source)
 }
 
 std::string lower(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  std::transform(s.begin(), s.end(), s.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
   return s;
 }
 
@@ -84,7 +86,8 @@ std::vector<Marker> read_markers_file(const std::string& path) {
     while (std::getline(in, line)) {
       ++line_no;
       if (!line.empty() && line.back() == '\r') line.pop_back();
-      if (line.empty() || line[0] == '#' || (line_no == 1 && lower(line).rfind("id", 0) == 0)) continue;
+      if (line.empty() || line[0] == '#' || (line_no == 1 && lower(line).rfind("id", 0) == 0))
+        continue;
       std::replace(line.begin(), line.end(), ',', ' ');
       std::istringstream fields(line);
       Marker m;
@@ -92,11 +95,12 @@ std::vector<Marker> read_markers_file(const std::string& path) {
       std::string surface;
       if (!(fields >> m.id >> type >> m.position.x() >> m.position.y() >> m.position.z()) ||
           type < 0 || type > 3 || !m.position.allFinite())
-        throw InputError(path, "line " + std::to_string(line_no) +
-                                   ": expected id,type(0-3),x,y,z[,surface]");
+        throw InputError(
+            path, "line " + std::to_string(line_no) + ": expected id,type(0-3),x,y,z[,surface]");
       m.type = static_cast<MarkerType>(type);
-      m.surface = fields >> surface ? surface_from_text(surface, path, "line " + std::to_string(line_no))
-                                    : default_surface(m.type);
+      m.surface = fields >> surface
+                      ? surface_from_text(surface, path, "line " + std::to_string(line_no))
+                      : default_surface(m.type);
       out.push_back(m);
     }
     if (out.empty()) throw InputError(path, "holds no markers");
@@ -112,8 +116,9 @@ void write_markers_file(const std::vector<Marker>& markers, const std::string& p
     std::string text = "id,type,x,y,z,surface\n";
     char buf[256];
     for (const auto& m : markers) {
-      std::snprintf(buf, sizeof(buf), "%d,%d,%.17g,%.17g,%.17g,%s\n", m.id, static_cast<int>(m.type),
-                    m.position.x(), m.position.y(), m.position.z(), to_string(m.surface));
+      std::snprintf(buf, sizeof(buf), "%d,%d,%.17g,%.17g,%.17g,%s\n", m.id,
+                    static_cast<int>(m.type), m.position.x(), m.position.y(), m.position.z(),
+                    to_string(m.surface));
       text += buf;
     }
     write_file_atomically(path, text);

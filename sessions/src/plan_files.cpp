@@ -113,7 +113,8 @@ Json to_json(const CompareResult& c) {
   return j;
 }
 
-Eigen::Vector3d vector_from_json(const Json& j, const std::string& source, const std::string& what) {
+Eigen::Vector3d vector_from_json(const Json& j, const std::string& source,
+                                 const std::string& what) {
   if (!j.is_array() || j.size() != 3)
     throw InputError(source, "'" + what + "' must be an array of 3 numbers");
   Eigen::Vector3d v;
@@ -142,7 +143,8 @@ RigidTransform transform_from_json(const Json& j, const std::string& source) {
   const Json& rows = j["rotation"];
   if (!rows.is_array() || rows.size() != 3)
     throw InputError(source, "'rotation' must be 3 rows of 3 numbers");
-  for (int r = 0; r < 3; ++r) t.rotation.row(r) = vector_from_json(rows[r], source, "rotation").transpose();
+  for (int r = 0; r < 3; ++r)
+    t.rotation.row(r) = vector_from_json(rows[r], source, "rotation").transpose();
   if ((t.rotation * t.rotation.transpose() - Eigen::Matrix3d::Identity()).norm() > 1e-4 ||
       t.rotation.determinant() < 0)
     throw InputError(source, "'rotation' is not a rotation matrix");
@@ -154,7 +156,8 @@ Landmarks landmarks_from_json(const Json& j, const std::string& source) {
   if (!j.is_object()) throw InputError(source, "landmarks must be a JSON object");
   Landmarks lm;
   if (j.contains("nasion")) lm.nasion = vector_from_json(j["nasion"], source, "nasion");
-  if (j.contains("orbit_left")) lm.orbit_left = vector_from_json(j["orbit_left"], source, "orbit_left");
+  if (j.contains("orbit_left"))
+    lm.orbit_left = vector_from_json(j["orbit_left"], source, "orbit_left");
   if (j.contains("orbit_right"))
     lm.orbit_right = vector_from_json(j["orbit_right"], source, "orbit_right");
   if (j.contains("midline")) {
@@ -177,13 +180,15 @@ Json read_json_file(const std::string& path) {
   std::stringstream buffer;
   buffer << in.rdbuf();
   const std::string text = buffer.str();
-  if (text.find_first_not_of(" \t\r\n") == std::string::npos) throw InputError(path, "file is empty");
+  if (text.find_first_not_of(" \t\r\n") == std::string::npos)
+    throw InputError(path, "file is empty");
   try {
     return Json::parse(text);
   } catch (const nlohmann::json::parse_error& e) {
     std::string what = e.what();
     const size_t colon = what.find("] ");
-    throw InputError(path, "not valid JSON (" + (colon == std::string::npos ? what : what.substr(colon + 2)) + ")");
+    throw InputError(path, "not valid JSON (" +
+                               (colon == std::string::npos ? what : what.substr(colon + 2)) + ")");
   }
 }
 
@@ -195,6 +200,8 @@ Landmarks read_landmarks_file(const std::string& path) {
   return landmarks_from_json(read_json_file(path), path);
 }
 
-Plane read_plane_file(const std::string& path) { return plane_from_json(read_json_file(path), path); }
+Plane read_plane_file(const std::string& path) {
+  return plane_from_json(read_json_file(path), path);
+}
 
 }  // namespace cranioplan

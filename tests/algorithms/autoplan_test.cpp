@@ -67,7 +67,8 @@ TEST(Autoplan, StagesAreConsistent) {
   const SurfaceLocator bone(d.defective), mirror(r.mirrored);
   for (const auto& m : r.markers) {
     const SurfaceLocator& surface = m.surface == MarkerSurface::Mirrored ? mirror : bone;
-    EXPECT_LT(surface.closest(m.position).distance, 0.05) << "marker " << m.id << " off its surface";
+    EXPECT_LT(surface.closest(m.position).distance, 0.05)
+        << "marker " << m.id << " off its surface";
     if (is_edge(m.type)) EXPECT_LT(bone.closest(m.position).distance, 0.05);
   }
   EXPECT_GE(r.stage_seconds.size(), 6u);

@@ -32,7 +32,8 @@ TEST(CompareImplants, DisjointGiveDiceZero) {
 }
 
 TEST(CompareImplants, ConcentricSpheresGiveTheirRadiusDifference) {
-  const CompareResult r = compare_implants(sphere(20), sphere(25), nullptr, CompareParams{0.25, 10});
+  const CompareResult r =
+      compare_implants(sphere(20), sphere(25), nullptr, CompareParams{0.25, 10});
   EXPECT_NEAR(r.hausdorff_mm, 5.0, 0.3);
   // Dice of nested balls: 2·r1³ / (r1³ + r2³)
   EXPECT_NEAR(r.dice, 2.0 * 8000.0 / (8000.0 + 15625.0), 0.02);
@@ -61,7 +62,8 @@ TEST(InjectDefect, DefectiveAndImplantPartitionTheSkull) {
   // On a common grid: union = skull, no overlap.
   const auto [lo, hi] = mesh_bounds(skull);
   const VoxelGrid g = VoxelGrid::covering(lo, hi, 0.5);
-  const auto s = voxelize_mesh(skull, g), d = voxelize_mesh(r.defective, g), i = voxelize_mesh(r.implant, g);
+  const auto s = voxelize_mesh(skull, g), d = voxelize_mesh(r.defective, g),
+             i = voxelize_mesh(r.implant, g);
   long long overlap = 0, mismatch = 0, bone = 0;
   for (size_t k = 0; k < s.size(); ++k) {
     overlap += d[k] && i[k];

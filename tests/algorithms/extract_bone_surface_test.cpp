@@ -31,7 +31,8 @@ TEST(ExtractBoneSurface, LargestPieceOrAllPiecesAboveASize) {
   for (int k = 0; k < 40; ++k)
     for (int j = 0; j < 40; ++j)
       for (int i = 0; i < 40; ++i)
-        if ((v.world(Eigen::Vector3d(i, j, k)) - Eigen::Vector3d(10, 10, 10)).norm() < 7) v.data[v.index(i, j, k)] = 1;
+        if ((v.world(Eigen::Vector3d(i, j, k)) - Eigen::Vector3d(10, 10, 10)).norm() < 7)
+          v.data[v.index(i, j, k)] = 1;
   const auto largest = extract_bone_surface(v);
   EXPECT_EQ(largest.pieces_found, 2);
   EXPECT_EQ(report_mesh(largest.mesh).pieces, 1);

@@ -61,7 +61,9 @@ TEST(FitSagittalPlane, WithAHoleOnOneSideAndLandmarksOffBy3mm) {
     return fit_sagittal_plane(head, lm, p);
   }();
   // Landmarks alone are visibly off; the surface symmetry refinement must recover the truth.
-  EXPECT_GT(initial_only.plane.angle_to_deg(kTruth) + std::abs(initial_only.plane.signed_distance(kPose.apply({0, 60, 40}))), 0.5);
+  EXPECT_GT(initial_only.plane.angle_to_deg(kTruth) +
+                std::abs(initial_only.plane.signed_distance(kPose.apply({0, 60, 40}))),
+            0.5);
 
   const PlaneFit fit = fit_sagittal_plane(head, lm);
   ASSERT_TRUE(fit.usable()) << fit.message;

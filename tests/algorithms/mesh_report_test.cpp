@@ -17,9 +17,11 @@ TEST(MeshReport, ClosedHeadIsWatertightWithOnePiece) {
 }
 
 TEST(MeshReport, HoleGivesBoundaryEdgesAndCubeHasKnownAreaAndVolume) {
-  EXPECT_FALSE(report_mesh(test::cut_hole(test::make_symmetric_head(3), {70, 0, 0}, 20)).watertight);
+  EXPECT_FALSE(
+      report_mesh(test::cut_hole(test::make_symmetric_head(3), {70, 0, 0}, 20)).watertight);
   TriangleSoup cube;
-  for (int i = 0; i < 8; ++i) cube.vertices.emplace_back(i & 1 ? 2 : 0, i & 2 ? 2 : 0, i & 4 ? 2 : 0);
+  for (int i = 0; i < 8; ++i)
+    cube.vertices.emplace_back(i & 1 ? 2 : 0, i & 2 ? 2 : 0, i & 4 ? 2 : 0);
   cube.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
                     {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
   const MeshReport r = report_mesh(build_mesh(cube));

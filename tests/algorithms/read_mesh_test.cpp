@@ -1,11 +1,11 @@
 #include "cranioplan/algorithms/read_mesh.h"
 
 #include <gtest/gtest.h>
+#include <vtkCellArray.h>
 #include <vtkNew.h>
+#include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkXMLPolyDataWriter.h>
-#include <vtkPoints.h>
-#include <vtkCellArray.h>
 
 #include <cmath>
 #include <cstring>
@@ -72,7 +72,8 @@ TEST(ReadMesh, PlyRoundTrip) {
   const MeshFile f = read_mesh(dir.path("head.ply"));
   ASSERT_EQ(f.mesh.n_vertices(), head.n_vertices());
   for (auto vh : head.vertices())
-    EXPECT_LT((to_eigen(f.mesh.point(vh)) - to_eigen(head.point(vh))).norm(), 1e-4);  // VTK reads PLY as float
+    EXPECT_LT((to_eigen(f.mesh.point(vh)) - to_eigen(head.point(vh))).norm(),
+              1e-4);  // VTK reads PLY as float
   EXPECT_EQ(f.mesh.n_faces(), head.n_faces());
 }
 
@@ -87,10 +88,12 @@ TEST(ReadMesh, AsciiStlObjOffAndVtp) {
   EXPECT_EQ(a.mesh.n_faces(), 2u);
   EXPECT_EQ(a.mesh.n_vertices(), 4u);
 
-  test::write_bytes(dir.path("q.obj"), "# quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1/1 2/2 3/3 4/4\n");
+  test::write_bytes(dir.path("q.obj"),
+                    "# quad\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1/1 2/2 3/3 4/4\n");
   EXPECT_EQ(read_mesh(dir.path("q.obj")).mesh.n_faces(), 2u);
 
-  test::write_bytes(dir.path("q.off"), "OFF\n# comment\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n");
+  test::write_bytes(dir.path("q.off"),
+                    "OFF\n# comment\n4 1 0\n0 0 0\n1 0 0\n1 1 0\n0 1 0\n4 0 1 2 3\n");
   EXPECT_EQ(read_mesh(dir.path("q.off")).mesh.n_faces(), 2u);
 
   vtkNew<vtkPoints> pts;

@@ -7,8 +7,8 @@
 
 #include "cranioplan/algorithms/extract_bone_surface.h"
 #include "cranioplan/model/error.h"
-#include "support/synthetic.h"
 #include "support/dicom_writer.h"
+#include "support/synthetic.h"
 #include "support/test_files.h"
 
 namespace cranioplan {

@@ -20,7 +20,8 @@ void expect_transform_near(const RigidTransform& got, const RigidTransform& trut
 
 TEST(RegisterIcp, RecoversAKnownTransform) {
   const SkullMesh fixed = test::make_symmetric_head(5);
-  const RigidTransform truth = RigidTransform::from_axis_angle({0.2, 0.5, 1.0}, 6.0, {3.0, -2.0, 4.0});
+  const RigidTransform truth =
+      RigidTransform::from_axis_angle({0.2, 0.5, 1.0}, 6.0, {3.0, -2.0, 4.0});
   const SkullMesh moving = test::transformed(fixed, truth.inverse());
   const RegisterResult r = register_icp(moving, fixed);
   ASSERT_TRUE(r.usable()) << r.message;
@@ -32,7 +33,8 @@ TEST(RegisterIcp, RecoversAKnownTransform) {
 TEST(RegisterIcp, TrimmedIcpIgnoresADefectInTheFixedMesh) {
   const SkullMesh full = test::make_symmetric_head(5);
   const SkullMesh fixed = test::cut_hole(full, {55, 30, 35}, 30.0);
-  const RigidTransform truth = RigidTransform::from_axis_angle({1, 0.3, 0.1}, 4.0, {-2.0, 1.5, 2.5});
+  const RigidTransform truth =
+      RigidTransform::from_axis_angle({1, 0.3, 0.1}, 4.0, {-2.0, 1.5, 2.5});
   const SkullMesh moving = test::transformed(full, truth.inverse());
   const RegisterResult r = register_icp(moving, fixed);
   ASSERT_TRUE(r.usable()) << r.message;
@@ -61,7 +63,8 @@ TEST(RegisterIcp, RegionOfInterestRestrictsTheFit) {
 
 TEST(RegisterIcp, FarApartMeshesFailWithAStatus) {
   const SkullMesh fixed = test::make_symmetric_head(3);
-  const SkullMesh moving = test::transformed(fixed, RigidTransform::from_axis_angle({0, 0, 1}, 0, {500, 0, 0}));
+  const SkullMesh moving =
+      test::transformed(fixed, RigidTransform::from_axis_angle({0, 0, 1}, 0, {500, 0, 0}));
   const RegisterResult r = register_icp(moving, fixed);
   EXPECT_FALSE(r.usable());
 }

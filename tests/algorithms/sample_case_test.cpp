@@ -1,6 +1,7 @@
 // The whole foundation chain on the real sample case (Debian's invesalius-examples).
 #include <gtest/gtest.h>
 
+#include <Eigen/LU>
 #include <filesystem>
 
 #include "cranioplan/algorithms/autoplan.h"
@@ -9,8 +10,6 @@
 #include "cranioplan/algorithms/mesh_report.h"
 #include "cranioplan/algorithms/mirror_mesh.h"
 #include "cranioplan/algorithms/read_volume.h"
-
-#include <Eigen/LU>
 #include "cranioplan/algorithms/register_icp.h"
 
 namespace cranioplan {
@@ -18,7 +17,8 @@ namespace {
 
 TEST(SampleCase, ImportPlaneMirrorRegister) {
   const std::string path = sample_case_path();
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not installed (scripts/install-deps)";
+  if (!std::filesystem::exists(path))
+    GTEST_SKIP() << path << " not installed (scripts/install-deps)";
   const Volume volume = read_volume(path);
   // InVesalius stores rows flipped: the reader's index-to-world map must undo that mirror
   // (negative determinant), so the world coordinates are patient-true.
@@ -58,14 +58,16 @@ TEST(SampleCase, ImportPlaneMirrorRegister) {
 // The sample's real right frontal defect, planned automatically and built as a shell.
 TEST(SampleCase, AutoplanFillsTheRealDefect) {
   const std::string path = sample_case_path();
-  if (!std::filesystem::exists(path)) GTEST_SKIP() << path << " not installed (scripts/install-deps)";
+  if (!std::filesystem::exists(path))
+    GTEST_SKIP() << path << " not installed (scripts/install-deps)";
   const LoadedSkull skull = load_skull(path);
   const AutoplanResult r = autoplan(skull.mesh, Landmarks{});
   ASSERT_TRUE(r.planned()) << r.message;
   EXPECT_EQ(r.method_used, PlanMethod::Mirror);
   // The defect is on the patient's right (−x in the patient-true frame) and in front (−y).
   const Eigen::Vector3d c = r.plane.plane.project(r.defect.center);
-  EXPECT_LT(r.plane.plane.signed_distance(c + 100.0 * r.defect.axis) * r.plane.plane.normal.x(), 0.0);
+  EXPECT_LT(r.plane.plane.signed_distance(c + 100.0 * r.defect.axis) * r.plane.plane.normal.x(),
+            0.0);
   EXPECT_LT(r.defect.axis.y(), 0.0);
   EXPECT_TRUE(r.quality.watertight);
   EXPECT_TRUE(r.quality.manifold);

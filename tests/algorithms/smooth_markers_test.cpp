@@ -17,10 +17,9 @@ Marker mk(int id, MarkerType t, double x, double y, double z) {
 
 TEST(SmoothMarkers, HandComputedWeightedMeanWithFixedEdges) {
   // Outer layer: two edge markers and one surface marker; an inner marker far away.
-  const std::vector<Marker> in = {mk(1, MarkerType::OuterEdge, 0, 0, 0),
-                                  mk(2, MarkerType::OuterEdge, 4, 0, 0),
-                                  mk(3, MarkerType::OuterSurface, 2, 3, 0),
-                                  mk(4, MarkerType::InnerSurface, 2, 3, 1)};
+  const std::vector<Marker> in = {
+      mk(1, MarkerType::OuterEdge, 0, 0, 0), mk(2, MarkerType::OuterEdge, 4, 0, 0),
+      mk(3, MarkerType::OuterSurface, 2, 3, 0), mk(4, MarkerType::InnerSurface, 2, 3, 1)};
   SmoothParams p;
   p.radius_mm = 5.0;
   p.edge_weight = 2.0;
@@ -36,10 +35,11 @@ TEST(SmoothMarkers, HandComputedWeightedMeanWithFixedEdges) {
 }
 
 TEST(SmoothMarkers, RadiusCutOffIsInclusiveAndExcludesCoincidentPoints) {
-  const std::vector<Marker> in = {mk(1, MarkerType::OuterSurface, 0, 0, 0),
-                                  mk(2, MarkerType::OuterSurface, 3, 0, 0),   // exactly at radius
-                                  mk(3, MarkerType::OuterSurface, 3.001, 0, 0.0001),
-                                  mk(4, MarkerType::OuterSurface, 0, 0, 0)};  // same place: 0 < dist fails
+  const std::vector<Marker> in = {
+      mk(1, MarkerType::OuterSurface, 0, 0, 0),
+      mk(2, MarkerType::OuterSurface, 3, 0, 0),  // exactly at radius
+      mk(3, MarkerType::OuterSurface, 3.001, 0, 0.0001),
+      mk(4, MarkerType::OuterSurface, 0, 0, 0)};  // same place: 0 < dist fails
   SmoothParams p;
   p.radius_mm = 3.0;
   p.edge_weight = 1.0;
@@ -62,7 +62,8 @@ TEST(SmoothMarkers, IndependentOfMarkerOrder) {
   std::shuffle(shuffled.begin(), shuffled.end(), rng);
   const SmoothResult b = smooth_markers(shuffled, p);
   for (const auto& m : b.markers) {
-    const auto it = std::find_if(a.markers.begin(), a.markers.end(), [&](const Marker& x) { return x.id == m.id; });
+    const auto it = std::find_if(a.markers.begin(), a.markers.end(),
+                                 [&](const Marker& x) { return x.id == m.id; });
     EXPECT_LT((it->position - m.position).norm(), 1e-12) << m.id;
   }
 }
@@ -86,7 +87,8 @@ TEST(SmoothMarkers, EachIterationStartsFromThePreviousPositions) {
 }
 
 TEST(SmoothMarkers, FewerThanThreeMarkersChangeNothing) {
-  const std::vector<Marker> in = {mk(1, MarkerType::OuterSurface, 0, 0, 0), mk(2, MarkerType::OuterSurface, 1, 0, 0)};
+  const std::vector<Marker> in = {mk(1, MarkerType::OuterSurface, 0, 0, 0),
+                                  mk(2, MarkerType::OuterSurface, 1, 0, 0)};
   const SmoothResult r = smooth_markers(in, SmoothParams{});
   EXPECT_EQ(r.status, SmoothResult::Status::TooFewMarkers);
   EXPECT_NE(r.message.find("at least 3"), std::string::npos);
@@ -101,7 +103,8 @@ TEST(SmoothMarkers, ProjectionKeepsSurfaceMarkersOnTheSurface) {
   for (double a = -0.3; a <= 0.3; a += 0.1)
     for (double b = -0.3; b <= 0.3; b += 0.1)
       in.push_back({id++, MarkerType::OuterSurface,
-                    test::head_surface_point(Eigen::Vector3d(a, 1, b).normalized()), MarkerSurface::Mirrored});
+                    test::head_surface_point(Eigen::Vector3d(a, 1, b).normalized()),
+                    MarkerSurface::Mirrored});
   SmoothParams p;
   p.radius_mm = 15;
   const SmoothResult r = smooth_markers(in, p, &surface);

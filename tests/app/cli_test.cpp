@@ -21,14 +21,25 @@ TEST(Cli, InfoPlaneMirrorRegisterOnASyntheticHead) {
   EXPECT_TRUE(info["watertight"].get<bool>());
   EXPECT_EQ(info["triangles"].get<long long>(), static_cast<long long>(head.n_faces()));
 
-  ASSERT_EQ(test::run_command(kCli + " plane " + dir.path("head.stl") + " --json -o " + dir.path("plane.json"), &out), 0);
+  ASSERT_EQ(
+      test::run_command(
+          kCli + " plane " + dir.path("head.stl") + " --json -o " + dir.path("plane.json"), &out),
+      0);
   const Json plane = Json::parse(out);
-  for (const char* key : {"normal", "offset_mm", "symmetry_rms_mm", "inlier_fraction", "iterations", "status"})
+  for (const char* key :
+       {"normal", "offset_mm", "symmetry_rms_mm", "inlier_fraction", "iterations", "status"})
     EXPECT_TRUE(plane.contains(key)) << key;
   EXPECT_NEAR(std::abs(plane["normal"][0].get<double>()), 1.0, 1e-4);
 
-  ASSERT_EQ(test::run_command(kCli + " mirror " + dir.path("head.stl") + " --plane " + dir.path("plane.json") + " -o " + dir.path("m.ply"), &out), 0);
-  ASSERT_EQ(test::run_command(kCli + " register " + dir.path("m.ply") + " " + dir.path("head.stl") + " --json -o " + dir.path("r.stl") + " --roi-center 0,80,0 --roi-radius 80", &out), 0);
+  ASSERT_EQ(test::run_command(kCli + " mirror " + dir.path("head.stl") + " --plane " +
+                                  dir.path("plane.json") + " -o " + dir.path("m.ply"),
+                              &out),
+            0);
+  ASSERT_EQ(test::run_command(kCli + " register " + dir.path("m.ply") + " " + dir.path("head.stl") +
+                                  " --json -o " + dir.path("r.stl") +
+                                  " --roi-center 0,80,0 --roi-radius 80",
+                              &out),
+            0);
   const Json reg = Json::parse(out);
   EXPECT_EQ(reg["rotation"].size(), 3u);
   EXPECT_LT(reg["rms_mm"].get<double>(), 0.1);
@@ -48,9 +59,14 @@ TEST(Cli, ExitCodesForUsageAndBadInput) {
   EXPECT_NE(err["error"].get<std::string>().find("empty.stl: file is empty"), std::string::npos);
   test::write_bytes(dir.path("bad.json"), "nope");
   write_mesh(test::make_symmetric_head(2), dir.path("h.stl"));
-  EXPECT_EQ(test::run_command(kCli + " plane " + dir.path("h.stl") + " --landmarks " + dir.path("bad.json")), 3);
-  EXPECT_EQ(test::run_command(kCli + " register " + dir.path("h.stl") + " " + dir.path("h.stl") + " --roi-center 1,2"), 2);
-  EXPECT_EQ(test::run_command(kCli + " import-ct " + dir.path("h.stl") + " -o " + dir.path("x.stl")), 3);
+  EXPECT_EQ(test::run_command(kCli + " plane " + dir.path("h.stl") + " --landmarks " +
+                              dir.path("bad.json")),
+            3);
+  EXPECT_EQ(test::run_command(kCli + " register " + dir.path("h.stl") + " " + dir.path("h.stl") +
+                              " --roi-center 1,2"),
+            2);
+  EXPECT_EQ(
+      test::run_command(kCli + " import-ct " + dir.path("h.stl") + " -o " + dir.path("x.stl")), 3);
 }
 
 TEST(Cli, ImplantSubcommandsAndTheirErrors) {
@@ -59,26 +75,49 @@ TEST(Cli, ImplantSubcommandsAndTheirErrors) {
   write_mesh(head, dir.path("head.stl"));
   std::string out;
   // compare: identical meshes agree perfectly.
-  ASSERT_EQ(test::run_command(kCli + " compare --json " + dir.path("head.stl") + " " + dir.path("head.stl"), &out), 0);
+  ASSERT_EQ(
+      test::run_command(
+          kCli + " compare --json " + dir.path("head.stl") + " " + dir.path("head.stl"), &out),
+      0);
   EXPECT_DOUBLE_EQ(Json::parse(out)["dice"].get<double>(), 1.0);
   // smooth: too few markers is a status (exit 1), malformed markers a bad file (exit 3).
-  test::write_bytes(dir.path("two.json"),
-                    R"({"markers":[{"id":1,"type":2,"position":[0,0,0]},{"id":2,"type":2,"position":[1,0,0]}]})");
-  EXPECT_EQ(test::run_command(kCli + " smooth " + dir.path("two.json") + " --radius 5 --edge-weight 2 -o " + dir.path("o.json")), 1);
+  test::write_bytes(
+      dir.path("two.json"),
+      R"({"markers":[{"id":1,"type":2,"position":[0,0,0]},{"id":2,"type":2,"position":[1,0,0]}]})");
+  EXPECT_EQ(test::run_command(kCli + " smooth " + dir.path("two.json") +
+                              " --radius 5 --edge-weight 2 -o " + dir.path("o.json")),
+            1);
   test::write_bytes(dir.path("bad.json"), R"({"markers":[{"id":1,"type":7,"position":[0,0,0]}]})");
-  EXPECT_EQ(test::run_command(kCli + " smooth " + dir.path("bad.json") + " --radius 5 --edge-weight 2 -o " + dir.path("o.json"), &out), 3);
+  EXPECT_EQ(test::run_command(kCli + " smooth " + dir.path("bad.json") +
+                                  " --radius 5 --edge-weight 2 -o " + dir.path("o.json"),
+                              &out),
+            3);
   test::write_bytes(dir.path("dup.csv"), "id,type,x,y,z\n1,0,0,0,0\n1,0,1,0,0\n");
-  EXPECT_EQ(test::run_command(kCli + " smooth " + dir.path("dup.csv") + " --radius 5 --edge-weight 2 -o " + dir.path("o.json")), 3);
-  EXPECT_EQ(test::run_command(kCli + " smooth " + dir.path("two.json") + " --radius 5 --edge-weight 0.5 -o " + dir.path("o.json")), 2);
+  EXPECT_EQ(test::run_command(kCli + " smooth " + dir.path("dup.csv") +
+                              " --radius 5 --edge-weight 2 -o " + dir.path("o.json")),
+            3);
+  EXPECT_EQ(test::run_command(kCli + " smooth " + dir.path("two.json") +
+                              " --radius 5 --edge-weight 0.5 -o " + dir.path("o.json")),
+            2);
   // implant: a marker far from any surface is refused with its id.
-  test::write_bytes(dir.path("far.json"),
-                    R"({"markers":[{"id":4,"type":0,"position":[500,0,0]},{"id":5,"type":0,"position":[0,85,0]},{"id":6,"type":0,"position":[0,-85,0]}]})");
-  EXPECT_EQ(test::run_command(kCli + " implant --json --skull " + dir.path("head.stl") + " --markers " + dir.path("far.json") + " -o " + dir.path("i.stl"), &out), 3);
+  test::write_bytes(
+      dir.path("far.json"),
+      R"({"markers":[{"id":4,"type":0,"position":[500,0,0]},{"id":5,"type":0,"position":[0,85,0]},{"id":6,"type":0,"position":[0,-85,0]}]})");
+  EXPECT_EQ(test::run_command(kCli + " implant --json --skull " + dir.path("head.stl") +
+                                  " --markers " + dir.path("far.json") + " -o " + dir.path("i.stl"),
+                              &out),
+            3);
   EXPECT_NE(Json::parse(out)["error"].get<std::string>().find("marker 4"), std::string::npos);
   // inject-defect away from the skull: nothing to remove (exit 1).
-  EXPECT_EQ(test::run_command(kCli + " inject-defect " + dir.path("head.stl") + " --center 500,0,0 --size 20 -o " + dir.path("d.stl") + " --implant " + dir.path("t.stl")), 1);
+  EXPECT_EQ(test::run_command(kCli + " inject-defect " + dir.path("head.stl") +
+                              " --center 500,0,0 --size 20 -o " + dir.path("d.stl") +
+                              " --implant " + dir.path("t.stl")),
+            1);
   // autoplan on an intact skull: no defect found (exit 1).
-  ASSERT_EQ(test::run_command(kCli + " autoplan --json " + dir.path("head.stl") + " -o " + dir.path("a.stl"), &out), 1);
+  ASSERT_EQ(
+      test::run_command(
+          kCli + " autoplan --json " + dir.path("head.stl") + " -o " + dir.path("a.stl"), &out),
+      1);
   EXPECT_EQ(Json::parse(out)["status"].get<std::string>(), "no_defect");
   EXPECT_EQ(test::run_command(kCli + " evaluate " + dir.path("")), 3);  // no cases in it
 }

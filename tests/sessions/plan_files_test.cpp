@@ -42,7 +42,9 @@ TEST(PlanFiles, BadFilesNameTheFileAndTheProblem) {
   }
   test::write_bytes(dir.path("few.json"), "{\"nasion\": [1, 2, 3]}");
   EXPECT_THROW(read_landmarks_file(dir.path("few.json")), InputError);
-  test::write_bytes(dir.path("text.json"), "{\"nasion\": [1, \"a\", 3], \"orbit_left\": [0,0,0], \"orbit_right\": [9,0,0]}");
+  test::write_bytes(
+      dir.path("text.json"),
+      "{\"nasion\": [1, \"a\", 3], \"orbit_left\": [0,0,0], \"orbit_right\": [9,0,0]}");
   EXPECT_THROW(read_landmarks_file(dir.path("text.json")), InputError);
   test::write_bytes(dir.path("zero.json"), "{\"normal\": [0, 0, 0], \"offset_mm\": 1}");
   EXPECT_THROW(read_plane_file(dir.path("zero.json")), InputError);

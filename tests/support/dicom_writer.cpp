@@ -72,7 +72,8 @@ void write_dicom_series(const Volume& v, const std::string& folder) {
     element(file, 0x0028, 0x1053, "DS", "1");
     std::string pixels;
     for (int j = 0; j < v.dims[1]; ++j)
-      for (int i = 0; i < v.dims[0]; ++i) put16(pixels, static_cast<uint16_t>(v.at(i, j, k) + 1024));
+      for (int i = 0; i < v.dims[0]; ++i)
+        put16(pixels, static_cast<uint16_t>(v.at(i, j, k) + 1024));
     element(file, 0x7FE0, 0x0010, "OW", pixels);
     std::ostringstream name;
     name << folder << "/slice" << (1000 + k) << ".dcm";

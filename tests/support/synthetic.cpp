@@ -14,8 +14,8 @@ namespace {
 TriangleSoup icosphere(int subdivisions) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
   TriangleSoup s;
-  s.vertices = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
-                {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
+  s.vertices = {{-1, t, 0},  {1, t, 0},  {-1, -t, 0}, {1, -t, 0}, {0, -1, t},  {0, 1, t},
+                {0, -1, -t}, {0, 1, -t}, {t, 0, -1},  {t, 0, 1},  {-t, 0, -1}, {-t, 0, 1}};
   for (auto& v : s.vertices) v.normalize();
   s.triangles = {{0, 11, 5}, {0, 5, 1},  {0, 1, 7},   {0, 7, 10}, {0, 10, 11},
                  {1, 5, 9},  {5, 11, 4}, {11, 10, 2}, {10, 7, 6}, {7, 1, 8},
@@ -162,7 +162,8 @@ std::vector<Marker> round_defect_markers(const Eigen::Vector3d& center, double r
     const MarkerType surface = layer == 0 ? MarkerType::OuterSurface : MarkerType::InnerSurface;
     for (int e = 0; e < edge_count; ++e) {
       const double phi = 2.0 * M_PI * e / edge_count;
-      markers.push_back({id++, edge, scale * head_surface_point(direction(rim_angle(scale, phi), phi)),
+      markers.push_back({id++, edge,
+                         scale * head_surface_point(direction(rim_angle(scale, phi), phi)),
                          MarkerSurface::Original});
     }
     for (int ring = 1; ring <= surface_rings; ++ring) {

@@ -30,7 +30,9 @@ TempDir::~TempDir() {
   fs::remove_all(root_, ec);
 }
 
-std::string TempDir::path(const std::string& name) const { return (fs::path(root_) / name).string(); }
+std::string TempDir::path(const std::string& name) const {
+  return (fs::path(root_) / name).string();
+}
 
 void write_bytes(const std::string& path, const std::string& bytes) {
   std::ofstream out(path, std::ios::binary);
@@ -65,7 +67,8 @@ void write_nrrd(const Volume& v, const std::string& path, bool gzip_encoding) {
   h << "sizes: " << v.dims[0] << " " << v.dims[1] << " " << v.dims[2] << "\n";
   h << "space directions:";
   for (int c = 0; c < 3; ++c)
-    h << " (" << v.directions(0, c) << "," << v.directions(1, c) << "," << v.directions(2, c) << ")";
+    h << " (" << v.directions(0, c) << "," << v.directions(1, c) << "," << v.directions(2, c)
+      << ")";
   h << "\nkinds: domain domain domain\nendian: little\n";
   h << "encoding: " << (gzip_encoding ? "gzip" : "raw") << "\n";
   h << "space origin: (" << v.origin.x() << "," << v.origin.y() << "," << v.origin.z() << ")\n\n";

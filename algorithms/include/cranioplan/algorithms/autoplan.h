@@ -42,11 +42,11 @@ struct AutoplanResult {
   std::string message;
   PlaneFit plane;
   RegisterResult registration;
-  SkullMesh mirrored;              ///< mirrored and registered onto the skull
+  SkullMesh mirrored;  ///< mirrored and registered onto the skull
   DefectRegion defect;
   PlanMethod method_used = PlanMethod::RimOnly;
-  double mirror_coverage = 0.0;    ///< fraction of the opening's rays that meet mirrored bone
-  std::vector<Marker> markers;     ///< proposed (after smoothing)
+  double mirror_coverage = 0.0;  ///< fraction of the opening's rays that meet mirrored bone
+  std::vector<Marker> markers;   ///< proposed (after smoothing)
   ImplantResult implant;
   QualityReport quality;
   std::vector<std::pair<std::string, double>> stage_seconds;

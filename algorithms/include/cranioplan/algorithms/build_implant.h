@@ -28,7 +28,7 @@ struct ImplantParams {
   /// weight (dimensionless, ≥ 0; 0: the surfaces pass through them). Edge markers are always
   /// met exactly. Automatic plans use a little, to ride over noise in sampled bone.
   double surface_smoothing = 0.0;
-  double max_rim_snap_mm = 3.0;   ///< rim points farther than this from bone stay where they are
+  double max_rim_snap_mm = 3.0;  ///< rim points farther than this from bone stay where they are
   /// Radial needs a skull (its centroid is the centre) or `radial_center`; otherwise planar.
   ImplantFrame frame = ImplantFrame::Radial;
   std::optional<Eigen::Vector3d> radial_center;  ///< centre of the rays (inside the skull)
@@ -42,11 +42,11 @@ struct ImplantResult {
   enum class Status { Built, TooFewMarkers, Failed };
   Status status = Status::Failed;
   std::string message;
-  SkullMesh mesh;               ///< closed and outward-oriented for the shell method
+  SkullMesh mesh;  ///< closed and outward-oriented for the shell method
   bool watertight = false;
-  double thickness_used_mm = 0.0;     ///< shell without inner markers: the offset applied
-  double rim_marker_error_mm = 0.0;   ///< largest distance from an edge marker to its rim
-  int rim_points = 0;                 ///< samples along each rim
+  double thickness_used_mm = 0.0;    ///< shell without inner markers: the offset applied
+  double rim_marker_error_mm = 0.0;  ///< largest distance from an edge marker to its rim
+  int rim_points = 0;                ///< samples along each rim
   double seconds = 0.0;
   bool usable() const { return status == Status::Built; }
 };

@@ -8,25 +8,25 @@
 namespace cranioplan {
 
 struct QualityParams {
-  double min_thickness_mm = 1.0;      ///< thinner than this is not printable, mm
-  double max_rim_gap_mm = 1.0;        ///< a larger gap to the bone is not printable, mm
-  double max_penetration_mm3 = 5.0;   ///< more overlap with the skull is not printable, mm³
-  double overlap_voxel_mm = 0.25;     ///< voxel size of the overlap measurement, mm
+  double min_thickness_mm = 1.0;     ///< thinner than this is not printable, mm
+  double max_rim_gap_mm = 1.0;       ///< a larger gap to the bone is not printable, mm
+  double max_penetration_mm3 = 5.0;  ///< more overlap with the skull is not printable, mm³
+  double overlap_voxel_mm = 0.25;    ///< voxel size of the overlap measurement, mm
 };
 
 struct QualityReport {
   bool watertight = false;
   bool manifold = false;
-  bool outward = false;             ///< positive signed volume
+  bool outward = false;  ///< positive signed volume
   long long self_intersections = 0;
   long long pieces = 0;
   double volume_mm3 = 0.0;
   double area_mm2 = 0.0;
   double thickness_min_mm = 0.0, thickness_median_mm = 0.0, thickness_max_mm = 0.0;
-  double rim_gap_mm = -1.0;         ///< −1 without a skull
-  double penetration_mm3 = -1.0;    ///< −1 without a skull
+  double rim_gap_mm = -1.0;       ///< −1 without a skull
+  double penetration_mm3 = -1.0;  ///< −1 without a skull
   bool printable = false;
-  std::vector<std::string> reasons; ///< why not printable, one sentence each
+  std::vector<std::string> reasons;  ///< why not printable, one sentence each
 };
 
 /// Checks an implant, optionally against the (defective) skull it is made for.
@@ -35,8 +35,8 @@ struct QualityReport {
 /// normal is within 45° of the implant's thinnest principal axis), along the inward normal to
 /// the opposite surface. Rim: the side wall (the other faces). Rim gap: around the implant's
 /// axis in 5° sectors, the distance from the sector's side-wall vertex nearest the bone to the
-/// bone; the largest over the sectors (a gap anywhere along the rim shows in its sector). Penetration: the volume inside both the implant and the
-/// skull, on a voxel grid.
+/// bone; the largest over the sectors (a gap anywhere along the rim shows in its sector).
+/// Penetration: the volume inside both the implant and the skull, on a voxel grid.
 QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
                             const QualityParams& params = {});
 

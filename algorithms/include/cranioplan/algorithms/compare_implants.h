@@ -8,16 +8,16 @@
 namespace cranioplan {
 
 struct CompareParams {
-  double spacing_mm = 0.5;        ///< common voxel grid, mm (0.1..2)
-  double boundary_mm = 10.0;      ///< boundary Dice: voxels within this of the defective skull
+  double spacing_mm = 0.5;    ///< common voxel grid, mm (0.1..2)
+  double boundary_mm = 10.0;  ///< boundary Dice: voxels within this of the defective skull
 };
 
 struct CompareResult {
-  double dice = 0.0;               ///< 2|A∩B| / (|A| + |B|)
-  double boundary_dice = -1.0;     ///< same, restricted near the defective skull; −1 without one
-  double hausdorff_mm = 0.0;       ///< largest surface-voxel distance, both directions
-  double hd95_mm = 0.0;            ///< 95th percentile of both directions' distances together
-  double mean_surface_mm = 0.0;    ///< mean of both directions' distances together
+  double dice = 0.0;             ///< 2|A∩B| / (|A| + |B|)
+  double boundary_dice = -1.0;   ///< same, restricted near the defective skull; −1 without one
+  double hausdorff_mm = 0.0;     ///< largest surface-voxel distance, both directions
+  double hd95_mm = 0.0;          ///< 95th percentile of both directions' distances together
+  double mean_surface_mm = 0.0;  ///< mean of both directions' distances together
   double volume_a_mm3 = 0.0, volume_b_mm3 = 0.0;
   long long voxels_a = 0, voxels_b = 0, voxels_both = 0;
   double seconds = 0.0;

@@ -23,8 +23,8 @@ struct ExtractBoneSurfaceParams {
 struct ExtractBoneSurfaceResult {
   enum class Status { Ok, NoSurface };
   Status status = Status::Ok;
-  std::string message;     ///< why there is no surface, e.g. threshold above every sample
-  SkullMesh mesh;          ///< closed, outward-oriented, in the volume's world coordinates (mm)
+  std::string message;  ///< why there is no surface, e.g. threshold above every sample
+  SkullMesh mesh;       ///< closed, outward-oriented, in the volume's world coordinates (mm)
   double threshold_used = 0.0;
   long long pieces_found = 0;
   long long pieces_kept = 0;

@@ -25,15 +25,15 @@ struct PlaneFitParams {
 struct PlaneFit {
   enum class Status { Converged, MaxIterations, Failed };
   Status status = Status::Failed;
-  std::string message;                ///< plain words: how it ended, or why it failed
-  Plane plane;                        ///< the refined plane (or the initial one without refining)
-  Plane initial;                      ///< the starting plane
-  std::string initial_method;         ///< "landmarks" or "automatic"
-  double symmetry_rms_mm = 0.0;       ///< RMS of point-to-plane symmetry residuals over inliers
-  double inlier_fraction = 0.0;       ///< fraction of samples whose residual is an inlier
-  int iterations = 0;                 ///< outer iterations (correspondence updates)
-  int solver_iterations = 0;          ///< Ceres iterations summed over outer iterations
-  std::string termination;            ///< Ceres termination of the last solve
+  std::string message;           ///< plain words: how it ended, or why it failed
+  Plane plane;                   ///< the refined plane (or the initial one without refining)
+  Plane initial;                 ///< the starting plane
+  std::string initial_method;    ///< "landmarks" or "automatic"
+  double symmetry_rms_mm = 0.0;  ///< RMS of point-to-plane symmetry residuals over inliers
+  double inlier_fraction = 0.0;  ///< fraction of samples whose residual is an inlier
+  int iterations = 0;            ///< outer iterations (correspondence updates)
+  int solver_iterations = 0;     ///< Ceres iterations summed over outer iterations
+  std::string termination;       ///< Ceres termination of the last solve
   double seconds = 0.0;
   bool usable() const { return status != Status::Failed; }
 };

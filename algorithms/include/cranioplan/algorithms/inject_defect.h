@@ -11,8 +11,8 @@ struct InjectDefectParams {
   enum class Shape { Sphere, Cube };
   Shape shape = Shape::Sphere;
   Eigen::Vector3d center = Eigen::Vector3d::Zero();  ///< mm
-  double size_mm = 40.0;    ///< sphere diameter or cube edge, mm (>0)
-  double voxel_mm = 0.4;    ///< resolution of the cut, mm (0.1..2)
+  double size_mm = 40.0;                             ///< sphere diameter or cube edge, mm (>0)
+  double voxel_mm = 0.4;                             ///< resolution of the cut, mm (0.1..2)
 };
 
 struct InjectDefectResult {

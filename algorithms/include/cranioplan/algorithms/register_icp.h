@@ -13,30 +13,30 @@ namespace cranioplan {
 struct RegionOfInterest {
   enum class Shape { Sphere, Box };
   Shape shape = Shape::Sphere;
-  Eigen::Vector3d center = Eigen::Vector3d::Zero();         ///< mm
-  double radius = 50.0;                                     ///< sphere radius, mm (>0)
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();           ///< mm
+  double radius = 50.0;                                       ///< sphere radius, mm (>0)
   Eigen::Vector3d half_size = Eigen::Vector3d::Constant(50);  ///< box half extents, mm (>0)
   bool contains(const Eigen::Vector3d& p) const;
 };
 
 struct RegisterParams {
-  RigidTransform initial;              ///< starting transform of MOVING
-  int sample_count = 6000;             ///< moving samples used, 100..200000
-  int max_iterations = 60;             ///< 1..500
-  double max_correspondence_mm = 8.0;  ///< pairs farther apart are ignored, mm (>0)
-  double trim_fraction = 0.85;         ///< keep this best fraction of pairs, (0, 1]
-  double huber_mm = 1.0;               ///< Huber weight scale for residuals, mm (>0)
-  double convergence_mm = 0.01;        ///< stop when an update moves no sample more than this, mm
-  std::optional<RegionOfInterest> roi; ///< only moving samples inside it (after transform)
+  RigidTransform initial;               ///< starting transform of MOVING
+  int sample_count = 6000;              ///< moving samples used, 100..200000
+  int max_iterations = 60;              ///< 1..500
+  double max_correspondence_mm = 8.0;   ///< pairs farther apart are ignored, mm (>0)
+  double trim_fraction = 0.85;          ///< keep this best fraction of pairs, (0, 1]
+  double huber_mm = 1.0;                ///< Huber weight scale for residuals, mm (>0)
+  double convergence_mm = 0.01;         ///< stop when an update moves no sample more than this, mm
+  std::optional<RegionOfInterest> roi;  ///< only moving samples inside it (after transform)
 };
 
 struct RegisterResult {
   enum class Status { Converged, MaxIterations, Failed };
   Status status = Status::Failed;
   std::string message;
-  RigidTransform transform;     ///< x ↦ R·x + t carrying MOVING onto FIXED
-  double rms_mm = 0.0;          ///< point-to-plane RMS over the pairs kept in the last step
-  double inlier_fraction = 0.0; ///< pairs kept / samples considered
+  RigidTransform transform;      ///< x ↦ R·x + t carrying MOVING onto FIXED
+  double rms_mm = 0.0;           ///< point-to-plane RMS over the pairs kept in the last step
+  double inlier_fraction = 0.0;  ///< pairs kept / samples considered
   int iterations = 0;
   double seconds = 0.0;
   bool usable() const { return status != Status::Failed; }

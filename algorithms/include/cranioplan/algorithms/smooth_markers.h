@@ -12,9 +12,9 @@ namespace cranioplan {
 class SurfaceLocator;
 
 struct SmoothParams {
-  double radius_mm = 10.0;  ///< neighbours within this distance take part, mm (>0)
-  double edge_weight = 2.0; ///< an edge marker counts this many times, ≥ 1
-  int iterations = 1;       ///< ≥ 1; each uses the previous iteration's positions
+  double radius_mm = 10.0;   ///< neighbours within this distance take part, mm (>0)
+  double edge_weight = 2.0;  ///< an edge marker counts this many times, ≥ 1
+  int iterations = 1;        ///< ≥ 1; each uses the previous iteration's positions
 };
 
 struct SmoothResult {

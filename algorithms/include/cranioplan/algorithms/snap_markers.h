@@ -15,9 +15,9 @@ struct SnapMarkersParams {
 struct SnapMarkersResult {
   enum class Status { Snapped, TooFar };
   Status status = Status::Snapped;
-  std::string message;              ///< names the first marker too far away
-  std::vector<Marker> markers;      ///< snapped (or the input, unchanged, when TooFar)
-  double max_distance_mm = 0.0;     ///< largest snap distance
+  std::string message;           ///< names the first marker too far away
+  std::vector<Marker> markers;   ///< snapped (or the input, unchanged, when TooFar)
+  double max_distance_mm = 0.0;  ///< largest snap distance
 };
 
 /// Moves every marker to the closest point of its surface (`original` for markers on the

@@ -17,9 +17,9 @@ class SurfaceLocator {
   SurfaceLocator& operator=(SurfaceLocator&&) noexcept;
 
   struct Closest {
-    Eigen::Vector3d point;   ///< closest point on the surface, mm
-    int face = -1;           ///< face index of the mesh
-    double distance = 0.0;   ///< mm
+    Eigen::Vector3d point;  ///< closest point on the surface, mm
+    int face = -1;          ///< face index of the mesh
+    double distance = 0.0;  ///< mm
   };
   /// Closest point on the surface. Requires a mesh with at least one face.
   Closest closest(const Eigen::Vector3d& query) const;

@@ -19,7 +19,9 @@ struct Marker {
   MarkerSurface surface = MarkerSurface::Original;
 };
 
-inline bool is_edge(MarkerType t) { return t == MarkerType::OuterEdge || t == MarkerType::InnerEdge; }
+inline bool is_edge(MarkerType t) {
+  return t == MarkerType::OuterEdge || t == MarkerType::InnerEdge;
+}
 inline bool is_outer(MarkerType t) {
   return t == MarkerType::OuterEdge || t == MarkerType::OuterSurface;
 }

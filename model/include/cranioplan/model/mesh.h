@@ -1,8 +1,7 @@
 #pragma once
 // Triangle meshes of skulls and implants: OpenMesh with double-precision points, lengths in mm.
-#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
-
 #include <Eigen/Core>
+#include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
 #include <vector>
 
 namespace cranioplan {
@@ -31,8 +30,8 @@ struct TriangleSoup {
 
 /// Result of building a SkullMesh from an indexed soup.
 struct BuildMeshStats {
-  long long degenerate_dropped = 0;   ///< triangles with repeated vertices or zero area
-  long long nonmanifold_split = 0;    ///< faces added with duplicated vertices (complex edges)
+  long long degenerate_dropped = 0;  ///< triangles with repeated vertices or zero area
+  long long nonmanifold_split = 0;   ///< faces added with duplicated vertices (complex edges)
 };
 
 /// Builds a mesh from an indexed soup. Triangles with a repeated index or zero area are dropped;

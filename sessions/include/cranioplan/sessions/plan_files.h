@@ -20,7 +20,7 @@ namespace cranioplan {
 using Json = nlohmann::ordered_json;
 
 Json to_json(const Eigen::Vector3d& v);
-Json to_json(const Plane& plane);  ///< {"normal":[..],"offset_mm":d}
+Json to_json(const Plane& plane);       ///< {"normal":[..],"offset_mm":d}
 Json to_json(const RigidTransform& t);  ///< {"rotation":[[..],[..],[..]],"translation":[..]}
 Json to_json(const Landmarks& lm);
 Json to_json(const MeshReport& r);
