@@ -242,6 +242,7 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
     return tps.fit(uv, h, smoothing, kMinMarkerSeparation, edges);
   };
   ThinPlateSpline outer_tps, thickness_tps;
+  thickness_tps.set_quadratic_trend(false);
   if (!fit(outer, outer_edges.size(), outer_tps, nullptr)) {
     result.message = "the outer markers lie on a line: no surface can be fitted";
     return result;
@@ -250,11 +251,16 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
     result.message = "the inner markers lie on a line: no surface can be fitted";
     return result;
   }
+  // Without an inner rim, inner surface markers (six or more) still give the thickness field;
+  // the inner rim is then the outer one offset by it.
+  const bool thickness_from_markers = !has_inner && inner.size() >= 6 &&
+                                      std::isnan(params.thickness_mm) &&
+                                      fit(inner, 0, thickness_tps, &outer_tps);
+  // Depths are kept between 0.3 mm and 20 mm: the inner surface never crosses the outer one.
+  auto depth = [&](const Eigen::Vector2d& q) { return std::clamp(thickness_tps(q), 0.3, 20.0); };
   using Height = std::function<double(const Eigen::Vector2d&)>;
   const Height outer_height = [&](const Eigen::Vector2d& q) { return outer_tps(q); };
-  const Height inner_height = [&](const Eigen::Vector2d& q) {
-    return outer_tps(q) - thickness_tps(q);
-  };
+  const Height inner_height = [&](const Eigen::Vector2d& q) { return outer_tps(q) - depth(q); };
   // Outward normal of the outer surface: from the spline's gradient (planar), or the ray
   // direction (radial; the surfaces of a skull are nearly perpendicular to rays from inside).
   auto outer_normal = [&](const Eigen::Vector2d& q) {
@@ -263,10 +269,14 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
     return Eigen::Vector3d(f.n - g.x() * f.e1 - g.y() * f.e2).normalized();
   };
   result.thickness_used_mm =
-      has_inner ? 0.0
-                : (!std::isnan(params.thickness_mm) ? params.thickness_mm
-                   : bone ? measure_bone_thickness(outer_edges, marker_centroid, *bone)
-                          : 6.0);
+      has_inner                ? 0.0
+      : thickness_from_markers ? depth(Eigen::Vector2d::Zero())
+      : !std::isnan(params.thickness_mm)
+          ? params.thickness_mm
+          : (bone ? measure_bone_thickness(outer_edges, marker_centroid, *bone) : 6.0);
+  auto offset = [&](const Eigen::Vector2d& q) {
+    return thickness_from_markers ? depth(q) : result.thickness_used_mm;
+  };
 
   // Rim polygons around the centre of the outer edge markers.
   // Polar centre: the ray axis (radial; the rim is ordered around it), or the rim's centroid.
@@ -322,7 +332,7 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
       if (tps) {
         pts[k] = f.lift(q, (*tps)(q));
       } else {  // no inner markers: the outer rim offset inwards along the surface normal
-        pts[k] = f.lift(q, outer_tps(q)) - result.thickness_used_mm * outer_normal(q);
+        pts[k] = f.lift(q, outer_tps(q)) - offset(q) * outer_normal(q);
       }
       const bool exact = is_marker_angle[k] && tps != nullptr;
       if (bone && params.snap_rim_to_skull && !exact) {
@@ -375,8 +385,7 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
     const PolarPolygon poly = rim_polygon(rim, offset_from_outer ? &outer_height : tps);
     auto surface_point = [&](const Eigen::Vector2d& q, double correction) {
       if (!offset_from_outer) return f.lift(q, (*tps)(q) + correction);
-      return Eigen::Vector3d(f.lift(q, outer_tps(q) + correction) -
-                             result.thickness_used_mm * outer_normal(q));
+      return Eigen::Vector3d(f.lift(q, outer_tps(q) + correction) - offset(q) * outer_normal(q));
     };
     std::vector<Eigen::Vector3i> tris;
     const int center_vertex = static_cast<int>(soup.vertices.size());

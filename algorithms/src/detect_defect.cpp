@@ -205,7 +205,15 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
       support.insert(support.end(), next.begin(), next.end());
       frontier = std::move(next);
     }
+    // Only rays through the full bone support the surfaces: rays that cross the bone obliquely
+    // near the cut face see it thinner and would pull the inner surface outwards.
+    std::vector<double> thickness;
+    for (int i = 0; i < n; ++i)
+      if (paired[i]) thickness.push_back((*outer[i] - *inner[i]).norm());
+    std::nth_element(thickness.begin(), thickness.begin() + thickness.size() / 2, thickness.end());
+    const double full = 0.7 * thickness[thickness.size() / 2];
     for (int j : support) {
+      if ((*outer[j] - *inner[j]).norm() < full) continue;
       region.outer_support.push_back(*outer[j]);
       region.inner_support.push_back(*inner[j]);
     }

@@ -45,7 +45,7 @@ bool ThinPlateSpline::fit(const std::vector<Eigen::Vector2d>& sites,
 
   // Quadratic trend by least squares (needs 6 sites not on a conic; otherwise none).
   trend_.setZero();
-  if (n >= 12) {
+  if (quadratic_trend_ && n >= 12) {
     Eigen::MatrixXd M(n, 6);
     Eigen::VectorXd y(n);
     for (int i = 0; i < n; ++i) {

@@ -24,6 +24,9 @@ class ThinPlateSpline {
   /// ∂h/∂u, ∂h/∂v at p.
   Eigen::Vector2d gradient(const Eigen::Vector2d& p) const;
   bool valid() const { return !sites_.empty(); }
+  /// Whether fit() removes a quadratic trend first (default true). Fields that vary little,
+  /// such as a thickness, extrapolate more calmly with the affine part alone.
+  void set_quadratic_trend(bool on) { quadratic_trend_ = on; }
 
  private:
   std::vector<Eigen::Vector2d> sites_;  // scaled by 1/scale_
@@ -32,6 +35,7 @@ class ThinPlateSpline {
   Eigen::Vector2d shift_ = Eigen::Vector2d::Zero();
   Eigen::Matrix<double, 6, 1> trend_ = Eigen::Matrix<double, 6, 1>::Zero();  // 1 u v u² uv v²
   double scale_ = 1.0;
+  bool quadratic_trend_ = true;
 };
 
 }  // namespace cranioplan
