@@ -335,7 +335,9 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
         pts[k] = f.lift(q, outer_tps(q)) - offset(q) * outer_normal(q);
       }
       const bool exact = is_marker_angle[k] && tps != nullptr;
-      if (bone && params.snap_rim_to_skull && !exact) {
+      // An inner rim set in from the outer one is not snapped: its nearest bone is often the
+      // cut face far along the rim, and snapping it there makes spikes.
+      if (bone && params.snap_rim_to_skull && !exact && tps != nullptr) {
         const auto c = bone->closest(pts[k]);
         // The snapped point must keep its place in the rim's angular order (else the cap
         // folds) and not land on its predecessor (else the wall gets a zero-area face).
