@@ -122,5 +122,18 @@ TEST(Cli, ImplantSubcommandsAndTheirErrors) {
   EXPECT_EQ(test::run_command(kCli + " evaluate " + dir.path("")), 3);  // no cases in it
 }
 
+TEST(Cli, StudyInjectsPlansAndScoresDefects) {
+  test::TempDir dir;
+  write_mesh(test::make_thick_head(), dir.path("thick.stl"));
+  std::string out;
+  ASSERT_EQ(test::run_command(kCli + " study --json --count 2 " + dir.path("thick.stl"), &out), 0);
+  const Json j = Json::parse(out);
+  ASSERT_EQ(j["defects"].size(), 2u);
+  for (const auto& row : j["defects"]) {
+    EXPECT_EQ(row["method"].get<std::string>(), "mirror");
+    EXPECT_GT(row["dice"].get<double>(), 0.6);
+  }
+}
+
 }  // namespace
 }  // namespace cranioplan
