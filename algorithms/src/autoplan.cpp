@@ -1,12 +1,10 @@
 #include "cranioplan/algorithms/autoplan.h"
 
-#include <Eigen/Geometry>
 #include <chrono>
 #include <cstdio>
 
 #include "cranioplan/algorithms/mirror_mesh.h"
 #include "cranioplan/algorithms/surface_locator.h"
-#include "cranioplan/algorithms/thin_plate_spline.h"
 
 namespace cranioplan {
 
@@ -125,30 +123,6 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
   // Outer edge markers only: at a cut face that is not along the rays, the inner table's end
   // cannot be told from the rays that found the rim (they graze the cut); the inner rim is the
   // outer one set in by the thickness the inner markers measure.
-  // Where a cut face is not along the rays, the bone ray next to the opening meets the cut face
-  // below the outer table. The implant must be flush with the outer table: a rim point below the
-  // outer surface of the intact ring (a spline through the ring, along the rays) is raised onto
-  // it.
-  {
-    const Eigen::Vector3d axis = r.defect.axis, e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
-    auto uv = [&](const Eigen::Vector3d& p) {
-      const Eigen::Vector3d d = p - c;
-      return Eigen::Vector2d(d.dot(e1), d.dot(e2)) *
-             (100.0 / std::max(d.dot(axis), 1e-3 * d.norm()));
-    };
-    std::vector<Eigen::Vector2d> sites;
-    std::vector<double> radii;
-    for (const auto& p : r.defect.outer_support) {
-      sites.push_back(uv(p));
-      radii.push_back((p - c).norm());
-    }
-    ThinPlateSpline ring;
-    if (ring.fit(sites, radii, std::vector<double>(sites.size(), 0.01), 1.0))
-      for (auto& p : r.defect.outer_rim) {
-        const double expected = ring(uv(p)), radius = (p - c).norm();
-        if (radius < expected - 0.5) p = c + expected * (p - c).normalized();
-      }
-  }
   for (size_t i : along(r.defect.outer_rim, params.edge_spacing_mm))
     r.markers.push_back(
         {id++, MarkerType::OuterEdge, r.defect.outer_rim[i], MarkerSurface::Original});

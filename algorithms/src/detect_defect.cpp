@@ -37,17 +37,31 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
 
   const int n = std::clamp(params.directions, 2000, 200000);
   const std::vector<Eigen::Vector3d> dirs = fibonacci_sphere(n);
+  // One ray: the first bone from the centre (inner table) and from outside (outer table);
+  // `paired` when both are met no more than a plausible skull thickness apart.
+  struct RayHits {
+    std::optional<Eigen::Vector3d> inner, outer;
+    bool paired = false;
+  };
+  auto cast = [&](const Eigen::Vector3d& d) {
+    RayHits h;
+    const auto in = locator.first_hit(center, center + reach * d);
+    if (!in) return h;
+    h.inner = in->point;
+    const auto out = locator.first_hit(center + reach * d, center);
+    if (!out) return h;
+    h.outer = out->point;
+    const double t = (*h.outer - *h.inner).norm();
+    h.paired = t >= params.min_thickness_mm && t <= params.max_thickness_mm;
+    return h;
+  };
   std::vector<std::optional<Eigen::Vector3d>> inner(n), outer(n);
-  std::vector<char> paired(n, 0);  // both tables met, no more than a skull's thickness apart
+  std::vector<char> paired(n, 0);
   for (int i = 0; i < n; ++i) {
-    const auto in = locator.first_hit(center, center + reach * dirs[i]);
-    if (!in) continue;
-    inner[i] = in->point;
-    const auto out = locator.first_hit(center + reach * dirs[i], center);
-    if (!out) continue;
-    outer[i] = out->point;
-    const double t = (*outer[i] - *inner[i]).norm();
-    paired[i] = t >= params.min_thickness_mm && t <= params.max_thickness_mm;
+    const RayHits h = cast(dirs[i]);
+    inner[i] = h.inner;
+    outer[i] = h.outer;
+    paired[i] = h.paired;
   }
   // Neighbours on the sphere: the 6 nearest directions.
   const PointIndex index(dirs);
@@ -133,17 +147,6 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
     // Refine each rim ray towards its nearest opening ray by bisection, so the rim sits where
     // the bone ends rather than up to a ray spacing inside it. Rays must still cross bone of
     // a plausible thickness on both tables (they share the ray).
-    auto cast = [&](const Eigen::Vector3d& d, Eigen::Vector3d& in_pt, Eigen::Vector3d& out_pt) {
-      const auto in = locator.first_hit(center, center + reach * d);
-      if (!in) return false;
-      const auto out = locator.first_hit(center + reach * d, center);
-      if (!out) return false;
-      const double t = (out->point - in->point).norm();
-      if (t < params.min_thickness_mm || t > params.max_thickness_mm) return false;
-      in_pt = in->point;
-      out_pt = out->point;
-      return true;
-    };
     for (int j : best) {
       if (j < 0) continue;
       Eigen::Vector3d in_pt = *inner[j], out_pt = *outer[j];
@@ -156,11 +159,11 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
         Eigen::Vector3d bone_dir = dirs[j], open_dir = dirs[open_nbr];
         for (int it = 0; it < 6; ++it) {
           const Eigen::Vector3d mid = (bone_dir + open_dir).normalized();
-          Eigen::Vector3d i2, o2;
-          if (cast(mid, i2, o2)) {
+          const RayHits h = cast(mid);
+          if (h.paired) {
             bone_dir = mid;
-            in_pt = i2;
-            out_pt = o2;
+            in_pt = *h.inner;
+            out_pt = *h.outer;
           } else {
             open_dir = mid;
           }

@@ -390,57 +390,69 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
     auto* cmd = app.add_subcommand(
         "study", "Inject one-sided defects into a healthy skull, autoplan and score each");
     cmd->add_option("SKULL", o->skull, "healthy skull (mesh or volume)")->required();
-    cmd->add_option("--count", o->count, "number of defects (default 10)")->check(CLI::Range(1, 100));
-    cmd->add_option("--min-size", o->min_size, "smallest sphere diameter (mm)")->check(CLI::PositiveNumber);
-    cmd->add_option("--max-size", o->max_size, "largest sphere diameter (mm)")->check(CLI::PositiveNumber);
-    out.push_back({cmd, [o, &json] {
-      const SkullMesh skull = load_skull(o->skull).mesh;
-      const SurfaceLocator bone(skull);
-      // Directions on the upper vault, alternately left and right, spread by the golden angle;
-      // each defect's centre is in the middle of the bone along that ray from the centroid.
-      Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-      for (auto vh : skull.vertices()) centroid += to_eigen(skull.point(vh));
-      centroid /= static_cast<double>(skull.n_vertices());
-      Json rows = Json::array();
-      std::vector<double> dsc, hd95;
-      for (int k = 0; k < o->count; ++k) {
-        const double side = k % 2 == 0 ? 1.0 : -1.0;
-        const double phi = 2.39996 * k, up = 0.25 + 0.5 * std::fmod(0.618034 * k, 1.0);
-        const Eigen::Vector3d dir =
-            Eigen::Vector3d(side * (0.55 + 0.25 * std::abs(std::cos(phi))), 0.6 * std::sin(phi), up).normalized();
-        const auto out_hit = bone.first_hit(centroid + 400.0 * dir, centroid);
-        const auto in_hit = bone.first_hit(centroid, centroid + 400.0 * dir);
-        if (!out_hit || !in_hit) continue;
-        InjectDefectParams ip;
-        ip.center = 0.5 * (out_hit->point + in_hit->point);
-        ip.size_mm = o->min_size + (o->max_size - o->min_size) * std::fmod(0.381966 * (k + 1), 1.0);
-        ip.voxel_mm = 0.5;
-        const InjectDefectResult d = inject_defect(skull, ip);
-        if (!d.usable()) continue;
-        const AutoplanResult r = autoplan(d.defective, Landmarks{});
-        Json row{{"center", to_json(ip.center)}, {"size_mm", ip.size_mm}, {"message", r.message}};
-        if (r.planned()) {
-          const CompareResult c = compare_implants(r.implant.mesh, d.implant, &d.defective);
-          row["method"] = to_string(r.method_used);
-          row["dice"] = c.dice;
-          row["boundary_dice"] = c.boundary_dice;
-          row["hd95_mm"] = c.hd95_mm;
-          dsc.push_back(c.dice);
-          hd95.push_back(c.hd95_mm);
-        } else {
-          dsc.push_back(0.0);
-        }
-        if (!json)
-          std::cout << k << "  size " << ip.size_mm << " mm  " << row.value("method", "-") << "  DSC "
-                    << row.value("dice", 0.0) << "  HD95 " << row.value("hd95_mm", 0.0) << " mm  "
-                    << r.message << std::endl;
-        rows.push_back(row);
-      }
-      const Json summary{{"defects", rows.size()}, {"median_dice", median(dsc)}, {"median_hd95_mm", median(hd95)}};
-      if (json) print_result(Json{{"defects", rows}, {"median", summary}}, true);
-      else print_result(Json{{"median", summary}}, false);
-      return kOk;
-    }});
+    cmd->add_option("--count", o->count, "number of defects (default 10)")
+        ->check(CLI::Range(1, 100));
+    cmd->add_option("--min-size", o->min_size, "smallest sphere diameter (mm)")
+        ->check(CLI::PositiveNumber);
+    cmd->add_option("--max-size", o->max_size, "largest sphere diameter (mm)")
+        ->check(CLI::PositiveNumber);
+    out.push_back(
+        {cmd, [o, &json] {
+           const SkullMesh skull = load_skull(o->skull).mesh;
+           const SurfaceLocator bone(skull);
+           // Directions on the upper vault, alternately left and right, spread by the golden angle;
+           // each defect's centre is in the middle of the bone along that ray from the centroid.
+           Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+           for (auto vh : skull.vertices()) centroid += to_eigen(skull.point(vh));
+           centroid /= static_cast<double>(skull.n_vertices());
+           Json rows = Json::array();
+           std::vector<double> dsc, hd95;
+           for (int k = 0; k < o->count; ++k) {
+             const double side = k % 2 == 0 ? 1.0 : -1.0;
+             const double phi = 2.39996 * k, up = 0.25 + 0.5 * std::fmod(0.618034 * k, 1.0);
+             const Eigen::Vector3d dir =
+                 Eigen::Vector3d(side * (0.55 + 0.25 * std::abs(std::cos(phi))),
+                                 0.6 * std::sin(phi), up)
+                     .normalized();
+             const auto out_hit = bone.first_hit(centroid + 400.0 * dir, centroid);
+             const auto in_hit = bone.first_hit(centroid, centroid + 400.0 * dir);
+             if (!out_hit || !in_hit) continue;
+             InjectDefectParams ip;
+             ip.center = 0.5 * (out_hit->point + in_hit->point);
+             ip.size_mm =
+                 o->min_size + (o->max_size - o->min_size) * std::fmod(0.381966 * (k + 1), 1.0);
+             ip.voxel_mm = 0.5;
+             const InjectDefectResult d = inject_defect(skull, ip);
+             if (!d.usable()) continue;
+             const AutoplanResult r = autoplan(d.defective, Landmarks{});
+             Json row{
+                 {"center", to_json(ip.center)}, {"size_mm", ip.size_mm}, {"message", r.message}};
+             if (r.planned()) {
+               const CompareResult c = compare_implants(r.implant.mesh, d.implant, &d.defective);
+               row["method"] = to_string(r.method_used);
+               row["dice"] = c.dice;
+               row["boundary_dice"] = c.boundary_dice;
+               row["hd95_mm"] = c.hd95_mm;
+               dsc.push_back(c.dice);
+               hd95.push_back(c.hd95_mm);
+             } else {
+               dsc.push_back(0.0);
+             }
+             if (!json)
+               std::cout << k << "  size " << ip.size_mm << " mm  " << row.value("method", "-")
+                         << "  DSC " << row.value("dice", 0.0) << "  HD95 "
+                         << row.value("hd95_mm", 0.0) << " mm  " << r.message << std::endl;
+             rows.push_back(row);
+           }
+           const Json summary{{"defects", rows.size()},
+                              {"median_dice", median(dsc)},
+                              {"median_hd95_mm", median(hd95)}};
+           if (json)
+             print_result(Json{{"defects", rows}, {"median", summary}}, true);
+           else
+             print_result(Json{{"median", summary}}, false);
+           return kOk;
+         }});
   }
   return out;
 }
