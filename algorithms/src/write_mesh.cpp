@@ -63,9 +63,12 @@ MeshFormat mesh_format_for_path(const std::string& path) {
   throw InputError(path, "cannot write '" + ext + "' meshes (use .stl or .ply)");
 }
 
+std::string encode_mesh(const SkullMesh& mesh, MeshFormat format) {
+  return format == MeshFormat::BinarySTL ? encode_stl(mesh) : encode_ply(mesh);
+}
+
 void write_mesh(const SkullMesh& mesh, const std::string& path, MeshFormat format) {
-  write_file_atomically(path,
-                        format == MeshFormat::BinarySTL ? encode_stl(mesh) : encode_ply(mesh));
+  write_file_atomically(path, encode_mesh(mesh, format));
 }
 
 }  // namespace cranioplan

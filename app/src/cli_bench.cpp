@@ -91,8 +91,8 @@ Json run_bench(const BenchOptions& options) {
     // At least 300 markers, as a dense manual plan has: re-plan with closer spacing if needed.
     AutoplanParams dense;
     for (double spacing = 5.0; plan.markers.size() < 300 && spacing >= 2.0; spacing -= 1.0) {
-      dense.surface_spacing_mm = spacing;
-      dense.edge_spacing_mm = std::min(4.0, spacing);
+      dense.propose.surface_spacing_mm = spacing;
+      dense.propose.edge_spacing_mm = std::min(4.0, spacing);
       plan = autoplan(skull.mesh, Landmarks{}, dense);
     }
     const SurfaceLocator bone(skull.mesh), mirror(plan.mirrored);

@@ -292,7 +292,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
                      const Landmarks lm =
                          o->landmarks.empty() ? Landmarks{} : read_landmarks_file(o->landmarks);
                      const SkullMesh skull = load_skull(o->skull).mesh;
-                     o->params.method = o->method == "mirror"     ? PlanMethod::Mirror
+                     o->params.propose.method = o->method == "mirror"     ? PlanMethod::Mirror
                                         : o->method == "rim-only" ? PlanMethod::RimOnly
                                                                   : PlanMethod::Auto;
                      const AutoplanResult r = autoplan(skull, lm, o->params);

@@ -70,7 +70,9 @@ TEST(Autoplan, StagesAreConsistent) {
     const SurfaceLocator& surface = m.surface == MarkerSurface::Mirrored ? mirror : bone;
     EXPECT_LT(surface.closest(m.position).distance, 0.05)
         << "marker " << m.id << " off its surface";
-    if (is_edge(m.type)) EXPECT_LT(bone.closest(m.position).distance, 0.05);
+    if (is_edge(m.type)) {
+      EXPECT_LT(bone.closest(m.position).distance, 0.05);
+    }
   }
   EXPECT_GE(r.stage_seconds.size(), 6u);
   EXPECT_LT(r.plane.plane.angle_to_deg(Plane{Eigen::Vector3d::UnitX(), 0}), 1.0);

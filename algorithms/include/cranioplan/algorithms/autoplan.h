@@ -8,27 +8,18 @@
 
 #include "cranioplan/algorithms/build_implant.h"
 #include "cranioplan/algorithms/check_implant.h"
-#include "cranioplan/algorithms/detect_defect.h"
 #include "cranioplan/algorithms/fit_sagittal_plane.h"
+#include "cranioplan/algorithms/propose_markers.h"
 #include "cranioplan/algorithms/register_icp.h"
-#include "cranioplan/algorithms/smooth_markers.h"
 #include "cranioplan/model/landmarks.h"
 #include "cranioplan/model/marker.h"
 
 namespace cranioplan {
 
-enum class PlanMethod { Auto, Mirror, RimOnly };
-const char* to_string(PlanMethod m);
-
 struct AutoplanParams {
   PlaneFitParams plane;
   RegisterParams registration;
-  DetectDefectParams detect;
-  PlanMethod method = PlanMethod::Auto;  ///< Auto: mirror where it covers the defect, else rim
-  double min_mirror_coverage = 0.8;      ///< Auto uses the mirror above this coverage, 0..1
-  double edge_spacing_mm = 4.0;          ///< proposed edge markers along the rim, mm
-  double surface_spacing_mm = 6.0;       ///< proposed surface and support markers, mm
-  SmoothParams smooth{10.0, 2.0, 1};     ///< applied to mirror surface markers (projected back)
+  ProposeParams propose;  ///< defect detection and marker proposal
   ImplantParams implant = [] {
     ImplantParams p;
     p.surface_smoothing = 0.003;

@@ -11,6 +11,9 @@ enum class MeshFormat { BinarySTL, BinaryPLY };
 /// for other extensions.
 MeshFormat mesh_format_for_path(const std::string& path);
 
+/// The bytes `write_mesh` writes (deterministic: the same mesh gives the same bytes, so the
+/// SHA-256 of an export can be checked by replaying a plan).
+std::string encode_mesh(const SkullMesh& mesh, MeshFormat format);
 /// Writes the mesh atomically (temporary file in the same folder, then rename). Throws
 /// InputError when the file cannot be written.
 void write_mesh(const SkullMesh& mesh, const std::string& path, MeshFormat format);

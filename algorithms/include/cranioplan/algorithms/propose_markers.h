@@ -1,0 +1,56 @@
+#pragma once
+// Marker proposal for a detected defect: outer edge markers along the rim, support markers on
+// the intact ring around it, and — when the registered mirror covers the opening — surface
+// markers from the mirror, smoothed with the paper's smoother. The wizard's "Propose markers"
+// and the automatic planner both use it.
+#include <string>
+#include <vector>
+
+#include "cranioplan/algorithms/detect_defect.h"
+#include "cranioplan/algorithms/smooth_markers.h"
+#include "cranioplan/model/marker.h"
+#include "cranioplan/model/plane.h"
+
+namespace cranioplan {
+
+class SurfaceLocator;
+
+enum class PlanMethod { Auto, Mirror, RimOnly };
+const char* to_string(PlanMethod m);
+/// "auto", "mirror" or "rim-only"; false for anything else.
+bool plan_method_from_string(const std::string& text, PlanMethod& out);
+
+struct ProposeParams {
+  DetectDefectParams detect;
+  PlanMethod method = PlanMethod::Auto;  ///< Auto: mirror where it covers the defect, else rim
+  double min_mirror_coverage = 0.8;      ///< Auto uses the mirror above this coverage, 0..1
+  double edge_spacing_mm = 4.0;          ///< proposed edge markers along the rim, mm (>0)
+  double surface_spacing_mm = 6.0;       ///< proposed surface and support markers, mm (>0)
+  SmoothParams smooth{10.0, 2.0, 1};     ///< applied to mirror surface markers (projected back)
+};
+
+struct MarkerProposal {
+  enum class Status { Proposed, NoDefect };
+  Status status = Status::NoDefect;
+  std::string message;
+  DefectRegion defect;
+  PlanMethod method_used = PlanMethod::RimOnly;
+  double mirror_coverage = 0.0;  ///< fraction of the opening's rays that meet mirrored bone
+  std::vector<Marker> markers;   ///< ids from `first_id` on
+  bool proposed() const { return status == Status::Proposed; }
+};
+
+/// The defect seen from the skull's centroid moved onto the midsagittal plane.
+DefectRegion detect_defect_near_plane(const SkullMesh& skull, const SurfaceLocator& bone,
+                                      const Plane& plane, const DetectDefectParams& params);
+
+/// Markers for an already detected defect; `mirror` is the registered mirrored skull.
+MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const SurfaceLocator& mirror,
+                                          const ProposeParams& params, int first_id = 1);
+
+/// Detects the defect, then proposes markers (status NoDefect when there is none).
+MarkerProposal propose_markers(const SkullMesh& skull, const SurfaceLocator& bone,
+                               const Plane& plane, const SurfaceLocator& mirror,
+                               const ProposeParams& params, int first_id = 1);
+
+}  // namespace cranioplan
