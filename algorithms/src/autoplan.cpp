@@ -54,8 +54,7 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
   }
 
   const SurfaceLocator mirror(r.mirrored);
-  MarkerProposal proposal =
-      propose_markers_for_defect(r.defect, mirror, params.propose);
+  MarkerProposal proposal = propose_markers_for_defect(r.defect, mirror, params.propose);
   r.mirror_coverage = proposal.mirror_coverage;
   r.method_used = proposal.method_used;
   r.markers = std::move(proposal.markers);

@@ -88,8 +88,8 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
     }
   }
   r.mirror_coverage = defect.hole_directions.empty() ? 0.0
-                                                       : static_cast<double>(mirror_outer.size()) /
-                                                             defect.hole_directions.size();
+                                                     : static_cast<double>(mirror_outer.size()) /
+                                                           defect.hole_directions.size();
   r.method_used = params.method == PlanMethod::Auto
                       ? (r.mirror_coverage >= params.min_mirror_coverage ? PlanMethod::Mirror
                                                                          : PlanMethod::RimOnly)

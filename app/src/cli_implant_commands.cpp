@@ -10,6 +10,7 @@
 #include <sstream>
 
 #include "cli_output.h"
+#include "cli_session_commands.h"
 #include "cranioplan/algorithms/autoplan.h"
 #include "cranioplan/algorithms/build_implant.h"
 #include "cranioplan/algorithms/check_implant.h"
@@ -21,6 +22,7 @@
 #include "cranioplan/algorithms/surface_locator.h"
 #include "cranioplan/algorithms/write_mesh.h"
 #include "cranioplan/model/error.h"
+#include "cranioplan/sessions/autoplan_session.h"
 #include "cranioplan/sessions/marker_files.h"
 
 namespace cranioplan::cli {
@@ -75,6 +77,30 @@ Json autoplan_json(const AutoplanResult& r) {
   times["total"] = total;
   j["seconds"] = times;
   return j;
+}
+
+// autoplan --session: the plan made by session commands, saved for reopening and audit.
+int autoplan_with_session(const std::string& skull, const Landmarks& lm,
+                          const AutoplanParams& params, const std::string& output,
+                          const std::string& markers_out, const std::string& session_path,
+                          bool json) {
+  AutoplanSession a = autoplan_session(skull, lm, params, output);
+  a.session.save(session_path);
+  const PlanState& s = a.session.state();
+  Json j{{"status", a.planned()                                     ? "planned"
+                    : a.status == AutoplanSession::Status::NoDefect ? "no_defect"
+                                                                    : "failed"},
+         {"message", a.message}};
+  j.update(plan_state_json(s));
+  Json times = Json::object();
+  for (const auto& c : a.session.effective_commands())
+    times[type_tag(c.type)] = c.meta.duration_ms / 1000.0;
+  j["seconds"] = times;
+  j["session"] = session_path;
+  if (!markers_out.empty() && !s.markers.empty()) write_markers_file(s.markers, markers_out);
+  if (a.planned()) j["output"] = output;
+  print_result(j, json);
+  return a.planned() ? kOk : kUnusable;
 }
 
 double median(std::vector<double> v) {
@@ -276,7 +302,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
   }
   {  // autoplan
     struct Opts {
-      std::string skull, landmarks, output, markers_out, method = "auto";
+      std::string skull, landmarks, output, markers_out, session, method = "auto";
       AutoplanParams params;
     };
     auto o = std::make_shared<Opts>();
@@ -288,13 +314,17 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
         ->check(CLI::IsMember({"auto", "mirror", "rim-only"}));
     cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
     cmd->add_option("--markers-out", o->markers_out, "proposed markers to write (.json or .csv)");
-    out.push_back({cmd, [o, &json] {
+    cmd->add_option("--session", o->session,
+                    "plan through session commands and save the session (.json): reopen, edit, "
+                    "replay and audit it");
+    out.push_back({cmd, [o, &json]() -> int {
                      const Landmarks lm =
                          o->landmarks.empty() ? Landmarks{} : read_landmarks_file(o->landmarks);
+                     plan_method_from_string(o->method, o->params.propose.method);
+                     if (!o->session.empty())
+                       return autoplan_with_session(o->skull, lm, o->params, o->output,
+                                                    o->markers_out, o->session, json);
                      const SkullMesh skull = load_skull(o->skull).mesh;
-                     o->params.propose.method = o->method == "mirror"     ? PlanMethod::Mirror
-                                        : o->method == "rim-only" ? PlanMethod::RimOnly
-                                                                  : PlanMethod::Auto;
                      const AutoplanResult r = autoplan(skull, lm, o->params);
                      Json j = autoplan_json(r);
                      if (!o->markers_out.empty() && !r.markers.empty())

@@ -8,6 +8,7 @@
 #include "cli_bench.h"
 #include "cli_implant_commands.h"
 #include "cli_output.h"
+#include "cli_session_commands.h"
 #include "cranioplan/algorithms/fit_sagittal_plane.h"
 #include "cranioplan/algorithms/load_skull.h"
 #include "cranioplan/algorithms/mesh_report.h"
@@ -157,7 +158,8 @@ int run(int argc, char** argv) {
   bench->add_option("--runs", bench_options.runs, "repetitions per step (median reported)")
       ->check(CLI::Range(1, 100));
 
-  const std::vector<Subcommand> implant_commands = add_implant_commands(app, json);
+  std::vector<Subcommand> implant_commands = add_implant_commands(app, json);
+  for (auto& c : add_session_commands(app, json)) implant_commands.push_back(std::move(c));
 
   for (auto* sub : app.get_subcommands([](CLI::App*) { return true; }))
     sub->add_flag("--json", json, "print one JSON object on stdout");

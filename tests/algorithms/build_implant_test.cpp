@@ -52,7 +52,9 @@ TEST(BuildImplant, ShellThroughMarkersIsWatertightAndPassesThroughEdgeMarkers) {
   // Every edge marker is a vertex of the implant (within 0.05 mm).
   const SurfaceLocator implant(r.mesh);
   for (const auto& m : c.markers)
-    if (is_edge(m.type)) EXPECT_LT(implant.closest(m.position).distance, 0.05) << m.id;
+    if (is_edge(m.type)) {
+      EXPECT_LT(implant.closest(m.position).distance, 0.05) << m.id;
+    }
 }
 
 TEST(BuildImplant, ShellMatchesTheRemovedBone) {

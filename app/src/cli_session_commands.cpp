@@ -1,0 +1,166 @@
+#include "cli_session_commands.h"
+
+#include <memory>
+
+#include "cli_output.h"
+#include "cranioplan/algorithms/file_io.h"
+#include "cranioplan/algorithms/write_mesh.h"
+#include "cranioplan/sessions/audit.h"
+#include "cranioplan/sessions/session.h"
+
+namespace cranioplan::cli {
+
+Json plan_state_json(const PlanState& s) {
+  Json j;
+  Json steps = Json::array();
+  for (const auto& step : wizard_steps()) {
+    std::string missing;
+    const bool done = step_complete(s, step.number, &missing);
+    Json row{{"step", step.number}, {"title", step.title}, {"done", done}};
+    if (!done) row["missing"] = missing;
+    if (s.stale.count(step.number)) row["stale"] = s.stale.at(step.number);
+    steps.push_back(row);
+  }
+  j["steps"] = steps;
+  if (s.skull) j["skull"] = Json{{"path", s.skull->path}, {"sha256", s.skull->sha256}};
+  if (s.plane) j["plane"] = to_json(*s.plane);
+  if (s.mirrored) j["mirror_transform"] = to_json(s.mirror_transform());
+  j["markers"] = s.markers.size();
+  if (s.implant) {
+    const auto& r = s.implant->result();
+    j["implant"] = Json{{"triangles", r.mesh.n_faces()},
+                        {"watertight", r.watertight},
+                        {"sha256_stl", s.implant->stl_sha256()}};
+    j["quality"] = to_json(s.implant->quality());
+  }
+  Json exports = Json::array();
+  for (const auto& e : s.exports)
+    exports.push_back({{"path", e.path},
+                       {"recorded_sha256", e.recorded_sha256},
+                       {"replayed_sha256", e.replayed_sha256}});
+  j["exports"] = exports;
+  return j;
+}
+
+std::vector<Subcommand> add_session_commands(CLI::App& app, const bool& json) {
+  std::vector<Subcommand> out;
+  {  // replay
+    struct Opts {
+      std::string session, output;
+    };
+    auto o = std::make_shared<Opts>();
+    auto* cmd = app.add_subcommand("replay", "Rebuild a saved plan headlessly from its commands");
+    cmd->add_option("SESSION", o->session, "session (.json)")->required();
+    cmd->add_option("-o,--output", o->output, "write the plan's implant (.stl or .ply)");
+    out.push_back({cmd, [o, &json] {
+                     const Session s = Session::open(o->session);
+                     Json j = plan_state_json(s.state());
+                     j["commands"] = s.effective_commands().size();
+                     if (!o->output.empty()) {
+                       if (!s.state().implant) {
+                         j["error"] = "the plan has no implant to write";
+                         print_result(j, json);
+                         return kUnusable;
+                       }
+                       write_mesh(s.state().implant->result().mesh, o->output);
+                       j["output"] = o->output;
+                     }
+                     print_result(j, json);
+                     return kOk;
+                   }});
+  }
+  {  // verify
+    auto session = std::make_shared<std::string>();
+    auto* cmd = app.add_subcommand(
+        "verify",
+        "Check a plan: inputs' hashes, hash chain, replay of every export (exit 4 if not)");
+    cmd->add_option("SESSION", *session, "session (.json)")->required();
+    out.push_back({cmd, [session, &json] {
+                     const VerifyReport r = verify_session(*session);
+                     Json j;
+                     j["ok"] = r.ok();
+                     for (const auto& c : r.checks)
+                       j[c.name] = (c.ok ? "holds: " : "FAILS: ") + c.detail;
+                     print_result(j, json);
+                     return r.ok() ? kOk : kVerifyFailed;
+                   }});
+  }
+  {  // audit
+    struct Opts {
+      std::string session, html;
+    };
+    auto o = std::make_shared<Opts>();
+    auto* cmd = app.add_subcommand("audit", "A plan's timeline: who, when, step, what, how long");
+    cmd->add_option("SESSION", o->session, "session (.json)")->required();
+    cmd->add_option("--html", o->html, "also write the timeline as HTML");
+    out.push_back(
+        {cmd, [o, &json] {
+           const SessionDocument doc = read_session_document(o->session);
+           if (!o->html.empty()) {
+             const VerifyReport v = verify_session(o->session);
+             write_file_atomically(o->html, audit_html(doc, &v));
+           }
+           if (json) {
+             Json rows = Json::array();
+             for (const auto& r : audit_rows(doc))
+               rows.push_back({{"seq", r.seq},
+                               {"time", r.time},
+                               {"user", r.user},
+                               {"event", r.event},
+                               {"step", r.step},
+                               {"what", r.what},
+                               {"duration_ms", r.duration_ms},
+                               {"undone", r.undone}});
+             const StepDurations d = step_durations(doc.header, doc.journal);
+             Json steps = Json::object();
+             for (const auto& s : wizard_steps())
+               steps[std::to_string(s.number)] = d.seconds[s.number];
+             print_result(
+                 Json{{"timeline", rows}, {"step_seconds", steps}, {"total_seconds", d.total}},
+                 true);
+           } else {
+             std::fputs(audit_text(doc).c_str(), stdout);
+           }
+           return kOk;
+         }});
+  }
+  {  // training-report
+    struct Opts {
+      std::string session, reference, html;
+    };
+    auto o = std::make_shared<Opts>();
+    auto* cmd = app.add_subcommand(
+        "training-report",
+        "A trainee's plan against an expert's: time per step, implant agreement");
+    cmd->add_option("SESSION", o->session, "the trainee's session")->required();
+    cmd->add_option("--reference", o->reference, "the expert's session")->required();
+    cmd->add_option("--html", o->html, "also write the report as HTML");
+    out.push_back({cmd, [o, &json] {
+                     const Session trainee = Session::open(o->session);
+                     const Session reference = Session::open(o->reference);
+                     const TrainingReport r = training_report(trainee, reference);
+                     if (!o->html.empty()) write_file_atomically(o->html, training_report_html(r));
+                     if (json) {
+                       Json steps = Json::array();
+                       for (const auto& s : wizard_steps())
+                         steps.push_back({{"step", s.number},
+                                          {"trainee_s", r.trainee.seconds[s.number]},
+                                          {"reference_s", r.reference.seconds[s.number]}});
+                       Json j{{"steps", steps},
+                              {"trainee_total_s", r.trainee.total},
+                              {"reference_total_s", r.reference.total}};
+                       if (r.agreement)
+                         j["agreement"] = to_json(*r.agreement);
+                       else
+                         j["note"] = r.note;
+                       print_result(j, true);
+                     } else {
+                       std::fputs(training_report_text(r).c_str(), stdout);
+                     }
+                     return kOk;
+                   }});
+  }
+  return out;
+}
+
+}  // namespace cranioplan::cli

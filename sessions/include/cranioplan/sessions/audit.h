@@ -1,0 +1,73 @@
+#pragma once
+// Audit and training: verify a saved plan (inputs, hash chain, replay), read its timeline, and
+// compare a trainee's plan with an expert's (time per step, implant agreement).
+#include <array>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cranioplan/algorithms/compare_implants.h"
+#include "cranioplan/sessions/session.h"
+
+namespace cranioplan {
+
+struct VerifyCheck {
+  std::string name;  ///< "inputs", "hash chain", "commands", "replay"
+  bool ok = false;
+  std::string detail;  ///< plain words
+};
+
+struct VerifyReport {
+  std::vector<VerifyCheck> checks;
+  bool ok() const;
+};
+
+/// Inputs' SHA-256, the journal's hash chain, the command lists against the journal, and a
+/// replay that reproduces every recorded export hash. Throws SessionError / InputError only when
+/// the file cannot be read as a session at all (not JSON, unknown schema, ...).
+VerifyReport verify_session(const std::string& path);
+
+/// Wall-clock time spent in each wizard step, from the journal: the time from one event to the
+/// next counts for the step of the later event (notes count for the step before them). Idle
+/// gaps longer than `idle_cap_s` count as `idle_cap_s`.
+struct StepDurations {
+  std::array<double, 10> seconds{};  ///< [1..9] used
+  double total = 0.0;
+};
+StepDurations step_durations(const SessionHeader& header, const std::vector<JournalEntry>& journal,
+                             double idle_cap_s = 300.0);
+
+/// Seconds since the epoch of an ISO-8601 UTC time as this program writes it; NaN if malformed.
+double parse_iso8601(const std::string& text);
+
+/// One line of the timeline.
+struct AuditRow {
+  int seq = 0;
+  std::string time;
+  std::string user;
+  std::string event;  ///< do, undo, redo, merge
+  int step = 0;
+  std::string what;    ///< describe() of the command done, undone or redone
+  std::string params;  ///< compact JSON of the parameters (do and merge)
+  double duration_ms = 0;
+  bool undone = false;  ///< a do whose command is not in the final plan
+};
+std::vector<AuditRow> audit_rows(const SessionDocument& doc);
+std::string audit_text(const SessionDocument& doc);
+std::string audit_html(const SessionDocument& doc, const VerifyReport* verify = nullptr);
+
+struct TrainingReport {
+  std::string trainee_user, reference_user;
+  StepDurations trainee, reference;
+  std::optional<CompareResult> agreement;  ///< trainee implant vs reference implant
+  double trainee_volume_mm3 = 0.0, reference_volume_mm3 = 0.0;
+  std::string note;  ///< why there is no agreement, when there is none
+};
+/// Times from both journals; agreement from both sessions' final implants (boundary Dice near
+/// the trainee's skull).
+TrainingReport training_report(const Session& trainee, const Session& reference,
+                               const CompareParams& params = {});
+std::string training_report_text(const TrainingReport& report);
+std::string training_report_html(const TrainingReport& report);
+
+}  // namespace cranioplan

@@ -1,0 +1,27 @@
+#pragma once
+// The automatic planner run as session commands, so every automatic plan can be reopened,
+// edited, replayed and audited like a hand-made one.
+#include <string>
+
+#include "cranioplan/algorithms/autoplan.h"
+#include "cranioplan/model/landmarks.h"
+#include "cranioplan/sessions/session.h"
+
+namespace cranioplan {
+
+struct AutoplanSession {
+  enum class Status { Planned, NoDefect, Failed };
+  Status status = Status::Failed;
+  std::string message;  ///< what happened, or the stage that stopped and why
+  Session session;      ///< every command run, whether or not it planned
+  bool planned() const { return status == Status::Planned; }
+};
+
+/// Load → landmarks → fit plane → mirror → register → inspect → propose markers → build
+/// implant → review, and, when `export_path` is not empty, export. The same algorithms and
+/// parameters as `autoplan()`, so the implant is the same. Throws InputError for a bad skull.
+AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks& landmarks,
+                                 const AutoplanParams& params, const std::string& export_path,
+                                 const SessionInfo& info = {});
+
+}  // namespace cranioplan

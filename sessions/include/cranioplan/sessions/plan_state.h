@@ -1,0 +1,132 @@
+#pragma once
+// The plan's state: a pure function of the inputs and the effective commands. Heavy results
+// (meshes, locators, the implant) are shared immutable pieces, so a state is cheap to copy and
+// the session keeps one per command for instant undo.
+#include <array>
+#include <map>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cranioplan/algorithms/build_implant.h"
+#include "cranioplan/algorithms/check_implant.h"
+#include "cranioplan/algorithms/fit_sagittal_plane.h"
+#include "cranioplan/algorithms/register_icp.h"
+#include "cranioplan/algorithms/surface_locator.h"
+#include "cranioplan/model/landmarks.h"
+#include "cranioplan/model/marker.h"
+#include "cranioplan/model/mesh.h"
+#include "cranioplan/sessions/command.h"
+
+namespace cranioplan {
+
+/// A mesh with its locator, built once and shared by every state that uses it.
+struct SharedSurface {
+  explicit SharedSurface(SkullMesh m);
+  SkullMesh mesh;
+  SurfaceLocator locator;
+};
+
+struct SkullInput {
+  std::string path;    ///< as recorded in the command
+  std::string sha256;  ///< of the file's bytes
+  std::string description;
+  std::vector<std::string> warnings;
+  std::shared_ptr<const SharedSurface> surface;
+};
+
+/// The implant and what is derived from it; the quality report is computed on first use.
+class ImplantData {
+ public:
+  ImplantData(ImplantResult result, std::shared_ptr<const SkullInput> skull);
+  const ImplantResult& result() const { return result_; }
+  /// SHA-256 of the binary STL bytes of the implant (what an .stl export writes).
+  const std::string& stl_sha256() const { return stl_sha256_; }
+  const QualityReport& quality() const;
+
+ private:
+  ImplantResult result_;
+  std::string stl_sha256_;
+  std::shared_ptr<const SkullInput> skull_;
+  mutable std::once_flag quality_once_;
+  mutable QualityReport quality_;
+};
+
+struct ExportRecord {
+  std::string path;
+  std::string format;           ///< "stl" or "ply"
+  std::string recorded_sha256;  ///< what the command says was written
+  std::string replayed_sha256;  ///< the bytes this state's implant encodes to
+  std::string implant_sha256;   ///< the implant's STL hash at the time of the export
+};
+
+struct PlanState {
+  // Step 1
+  std::shared_ptr<const SkullInput> skull;
+  // Step 2
+  Landmarks landmarks;
+  std::optional<Plane> plane;
+  std::optional<PlaneFit> plane_fit;  ///< diagnostics of the last fit
+  // Step 3
+  bool mirror_requested = false;
+  std::shared_ptr<const SkullMesh> mirror_base;   ///< the skull mirrored across `plane`
+  std::optional<RegisterParams> register_params;  ///< re-run when the plane changes
+  std::optional<RegisterResult> registration;
+  RigidTransform manual;                          ///< hand moves, applied after the registration
+  std::shared_ptr<const SharedSurface> mirrored;  ///< base carried by manual ∘ registration
+  // Step 4
+  std::optional<Plane> clip_plane;
+  // Steps 5, 6, 8
+  std::vector<Marker> markers;
+  int next_marker_id = 1;                        ///< ids are never reused
+  std::optional<Eigen::Vector3d> defect_center;  ///< from the last proposal
+  std::string proposal_message;
+  // Step 7
+  std::optional<ImplantParams> implant_params;  ///< rebuilt after every marker change
+  std::shared_ptr<const ImplantData> implant;
+  // Step 9
+  std::vector<ExportRecord> exports;
+  // Wizard
+  std::array<bool, 10> acknowledged{};  ///< steps completed by hand (3, 4, 8)
+  std::map<int, std::string> stale;     ///< step → why its results were recomputed
+  int current_step = 1;
+  std::vector<std::string> notes;
+  std::string message;  ///< what the last command did, or why it had no effect
+
+  RigidTransform mirror_transform() const;
+  const Marker* find_marker(int id) const;
+};
+
+struct WizardStep {
+  int number;
+  const char* title;
+  const char* instructions;
+};
+/// The nine steps of the wizard, 1..9.
+const std::array<WizardStep, 9>& wizard_steps();
+/// Whether step `step` (1..9) is done; when not, `missing` says what is missing.
+bool step_complete(const PlanState& state, int step, std::string* missing = nullptr);
+/// Whether every step before `step` is done; when not, `why` names the first that is not.
+bool step_unlocked(const PlanState& state, int step, std::string* why = nullptr);
+/// The wizard step a command belongs to (marker edits: the marker's step); 0 for notes.
+int command_step(const PlanState& state, const Command& command);
+
+struct ApplyContext {
+  std::string session_dir;  ///< relative and moved input paths are looked up here too
+};
+
+struct ApplyOutcome {
+  bool accepted = false;
+  std::string message;  ///< why it was refused, or what it did
+  PlanState state;      ///< the new state (the old one when refused)
+};
+
+/// Applies one command. A command of a locked step, or one that refers to something that does
+/// not exist (a marker id, a plane before landmarks), is refused. Bad inputs (a missing skull
+/// file, a changed file) throw InputError/SessionError.
+ApplyOutcome apply_command(const PlanState& before, const Command& command,
+                           const ApplyContext& context = {});
+
+}  // namespace cranioplan

@@ -1,0 +1,385 @@
+#include "cranioplan/sessions/audit.h"
+
+#include <cmath>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
+#include <limits>
+#include <sstream>
+
+#include "cranioplan/sessions/session_error.h"
+#include "cranioplan/sessions/sha256.h"
+
+namespace cranioplan {
+
+namespace fs = std::filesystem;
+
+bool VerifyReport::ok() const {
+  for (const auto& c : checks)
+    if (!c.ok) return false;
+  return !checks.empty();
+}
+
+namespace {
+
+std::string resolve(const std::string& recorded, const std::string& session_dir) {
+  std::error_code ec;
+  if (fs::exists(recorded, ec)) return recorded;
+  for (const fs::path& candidate :
+       {fs::path(session_dir) / recorded, fs::path(session_dir) / fs::path(recorded).filename()})
+    if (fs::exists(candidate, ec)) return candidate.string();
+  return {};
+}
+
+std::string fmt(const char* format, double value) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), format, value);
+  return buf;
+}
+
+std::string html_escape(const std::string& s) {
+  std::string out;
+  for (char c : s) {
+    switch (c) {
+      case '&':
+        out += "&amp;";
+        break;
+      case '<':
+        out += "&lt;";
+        break;
+      case '>':
+        out += "&gt;";
+        break;
+      case '"':
+        out += "&quot;";
+        break;
+      default:
+        out += c;
+    }
+  }
+  return out;
+}
+
+const char* kHtmlHead =
+    "<!DOCTYPE html><html><head><meta charset=\"utf-8\"><title>%s</title><style>"
+    "body{font-family:sans-serif;margin:2em;color:#222}table{border-collapse:collapse}"
+    "td,th{border:1px solid #bbb;padding:3px 8px;text-align:left;vertical-align:top}"
+    "th{background:#eee}.undone{color:#999;text-decoration:line-through}.ok{color:#070}"
+    ".bad{color:#b00;font-weight:bold}code{font-size:85%%}</style></head><body>";
+
+std::string html_head(const std::string& title) {
+  char buf[1024];
+  std::snprintf(buf, sizeof(buf), kHtmlHead, html_escape(title).c_str());
+  return buf;
+}
+
+std::string duration_text(double seconds) {
+  const int s = static_cast<int>(std::lround(seconds));
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%d:%02d", s / 60, s % 60);
+  return buf;
+}
+
+}  // namespace
+
+VerifyReport verify_session(const std::string& path) {
+  VerifyReport report;
+  const SessionDocument doc = read_session_document(path);
+  const std::string dir = fs::path(path).parent_path().string();
+
+  VerifyCheck inputs{"inputs", true, ""};
+  int n_inputs = 0;
+  for (const auto& c : doc.commands) {
+    if (c.type != CommandType::LoadSkull) continue;
+    ++n_inputs;
+    const std::string recorded = c.params.value("path", std::string());
+    const std::string found = resolve(recorded, dir);
+    if (found.empty()) {
+      inputs.ok = false;
+      inputs.detail += recorded + ": missing. ";
+    } else if (sha256_file(found) != c.params.value("sha256", std::string())) {
+      inputs.ok = false;
+      inputs.detail += found + ": the skull file changed since this plan was made. ";
+    }
+  }
+  if (inputs.ok) inputs.detail = std::to_string(n_inputs) + " input file(s) unchanged (SHA-256)";
+  report.checks.push_back(inputs);
+
+  VerifyCheck chain{"hash chain", true, ""};
+  if (auto bad = first_broken_link(doc.header, doc.journal)) {
+    chain.ok = false;
+    chain.detail = "broken at journal entry " + std::to_string(*bad + 1) + " of " +
+                   std::to_string(doc.journal.size()) +
+                   ": the session was changed after it was written";
+  } else {
+    chain.detail = std::to_string(doc.journal.size()) + " journal entries, every link holds";
+  }
+  report.checks.push_back(chain);
+
+  VerifyCheck replay{"replay", false, ""};
+  if (!inputs.ok || !chain.ok) {
+    replay.detail = "not run: the inputs or the journal do not hold";
+    report.checks.push_back(replay);
+    return report;
+  }
+  try {
+    const Session session = Session::open(path);
+    const auto& exports = session.state().exports;
+    int matching = 0;
+    replay.ok = true;
+    for (const auto& e : exports) {
+      if (e.recorded_sha256 == e.replayed_sha256) {
+        ++matching;
+      } else {
+        replay.ok = false;
+        replay.detail += e.path + ": the replayed implant differs from the one exported. ";
+      }
+    }
+    if (replay.ok)
+      replay.detail = std::to_string(session.effective_commands().size()) + " commands replayed; " +
+                      std::to_string(matching) + " of " + std::to_string(exports.size()) +
+                      " export(s) reproduced byte for byte";
+  } catch (const Error& e) {
+    replay.detail = e.what();
+  }
+  report.checks.push_back(replay);
+  return report;
+}
+
+double parse_iso8601(const std::string& text) {
+  std::tm tm{};
+  int ms = 0;
+  if (std::sscanf(text.c_str(), "%d-%d-%dT%d:%d:%d.%dZ", &tm.tm_year, &tm.tm_mon, &tm.tm_mday,
+                  &tm.tm_hour, &tm.tm_min, &tm.tm_sec, &ms) < 6)
+    return std::numeric_limits<double>::quiet_NaN();
+  tm.tm_year -= 1900;
+  tm.tm_mon -= 1;
+  return static_cast<double>(timegm(&tm)) + ms / 1000.0;
+}
+
+StepDurations step_durations(const SessionHeader& header, const std::vector<JournalEntry>& journal,
+                             double idle_cap_s) {
+  StepDurations d;
+  double previous = parse_iso8601(header.info.created);
+  int last_step = 1;
+  std::vector<Command> stack;
+  size_t index = 0;
+  for (const auto& e : journal) {
+    int step = last_step;
+    if (e.event == "do" || e.event == "merge") {
+      if (e.command->meta.step >= 1) step = e.command->meta.step;
+      if (e.event == "do") {
+        stack.resize(index);
+        stack.push_back(*e.command);
+        ++index;
+      } else if (index > 0) {
+        stack[index - 1] = *e.command;
+      }
+    } else if (e.event == "undo" && index > 0) {
+      step = std::max(1, stack[index - 1].meta.step);
+      --index;
+    } else if (e.event == "redo" && index < stack.size()) {
+      step = std::max(1, stack[index].meta.step);
+      ++index;
+    }
+    const double t = parse_iso8601(e.time);
+    if (std::isfinite(t) && std::isfinite(previous)) {
+      const double gap = std::clamp(t - previous, 0.0, idle_cap_s);
+      d.seconds[step] += gap;
+      d.total += gap;
+    }
+    if (std::isfinite(t)) previous = t;
+    last_step = step;
+  }
+  return d;
+}
+
+std::vector<AuditRow> audit_rows(const SessionDocument& doc) {
+  std::vector<AuditRow> rows;
+  std::vector<Command> stack;
+  std::vector<size_t> stack_rows;  // the row that did each stack entry
+  size_t index = 0;
+  for (const auto& e : doc.journal) {
+    AuditRow row;
+    row.seq = e.seq;
+    row.time = e.time;
+    row.user = e.user;
+    row.event = e.event;
+    if (e.command) {
+      row.step = e.command->meta.step;
+      row.what = describe(*e.command);
+      row.params = e.command->params.dump();
+      row.duration_ms = e.command->meta.duration_ms;
+    }
+    if (e.event == "do") {
+      stack.resize(index);
+      stack_rows.resize(index);
+      stack.push_back(*e.command);
+      stack_rows.push_back(rows.size());
+      ++index;
+    } else if (e.event == "merge" && index > 0) {
+      stack[index - 1] = *e.command;
+    } else if (e.event == "undo" && index > 0) {
+      --index;
+      row.step = stack[index].meta.step;
+      row.what = describe(stack[index]);
+    } else if (e.event == "redo" && index < stack.size()) {
+      row.step = stack[index].meta.step;
+      row.what = describe(stack[index]);
+      ++index;
+    }
+    rows.push_back(row);
+  }
+  // A do whose command is not among the effective ones was undone (or dropped by a later push).
+  std::vector<bool> effective(rows.size(), false);
+  for (size_t i = 0; i < index; ++i) effective[stack_rows[i]] = true;
+  for (size_t i = 0; i < rows.size(); ++i)
+    if (rows[i].event == "do") rows[i].undone = !effective[i];
+  return rows;
+}
+
+std::string audit_text(const SessionDocument& doc) {
+  std::ostringstream out;
+  out << "Plan " << doc.header.info.case_id << " by " << doc.header.info.user << ", created "
+      << doc.header.info.created << " (Cranioplan " << doc.header.app_version << ")\n";
+  out << doc.commands.size() << " commands in the plan, " << doc.journal.size()
+      << " journal events\n\n";
+  for (const auto& r : audit_rows(doc)) {
+    char buf[200];
+    std::snprintf(buf, sizeof(buf), "%4d  %s  %-10s step %d  %-6s ", r.seq, r.time.c_str(),
+                  r.user.c_str(), r.step, r.event.c_str());
+    out << buf << r.what;
+    if (r.event == "do" || r.event == "merge") out << "  (" << fmt("%.0f ms", r.duration_ms) << ")";
+    if (r.undone) out << "  [undone]";
+    if (!r.params.empty() && r.params != "{}") out << "\n        " << r.params.substr(0, 300);
+    out << "\n";
+  }
+  const StepDurations d = step_durations(doc.header, doc.journal);
+  out << "\nTime per step (m:ss)\n";
+  for (const auto& s : wizard_steps())
+    out << "  " << s.number << " " << s.title << ": " << duration_text(d.seconds[s.number]) << "\n";
+  out << "  total: " << duration_text(d.total) << "\n";
+  return out.str();
+}
+
+std::string audit_html(const SessionDocument& doc, const VerifyReport* verify) {
+  std::ostringstream out;
+  out << html_head("Cranioplan audit: " + doc.header.info.case_id);
+  out << "<h1>Plan " << html_escape(doc.header.info.case_id) << "</h1><p>By "
+      << html_escape(doc.header.info.user) << ", created " << html_escape(doc.header.info.created)
+      << ", Cranioplan " << html_escape(doc.header.app_version) << ". " << doc.commands.size()
+      << " commands in the plan, " << doc.journal.size() << " journal events.</p>";
+  if (verify) {
+    out << "<h2>Verification</h2><ul>";
+    for (const auto& c : verify->checks)
+      out << "<li class=\"" << (c.ok ? "ok" : "bad") << "\">" << html_escape(c.name) << ": "
+          << (c.ok ? "holds" : "FAILS") << " — " << html_escape(c.detail) << "</li>";
+    out << "</ul>";
+  }
+  out << "<h2>Timeline</h2><table><tr><th>#</th><th>time (UTC)</th><th>user</th><th>step</th>"
+         "<th>event</th><th>what</th><th>parameters</th><th>ms</th></tr>";
+  for (const auto& r : audit_rows(doc)) {
+    out << "<tr" << (r.undone ? " class=\"undone\"" : "") << "><td>" << r.seq << "</td><td>"
+        << html_escape(r.time) << "</td><td>" << html_escape(r.user) << "</td><td>" << r.step
+        << "</td><td>" << r.event << "</td><td>" << html_escape(r.what) << "</td><td><code>"
+        << html_escape(r.params.substr(0, 400)) << "</code></td><td>"
+        << (r.event == "do" || r.event == "merge" ? fmt("%.0f", r.duration_ms) : std::string())
+        << "</td></tr>";
+  }
+  out << "</table>";
+  const StepDurations d = step_durations(doc.header, doc.journal);
+  out << "<h2>Time per step</h2><table><tr><th>step</th><th>m:ss</th></tr>";
+  for (const auto& s : wizard_steps())
+    out << "<tr><td>" << s.number << " " << html_escape(s.title) << "</td><td>"
+        << duration_text(d.seconds[s.number]) << "</td></tr>";
+  out << "<tr><th>total</th><th>" << duration_text(d.total) << "</th></tr></table></body></html>";
+  return out.str();
+}
+
+TrainingReport training_report(const Session& trainee, const Session& reference,
+                               const CompareParams& params) {
+  TrainingReport r;
+  r.trainee_user = trainee.header().info.user;
+  r.reference_user = reference.header().info.user;
+  r.trainee = step_durations(trainee.header(), trainee.journal());
+  r.reference = step_durations(reference.header(), reference.journal());
+  const auto& a = trainee.state().implant;
+  const auto& b = reference.state().implant;
+  if (!a || !b) {
+    r.note = !a ? "the trainee's plan has no implant" : "the reference plan has no implant";
+    return r;
+  }
+  r.trainee_volume_mm3 = std::abs(signed_volume(a->result().mesh));
+  r.reference_volume_mm3 = std::abs(signed_volume(b->result().mesh));
+  r.agreement = compare_implants(
+      a->result().mesh, b->result().mesh,
+      trainee.state().skull ? &trainee.state().skull->surface->mesh : nullptr, params);
+  return r;
+}
+
+std::string training_report_text(const TrainingReport& r) {
+  std::ostringstream out;
+  out << "Training report: " << r.trainee_user << " against " << r.reference_user << "\n\n";
+  char buf[200];
+  std::snprintf(buf, sizeof(buf), "  %-34s %9s %9s %7s\n", "step", "trainee", "reference", "ratio");
+  out << buf;
+  for (const auto& s : wizard_steps()) {
+    const double t = r.trainee.seconds[s.number], ref = r.reference.seconds[s.number];
+    std::snprintf(buf, sizeof(buf), "  %d %-32s %9s %9s %7s\n", s.number, s.title,
+                  duration_text(t).c_str(), duration_text(ref).c_str(),
+                  ref > 0 ? fmt("%.2f", t / ref).c_str() : "-");
+    out << buf;
+  }
+  std::snprintf(
+      buf, sizeof(buf), "  %-34s %9s %9s %7s\n", "total", duration_text(r.trainee.total).c_str(),
+      duration_text(r.reference.total).c_str(),
+      r.reference.total > 0 ? fmt("%.2f", r.trainee.total / r.reference.total).c_str() : "-");
+  out << buf << "\n";
+  if (r.agreement) {
+    const CompareResult& c = *r.agreement;
+    std::snprintf(buf, sizeof(buf),
+                  "Implant agreement: DSC %.3f, boundary DSC %.3f, HD95 %.2f mm, HD %.2f mm\n"
+                  "Volumes: trainee %.0f mm³, reference %.0f mm³\n",
+                  c.dice, c.boundary_dice, c.hd95_mm, c.hausdorff_mm, r.trainee_volume_mm3,
+                  r.reference_volume_mm3);
+    out << buf;
+  } else {
+    out << "Implant agreement: not measured — " << r.note << "\n";
+  }
+  return out.str();
+}
+
+std::string training_report_html(const TrainingReport& r) {
+  std::ostringstream out;
+  out << html_head("Cranioplan training report");
+  out << "<h1>Training report</h1><p>Trainee " << html_escape(r.trainee_user)
+      << " against reference " << html_escape(r.reference_user) << ".</p>";
+  out << "<h2>Time per step (m:ss)</h2><table><tr><th>step</th><th>trainee</th>"
+         "<th>reference</th><th>ratio</th></tr>";
+  for (const auto& s : wizard_steps()) {
+    const double t = r.trainee.seconds[s.number], ref = r.reference.seconds[s.number];
+    out << "<tr><td>" << s.number << " " << html_escape(s.title) << "</td><td>" << duration_text(t)
+        << "</td><td>" << duration_text(ref) << "</td><td>"
+        << (ref > 0 ? fmt("%.2f", t / ref) : std::string("-")) << "</td></tr>";
+  }
+  out << "<tr><th>total</th><th>" << duration_text(r.trainee.total) << "</th><th>"
+      << duration_text(r.reference.total) << "</th><th>"
+      << (r.reference.total > 0 ? fmt("%.2f", r.trainee.total / r.reference.total)
+                                : std::string("-"))
+      << "</th></tr></table><h2>Implant agreement</h2>";
+  if (r.agreement) {
+    const CompareResult& c = *r.agreement;
+    out << "<table><tr><th>DSC</th><td>" << fmt("%.3f", c.dice) << "</td></tr><tr><th>boundary "
+        << "DSC</th><td>" << fmt("%.3f", c.boundary_dice) << "</td></tr><tr><th>HD95</th><td>"
+        << fmt("%.2f mm", c.hd95_mm) << "</td></tr><tr><th>HD</th><td>"
+        << fmt("%.2f mm", c.hausdorff_mm) << "</td></tr><tr><th>volume trainee</th><td>"
+        << fmt("%.0f mm³", r.trainee_volume_mm3) << "</td></tr><tr><th>volume reference</th><td>"
+        << fmt("%.0f mm³", r.reference_volume_mm3) << "</td></tr></table>";
+  } else {
+    out << "<p>Not measured: " << html_escape(r.note) << "</p>";
+  }
+  out << "</body></html>";
+  return out.str();
+}
+
+}  // namespace cranioplan

@@ -1,0 +1,51 @@
+#include "cranioplan/sessions/autoplan_session.h"
+
+#include <filesystem>
+
+namespace cranioplan {
+
+AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks& landmarks,
+                                 const AutoplanParams& params, const std::string& export_path,
+                                 const SessionInfo& info) {
+  AutoplanSession out;
+  SessionInfo with_case = info;
+  if (with_case.case_id.empty())
+    with_case.case_id = std::filesystem::path(skull_path).stem().string();
+  out.session = Session(with_case);
+  Session& s = out.session;
+  auto run = [&](Command c) {
+    const PushResult r = s.push(std::move(c));
+    if (!r.accepted) out.message = r.message;
+    return r.accepted;
+  };
+  auto stop = [&](const std::string& why) {
+    out.message = why;
+    return std::move(out);
+  };
+  if (!run(commands::load_skull(skull_path))) return out;
+  if (landmarks.nasion) run(commands::set_landmark("nasion", *landmarks.nasion));
+  if (landmarks.orbit_left) run(commands::set_landmark("orbit_left", *landmarks.orbit_left));
+  if (landmarks.orbit_right) run(commands::set_landmark("orbit_right", *landmarks.orbit_right));
+  for (const auto& p : landmarks.midline) run(commands::set_landmark("midline", p));
+  run(commands::fit_plane(params.plane));
+  if (!s.state().plane) return stop("midsagittal plane: " + s.state().message);
+  run(commands::mirror());
+  run(commands::register_mirror(params.registration));
+  // An unusable registration leaves the mirror where mirroring put it, as autoplan() does.
+  if (!step_complete(s.state(), 3)) run(commands::complete_step(3));
+  run(commands::complete_step(4));
+  run(commands::propose_markers(params.propose));
+  if (s.state().markers.empty()) {
+    out.status = AutoplanSession::Status::NoDefect;
+    return stop(s.state().message);
+  }
+  run(commands::build_implant(params.implant));
+  if (!s.state().implant) return stop(s.state().message);
+  run(commands::complete_step(8));
+  if (!export_path.empty() && !run(commands::export_implant(export_path))) return out;
+  out.status = AutoplanSession::Status::Planned;
+  out.message = s.state().proposal_message;
+  return out;
+}
+
+}  // namespace cranioplan

@@ -1,0 +1,549 @@
+#include "cranioplan/sessions/command.h"
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <limits>
+
+#include "cranioplan/algorithms/write_mesh.h"
+#include "cranioplan/sessions/marker_files.h"
+#include "cranioplan/sessions/session_error.h"
+
+namespace cranioplan {
+
+namespace {
+
+struct TypeInfo {
+  CommandType type;
+  const char* tag;
+  std::vector<const char*> required;  ///< parameters every version-1 command carries
+};
+
+const std::vector<TypeInfo>& type_table() {
+  static const std::vector<TypeInfo> table = {
+      {CommandType::LoadSkull, "load_skull", {"path", "sha256", "import"}},
+      {CommandType::SetLandmark, "set_landmark", {"name", "position"}},
+      {CommandType::ClearLandmark, "clear_landmark", {"name"}},
+      {CommandType::FitPlane, "fit_plane", {"params"}},
+      {CommandType::AdjustPlane, "adjust_plane", {"axis", "angle_deg", "shift_mm"}},
+      {CommandType::Mirror, "mirror", {}},
+      {CommandType::Register, "register", {"params"}},
+      {CommandType::MoveMirrored, "move_mirrored", {"axis", "angle_deg", "center", "translation"}},
+      {CommandType::SetClipPlane, "set_clip_plane", {"enabled"}},
+      {CommandType::AddMarker, "add_marker", {"type", "position"}},
+      {CommandType::MoveMarker, "move_marker", {"id", "position"}},
+      {CommandType::DeleteMarker, "delete_marker", {"id"}},
+      {CommandType::RetypeMarker, "retype_marker", {"id", "type"}},
+      {CommandType::ImportMarkers, "import_markers", {"source", "sha256", "markers"}},
+      {CommandType::ClearMarkers, "clear_markers", {}},
+      {CommandType::ProposeMarkers, "propose_markers", {"params"}},
+      {CommandType::SmoothMarkers, "smooth_markers", {"params", "project_onto_mirror"}},
+      {CommandType::BuildImplant, "build_implant", {"params"}},
+      {CommandType::ExportImplant, "export_implant", {"path", "format", "sha256"}},
+      {CommandType::GoToStep, "go_to_step", {"step"}},
+      {CommandType::CompleteStep, "complete_step", {"step"}},
+      {CommandType::Note, "note", {"text"}},
+  };
+  return table;
+}
+
+const TypeInfo& info(CommandType type) {
+  for (const auto& t : type_table())
+    if (t.type == type) return t;
+  assert(false && "every CommandType has a row in type_table()");
+  return type_table().front();
+}
+
+Json number_or_null(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+
+// Visitors over a Params struct's fields: one list of fields per struct serves both directions.
+struct Writer {
+  Json& j;
+  void operator()(const char* name, const double& v) { j[name] = number_or_null(v); }
+  void operator()(const char* name, const int& v) { j[name] = v; }
+  void operator()(const char* name, const long long& v) { j[name] = v; }
+  void operator()(const char* name, const bool& v) { j[name] = v; }
+};
+
+struct Reader {
+  const ParamReader& r;
+  void operator()(const char* name, double& v) { v = r.number(name); }
+  void operator()(const char* name, int& v) { v = r.integer(name); }
+  void operator()(const char* name, long long& v) {
+    v = static_cast<long long>(std::llround(r.number(name)));
+  }
+  void operator()(const char* name, bool& v) { v = r.boolean(name); }
+};
+
+template <class V, class P>
+void extract_fields(V& v, P& p) {
+  v("threshold", p.threshold);
+  v("largest_piece_only", p.largest_piece_only);
+  v("min_piece_triangles", p.min_piece_triangles);
+  v("target_triangles", p.target_triangles);
+}
+
+template <class V, class P>
+void plane_fields(V& v, P& p) {
+  v("refine", p.refine);
+  v("use_surface_symmetry", p.use_surface_symmetry);
+  v("sample_count", p.sample_count);
+  v("outer_iterations", p.outer_iterations);
+  v("robust_scale_mm", p.robust_scale_mm);
+  v("max_correspondence_mm", p.max_correspondence_mm);
+  v("inlier_threshold_mm", p.inlier_threshold_mm);
+  v("landmark_weight", p.landmark_weight);
+  v("convergence_deg", p.convergence_deg);
+  v("convergence_mm", p.convergence_mm);
+}
+
+template <class V, class P>
+void register_fields(V& v, P& p) {
+  v("sample_count", p.sample_count);
+  v("max_iterations", p.max_iterations);
+  v("max_correspondence_mm", p.max_correspondence_mm);
+  v("trim_fraction", p.trim_fraction);
+  v("huber_mm", p.huber_mm);
+  v("convergence_mm", p.convergence_mm);
+}
+
+template <class V, class P>
+void smooth_fields(V& v, P& p) {
+  v("radius_mm", p.radius_mm);
+  v("edge_weight", p.edge_weight);
+  v("iterations", p.iterations);
+}
+
+template <class V, class P>
+void detect_fields(V& v, P& p) {
+  v("directions", p.directions);
+  v("min_area_mm2", p.min_area_mm2);
+  v("support_width_mm", p.support_width_mm);
+  v("max_thickness_mm", p.max_thickness_mm);
+  v("min_thickness_mm", p.min_thickness_mm);
+}
+
+template <class V, class P>
+void propose_fields(V& v, P& p) {
+  v("min_mirror_coverage", p.min_mirror_coverage);
+  v("edge_spacing_mm", p.edge_spacing_mm);
+  v("surface_spacing_mm", p.surface_spacing_mm);
+}
+
+template <class V, class P>
+void implant_fields(V& v, P& p) {
+  v("resolution_mm", p.resolution_mm);
+  v("thickness_mm", p.thickness_mm);
+  v("snap_rim_to_skull", p.snap_rim_to_skull);
+  v("surface_smoothing", p.surface_smoothing);
+  v("max_rim_snap_mm", p.max_rim_snap_mm);
+  v("delaunay_alpha", p.delaunay_alpha);
+  v("delaunay_tolerance", p.delaunay_tolerance);
+  v("delaunay_offset", p.delaunay_offset);
+}
+
+template <class Fields, class P>
+Json write_fields(Fields fields, const P& p) {
+  Json j = Json::object();
+  Writer w{j};
+  fields(w, p);
+  return j;
+}
+
+Command make(CommandType type, Json params, int step = 0) {
+  Command c;
+  c.type = type;
+  c.version = current_version(type);
+  c.params = std::move(params);
+  c.meta.step = step;
+  return c;
+}
+
+}  // namespace
+
+const std::vector<CommandType>& all_command_types() {
+  static const std::vector<CommandType> all = [] {
+    std::vector<CommandType> v;
+    for (const auto& t : type_table()) v.push_back(t.type);
+    return v;
+  }();
+  return all;
+}
+
+const char* type_tag(CommandType type) { return info(type).tag; }
+
+std::optional<CommandType> command_type_from_tag(const std::string& tag) {
+  for (const auto& t : type_table())
+    if (tag == t.tag) return t.type;
+  return std::nullopt;
+}
+
+int current_version(CommandType) { return 1; }
+
+// ---------------------------------------------------------------------------------------------
+// ParamReader
+
+bool ParamReader::has(const char* name) const {
+  return params_.is_object() && params_.contains(name);
+}
+
+const Json& ParamReader::value(const char* name) const {
+  if (!has(name)) throw SessionError(where_, std::string("missing parameter '") + name + "'");
+  return params_.at(name);
+}
+
+double ParamReader::number(const char* name) const {
+  const Json& v = value(name);
+  if (v.is_null()) return std::numeric_limits<double>::quiet_NaN();
+  if (!v.is_number())
+    throw SessionError(where_, std::string("parameter '") + name + "' must be a number");
+  return v.get<double>();
+}
+
+int ParamReader::integer(const char* name) const {
+  const Json& v = value(name);
+  if (!v.is_number_integer())
+    throw SessionError(where_, std::string("parameter '") + name + "' must be a whole number");
+  return v.get<int>();
+}
+
+bool ParamReader::boolean(const char* name) const {
+  const Json& v = value(name);
+  if (!v.is_boolean())
+    throw SessionError(where_, std::string("parameter '") + name + "' must be true or false");
+  return v.get<bool>();
+}
+
+std::string ParamReader::string(const char* name) const {
+  const Json& v = value(name);
+  if (!v.is_string())
+    throw SessionError(where_, std::string("parameter '") + name + "' must be text");
+  return v.get<std::string>();
+}
+
+Eigen::Vector3d ParamReader::vector3(const char* name) const {
+  return vector_from_json(value(name), where_, std::string("parameter '") + name + "'");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Parameter forms
+
+Json params_to_json(const ExtractBoneSurfaceParams& p) {
+  return write_fields([](auto& v, auto& q) { extract_fields(v, q); }, p);
+}
+Json params_to_json(const PlaneFitParams& p) {
+  return write_fields([](auto& v, auto& q) { plane_fields(v, q); }, p);
+}
+Json params_to_json(const SmoothParams& p) {
+  return write_fields([](auto& v, auto& q) { smooth_fields(v, q); }, p);
+}
+
+Json params_to_json(const RegisterParams& p) {
+  Json j = write_fields([](auto& v, auto& q) { register_fields(v, q); }, p);
+  j["initial"] = to_json(p.initial);
+  if (p.roi) {
+    Json roi;
+    roi["shape"] = p.roi->shape == RegionOfInterest::Shape::Sphere ? "sphere" : "box";
+    roi["center"] = to_json(p.roi->center);
+    roi["radius_mm"] = p.roi->radius;
+    roi["half_size_mm"] = to_json(p.roi->half_size);
+    j["roi"] = roi;
+  } else {
+    j["roi"] = nullptr;
+  }
+  return j;
+}
+
+Json params_to_json(const ProposeParams& p) {
+  Json j = write_fields([](auto& v, auto& q) { propose_fields(v, q); }, p);
+  j["method"] = to_string(p.method);
+  j["detect"] = write_fields([](auto& v, auto& q) { detect_fields(v, q); }, p.detect);
+  j["smooth"] = params_to_json(p.smooth);
+  return j;
+}
+
+Json params_to_json(const ImplantParams& p) {
+  Json j = write_fields([](auto& v, auto& q) { implant_fields(v, q); }, p);
+  j["method"] = to_string(p.method);
+  j["frame"] = p.frame == ImplantFrame::Radial ? "radial" : "planar";
+  j["radial_center"] = p.radial_center ? to_json(*p.radial_center) : Json(nullptr);
+  return j;
+}
+
+void params_from_json(const ParamReader& r, ExtractBoneSurfaceParams& p) {
+  Reader v{r};
+  extract_fields(v, p);
+}
+void params_from_json(const ParamReader& r, PlaneFitParams& p) {
+  Reader v{r};
+  plane_fields(v, p);
+}
+void params_from_json(const ParamReader& r, SmoothParams& p) {
+  Reader v{r};
+  smooth_fields(v, p);
+}
+
+void params_from_json(const ParamReader& r, RegisterParams& p) {
+  Reader v{r};
+  register_fields(v, p);
+  p.initial = transform_from_json(r.value("initial"), r.where());
+  const Json& roi = r.value("roi");
+  if (roi.is_null()) {
+    p.roi.reset();
+    return;
+  }
+  const ParamReader rr(roi, r.where() + " roi");
+  RegionOfInterest region;
+  const std::string shape = rr.string("shape");
+  if (shape != "sphere" && shape != "box")
+    throw SessionError(r.where(), "roi shape must be \"sphere\" or \"box\", not \"" + shape + "\"");
+  region.shape = shape == "sphere" ? RegionOfInterest::Shape::Sphere : RegionOfInterest::Shape::Box;
+  region.center = rr.vector3("center");
+  region.radius = rr.number("radius_mm");
+  region.half_size = rr.vector3("half_size_mm");
+  p.roi = region;
+}
+
+void params_from_json(const ParamReader& r, ProposeParams& p) {
+  Reader v{r};
+  propose_fields(v, p);
+  const std::string method = r.string("method");
+  if (!plan_method_from_string(method, p.method))
+    throw SessionError(r.where(), "unknown planning method \"" + method + "\"");
+  const ParamReader detect(r.value("detect"), r.where() + " detect");
+  Reader dv{detect};
+  detect_fields(dv, p.detect);
+  params_from_json(ParamReader(r.value("smooth"), r.where() + " smooth"), p.smooth);
+}
+
+void params_from_json(const ParamReader& r, ImplantParams& p) {
+  Reader v{r};
+  implant_fields(v, p);
+  const std::string method = r.string("method");
+  if (method == to_string(ImplantMethod::Shell))
+    p.method = ImplantMethod::Shell;
+  else if (method == to_string(ImplantMethod::Delaunay3D))
+    p.method = ImplantMethod::Delaunay3D;
+  else
+    throw SessionError(r.where(), "unknown implant method \"" + method + "\"");
+  const std::string frame = r.string("frame");
+  if (frame != "radial" && frame != "planar")
+    throw SessionError(r.where(), "implant frame must be \"radial\" or \"planar\"");
+  p.frame = frame == "radial" ? ImplantFrame::Radial : ImplantFrame::Planar;
+  const Json& c = r.value("radial_center");
+  p.radial_center.reset();
+  if (!c.is_null()) p.radial_center = vector_from_json(c, r.where(), "radial_center");
+}
+
+// ---------------------------------------------------------------------------------------------
+// Commands as JSON
+
+Json to_json(const Command& c) {
+  Json j;
+  j["type"] = type_tag(c.type);
+  j["version"] = c.version;
+  j["params"] = c.params;
+  Json meta;
+  meta["step"] = c.meta.step;
+  meta["started"] = c.meta.started;
+  meta["ended"] = c.meta.ended;
+  meta["duration_ms"] = c.meta.duration_ms;
+  meta["user"] = c.meta.user;
+  j["meta"] = meta;
+  return j;
+}
+
+Command command_from_json(const Json& j, const std::string& where) {
+  if (!j.is_object()) throw SessionError(where, "a command must be a JSON object");
+  const ParamReader top(j, where);
+  const std::string tag = top.string("type");
+  const auto type = command_type_from_tag(tag);
+  if (!type) throw SessionError(where, "unknown command type \"" + tag + "\"");
+  Command c;
+  c.type = *type;
+  c.version = top.integer("version");
+  if (c.version < 1 || c.version > current_version(*type))
+    throw SessionError(where, "command \"" + tag + "\" version " + std::to_string(c.version) +
+                                  " is newer than this program knows (" +
+                                  std::to_string(current_version(*type)) + ")");
+  c.params = top.value("params");
+  if (!c.params.is_object()) throw SessionError(where, "\"params\" must be a JSON object");
+  const std::string cw = where + " (" + tag + ")";
+  const ParamReader params(c.params, cw);
+  for (const char* name : info(*type).required) params.value(name);
+  const ParamReader meta(top.value("meta"), where + " meta");
+  c.meta.step = meta.integer("step");
+  c.meta.started = meta.string("started");
+  c.meta.ended = meta.string("ended");
+  c.meta.duration_ms = meta.number("duration_ms");
+  c.meta.user = meta.string("user");
+  return c;
+}
+
+std::string describe(const Command& c) {
+  const Json& p = c.params;
+  auto id = [&] {
+    return p.contains("id") ? std::to_string(p["id"].get<int>()) : std::string("?");
+  };
+  auto marker_type = [&] {
+    const int t = p.contains("type") && p["type"].is_number_integer() ? p["type"].get<int>() : 0;
+    return std::string(to_string(static_cast<MarkerType>(std::clamp(t, 0, 3))));
+  };
+  switch (c.type) {
+    case CommandType::LoadSkull:
+      return "Load skull " + p.value("path", std::string());
+    case CommandType::SetLandmark:
+      return "Set landmark " + p.value("name", std::string());
+    case CommandType::ClearLandmark:
+      return "Clear landmark " + p.value("name", std::string());
+    case CommandType::FitPlane:
+      return "Fit midsagittal plane";
+    case CommandType::AdjustPlane:
+      return "Adjust plane by hand";
+    case CommandType::Mirror:
+      return "Mirror skull";
+    case CommandType::Register:
+      return "Register mirrored skull";
+    case CommandType::MoveMirrored:
+      return "Move mirrored skull by hand";
+    case CommandType::SetClipPlane:
+      return p.value("enabled", false) ? "Set clip plane" : "Remove clip plane";
+    case CommandType::AddMarker:
+      return "Add " + marker_type() + " marker";
+    case CommandType::MoveMarker:
+      return "Move marker " + id();
+    case CommandType::DeleteMarker:
+      return "Delete marker " + id();
+    case CommandType::RetypeMarker:
+      return "Make marker " + id() + " " + marker_type();
+    case CommandType::ImportMarkers:
+      return "Import markers from " + p.value("source", std::string());
+    case CommandType::ClearMarkers:
+      return "Clear markers";
+    case CommandType::ProposeMarkers:
+      return "Propose markers automatically";
+    case CommandType::SmoothMarkers:
+      return "Smooth markers";
+    case CommandType::BuildImplant:
+      return "Build implant (" +
+             (p.contains("params") ? p["params"].value("method", std::string("shell"))
+                                   : std::string("shell")) +
+             ")";
+    case CommandType::ExportImplant:
+      return "Export implant to " + p.value("path", std::string());
+    case CommandType::GoToStep:
+      return "Go to step " + std::to_string(p.value("step", 0));
+    case CommandType::CompleteStep:
+      return "Complete step " + std::to_string(p.value("step", 0));
+    case CommandType::Note:
+      return "Note: " + p.value("text", std::string());
+  }
+  return type_tag(c.type);
+}
+
+// ---------------------------------------------------------------------------------------------
+// Builders
+
+namespace commands {
+
+Command load_skull(const std::string& path, const ExtractBoneSurfaceParams& import,
+                   const std::string& sha256) {
+  return make(CommandType::LoadSkull,
+              {{"path", path}, {"sha256", sha256}, {"import", params_to_json(import)}}, 1);
+}
+
+Command set_landmark(const std::string& name, const Eigen::Vector3d& position) {
+  return make(CommandType::SetLandmark, {{"name", name}, {"position", to_json(position)}}, 2);
+}
+
+Command clear_landmark(const std::string& name) {
+  return make(CommandType::ClearLandmark, {{"name", name}}, 2);
+}
+
+Command fit_plane(const PlaneFitParams& params) {
+  return make(CommandType::FitPlane, {{"params", params_to_json(params)}}, 2);
+}
+
+Command adjust_plane(const Eigen::Vector3d& axis, double angle_deg, double shift_mm) {
+  return make(CommandType::AdjustPlane,
+              {{"axis", to_json(axis)}, {"angle_deg", angle_deg}, {"shift_mm", shift_mm}}, 2);
+}
+
+Command mirror() { return make(CommandType::Mirror, Json::object(), 3); }
+
+Command register_mirror(const RegisterParams& params) {
+  return make(CommandType::Register, {{"params", params_to_json(params)}}, 3);
+}
+
+Command move_mirrored(const Eigen::Vector3d& axis, double angle_deg, const Eigen::Vector3d& center,
+                      const Eigen::Vector3d& translation) {
+  return make(CommandType::MoveMirrored,
+              {{"axis", to_json(axis)},
+               {"angle_deg", angle_deg},
+               {"center", to_json(center)},
+               {"translation", to_json(translation)}},
+              3);
+}
+
+Command set_clip_plane(const Plane& plane) {
+  return make(CommandType::SetClipPlane, {{"enabled", true}, {"plane", to_json(plane)}}, 4);
+}
+
+Command clear_clip_plane() { return make(CommandType::SetClipPlane, {{"enabled", false}}, 4); }
+
+Command add_marker(MarkerType type, const Eigen::Vector3d& position) {
+  return make(CommandType::AddMarker,
+              {{"type", static_cast<int>(type)}, {"position", to_json(position)}},
+              is_edge(type) ? 5 : 6);
+}
+
+Command move_marker(int id, const Eigen::Vector3d& position) {
+  return make(CommandType::MoveMarker, {{"id", id}, {"position", to_json(position)}});
+}
+
+Command delete_marker(int id) { return make(CommandType::DeleteMarker, {{"id", id}}); }
+
+Command retype_marker(int id, MarkerType type) {
+  return make(CommandType::RetypeMarker, {{"id", id}, {"type", static_cast<int>(type)}});
+}
+
+Command import_markers(const std::vector<Marker>& markers, const std::string& source,
+                       const std::string& sha256) {
+  return make(CommandType::ImportMarkers,
+              {{"source", source}, {"sha256", sha256}, {"markers", markers_to_json(markers)}}, 5);
+}
+
+Command clear_markers() { return make(CommandType::ClearMarkers, Json::object(), 5); }
+
+Command propose_markers(const ProposeParams& params) {
+  return make(CommandType::ProposeMarkers, {{"params", params_to_json(params)}}, 5);
+}
+
+Command smooth_markers(const SmoothParams& params, bool project_onto_mirror) {
+  return make(CommandType::SmoothMarkers,
+              {{"params", params_to_json(params)}, {"project_onto_mirror", project_onto_mirror}},
+              8);
+}
+
+Command build_implant(const ImplantParams& params) {
+  return make(CommandType::BuildImplant, {{"params", params_to_json(params)}}, 7);
+}
+
+Command export_implant(const std::string& path, const std::string& sha256) {
+  const MeshFormat format = mesh_format_for_path(path);
+  return make(CommandType::ExportImplant,
+              {{"path", path},
+               {"format", format == MeshFormat::BinarySTL ? "stl" : "ply"},
+               {"sha256", sha256}},
+              9);
+}
+
+Command go_to_step(int step) { return make(CommandType::GoToStep, {{"step", step}}, step); }
+
+Command complete_step(int step) { return make(CommandType::CompleteStep, {{"step", step}}, step); }
+
+Command note(const std::string& text) { return make(CommandType::Note, {{"text", text}}); }
+
+}  // namespace commands
+
+}  // namespace cranioplan

@@ -1,0 +1,706 @@
+#include "cranioplan/sessions/plan_state.h"
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <cstdio>
+#include <filesystem>
+
+#include "cranioplan/algorithms/file_io.h"
+#include "cranioplan/algorithms/load_skull.h"
+#include "cranioplan/algorithms/mirror_mesh.h"
+#include "cranioplan/algorithms/propose_markers.h"
+#include "cranioplan/algorithms/smooth_markers.h"
+#include "cranioplan/algorithms/snap_markers.h"
+#include "cranioplan/algorithms/write_mesh.h"
+#include "cranioplan/sessions/marker_files.h"
+#include "cranioplan/sessions/session_error.h"
+#include "cranioplan/sessions/sha256.h"
+
+namespace cranioplan {
+
+SharedSurface::SharedSurface(SkullMesh m) : mesh(std::move(m)), locator(mesh) {}
+
+ImplantData::ImplantData(ImplantResult result, std::shared_ptr<const SkullInput> skull)
+    : result_(std::move(result)),
+      stl_sha256_(sha256_hex(encode_mesh(result_.mesh, MeshFormat::BinarySTL))),
+      skull_(std::move(skull)) {}
+
+const QualityReport& ImplantData::quality() const {
+  std::call_once(quality_once_, [this] {
+    quality_ = check_implant(result_.mesh, skull_ ? &skull_->surface->mesh : nullptr);
+  });
+  return quality_;
+}
+
+RigidTransform PlanState::mirror_transform() const {
+  const RigidTransform reg =
+      registration && registration->usable() ? registration->transform : RigidTransform{};
+  return manual * reg;
+}
+
+const Marker* PlanState::find_marker(int id) const {
+  for (const auto& m : markers)
+    if (m.id == id) return &m;
+  return nullptr;
+}
+
+const std::array<WizardStep, 9>& wizard_steps() {
+  static const std::array<WizardStep, 9> steps = {{
+      {1, "Load skull",
+       "Open the patient's skull: a surface mesh (STL, PLY, OBJ, OFF, VTP) or a CT (InVesalius "
+       ".inv3, NRRD, NIfTI, DICOM folder), which is turned into a bone surface at the threshold "
+       "you choose. Done when a skull is loaded."},
+      {2, "Landmarks and midsagittal plane",
+       "Click the nasion and the centres of the left and right orbits (optional: points on the "
+       "midline), then press Fit: the plane is refined from the landmarks and the skull's "
+       "symmetry. Adjust it by hand if needed. Done when a plane is set."},
+      {3, "Mirror and register",
+       "Mirror the skull across the plane (green), then Register: the mirror is fitted onto the "
+       "healthy bone (whole skull or a region). Nudge it by hand if needed. Done when the mirror "
+       "is registered (or accepted as it is)."},
+      {4, "Clip and inspect",
+       "Move the clip plane through the defect to see its inner edge and the mirrored bone that "
+       "will fill it. Press Done when you have seen enough."},
+      {5, "Edge markers",
+       "Place outer edge markers (key 0) along the outer rim of the defect on the skull, and "
+       "optionally inner edge markers (key 1) along its inner rim — or press Propose to place "
+       "them automatically and edit them. Done with at least 3 outer edge markers (and either "
+       "no inner edge markers or at least 3)."},
+      {6, "Surface markers",
+       "Place outer surface markers (key 2) and inner surface markers (key 3) on the mirrored "
+       "skull inside the defect. Done with at least 3 outer surface markers."},
+      {7, "Build implant",
+       "Choose the method (shell: smooth fitted surfaces, or the paper's Delaunay 3D) and the "
+       "resolution, then Build. Done when an implant is built."},
+      {8, "Smooth and refine",
+       "Smooth the surface markers (radius, edge-marker weight; edge markers stay fixed) and "
+       "move markers where needed: the implant follows. Press Done when satisfied."},
+      {9, "Check and export",
+       "Read the quality report (watertight, thickness, gap to bone, overlap) and export the "
+       "implant as STL or PLY. Done when the current implant has been exported."},
+  }};
+  return steps;
+}
+
+namespace {
+
+int count_type(const PlanState& s, MarkerType t) {
+  int n = 0;
+  for (const auto& m : s.markers) n += m.type == t;
+  return n;
+}
+
+bool fail(std::string* out, const std::string& why) {
+  if (out) *out = why;
+  return false;
+}
+
+}  // namespace
+
+bool step_complete(const PlanState& s, int step, std::string* missing) {
+  switch (step) {
+    case 1:
+      return s.skull ? true : fail(missing, "load a skull");
+    case 2:
+      return s.plane ? true : fail(missing, "fit the midsagittal plane (or set it by hand)");
+    case 3:
+      if (!s.mirrored) return fail(missing, "mirror the skull");
+      if ((s.registration && s.registration->usable()) || s.acknowledged[3]) return true;
+      return fail(missing, "register the mirrored skull (or accept it as it is)");
+    case 4:
+      return s.acknowledged[4] ? true : fail(missing, "inspect the defect and press Done");
+    case 5: {
+      const int outer = count_type(s, MarkerType::OuterEdge);
+      const int inner = count_type(s, MarkerType::InnerEdge);
+      if (outer < 3)
+        return fail(missing,
+                    "place at least 3 outer edge markers (" + std::to_string(outer) + " so far)");
+      if (inner > 0 && inner < 3)
+        return fail(missing, "inner edge markers: " + std::to_string(inner) +
+                                 " placed; place at least 3, or none (the inner rim then "
+                                 "follows the bone thickness)");
+      return true;
+    }
+    case 6: {
+      const int outer = count_type(s, MarkerType::OuterSurface);
+      return outer >= 3 ? true
+                        : fail(missing, "place at least 3 outer surface markers (" +
+                                            std::to_string(outer) + " so far)");
+    }
+    case 7:
+      if (s.implant && s.implant->result().usable()) return true;
+      return fail(missing, s.implant_params ? "the implant could not be built: " + s.message
+                                            : std::string("build the implant"));
+    case 8:
+      return s.acknowledged[8] ? true : fail(missing, "review the markers and implant, press Done");
+    case 9:
+      for (const auto& e : s.exports)
+        if (s.implant && e.implant_sha256 == s.implant->stl_sha256()) return true;
+      return fail(missing, "export the implant");
+    default:
+      return fail(missing, "there is no step " + std::to_string(step));
+  }
+}
+
+bool step_unlocked(const PlanState& s, int step, std::string* why) {
+  for (int k = 1; k < step && k <= 9; ++k) {
+    std::string missing;
+    if (!step_complete(s, k, &missing))
+      return fail(why, "step " + std::to_string(step) + " (" + wizard_steps()[step - 1].title +
+                           ") is locked: step " + std::to_string(k) + " (" +
+                           wizard_steps()[k - 1].title + ") is not done — " + missing);
+  }
+  return true;
+}
+
+int command_step(const PlanState& s, const Command& c) {
+  auto marker_step = [](MarkerType t) { return is_edge(t) ? 5 : 6; };
+  const Json& p = c.params;
+  switch (c.type) {
+    case CommandType::LoadSkull:
+      return 1;
+    case CommandType::SetLandmark:
+    case CommandType::ClearLandmark:
+    case CommandType::FitPlane:
+    case CommandType::AdjustPlane:
+      return 2;
+    case CommandType::Mirror:
+    case CommandType::Register:
+    case CommandType::MoveMirrored:
+      return 3;
+    case CommandType::SetClipPlane:
+      return 4;
+    case CommandType::AddMarker:
+      return marker_step(static_cast<MarkerType>(std::clamp(p.value("type", 0), 0, 3)));
+    case CommandType::MoveMarker:
+    case CommandType::DeleteMarker:
+    case CommandType::RetypeMarker: {
+      const Marker* m = s.find_marker(p.value("id", -1));
+      int step = m ? marker_step(m->type) : 5;
+      if (c.type == CommandType::RetypeMarker)
+        step = std::max(step,
+                        marker_step(static_cast<MarkerType>(std::clamp(p.value("type", 0), 0, 3))));
+      return step;
+    }
+    case CommandType::ImportMarkers:
+    case CommandType::ClearMarkers:
+    case CommandType::ProposeMarkers:
+      return 5;
+    case CommandType::BuildImplant:
+      return 7;
+    case CommandType::SmoothMarkers:
+      return 8;
+    case CommandType::ExportImplant:
+      return 9;
+    case CommandType::GoToStep:
+    case CommandType::CompleteStep:
+      return std::clamp(p.value("step", 1), 1, 9);
+    case CommandType::Note:
+      return 0;
+  }
+  return 0;
+}
+
+namespace {
+
+// ----- derived results ---------------------------------------------------------------------
+
+void unacknowledge(PlanState& s, int step, const std::string& why) {
+  if (!s.acknowledged[step]) return;
+  s.acknowledged[step] = false;
+  s.stale[step] = why;
+}
+
+void update_mirrored(PlanState& s, const std::string& why) {
+  if (!s.mirror_base) {
+    s.mirrored.reset();
+    return;
+  }
+  s.mirrored =
+      std::make_shared<const SharedSurface>(transform_mesh(*s.mirror_base, s.mirror_transform()));
+  unacknowledge(s, 4, why);
+  for (const auto& m : s.markers)
+    if (m.surface == MarkerSurface::Mirrored) {
+      s.stale[6] = why + ": surface markers were placed on the mirror before it moved";
+      break;
+    }
+}
+
+void run_registration(PlanState& s) {
+  s.registration = register_icp(*s.mirror_base, s.skull->surface->mesh, *s.register_params);
+  s.manual = RigidTransform{};
+  char buf[200];
+  if (s.registration->usable())
+    std::snprintf(buf, sizeof(buf),
+                  "registered: RMS %.2f mm, %.0f%% of samples paired, %d iterations",
+                  s.registration->rms_mm, 100.0 * s.registration->inlier_fraction,
+                  s.registration->iterations);
+  else
+    std::snprintf(buf, sizeof(buf), "registration failed: %s", s.registration->message.c_str());
+  s.message = buf;
+}
+
+void rebuild_implant(PlanState& s) {
+  if (!s.implant_params) return;
+  ImplantParams p = *s.implant_params;
+  if (!p.radial_center && s.defect_center) p.radial_center = s.defect_center;
+  ImplantResult r =
+      build_implant(s.markers, &s.skull->surface->mesh, &s.skull->surface->locator, p);
+  if (r.usable()) {
+    char buf[160];
+    std::snprintf(buf, sizeof(buf), "implant built: %s triangles, %s",
+                  format_count(static_cast<long long>(r.mesh.n_faces())).c_str(),
+                  r.watertight ? "watertight" : "not watertight");
+    s.message = buf;
+    s.implant = std::make_shared<const ImplantData>(std::move(r), s.skull);
+  } else {
+    s.message = "implant not built: " + r.message;
+    s.implant.reset();
+  }
+}
+
+void markers_changed(PlanState& s) {
+  unacknowledge(s, 8, "the markers changed");
+  rebuild_implant(s);
+}
+
+void plane_changed(PlanState& s) {
+  unacknowledge(s, 4, "the plane changed");
+  if (!s.mirror_requested) return;
+  s.mirror_base = std::make_shared<const SkullMesh>(mirror_mesh(s.skull->surface->mesh, *s.plane));
+  std::string why = "the plane changed: mirror recomputed";
+  if (s.register_params) {
+    const std::string plane_message = s.message;
+    run_registration(s);
+    why += " and registered again";
+    s.message = plane_message + "; " + s.message;
+  }
+  s.stale[3] = why;
+  update_mirrored(s, "the plane changed");
+}
+
+const SurfaceLocator* surface_for(const PlanState& s, MarkerSurface surface) {
+  if (surface == MarkerSurface::Mirrored && s.mirrored) return &s.mirrored->locator;
+  return &s.skull->surface->locator;
+}
+
+// Snaps markers onto their surfaces; false (with the reason) when one is too far away.
+bool snap(const PlanState& s, std::vector<Marker>& markers, std::string& why) {
+  const SnapMarkersResult r =
+      snap_markers(markers, s.skull->surface->locator, s.mirrored ? &s.mirrored->locator : nullptr);
+  if (r.status != SnapMarkersResult::Status::Snapped) {
+    why = r.message;
+    return false;
+  }
+  markers = r.markers;
+  return true;
+}
+
+std::string resolve_input(const std::string& recorded, const ApplyContext& ctx) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (fs::exists(recorded, ec)) return recorded;
+  if (!ctx.session_dir.empty()) {
+    for (const fs::path& candidate : {fs::path(ctx.session_dir) / recorded,
+                                      fs::path(ctx.session_dir) / fs::path(recorded).filename()})
+      if (fs::exists(candidate, ec)) return candidate.string();
+  }
+  throw InputError(recorded, "the skull file of this plan is missing");
+}
+
+struct Refusal {
+  std::string message;
+};
+
+// ----- the commands ----------------------------------------------------------------------------
+
+void apply_load(PlanState& s, const ParamReader& r, const ApplyContext& ctx) {
+  const std::string recorded = r.string("path");
+  const std::string path = resolve_input(recorded, ctx);
+  const std::string bytes = read_file_bytes(path);
+  const std::string sha = sha256_hex(bytes);
+  const std::string expected = r.string("sha256");
+  if (sha != expected)
+    throw SessionError(
+        path, "the skull file changed since this plan was made (SHA-256 " + sha.substr(0, 12) +
+                  "… now, " +
+                  (expected.empty() ? std::string("none") : expected.substr(0, 12) + "…") +
+                  " recorded)");
+  ExtractBoneSurfaceParams import;
+  params_from_json(ParamReader(r.value("import"), r.where() + " import"), import);
+  LoadedSkull loaded = load_skull(path, import);
+  auto input = std::make_shared<SkullInput>();
+  input->path = recorded;
+  input->sha256 = sha;
+  input->description = loaded.description;
+  input->warnings = loaded.warnings;
+  input->surface = std::make_shared<const SharedSurface>(std::move(loaded.mesh));
+  PlanState fresh;
+  fresh.notes = s.notes;
+  fresh.skull = std::move(input);
+  fresh.current_step = 2;
+  fresh.message = "loaded " + loaded.description + ": " +
+                  format_count(static_cast<long long>(fresh.skull->surface->mesh.n_faces())) +
+                  " triangles";
+  s = std::move(fresh);
+}
+
+void apply_landmark(PlanState& s, const ParamReader& r, bool set) {
+  const std::string name = r.string("name");
+  std::optional<Eigen::Vector3d> value;
+  if (set) value = s.skull->surface->locator.closest(r.vector3("position")).point;
+  if (name == "nasion")
+    s.landmarks.nasion = value;
+  else if (name == "orbit_left")
+    s.landmarks.orbit_left = value;
+  else if (name == "orbit_right")
+    s.landmarks.orbit_right = value;
+  else if (name == "midline") {
+    if (set)
+      s.landmarks.midline.push_back(*value);
+    else
+      s.landmarks.midline.clear();
+  } else {
+    throw Refusal{"unknown landmark \"" + name + "\" (nasion, orbit_left, orbit_right or midline)"};
+  }
+  s.message = (set ? "set " : "cleared ") + name;
+}
+
+void apply_fit_plane(PlanState& s, const ParamReader& r) {
+  PlaneFitParams params;
+  params_from_json(ParamReader(r.value("params"), r.where() + " params"), params);
+  const PlaneFit fit = fit_sagittal_plane(s.skull->surface->mesh, s.landmarks, params);
+  s.plane_fit = fit;
+  if (!fit.usable()) {
+    s.message = "plane fit failed: " + fit.message;
+    return;
+  }
+  s.plane = fit.plane;
+  char buf[200];
+  std::snprintf(buf, sizeof(buf), "plane fitted (%s start): symmetry RMS %.2f mm, %.0f%% inliers",
+                fit.initial_method.c_str(), fit.symmetry_rms_mm, 100.0 * fit.inlier_fraction);
+  s.message = buf;
+  plane_changed(s);
+}
+
+Eigen::Vector3d skull_centroid(const PlanState& s) {
+  const SkullMesh& m = s.skull->surface->mesh;
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (auto vh : m.vertices()) c += to_eigen(m.point(vh));
+  return c / static_cast<double>(std::max<size_t>(1, m.n_vertices()));
+}
+
+void apply_adjust_plane(PlanState& s, const ParamReader& r) {
+  if (!s.plane) throw Refusal{"there is no plane to adjust yet: fit it first"};
+  const Eigen::Vector3d axis = r.vector3("axis");
+  const double angle = r.number("angle_deg");
+  const double shift = r.number("shift_mm");
+  if (!std::isfinite(angle) || !std::isfinite(shift))
+    throw Refusal{"angle and shift must be numbers"};
+  if (angle != 0.0 && axis.norm() < 1e-9) throw Refusal{"the rotation axis has no direction"};
+  const Eigen::Vector3d pivot = s.plane->project(skull_centroid(s));
+  Eigen::Vector3d normal = s.plane->normal;
+  if (angle != 0.0) normal = Eigen::AngleAxisd(angle * M_PI / 180.0, axis.normalized()) * normal;
+  s.plane = Plane::through(pivot + shift * normal.normalized(), normal);
+  s.message = "plane adjusted by hand";
+  plane_changed(s);
+}
+
+void apply_mirror(PlanState& s) {
+  s.mirror_requested = true;
+  s.mirror_base = std::make_shared<const SkullMesh>(mirror_mesh(s.skull->surface->mesh, *s.plane));
+  s.registration.reset();
+  s.register_params.reset();
+  s.manual = RigidTransform{};
+  s.message = "skull mirrored across the plane";
+  update_mirrored(s, "the mirror was made again");
+}
+
+void apply_register(PlanState& s, const ParamReader& r) {
+  if (!s.mirror_base) throw Refusal{"mirror the skull before registering it"};
+  RegisterParams params;
+  params_from_json(ParamReader(r.value("params"), r.where() + " params"), params);
+  s.register_params = params;
+  run_registration(s);
+  update_mirrored(s, "the mirror was registered again");
+}
+
+void apply_move_mirrored(PlanState& s, const ParamReader& r) {
+  if (!s.mirror_base) throw Refusal{"mirror the skull before moving the mirror"};
+  const Eigen::Vector3d axis = r.vector3("axis");
+  const double angle = r.number("angle_deg");
+  const Eigen::Vector3d center = r.vector3("center");
+  const Eigen::Vector3d translation = r.vector3("translation");
+  if (!std::isfinite(angle)) throw Refusal{"the angle must be a number"};
+  if (angle != 0.0 && axis.norm() < 1e-9) throw Refusal{"the rotation axis has no direction"};
+  RigidTransform turn;
+  if (angle != 0.0) turn = RigidTransform::from_axis_angle(axis, angle, Eigen::Vector3d::Zero());
+  // x ↦ R(x − c) + c + t
+  RigidTransform delta;
+  delta.rotation = turn.rotation;
+  delta.translation = center - turn.rotation * center + translation;
+  s.manual = delta * s.manual;
+  s.message = "mirrored skull moved by hand";
+  update_mirrored(s, "the mirror was moved by hand");
+}
+
+void apply_clip(PlanState& s, const ParamReader& r) {
+  if (r.boolean("enabled")) {
+    s.clip_plane = plane_from_json(r.value("plane"), r.where());
+    s.message = "clip plane set";
+  } else {
+    s.clip_plane.reset();
+    s.message = "clip plane removed";
+  }
+}
+
+MarkerType marker_type(const ParamReader& r) {
+  const int t = r.integer("type");
+  if (t < 0 || t > 3) throw Refusal{"marker type must be 0..3, not " + std::to_string(t)};
+  return static_cast<MarkerType>(t);
+}
+
+Marker& marker_ref(PlanState& s, const ParamReader& r) {
+  const int id = r.integer("id");
+  for (auto& m : s.markers)
+    if (m.id == id) return m;
+  throw Refusal{"there is no marker " + std::to_string(id)};
+}
+
+void snap_one(const PlanState& s, Marker& m) {
+  m.position = surface_for(s, m.surface)->closest(m.position).point;
+}
+
+void apply_marker_edit(PlanState& s, CommandType type, const ParamReader& r) {
+  switch (type) {
+    case CommandType::AddMarker: {
+      Marker m;
+      m.type = marker_type(r);
+      m.surface = default_surface(m.type);
+      m.position = r.vector3("position");
+      m.id = s.next_marker_id++;
+      snap_one(s, m);
+      s.markers.push_back(m);
+      s.message = "added marker " + std::to_string(m.id);
+      break;
+    }
+    case CommandType::MoveMarker: {
+      Marker& m = marker_ref(s, r);
+      m.position = r.vector3("position");
+      snap_one(s, m);
+      s.message = "moved marker " + std::to_string(m.id);
+      break;
+    }
+    case CommandType::DeleteMarker: {
+      const int id = marker_ref(s, r).id;
+      s.markers.erase(std::remove_if(s.markers.begin(), s.markers.end(),
+                                     [id](const Marker& m) { return m.id == id; }),
+                      s.markers.end());
+      s.message = "deleted marker " + std::to_string(id);
+      break;
+    }
+    case CommandType::RetypeMarker: {
+      Marker& m = marker_ref(s, r);
+      m.type = marker_type(r);
+      m.surface = default_surface(m.type);
+      snap_one(s, m);
+      s.message = "marker " + std::to_string(m.id) + " is now " + to_string(m.type);
+      break;
+    }
+    case CommandType::ImportMarkers: {
+      std::vector<Marker> imported = markers_from_json(r.value("markers"), r.where());
+      std::string why;
+      if (!snap(s, imported, why)) throw Refusal{"imported markers: " + why};
+      for (auto& m : imported) {
+        m.id = s.next_marker_id++;
+        s.markers.push_back(m);
+      }
+      s.message = "imported " + std::to_string(imported.size()) + " markers";
+      break;
+    }
+    case CommandType::ClearMarkers:
+      s.markers.clear();
+      s.message = "markers cleared";
+      break;
+    default:
+      assert(false && "not a marker edit");
+  }
+  markers_changed(s);
+}
+
+void apply_propose(PlanState& s, const ParamReader& r) {
+  ProposeParams params;
+  params_from_json(ParamReader(r.value("params"), r.where() + " params"), params);
+  const SurfaceLocator& mirror = s.mirrored ? s.mirrored->locator : s.skull->surface->locator;
+  MarkerProposal p = propose_markers(s.skull->surface->mesh, s.skull->surface->locator, *s.plane,
+                                     mirror, params, s.next_marker_id);
+  if (!p.proposed()) {
+    s.message = "no markers proposed: " + p.message;
+    return;
+  }
+  s.markers = std::move(p.markers);
+  for (const auto& m : s.markers) s.next_marker_id = std::max(s.next_marker_id, m.id + 1);
+  s.defect_center = p.defect.center;
+  char buf[300];
+  std::snprintf(
+      buf, sizeof(buf), "%zu markers proposed, %s (mirror covers %.0f%% of the opening); %s",
+      s.markers.size(), p.method_used == PlanMethod::Mirror ? "mirror-guided" : "rim-only fitting",
+      100.0 * p.mirror_coverage, p.message.c_str());
+  s.proposal_message = buf;
+  s.message = buf;
+  markers_changed(s);
+}
+
+void apply_smooth(PlanState& s, const ParamReader& r) {
+  SmoothParams params;
+  params_from_json(ParamReader(r.value("params"), r.where() + " params"), params);
+  const bool project = r.boolean("project_onto_mirror");
+  const SmoothResult result =
+      smooth_markers(s.markers, params, project && s.mirrored ? &s.mirrored->locator : nullptr);
+  if (result.status != SmoothResult::Status::Smoothed) {
+    s.message = "markers not smoothed: " + result.message;
+    return;
+  }
+  s.markers = result.markers;
+  char buf[120];
+  std::snprintf(buf, sizeof(buf), "markers smoothed: largest move %.2f mm", result.max_move_mm);
+  s.message = buf;
+  markers_changed(s);
+  const std::string implant_message = s.message;
+  if (implant_message != buf) s.message = std::string(buf) + "; " + implant_message;
+}
+
+void apply_build(PlanState& s, const ParamReader& r) {
+  ImplantParams params;
+  params_from_json(ParamReader(r.value("params"), r.where() + " params"), params);
+  s.implant_params = params;
+  unacknowledge(s, 8, "the implant was built again");
+  rebuild_implant(s);
+}
+
+void apply_export(PlanState& s, const ParamReader& r) {
+  if (!s.implant) throw Refusal{"there is no implant to export: build it first"};
+  ExportRecord e;
+  e.path = r.string("path");
+  e.format = r.string("format");
+  if (e.format != "stl" && e.format != "ply")
+    throw Refusal{"export format must be \"stl\" or \"ply\", not \"" + e.format + "\""};
+  e.recorded_sha256 = r.string("sha256");
+  e.replayed_sha256 = sha256_hex(encode_mesh(
+      s.implant->result().mesh, e.format == "stl" ? MeshFormat::BinarySTL : MeshFormat::BinaryPLY));
+  e.implant_sha256 = s.implant->stl_sha256();
+  s.message = e.recorded_sha256 == e.replayed_sha256
+                  ? "implant exported to " + e.path
+                  : "implant exported to " + e.path +
+                        " — but the implant now encodes to different bytes than were recorded";
+  s.exports.push_back(std::move(e));
+}
+
+void apply_step(PlanState& s, CommandType type, const ParamReader& r) {
+  const int step = r.integer("step");
+  if (step < 1 || step > 9) throw Refusal{"there is no step " + std::to_string(step)};
+  if (type == CommandType::GoToStep) {
+    s.current_step = step;
+    s.message = std::string("step ") + std::to_string(step) + ": " + wizard_steps()[step - 1].title;
+    return;
+  }
+  std::string missing;
+  const bool by_hand = step == 3 || step == 4 || step == 8;
+  if (step == 3 && !s.mirrored) throw Refusal{"step 3 cannot be done: mirror the skull first"};
+  if (step == 8 && !(s.implant && s.implant->result().usable()))
+    throw Refusal{"step 8 cannot be done: build the implant first"};
+  if (!by_hand && !step_complete(s, step, &missing))
+    throw Refusal{"step " + std::to_string(step) + " is not done: " + missing};
+  if (by_hand) s.acknowledged[step] = true;
+  s.stale.erase(step);
+  s.current_step = std::min(9, step + 1);
+  s.message = std::string("step ") + std::to_string(step) + " done";
+}
+
+}  // namespace
+
+ApplyOutcome apply_command(const PlanState& before, const Command& command,
+                           const ApplyContext& context) {
+  ApplyOutcome out;
+  const int step = command_step(before, command);
+  std::string why;
+  if (step >= 1 && !step_unlocked(before, step, &why)) {
+    out.message = why;
+    out.state = before;
+    return out;
+  }
+  PlanState s = before;
+  s.message.clear();
+  const std::string where = std::string("command ") + type_tag(command.type);
+  const ParamReader r(command.params, where);
+  try {
+    switch (command.type) {
+      case CommandType::LoadSkull:
+        apply_load(s, r, context);
+        break;
+      case CommandType::SetLandmark:
+        apply_landmark(s, r, true);
+        break;
+      case CommandType::ClearLandmark:
+        apply_landmark(s, r, false);
+        break;
+      case CommandType::FitPlane:
+        apply_fit_plane(s, r);
+        break;
+      case CommandType::AdjustPlane:
+        apply_adjust_plane(s, r);
+        break;
+      case CommandType::Mirror:
+        apply_mirror(s);
+        break;
+      case CommandType::Register:
+        apply_register(s, r);
+        break;
+      case CommandType::MoveMirrored:
+        apply_move_mirrored(s, r);
+        break;
+      case CommandType::SetClipPlane:
+        apply_clip(s, r);
+        break;
+      case CommandType::AddMarker:
+      case CommandType::MoveMarker:
+      case CommandType::DeleteMarker:
+      case CommandType::RetypeMarker:
+      case CommandType::ImportMarkers:
+      case CommandType::ClearMarkers:
+        apply_marker_edit(s, command.type, r);
+        break;
+      case CommandType::ProposeMarkers:
+        apply_propose(s, r);
+        break;
+      case CommandType::SmoothMarkers:
+        apply_smooth(s, r);
+        break;
+      case CommandType::BuildImplant:
+        apply_build(s, r);
+        break;
+      case CommandType::ExportImplant:
+        apply_export(s, r);
+        break;
+      case CommandType::GoToStep:
+      case CommandType::CompleteStep:
+        apply_step(s, command.type, r);
+        break;
+      case CommandType::Note:
+        s.notes.push_back(r.string("text"));
+        s.message = "note added";
+        break;
+    }
+  } catch (const Refusal& refusal) {
+    out.message = refusal.message;
+    out.state = before;
+    return out;
+  }
+  if (step >= 1) s.stale.erase(step);
+  out.accepted = true;
+  out.message = s.message;
+  out.state = std::move(s);
+  return out;
+}
+
+}  // namespace cranioplan

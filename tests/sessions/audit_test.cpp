@@ -1,0 +1,236 @@
+#include "cranioplan/sessions/audit.h"
+
+#include <gtest/gtest.h>
+
+#include "cranioplan/algorithms/autoplan.h"
+#include "cranioplan/algorithms/load_skull.h"
+#include "cranioplan/algorithms/write_mesh.h"
+#include "cranioplan/model/error.h"
+#include "cranioplan/sessions/autoplan_session.h"
+#include "cranioplan/sessions/sha256.h"
+#include "support/session_cases.h"
+#include "support/test_files.h"
+
+namespace cranioplan {
+namespace {
+
+struct PlannedCase {
+  std::string session_path, implant_path;
+  std::string implant_sha;
+};
+
+// The automatic plan of the synthetic one-sided defect, as a saved session with an export.
+const PlannedCase& planned() {
+  static const PlannedCase c = [] {
+    PlannedCase p;
+    p.session_path = test::scratch_path("auto.json");
+    p.implant_path = test::scratch_path("auto_implant.stl");
+    AutoplanSession a = autoplan_session(test::defect_skull_stl(), Landmarks{}, AutoplanParams{},
+                                         p.implant_path, SessionInfo{"synthetic", "expert", ""});
+    EXPECT_TRUE(a.planned()) << a.message;
+    a.session.save(p.session_path);
+    p.implant_sha = sha256_file(p.implant_path);
+    return p;
+  }();
+  return c;
+}
+
+TEST(AutoplanSession, GivesTheSameImplantAsAutoplan) {
+  const PlannedCase& c = planned();
+  const AutoplanResult direct = autoplan(load_skull(test::defect_skull_stl()).mesh, Landmarks{});
+  ASSERT_TRUE(direct.planned());
+  EXPECT_EQ(sha256_hex(encode_mesh(direct.implant.mesh, MeshFormat::BinarySTL)), c.implant_sha);
+  EXPECT_EQ(test::validate_session_schema(c.session_path), "");
+}
+
+TEST(AutoplanSession, ReplayReproducesTheExportByteForByte) {
+  const PlannedCase& c = planned();
+  const Session replayed = Session::open(c.session_path);
+  ASSERT_TRUE(replayed.state().implant);
+  EXPECT_EQ(replayed.state().implant->stl_sha256(), c.implant_sha);
+  for (int step = 1; step <= 9; ++step) EXPECT_TRUE(step_complete(replayed.state(), step)) << step;
+  const VerifyReport v = verify_session(c.session_path);
+  EXPECT_TRUE(v.ok());
+  for (const auto& check : v.checks) EXPECT_TRUE(check.ok) << check.name << ": " << check.detail;
+}
+
+TEST(AutoplanSession, UndoOfTheLastCommandUsesTheCache) {
+  Session s = Session::open(planned().session_path);
+  const size_t n = s.index();
+  ASSERT_TRUE(s.undo());
+  EXPECT_EQ(s.index(), n - 1);
+  ASSERT_TRUE(s.undo());  // export, review: the implant is still there
+  EXPECT_TRUE(s.state().implant);
+  ASSERT_TRUE(s.redo());
+  ASSERT_TRUE(s.redo());
+  EXPECT_EQ(s.state().implant->stl_sha256(), planned().implant_sha);
+}
+
+// Tampering with any recorded parameter, in the command list or in the journal, is caught.
+TEST(Verify, DetectsTamperingWithAnyRecordedParameter) {
+  const PlannedCase& c = planned();
+  const Json doc = read_json_file(c.session_path);
+  std::vector<std::pair<std::string, Json::json_pointer>> leaves;
+  std::function<void(const Json&, const Json::json_pointer&)> walk =
+      [&](const Json& j, const Json::json_pointer& at) {
+        if (j.is_object()) {
+          for (auto it = j.begin(); it != j.end(); ++it) walk(it.value(), at / it.key());
+        } else if (j.is_array()) {
+          for (size_t i = 0; i < j.size(); ++i) walk(j[i], at / i);
+        } else if (j.is_number() || j.is_boolean() ||
+                   (j.is_string() && !j.get<std::string>().empty())) {
+          leaves.emplace_back(at.to_string(), at);
+        }
+      };
+  for (const char* list : {"commands", "journal"}) {
+    const Json& l = doc[list];
+    for (size_t i = 0; i < l.size(); ++i) {
+      const Json::json_pointer base = Json::json_pointer("/" + std::string(list)) / i;
+      const Json::json_pointer params =
+          std::string(list) == "journal" ? base / "command" / "params" : base / "params";
+      if (doc.contains(params)) walk(doc[params], params);
+    }
+  }
+  ASSERT_GT(leaves.size(), 100u);
+  int checked = 0;
+  for (size_t k = 0; k < leaves.size(); k += std::max<size_t>(1, leaves.size() / 60)) {
+    Json bad = doc;
+    Json& v = bad[leaves[k].second];
+    if (v.is_boolean())
+      v = !v.get<bool>();
+    else if (v.is_number_integer())
+      v = v.get<long long>() + 1;
+    else if (v.is_number())
+      v = v.get<double>() + 1e-3;
+    else
+      v = v.get<std::string>() + "x";
+    const std::string p = test::scratch_path("tampered.json");
+    write_json_file(bad, p);
+    bool detected = false;
+    try {
+      detected = !verify_session(p).ok();
+    } catch (const Error&) {
+      detected = true;  // unreadable as a session is also a failed verification
+    }
+    EXPECT_TRUE(detected) << "undetected change at " << leaves[k].first;
+    ++checked;
+  }
+  EXPECT_GE(checked, 50);
+}
+
+TEST(Verify, CliExitsFourWhenAnyCheckFails) {
+  const PlannedCase& c = planned();
+  std::string out;
+  EXPECT_EQ(test::run_command(std::string(CRANIOPLAN_CLI) + " verify " + c.session_path, &out), 0)
+      << out;
+  Json bad = read_json_file(c.session_path);
+  bad["journal"][3]["time"] = "2001-01-01T00:00:00.000Z";
+  const std::string p = test::scratch_path("bad_chain.json");
+  write_json_file(bad, p);
+  EXPECT_EQ(test::run_command(std::string(CRANIOPLAN_CLI) + " verify " + p, &out), 4);
+  EXPECT_NE(out.find("journal entry 4"), std::string::npos) << out;
+  const std::string replayed = test::scratch_path("replayed.stl");
+  EXPECT_EQ(test::run_command(std::string(CRANIOPLAN_CLI) + " replay " + c.session_path + " -o " +
+                              replayed),
+            0);
+  EXPECT_EQ(sha256_file(replayed), c.implant_sha);
+}
+
+TEST(Audit, TimelineNamesWhoWhenWhatAndStepTimes) {
+  const SessionDocument doc = read_session_document(planned().session_path);
+  const std::string text = audit_text(doc);
+  EXPECT_NE(text.find("expert"), std::string::npos);
+  EXPECT_NE(text.find("Propose markers automatically"), std::string::npos);
+  EXPECT_NE(text.find("Time per step"), std::string::npos);
+  const std::string html = audit_html(doc);
+  EXPECT_NE(html.find("<table>"), std::string::npos);
+  const StepDurations d = step_durations(doc.header, doc.journal);
+  double sum = 0;
+  for (int s = 1; s <= 9; ++s) sum += d.seconds[s];
+  EXPECT_NEAR(sum, d.total, 1e-9);
+  EXPECT_GT(d.seconds[5], 0.0) << "proposing markers takes time";
+}
+
+TEST(Audit, StepDurationsFollowTheJournalTimes) {
+  SessionHeader h;
+  h.info.created = "2026-01-01T10:00:00.000Z";
+  auto entry = [](const char* time, int step) {
+    JournalEntry e;
+    e.event = "do";
+    e.time = time;
+    Command c = commands::note("x");
+    c.meta.step = step;
+    e.command = c;
+    return e;
+  };
+  const std::vector<JournalEntry> j = {
+      entry("2026-01-01T10:01:00.000Z", 1), entry("2026-01-01T10:03:30.000Z", 2),
+      entry("2026-01-01T10:03:40.500Z", 0), entry("2026-01-01T11:00:00.000Z", 5)};
+  const StepDurations d = step_durations(h, j, 300);
+  EXPECT_NEAR(d.seconds[1], 60, 1e-6);
+  EXPECT_NEAR(d.seconds[2], 150 + 10.5, 1e-6) << "a note counts for the step before it";
+  EXPECT_NEAR(d.seconds[5], 300, 1e-6) << "idle gaps are capped";
+}
+
+TEST(Training, ReportComparesTimesAndImplants) {
+  const Session expert = Session::open(planned().session_path);
+  // A trainee who planned the same case with a coarser implant.
+  AutoplanParams coarse;
+  coarse.implant.resolution_mm = 2.0;
+  AutoplanSession trainee = autoplan_session(test::defect_skull_stl(), Landmarks{}, coarse, "",
+                                             SessionInfo{"synthetic", "trainee", ""});
+  ASSERT_TRUE(trainee.planned()) << trainee.message;
+  const TrainingReport r = training_report(trainee.session, expert);
+  ASSERT_TRUE(r.agreement);
+  EXPECT_GT(r.agreement->dice, 0.9);
+  EXPECT_LT(r.agreement->hd95_mm, 1.5);
+  EXPECT_GT(r.reference_volume_mm3, 0);
+  const std::string text = training_report_text(r);
+  EXPECT_NE(text.find("trainee against expert"), std::string::npos) << text;
+  EXPECT_NE(training_report_html(r).find("Implant agreement"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace cranioplan
+
+namespace cranioplan {
+namespace {
+
+TEST(SessionCli, AutoplanWritesASessionThatAuditAndTrainingReportRead) {
+  const std::string cli = CRANIOPLAN_CLI;
+  const std::string session = test::scratch_path("cli_session.json");
+  const std::string implant = test::scratch_path("cli_implant.stl");
+  std::string out;
+  ASSERT_EQ(test::run_command(cli + " autoplan " + test::defect_skull_stl() + " -o " + implant +
+                                  " --session " + session + " --json",
+                              &out),
+            0)
+      << out;
+  const Json j = Json::parse(out);
+  EXPECT_EQ(j["status"], "planned");
+  EXPECT_EQ(j["session"], session);
+  EXPECT_TRUE(j["quality"]["watertight"].get<bool>());
+  EXPECT_EQ(test::validate_session_schema(session), "");
+  EXPECT_EQ(test::run_command(cli + " verify " + session, &out), 0) << out;
+
+  const std::string html = test::scratch_path("audit.html");
+  ASSERT_EQ(test::run_command(cli + " audit " + session + " --html " + html, &out), 0);
+  EXPECT_NE(out.find("Time per step"), std::string::npos) << out;
+  EXPECT_NE(test::read_bytes(html).find("hash chain: holds"), std::string::npos);
+
+  const std::string report = test::scratch_path("training.html");
+  ASSERT_EQ(test::run_command(cli + " training-report " + session + " --reference " +
+                                  planned().session_path + " --html " + report + " --json",
+                              &out),
+            0)
+      << out;
+  const Json t = Json::parse(out);
+  EXPECT_GT(t["agreement"]["dice"].get<double>(), 0.99) << "the same plan twice";
+  EXPECT_NE(test::read_bytes(report).find("Implant agreement"), std::string::npos);
+
+  std::string missing_out;
+  EXPECT_EQ(test::run_command(cli + " replay " + test::scratch_path("nope.json"), &missing_out), 3);
+}
+
+}  // namespace
+}  // namespace cranioplan

@@ -1,0 +1,468 @@
+#include "cranioplan/sessions/session.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <random>
+
+#include "cranioplan/sessions/audit.h"
+#include "cranioplan/sessions/session_error.h"
+#include "support/session_cases.h"
+#include "support/synthetic.h"
+#include "support/test_files.h"
+
+namespace cranioplan {
+namespace {
+
+namespace fs = std::filesystem;
+using test::fingerprint;
+using test::push_ok;
+
+// A session on the small head brought to step 5 (markers unlocked).
+Session session_at_markers() {
+  Session s(SessionInfo{"small", "tester", ""});
+  push_ok(s, commands::load_skull(test::small_skull_stl()));
+  const Landmarks lm = test::head_landmarks();
+  push_ok(s, commands::set_landmark("nasion", *lm.nasion));
+  push_ok(s, commands::set_landmark("orbit_left", *lm.orbit_left));
+  push_ok(s, commands::set_landmark("orbit_right", *lm.orbit_right));
+  PlaneFitParams fit;
+  fit.sample_count = 1000;
+  push_ok(s, commands::fit_plane(fit));
+  push_ok(s, commands::mirror());
+  RegisterParams reg;
+  reg.sample_count = 1000;
+  push_ok(s, commands::register_mirror(reg));
+  push_ok(s, commands::complete_step(4));
+  return s;
+}
+
+Eigen::Vector3d on_head(double x, double y, double z) {
+  return test::head_surface_point(Eigen::Vector3d(x, y, z).normalized());
+}
+
+// Three outer edge markers around the hole: step 5 done, surface markers unlocked.
+void add_rim(Session& s) {
+  for (double a : {0.0, 2.1, 4.2})
+    push_ok(s, commands::add_marker(MarkerType::OuterEdge, on_head(0.7 + 0.2 * std::cos(a),
+                                                                   0.1 + 0.2 * std::sin(a), 0.7)));
+}
+
+std::string expect_session_error(const std::string& path) {
+  try {
+    Session::open(path);
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  ADD_FAILURE() << "no error for " << path;
+  return {};
+}
+
+TEST(Commands, EveryTypeRoundTripsThroughJson) {
+  std::vector<Command> all = {
+      commands::load_skull("skull.stl", {}, std::string(64, 'a')),
+      commands::set_landmark("nasion", {1, 2, 3}),
+      commands::clear_landmark("midline"),
+      commands::fit_plane(),
+      commands::adjust_plane({0, 0, 1}, 2.5, -1.0),
+      commands::mirror(),
+      commands::register_mirror(),
+      commands::move_mirrored({0, 1, 0}, 1.0, {1, 2, 3}, {0.5, 0, 0}),
+      commands::set_clip_plane(Plane{Eigen::Vector3d::UnitZ(), 12.0}),
+      commands::add_marker(MarkerType::InnerSurface, {4, 5, 6}),
+      commands::move_marker(3, {7, 8, 9}),
+      commands::delete_marker(3),
+      commands::retype_marker(4, MarkerType::OuterEdge),
+      commands::import_markers({{1, MarkerType::OuterEdge, {1, 1, 1}, MarkerSurface::Original}},
+                               "m.json", std::string(64, 'b')),
+      commands::clear_markers(),
+      commands::propose_markers(),
+      commands::smooth_markers({8.0, 3.0, 2}, false),
+      commands::build_implant(),
+      commands::export_implant("implant.ply", std::string(64, 'c')),
+      commands::go_to_step(4),
+      commands::complete_step(4),
+      commands::note("checked with the surgeon"),
+  };
+  RegisterParams with_roi;
+  with_roi.roi = RegionOfInterest{RegionOfInterest::Shape::Box, {1, 2, 3}, 10, {4, 5, 6}};
+  all.push_back(commands::register_mirror(with_roi));
+  std::set<CommandType> seen;
+  for (const Command& c : all) {
+    seen.insert(c.type);
+    const Json j = to_json(c);
+    const Command back = command_from_json(j, "test");
+    EXPECT_EQ(to_json(back), j) << type_tag(c.type);
+    EXPECT_FALSE(describe(c).empty());
+  }
+  EXPECT_EQ(seen.size(), all_command_types().size()) << "a command type has no round-trip case";
+  // Parameters read back into the algorithms' structs equal what was written.
+  RegisterParams back;
+  params_from_json(ParamReader(all.back().params["params"], "test"), back);
+  ASSERT_TRUE(back.roi);
+  EXPECT_EQ(back.roi->half_size, Eigen::Vector3d(4, 5, 6));
+  ImplantParams implant;
+  implant.thickness_mm = 5.5;
+  implant.radial_center = Eigen::Vector3d(1, 2, 3);
+  ImplantParams implant_back;
+  params_from_json(ParamReader(params_to_json(implant), "test"), implant_back);
+  EXPECT_EQ(implant_back.thickness_mm, 5.5);
+  EXPECT_EQ(*implant_back.radial_center, Eigen::Vector3d(1, 2, 3));
+  ImplantParams nan_thickness;  // NaN (the default: measured) goes through JSON as null
+  params_from_json(ParamReader(params_to_json(nan_thickness), "test"), implant_back);
+  EXPECT_TRUE(std::isnan(implant_back.thickness_mm));
+}
+
+TEST(Commands, UnknownTypeVersionAndMissingParameterAreNamed) {
+  Json j = to_json(commands::smooth_markers({8, 2, 1}));
+  Json unknown = j;
+  unknown["type"] = "paint_skull";
+  EXPECT_THROW(
+      {
+        try {
+          command_from_json(unknown, "plan.json: commands[4]");
+        } catch (const SessionError& e) {
+          EXPECT_NE(std::string(e.what()).find("plan.json: commands[4]"), std::string::npos);
+          EXPECT_NE(std::string(e.what()).find("unknown command type \"paint_skull\""),
+                    std::string::npos);
+          throw;
+        }
+      },
+      SessionError);
+  Json newer = j;
+  newer["version"] = 7;
+  EXPECT_THROW(command_from_json(newer, "x"), SessionError);
+  Json missing = j;
+  missing["params"].erase("project_onto_mirror");
+  try {
+    command_from_json(missing, "plan.json: commands[4]");
+    ADD_FAILURE() << "missing parameter accepted";
+  } catch (const SessionError& e) {
+    EXPECT_NE(std::string(e.what()).find("missing parameter 'project_onto_mirror'"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(StepLock, LaterStepsAreRefusedWithWhatIsMissing) {
+  Session s;
+  PushResult r = s.push(commands::add_marker(MarkerType::OuterEdge, {0, 0, 0}));
+  EXPECT_FALSE(r.accepted);
+  EXPECT_NE(r.message.find("step 5 (Edge markers) is locked: step 1 (Load skull) is not done"),
+            std::string::npos)
+      << r.message;
+  push_ok(s, commands::load_skull(test::small_skull_stl()));
+  r = s.push(commands::mirror());
+  EXPECT_FALSE(r.accepted);
+  EXPECT_NE(r.message.find("step 2"), std::string::npos) << r.message;
+  EXPECT_TRUE(s.push(commands::note("any step")).accepted);
+  EXPECT_FALSE(s.push(commands::complete_step(2)).accepted);
+  EXPECT_FALSE(s.push(commands::export_implant(test::scratch_path("x.stl"))).accepted);
+  EXPECT_FALSE(fs::exists(test::scratch_path("x.stl"))) << "a refused export wrote a file";
+  EXPECT_EQ(s.effective_commands().size(), 2u) << "refused commands are not recorded";
+
+  Session m = session_at_markers();
+  // Step 6 needs step 5: three outer edge markers.
+  r = m.push(commands::add_marker(MarkerType::OuterSurface, on_head(0.7, 0.1, 0.7)));
+  EXPECT_FALSE(r.accepted);
+  EXPECT_NE(r.message.find("outer edge markers (0 so far)"), std::string::npos) << r.message;
+  add_rim(m);
+  EXPECT_TRUE(
+      m.push(commands::add_marker(MarkerType::OuterSurface, on_head(0.7, 0.1, 0.7))).accepted);
+  // Two inner edge markers are neither none nor three.
+  push_ok(m, commands::add_marker(MarkerType::InnerEdge, on_head(0.6, 0.1, 0.7)));
+  std::string missing;
+  EXPECT_FALSE(step_complete(m.state(), 5, &missing));
+  EXPECT_NE(missing.find("inner edge markers: 1 placed"), std::string::npos) << missing;
+}
+
+TEST(Session, MarkersSnapToTheirSurfaceAndKeepStableIds) {
+  Session s = session_at_markers();
+  push_ok(s, commands::add_marker(MarkerType::OuterEdge, on_head(0.6, 0.0, 0.8) * 1.02));
+  add_rim(s);
+  const Marker first = s.state().markers[0];
+  EXPECT_EQ(first.id, 1);
+  EXPECT_LT(s.state().skull->surface->locator.closest(first.position).distance, 1e-6);
+  push_ok(s, commands::delete_marker(1));
+  push_ok(s, commands::add_marker(MarkerType::OuterEdge, on_head(0.6, 0.0, 0.8)));
+  EXPECT_EQ(s.state().markers.back().id, 5) << "ids are never reused";
+  push_ok(s, commands::retype_marker(5, MarkerType::OuterSurface));
+  EXPECT_EQ(s.state().markers.back().surface, MarkerSurface::Mirrored);
+  EXPECT_LT(s.state().mirrored->locator.closest(s.state().markers.back().position).distance, 1e-6);
+  EXPECT_FALSE(s.push(commands::move_marker(42, {0, 0, 0})).accepted);
+}
+
+TEST(Session, DragsOfOneMarkerMergeIntoOneCommand) {
+  Session s = session_at_markers();
+  push_ok(s, commands::add_marker(MarkerType::OuterEdge, on_head(0.6, 0.0, 0.8)));
+  const Json before = fingerprint(s.state());
+  const size_t n = s.effective_commands().size();
+  for (int i = 1; i <= 5; ++i) {
+    const PushResult r = s.push(commands::move_marker(1, on_head(0.6, 0.02 * i, 0.8)));
+    EXPECT_TRUE(r.accepted);
+    EXPECT_EQ(r.merged, i > 1);
+  }
+  EXPECT_EQ(s.effective_commands().size(), n + 1);
+  EXPECT_EQ(s.undo_text(), "Undo Move marker 1");
+  s.undo();
+  EXPECT_EQ(fingerprint(s.state()), before);
+  int merges = 0;
+  for (const auto& e : s.journal()) merges += e.event == "merge";
+  EXPECT_EQ(merges, 4);
+}
+
+TEST(Session, PushAfterUndoDropsTheRedoBranchButTheJournalKeepsIt) {
+  Session s = session_at_markers();
+  push_ok(s, commands::note("a"));
+  push_ok(s, commands::note("b"));
+  ASSERT_TRUE(s.undo());
+  EXPECT_EQ(s.redo_text(), "Redo Note: b");
+  push_ok(s, commands::note("c"));
+  EXPECT_FALSE(s.can_redo());
+  ASSERT_EQ(s.state().notes.size(), 2u);
+  EXPECT_EQ(s.state().notes[1], "c");
+  const std::string path = test::scratch_path("redo.json");
+  s.save(path);
+  const auto rows = audit_rows(read_session_document(path));
+  int undone = 0;
+  for (const auto& r : rows) undone += r.undone;
+  EXPECT_EQ(undone, 1) << "note b was done, undone, then dropped";
+}
+
+// The random walk: 1,000 do/undo/redo operations; the final state equals a fresh replay
+// of the effective list, and undoing everything gives the initial state back.
+TEST(Session, RandomWalkEqualsFreshReplay) {
+  Session s = session_at_markers();
+  add_rim(s);
+  s.set_cache_limit(40);            // also exercises recomputing evicted states
+  const size_t prefix = s.index();  // the walk stays above the loaded, registered skull
+  const Json initial = fingerprint(PlanState{});
+  std::mt19937 rng(12345);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  auto random_point = [&] {
+    return on_head(0.7 + 0.25 * unit(rng), 0.1 + 0.25 * unit(rng), 0.7 + 0.2 * unit(rng));
+  };
+  int accepted = 0;
+  for (int op = 0; op < 1000; ++op) {
+    const int kind = static_cast<int>(rng() % 12);
+    const auto& markers = s.state().markers;
+    const int some_id = markers.empty() ? 1 : markers[rng() % markers.size()].id;
+    PushResult r;
+    switch (kind) {
+      case 0:
+      case 1:
+        if (s.index() > prefix) s.undo();
+        continue;
+      case 2:
+        s.redo();
+        continue;
+      case 3:
+      case 4:
+        r = s.push(commands::add_marker(static_cast<MarkerType>(rng() % 4), random_point()));
+        break;
+      case 5:
+      case 6:
+        r = s.push(commands::move_marker(some_id, random_point()));
+        break;
+      case 7:
+        r = s.push(commands::delete_marker(some_id));
+        break;
+      case 8:
+        r = s.push(commands::retype_marker(some_id, static_cast<MarkerType>(rng() % 4)));
+        break;
+      case 9:
+        r = s.push(commands::set_clip_plane(Plane{Eigen::Vector3d::UnitZ(), 10 * unit(rng)}));
+        break;
+      case 10:
+        r = s.push(commands::note("n" + std::to_string(op)));
+        break;
+      default:
+        if (rng() % 25 == 0) {
+          r = s.push(commands::move_mirrored({0, 0, 1}, unit(rng), {0, 0, 0}, {unit(rng), 0, 0}));
+        } else {
+          s.set_index(prefix + rng() % (s.stack().size() - prefix + 1));
+          continue;
+        }
+    }
+    accepted += r.accepted;
+  }
+  EXPECT_GT(accepted, 200);
+  const std::string path = test::scratch_path("walk.json");
+  s.save(path);
+  const Session replayed = Session::open(path);
+  EXPECT_EQ(fingerprint(replayed.state()), fingerprint(s.state()));
+  EXPECT_EQ(replayed.effective_commands().size(), s.effective_commands().size());
+  EXPECT_EQ(replayed.stack().size(), s.stack().size()) << "the redo branch is kept";
+  s.set_index(0);
+  EXPECT_EQ(fingerprint(s.state()), initial);
+  EXPECT_EQ(test::validate_session_schema(path), "") << path;
+}
+
+TEST(Session, ChangingThePlaneRecomputesTheMirrorAndMarksLaterStepsStale) {
+  Session s = session_at_markers();
+  const Json mirror_before = fingerprint(s.state())["mirror"];
+  add_rim(s);
+  push_ok(s, commands::add_marker(MarkerType::OuterSurface, on_head(0.7, 0.1, 0.7)));
+  push_ok(s, commands::adjust_plane({0, 0, 1}, 2.0, 0.0));
+  EXPECT_TRUE(s.state().stale.count(3));
+  EXPECT_TRUE(s.state().stale.count(4));
+  EXPECT_TRUE(s.state().stale.count(6));
+  EXPECT_FALSE(step_complete(s.state(), 4)) << "inspect again after the plane moved";
+  EXPECT_NE(fingerprint(s.state())["mirror"], mirror_before) << "registered again";
+  s.undo();
+  EXPECT_TRUE(step_complete(s.state(), 4));
+}
+
+TEST(SessionFile, SavedSessionsFollowTheSchemaAndReopen) {
+  Session s = session_at_markers();
+  push_ok(s, commands::note("für den Chirurgen"));
+  const std::string path = test::scratch_path("schema.json");
+  s.save(path);
+  EXPECT_TRUE(s.is_clean());
+  EXPECT_EQ(test::validate_session_schema(path), "");
+  const Session back = Session::open(path);
+  EXPECT_TRUE(back.is_clean());
+  EXPECT_EQ(fingerprint(back.state()), fingerprint(s.state()));
+  EXPECT_EQ(back.journal().size(), s.journal().size());
+}
+
+TEST(SessionFile, VersionOneIsUpgraded) {
+  Session s = session_at_markers();
+  const std::string path = test::scratch_path("v2.json");
+  s.save(path);
+  Json v1 = read_json_file(path);
+  v1["schema_version"] = 1;
+  v1["app"] = "cranioplan 0.1.0";
+  v1["case"] = v1["case_id"];
+  for (const char* k : {"app_version", "case_id", "inputs", "redo_commands"}) v1.erase(k);
+  const std::string old_path = test::scratch_path("v1.json");
+  write_json_file(v1, old_path);
+  const Session back = Session::open(old_path);
+  EXPECT_EQ(back.header().info.case_id, "small");
+  EXPECT_EQ(fingerprint(back.state()), fingerprint(s.state()));
+}
+
+TEST(SessionFile, BadFilesGetClearErrors) {
+  Session s = session_at_markers();
+  const std::string good = test::scratch_path("good.json");
+  s.save(good);
+  const Json doc = read_json_file(good);
+  auto variant = [&](const std::string& name, const Json& j) {
+    const std::string p = test::scratch_path(name);
+    write_json_file(j, p);
+    return p;
+  };
+  auto contains = [](const std::string& text, const std::string& part) {
+    return text.find(part) != std::string::npos;
+  };
+
+  const std::string not_json = test::scratch_path("not.json");
+  test::write_bytes(not_json, "{\"schema_version\": 2, \"commands\": [");
+  EXPECT_TRUE(contains(expect_session_error(not_json), "not.json"));
+
+  Json future = doc;
+  future["schema_version"] = 9;
+  EXPECT_TRUE(contains(expect_session_error(variant("future.json", future)),
+                       "unknown session schema version 9"));
+
+  Json unknown = doc;
+  unknown["commands"][2]["type"] = "paint_skull";
+  const std::string unknown_msg = expect_session_error(variant("unknown.json", unknown));
+  EXPECT_TRUE(contains(unknown_msg, "commands[2]")) << unknown_msg;
+  EXPECT_TRUE(contains(unknown_msg, "unknown command type \"paint_skull\"")) << unknown_msg;
+
+  Json missing = doc;
+  missing["commands"][4]["params"].erase("params");
+  EXPECT_TRUE(contains(expect_session_error(variant("missing.json", missing)),
+                       "missing parameter 'params'"));
+
+  Json tampered = doc;
+  tampered["journal"][5]["time"] = "2020-01-01T00:00:00.000Z";
+  EXPECT_TRUE(contains(expect_session_error(variant("chain.json", tampered)),
+                       "the hash chain breaks at journal entry 6"));
+}
+
+TEST(SessionFile, MissingOrChangedSkullIsNamed) {
+  const std::string skull = test::scratch_path("own_skull.stl");
+  fs::copy_file(test::small_skull_stl(), skull, fs::copy_options::overwrite_existing);
+  Session s(SessionInfo{"own", "tester", ""});
+  push_ok(s, commands::load_skull(skull));
+  const std::string path = test::scratch_path("own.json");
+  s.save(path);
+  std::string bytes = test::read_bytes(skull);
+  bytes[100] ^= 1;
+  test::write_bytes(skull, bytes);
+  const std::string changed = expect_session_error(path);
+  EXPECT_NE(changed.find("the skull file changed since this plan was made"), std::string::npos)
+      << changed;
+  EXPECT_NE(changed.find("own_skull.stl"), std::string::npos);
+  fs::remove(skull);
+  const std::string missing = expect_session_error(path);
+  EXPECT_NE(missing.find("the skull file of this plan is missing"), std::string::npos) << missing;
+}
+
+TEST(SessionFile, AutosaveOffersRecoveryOfUnsavedCommands) {
+  Session s = session_at_markers();
+  const std::string path = test::scratch_path("autosaved.json");
+  s.save(path);
+  EXPECT_FALSE(Session::recovery_info(path).available);
+  push_ok(s, commands::note("after save 1"));
+  push_ok(s, commands::note("after save 2"));
+  s.undo();
+  const RecoveryInfo info = Session::recovery_info(path);
+  ASSERT_TRUE(info.available) << info.message;
+  EXPECT_EQ(info.extra_events, 3);
+  const Session recovered = Session::open(path, true);
+  EXPECT_EQ(fingerprint(recovered.state()), fingerprint(s.state()));
+  EXPECT_FALSE(recovered.is_clean());
+  EXPECT_TRUE(recovered.can_redo());
+}
+
+// The crash test: a process that plans and autosaves is killed with SIGKILL at random
+// points; every command it reported finished is recovered.
+TEST(SessionFile, KillMinusNineLosesNoCompletedCommand) {
+  std::mt19937 rng(777);
+  const int runs = 30;
+  int killed_midway = 0;
+  for (int run = 0; run < runs; ++run) {
+    const std::string autosave = test::scratch_path("crash" + std::to_string(run) + ".autosave");
+    int out_pipe[2];
+    ASSERT_EQ(pipe(out_pipe), 0);
+    const pid_t pid = fork();
+    ASSERT_GE(pid, 0);
+    if (pid == 0) {
+      dup2(out_pipe[1], 1);
+      close(out_pipe[0]);
+      execl(CRANIOPLAN_SESSION_WRITER, CRANIOPLAN_SESSION_WRITER, test::small_skull_stl().c_str(),
+            autosave.c_str(), "100000", static_cast<char*>(nullptr));
+      _exit(127);
+    }
+    close(out_pipe[1]);
+    usleep(50000 + rng() % 400000);
+    kill(pid, SIGKILL);
+    int status = 0;
+    waitpid(pid, &status, 0);
+    killed_midway += WIFSIGNALED(status);
+    std::string output;
+    char buf[4096];
+    ssize_t n;
+    while ((n = read(out_pipe[0], buf, sizeof(buf))) > 0) output.append(buf, n);
+    close(out_pipe[0]);
+    int last_done = 0;
+    for (size_t at = output.rfind("done "); at != std::string::npos;) {
+      last_done = std::atoi(output.c_str() + at + 5);
+      break;
+    }
+    if (last_done == 0) continue;  // killed before the skull was loaded
+    const Session recovered = Session::recover(autosave);
+    EXPECT_GE(static_cast<int>(recovered.journal().size()), last_done) << "run " << run;
+    // The recovered plan is the replay of its own journal.
+    const Reconstruction rec = reconstruct(recovered.journal(), autosave);
+    EXPECT_EQ(rec.index, recovered.index());
+    EXPECT_TRUE(recovered.state().skull != nullptr);
+  }
+  EXPECT_GE(killed_midway, runs - 2) << "the writer should be killed while writing";
+}
+
+}  // namespace
+}  // namespace cranioplan

@@ -1,0 +1,30 @@
+#pragma once
+// Skull files for session tests, written once per test program into a temporary folder.
+#include <string>
+
+#include "cranioplan/sessions/plan_state.h"
+#include "cranioplan/sessions/session.h"
+
+namespace cranioplan::test {
+
+/// A light synthetic head (5,120 triangles before the hole) with a round hole, as binary STL.
+const std::string& small_skull_stl();
+/// The thick synthetic skull with a one-sided 45 mm defect (what the planner is tested on), as
+/// binary STL; and its ground-truth implant.
+const std::string& defect_skull_stl();
+const std::string& defect_implant_stl();
+/// A folder that lives as long as the test program.
+std::string scratch_path(const std::string& name);
+
+/// Everything that defines a plan's state, as JSON, to compare states for equality.
+Json fingerprint(const PlanState& state);
+
+/// Pushes a command and fails the test (with the refusal) when it is refused.
+void push_ok(Session& session, Command command);
+
+/// Validates a JSON file against docs/session.schema.json with python3-jsonschema. Returns
+/// an empty string when valid, the validator's message otherwise; "skip" when python3 or
+/// jsonschema is missing.
+std::string validate_session_schema(const std::string& path);
+
+}  // namespace cranioplan::test
