@@ -19,6 +19,7 @@
 #include "cranioplan/algorithms/register_icp.h"
 #include "cranioplan/algorithms/surface_locator.h"
 #include "cranioplan/algorithms/write_mesh.h"
+#include "cranioplan/sessions/autoplan_session.h"
 
 namespace cranioplan::cli {
 namespace {
@@ -101,6 +102,29 @@ Json run_bench(const BenchOptions& options) {
       const SmoothResult s = smooth_markers(plan.markers, SmoothParams{10.0, 2.0, 1}, &mirror);
       build_implant(s.markers, &skull.mesh, &bone, AutoplanParams{}.implant);
     });
+  }
+  // The same plan as session commands: one marker drag (the implant follows), then undo and
+  // redo of it, which the session serves from its cache of states.
+  if (plan.planned()) {
+    AutoplanSession a = autoplan_session(input, Landmarks{}, AutoplanParams{}, "");
+    if (a.planned() && !a.session.state().markers.empty()) {
+      Session& session = a.session;
+      const Marker m = session.state().markers.back();
+      const SurfaceLocator& surface = m.surface == MarkerSurface::Mirrored
+                                          ? session.state().mirrored->locator
+                                          : session.state().skull->surface->locator;
+      int k = 0;
+      out["session_move_marker_s"] = median_seconds(runs, [&] {
+        const Eigen::Vector3d to = surface.closest(m.position + Eigen::Vector3d(0, 0, 0.2 * ++k)).point;
+        session.push(commands::note("separates the drags"));
+        session.push(commands::move_marker(m.id, to));
+      });
+      out["session_undo_s"] = median_seconds(runs, [&] {
+        session.undo();
+        session.redo();
+      }) / 2.0;
+      out["session_commands"] = session.index();
+    }
   }
   out["peak_memory_mb"] = peak_rss_mb();
   return out;
