@@ -146,17 +146,6 @@ VerifyReport verify_session(const std::string& path) {
   return report;
 }
 
-double parse_iso8601(const std::string& text) {
-  std::tm tm{};
-  int ms = 0;
-  if (std::sscanf(text.c_str(), "%d-%d-%dT%d:%d:%d.%dZ", &tm.tm_year, &tm.tm_mon, &tm.tm_mday,
-                  &tm.tm_hour, &tm.tm_min, &tm.tm_sec, &ms) < 6)
-    return std::numeric_limits<double>::quiet_NaN();
-  tm.tm_year -= 1900;
-  tm.tm_mon -= 1;
-  return static_cast<double>(timegm(&tm)) + ms / 1000.0;
-}
-
 StepDurations step_durations(const SessionHeader& header, const std::vector<JournalEntry>& journal,
                              double idle_cap_s) {
   StepDurations d;

@@ -5,9 +5,11 @@
 
 #include <cassert>
 #include <chrono>
+#include <cmath>
 #include <ctime>
 #include <filesystem>
 #include <fstream>
+#include <limits>
 
 #include "cranioplan/algorithms/file_io.h"
 #include "cranioplan/algorithms/write_mesh.h"
@@ -33,6 +35,17 @@ std::string now_iso8601() {
   std::snprintf(buf, sizeof(buf), "%04d-%02d-%02dT%02d:%02d:%02d.%03dZ", tm.tm_year + 1900,
                 tm.tm_mon + 1, tm.tm_mday, tm.tm_hour, tm.tm_min, tm.tm_sec, static_cast<int>(ms));
   return buf;
+}
+
+double parse_iso8601(const std::string& text) {
+  std::tm tm{};
+  int ms = 0;
+  if (std::sscanf(text.c_str(), "%d-%d-%dT%d:%d:%d.%dZ", &tm.tm_year, &tm.tm_mon, &tm.tm_mday,
+                  &tm.tm_hour, &tm.tm_min, &tm.tm_sec, &ms) < 6)
+    return std::numeric_limits<double>::quiet_NaN();
+  tm.tm_year -= 1900;
+  tm.tm_mon -= 1;
+  return static_cast<double>(timegm(&tm)) + ms / 1000.0;
 }
 
 std::string login_name() {
@@ -361,17 +374,18 @@ void Session::trim_cache() {
   }
 }
 
-PushResult Session::push(Command command) {
-  PushResult result;
+PreparedCommand Session::prepare(Command command) {
+  PreparedCommand p;
+  p.index = index_;
+  p.journal_size = journal_.size();
   const PlanState& before = state();
   command.meta.step = command_step(before, command);
   command.meta.user = header_.info.user;
   if (command.meta.started.empty()) command.meta.started = now_iso8601();
-  const auto t0 = std::chrono::steady_clock::now();
   std::string why;
   if (command.meta.step >= 1 && !step_unlocked(before, command.meta.step, &why)) {
-    result.message = why;
-    return result;
+    p.message = why;
+    return p;
   }
   // Live side effects: what replay checks rather than repeats.
   if (command.type == CommandType::LoadSkull) {
@@ -383,8 +397,8 @@ PushResult Session::push(Command command) {
       command.params["sha256"] = sha256_file(command.params["path"].get<std::string>());
   } else if (command.type == CommandType::ExportImplant) {
     if (!before.implant) {
-      result.message = "there is no implant to export: build it first";
-      return result;
+      p.message = "there is no implant to export: build it first";
+      return p;
     }
     const std::string path = command.params.value("path", std::string());
     const std::string bytes =
@@ -392,14 +406,37 @@ PushResult Session::push(Command command) {
     write_file_atomically(path, bytes);
     command.params["sha256"] = sha256_hex(bytes);
   }
-  ApplyOutcome out = apply_command(before, command, context_);
+  p.ok = true;
+  p.command = std::move(command);
+  return p;
+}
+
+PushResult Session::push(Command command) {
+  const auto t0 = std::chrono::steady_clock::now();
+  PreparedCommand prepared = prepare(std::move(command));
+  if (!prepared.ok) return PushResult{false, false, prepared.message};
+  ApplyOutcome out = apply_command(state(), prepared.command, context_);
+  prepared.command.meta.duration_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  return commit(prepared, std::move(out));
+}
+
+PushResult Session::commit(const PreparedCommand& prepared, ApplyOutcome out) {
+  PushResult result;
+  if (!prepared.ok || prepared.index != index_ || prepared.journal_size != journal_.size()) {
+    result.message = "the plan changed while the operation ran; run it again";
+    return result;
+  }
   if (!out.accepted) {
     result.message = out.message;
     return result;
   }
+  Command command = prepared.command;
   command.meta.ended = now_iso8601();
-  command.meta.duration_ms =
-      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  if (command.meta.duration_ms <= 0.0) {
+    const double span = parse_iso8601(command.meta.ended) - parse_iso8601(command.meta.started);
+    command.meta.duration_ms = std::isfinite(span) ? std::max(0.0, span * 1000.0) : 0.0;
+  }
   result.accepted = true;
   result.message = out.message;
 

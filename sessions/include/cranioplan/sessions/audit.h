@@ -37,9 +37,6 @@ struct StepDurations {
 StepDurations step_durations(const SessionHeader& header, const std::vector<JournalEntry>& journal,
                              double idle_cap_s = 300.0);
 
-/// Seconds since the epoch of an ISO-8601 UTC time as this program writes it; NaN if malformed.
-double parse_iso8601(const std::string& text);
-
 /// One line of the timeline.
 struct AuditRow {
   int seq = 0;

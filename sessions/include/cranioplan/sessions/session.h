@@ -73,6 +73,16 @@ struct Reconstruction {
 };
 Reconstruction reconstruct(const std::vector<JournalEntry>& journal, const std::string& source);
 
+/// A command checked against the step lock, with its live side effects done (skull hash
+/// recorded, export written), ready to be computed off the GUI thread and committed.
+struct PreparedCommand {
+  bool ok = false;
+  std::string message;  ///< why it is refused
+  Command command;
+  size_t index = 0;         ///< the session's index when prepared
+  size_t journal_size = 0;  ///< the session's journal length when prepared
+};
+
 struct PushResult {
   bool accepted = false;
   bool merged = false;  ///< merged into the previous command (a drag)
@@ -107,6 +117,15 @@ class Session {
   /// refused with what is missing. Live side effects happen here, not on replay: the skull's
   /// SHA-256 is recorded, an export is written and its hash recorded.
   PushResult push(Command command);
+  /// push() in three parts, for long operations: prepare on the GUI thread, compute
+  /// `apply_command(state(), prepared.command, context())` anywhere (the state is immutable),
+  /// commit on the GUI thread. A commit after the session changed is refused; dropping the
+  /// outcome instead (Cancel) leaves the plan as it was.
+  PreparedCommand prepare(Command command);
+  PushResult commit(const PreparedCommand& prepared, ApplyOutcome outcome);
+  const ApplyContext& context() const { return context_; }
+  /// The state shared (for computing on another thread while this session stays as it is).
+  std::shared_ptr<const PlanState> shared_state() const { return states_[index_]; }
   bool can_undo() const { return index_ > 0; }
   bool can_redo() const { return index_ < stack_.size(); }
   bool undo();
@@ -166,6 +185,8 @@ class Session {
 
 /// Now as ISO-8601 UTC with milliseconds.
 std::string now_iso8601();
+/// Seconds since the epoch of a time as now_iso8601() writes it; NaN if malformed.
+double parse_iso8601(const std::string& text);
 /// The login name of the person running the program.
 std::string login_name();
 
