@@ -1,0 +1,82 @@
+// cranioplan [MESH|VOLUME|SESSION] [--sample] [--step N] [--screenshot OUT.png] [--quit]
+#include <QApplication>
+#include <QCommandLineParser>
+#include <QFileInfo>
+#include <QSurfaceFormat>
+#include <QTimer>
+#include <cstdio>
+
+#include "main_window.h"
+
+int main(int argc, char** argv) {
+  // VTK's OpenGL2 back end needs a core profile of 3.2 or later.
+  QSurfaceFormat format;
+  format.setVersion(3, 2);
+  format.setProfile(QSurfaceFormat::CoreProfile);
+  format.setDepthBufferSize(24);
+  format.setStencilBufferSize(8);
+  format.setSamples(0);
+  QSurfaceFormat::setDefaultFormat(format);
+
+  QApplication app(argc, argv);
+  QApplication::setOrganizationName("Cranioplan");
+  QApplication::setApplicationName("Cranioplan");
+  QApplication::setApplicationVersion(CRANIOPLAN_VERSION);
+
+  QCommandLineParser parser;
+  parser.setApplicationDescription(
+      "Cranioplan: plan a patient-specific cranial implant, step by step.");
+  parser.addHelpOption();
+  parser.addVersionOption();
+  parser.addPositionalArgument("FILE", "a skull mesh, a CT volume or a saved session (.json)");
+  const QCommandLineOption sample("sample", "open the sample case (Cranium.inv3)");
+  const QCommandLineOption step("step", "show a session as it was at step N (1-9)", "N");
+  const QCommandLineOption screenshot("screenshot", "save a picture of the window", "OUT.png");
+  const QCommandLineOption quit("quit", "quit when done (no dialogs)");
+  const QCommandLineOption view("view", "front, back, left, right or top", "VIEW");
+  parser.addOptions({sample, step, screenshot, quit, view});
+  parser.process(app);
+
+  cranioplan::gui::MainWindow window;
+  const bool automated = parser.isSet(quit);
+  window.set_interactive(!automated);
+  window.show();
+
+  const QStringList files = parser.positionalArguments();
+  bool ok = true;
+  if (parser.isSet(sample)) {
+    window.open_sample();
+  } else if (!files.isEmpty()) {
+    const QString file = files.front();
+    if (file.endsWith(".json", Qt::CaseInsensitive)) {
+      ok = window.open_session(file);
+      if (ok && parser.isSet(step)) window.replay_to_step(parser.value(step).toInt());
+    } else {
+      window.open_input(file);
+    }
+  } else if (!automated) {
+    window.offer_recovery();
+  }
+  window.controller().wait();
+  if (parser.isSet(view)) {
+    const QString v = parser.value(view).toLower();
+    using V = cranioplan::gui::SkullView::StandardView;
+    window.view().set_standard_view(v == "back"    ? V::Back
+                                    : v == "left"  ? V::Left
+                                    : v == "right" ? V::Right
+                                    : v == "top"   ? V::Top
+                                                   : V::Front);
+  }
+  if (parser.isSet(screenshot)) {
+    const QString out = parser.value(screenshot);
+    QTimer::singleShot(300, &window, [&window, out, automated] {
+      const bool saved = window.screenshot().save(out);
+      std::fprintf(saved ? stdout : stderr, "%s %s\n", saved ? "wrote" : "cannot write",
+                   out.toLocal8Bit().constData());
+      if (automated) QApplication::exit(saved ? 0 : 3);
+    });
+  } else if (automated) {
+    QTimer::singleShot(0, &app, [ok] { QApplication::exit(ok ? 0 : 3); });
+  }
+  return app.exec();
+}

@@ -1,0 +1,542 @@
+// glew must come before any Qt OpenGL header.
+#include <vtk_glew.h>
+// clang-format off
+#include "skull_view.h"
+// clang-format on
+
+#include <vtkActor.h>
+#include <vtkCallbackCommand.h>
+#include <vtkCamera.h>
+#include <vtkCellArray.h>
+#include <vtkCellPicker.h>
+#include <vtkCoordinate.h>
+#include <vtkCubeSource.h>
+#include <vtkGenericOpenGLRenderWindow.h>
+#include <vtkGenericRenderWindowInteractor.h>
+#include <vtkGlyph3DMapper.h>
+#include <vtkInteractorStyleTrackballCamera.h>
+#include <vtkNew.h>
+#include <vtkPlane.h>
+#include <vtkPlaneSource.h>
+#include <vtkPoints.h>
+#include <vtkPolyData.h>
+#include <vtkPolyDataMapper.h>
+#include <vtkPolyDataNormals.h>
+#include <vtkProperty.h>
+#include <vtkRenderer.h>
+#include <vtkSmartPointer.h>
+#include <vtkSphereSource.h>
+#include <vtkStaticCellLocator.h>
+
+#include <Eigen/Geometry>
+#include <QMouseEvent>
+#include <QWheelEvent>
+#include <array>
+
+namespace cranioplan::gui {
+
+namespace {
+
+vtkSmartPointer<vtkPolyData> to_polydata(const SkullMesh& mesh) {
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(static_cast<vtkIdType>(mesh.n_vertices()));
+  for (auto vh : mesh.vertices()) {
+    const auto& p = mesh.point(vh);
+    points->SetPoint(vh.idx(), p[0], p[1], p[2]);
+  }
+  vtkNew<vtkCellArray> triangles;
+  triangles->AllocateExact(static_cast<vtkIdType>(mesh.n_faces()),
+                           3 * static_cast<vtkIdType>(mesh.n_faces()));
+  for (auto fh : mesh.faces()) {
+    vtkIdType ids[3];
+    int k = 0;
+    for (auto vh : mesh.fv_range(fh)) {
+      if (k < 3) ids[k] = vh.idx();
+      ++k;
+    }
+    if (k == 3) triangles->InsertNextCell(3, ids);
+  }
+  vtkNew<vtkPolyData> poly;
+  poly->SetPoints(points);
+  poly->SetPolys(triangles);
+  vtkNew<vtkPolyDataNormals> normals;
+  normals->SetInputData(poly);
+  normals->SplittingOff();
+  normals->ConsistencyOff();
+  normals->AutoOrientNormalsOff();
+  normals->ComputePointNormalsOn();
+  normals->Update();
+  vtkSmartPointer<vtkPolyData> out = normals->GetOutput();
+  return out;
+}
+
+// A mesh actor that converts its mesh only when a different mesh is shown.
+struct MeshLayer {
+  const void* shown = nullptr;
+  std::shared_ptr<const void> keep;  // keeps the shown mesh alive so its address stays unique
+  vtkNew<vtkPolyDataMapper> mapper;
+  vtkNew<vtkActor> actor;
+  vtkNew<vtkStaticCellLocator> locator;
+
+  MeshLayer() {
+    actor->SetMapper(mapper);
+    mapper->ScalarVisibilityOff();
+  }
+  void show(const SkullMesh* mesh, std::shared_ptr<const void> owner) {
+    if (!mesh) {
+      actor->SetVisibility(false);
+      shown = nullptr;
+      keep.reset();
+      return;
+    }
+    if (mesh != shown) {
+      vtkSmartPointer<vtkPolyData> poly = to_polydata(*mesh);
+      mapper->SetInputData(poly);
+      locator->SetDataSet(poly);
+      locator->BuildLocator();
+      shown = mesh;
+      keep = std::move(owner);
+    }
+    actor->SetVisibility(true);
+  }
+  bool visible() const { return shown && actor->GetVisibility(); }
+};
+
+// Points drawn as glyphs (markers, landmarks).
+struct GlyphLayer {
+  vtkNew<vtkPolyData> points_data;
+  vtkNew<vtkGlyph3DMapper> mapper;
+  vtkNew<vtkActor> actor;
+
+  GlyphLayer(vtkAlgorithm* source, const std::array<double, 3>& color) {
+    mapper->SetInputData(points_data);
+    mapper->SetSourceConnection(source->GetOutputPort());
+    mapper->ScalingOff();
+    mapper->ScalarVisibilityOff();
+    actor->SetMapper(mapper);
+    actor->GetProperty()->SetColor(color[0], color[1], color[2]);
+    actor->GetProperty()->SetSpecular(0.4);
+  }
+  void set(const std::vector<Eigen::Vector3d>& pts) {
+    vtkNew<vtkPoints> p;
+    for (const auto& x : pts) p->InsertNextPoint(x.x(), x.y(), x.z());
+    points_data->SetPoints(p);
+    points_data->Modified();
+    actor->SetVisibility(!pts.empty());
+  }
+};
+
+vtkSmartPointer<vtkAlgorithm> sphere(double radius) {
+  vtkNew<vtkSphereSource> s;
+  s->SetRadius(radius);
+  s->SetThetaResolution(16);
+  s->SetPhiResolution(12);
+  return s;
+}
+
+vtkSmartPointer<vtkAlgorithm> cube(double edge) {
+  vtkNew<vtkCubeSource> c;
+  c->SetXLength(edge);
+  c->SetYLength(edge);
+  c->SetZLength(edge);
+  return c;
+}
+
+constexpr std::array<double, 3> kBone{0.93, 0.90, 0.82};
+constexpr std::array<double, 3> kMirror{0.35, 0.80, 0.40};
+constexpr std::array<double, 3> kEdge{0.10, 0.75, 0.20};
+constexpr std::array<double, 3> kSurface{0.90, 0.20, 0.85};
+constexpr std::array<double, 3> kImplant{0.95, 0.70, 0.25};
+
+}  // namespace
+
+struct SkullView::Impl {
+  vtkNew<vtkGenericOpenGLRenderWindow> window;
+  vtkNew<vtkRenderer> renderer;
+  vtkNew<vtkGenericRenderWindowInteractor> interactor;
+  vtkNew<vtkInteractorStyleTrackballCamera> style;
+  vtkNew<vtkCellPicker> picker;
+  vtkNew<vtkPlane> clip;
+  MeshLayer skull, mirror, implant;
+  GlyphLayer outer_edge{sphere(1.6), kEdge}, inner_edge{cube(2.4), kEdge},
+      outer_surface{sphere(1.6), kSurface}, inner_surface{cube(2.4), kSurface},
+      landmarks{sphere(2.6), {0.90, 0.15, 0.10}}, selected{sphere(2.8), {1.0, 0.95, 0.1}};
+  vtkNew<vtkPlaneSource> plane_source;
+  vtkNew<vtkPolyDataMapper> plane_mapper;
+  vtkNew<vtkActor> plane_actor;
+
+  std::vector<Marker> markers;
+  bool mirror_wanted = true, plane_wanted = true, markers_editable = false, camera_set = false;
+  PickTarget target = PickTarget::None;
+  int selected_id = 0, drag_id = 0;
+  QPoint press_pos;
+  bool moved = false;
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  double radius = 100.0;
+
+  double dpr = 1.0;
+  int height_px() const { return window->GetSize()[1]; }
+  int display_x(const QPoint& p) const { return static_cast<int>(p.x() * dpr); }
+  int display_y(const QPoint& p) const {
+    return height_px() - 1 - static_cast<int>(p.y() * dpr);
+  }
+};
+
+SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_unique<Impl>()) {
+  setMinimumSize(400, 300);
+  setFocusPolicy(Qt::StrongFocus);
+  Impl& d = *d_;
+  d.window->AddRenderer(d.renderer);
+  d.interactor->SetRenderWindow(d.window);
+  d.interactor->SetInteractorStyle(d.style);
+  d.interactor->EnableRenderOff();
+  vtkNew<vtkCallbackCommand> on_render;
+  on_render->SetClientData(this);
+  on_render->SetCallback([](vtkObject*, unsigned long, void* self, void*) {
+    static_cast<SkullView*>(self)->update();
+  });
+  d.interactor->AddObserver(vtkCommand::RenderEvent, on_render);
+
+  d.renderer->GradientBackgroundOn();
+  d.renderer->SetBackground(0.10, 0.11, 0.14);
+  d.renderer->SetBackground2(0.30, 0.33, 0.40);
+  d.skull.actor->GetProperty()->SetColor(kBone[0], kBone[1], kBone[2]);
+  d.skull.actor->GetProperty()->SetSpecular(0.15);
+  d.mirror.actor->GetProperty()->SetColor(kMirror[0], kMirror[1], kMirror[2]);
+  d.mirror.actor->GetProperty()->SetOpacity(0.45);
+  d.implant.actor->GetProperty()->SetColor(kImplant[0], kImplant[1], kImplant[2]);
+  d.implant.actor->GetProperty()->SetSpecular(0.3);
+  d.selected.actor->GetProperty()->SetOpacity(0.55);
+  d.plane_actor->SetMapper(d.plane_mapper);
+  d.plane_mapper->SetInputConnection(d.plane_source->GetOutputPort());
+  d.plane_actor->GetProperty()->SetColor(0.30, 0.55, 1.0);
+  d.plane_actor->GetProperty()->SetOpacity(0.25);
+  for (vtkActor* a : {d.skull.actor.Get(), d.mirror.actor.Get(), d.implant.actor.Get(),
+                      d.outer_edge.actor.Get(), d.inner_edge.actor.Get(),
+                      d.outer_surface.actor.Get(), d.inner_surface.actor.Get(),
+                      d.landmarks.actor.Get(), d.selected.actor.Get(), d.plane_actor.Get()}) {
+    a->SetVisibility(false);
+    d.renderer->AddActor(a);
+  }
+  d.picker->SetTolerance(0.0005);
+  d.picker->PickFromListOn();
+}
+
+SkullView::~SkullView() {
+  makeCurrent();
+  d_->window->Finalize();
+  doneCurrent();
+}
+
+void SkullView::initializeGL() {
+  Impl& d = *d_;
+  d.window->SetOwnContext(false);
+  d.window->SetFrameBlitModeToBlitToCurrent();
+  d.window->SetIsCurrent(true);
+  d.window->SetMapped(1);
+  d.window->OpenGLInitContext();
+  d.interactor->Initialize();
+}
+
+void SkullView::resizeGL(int w, int h) {
+  Impl& d = *d_;
+  d.dpr = devicePixelRatioF();
+  const int pw = static_cast<int>(w * d.dpr), ph = static_cast<int>(h * d.dpr);
+  d.window->SetSize(pw, ph);
+  d.interactor->UpdateSize(pw, ph);
+}
+
+void SkullView::paintGL() {
+  Impl& d = *d_;
+  d.dpr = devicePixelRatioF();
+  d.window->SetReadyForRendering(true);
+  d.window->SetSize(static_cast<int>(width() * d.dpr), static_cast<int>(height() * d.dpr));
+  d.window->Render();
+  d.window->SetReadyForRendering(false);
+}
+
+void SkullView::show_state(const PlanState& s) {
+  Impl& d = *d_;
+  const bool had_skull = d.skull.shown != nullptr;
+  d.skull.show(s.skull ? &s.skull->surface->mesh : nullptr,
+               s.skull ? std::shared_ptr<const void>(s.skull) : nullptr);
+  d.mirror.show(s.mirrored ? &s.mirrored->mesh : nullptr, s.mirrored);
+  d.mirror.actor->SetVisibility(d.mirror.shown && d.mirror_wanted);
+  d.implant.show(s.implant ? &s.implant->result().mesh : nullptr, s.implant);
+
+  // Clip plane: keep the side the normal points away from.
+  d.skull.mapper->RemoveAllClippingPlanes();
+  d.mirror.mapper->RemoveAllClippingPlanes();
+  if (s.clip_plane) {
+    const Eigen::Vector3d keep = -s.clip_plane->normal;
+    d.clip->SetNormal(keep.x(), keep.y(), keep.z());
+    const Eigen::Vector3d origin = s.clip_plane->normal * s.clip_plane->offset;
+    d.clip->SetOrigin(origin.x(), origin.y(), origin.z());
+    d.skull.mapper->AddClippingPlane(d.clip);
+    d.mirror.mapper->AddClippingPlane(d.clip);
+  }
+
+  d.markers = s.markers;
+  std::array<std::vector<Eigen::Vector3d>, 4> by_type;
+  for (const auto& m : s.markers) by_type[static_cast<int>(m.type)].push_back(m.position);
+  d.outer_edge.set(by_type[0]);
+  d.inner_edge.set(by_type[1]);
+  d.outer_surface.set(by_type[2]);
+  d.inner_surface.set(by_type[3]);
+  std::vector<Eigen::Vector3d> lm;
+  for (const auto* p : {&s.landmarks.nasion, &s.landmarks.orbit_left, &s.landmarks.orbit_right})
+    if (*p) lm.push_back(**p);
+  lm.insert(lm.end(), s.landmarks.midline.begin(), s.landmarks.midline.end());
+  d.landmarks.set(lm);
+  set_selected_marker(s.find_marker(d.selected_id) ? d.selected_id : 0);
+
+  if (s.skull) {
+    double b[6];
+    d.skull.mapper->GetInput()->GetBounds(b);
+    d.center = Eigen::Vector3d((b[0] + b[1]) / 2, (b[2] + b[3]) / 2, (b[4] + b[5]) / 2);
+    d.radius = 0.5 * Eigen::Vector3d(b[1] - b[0], b[3] - b[2], b[5] - b[4]).norm();
+  }
+  if (s.plane && s.skull) {
+    const Eigen::Vector3d n = s.plane->normal;
+    const Eigen::Vector3d c = s.plane->project(d.center);
+    Eigen::Vector3d u = n.unitOrthogonal();
+    // In-plane axes along the skull's vertical where possible.
+    const Eigen::Vector3d z = Eigen::Vector3d::UnitZ();
+    if ((z - z.dot(n) * n).norm() > 0.3) u = (z - z.dot(n) * n).normalized();
+    const Eigen::Vector3d v = n.cross(u);
+    const double h = 1.1 * d.radius;
+    const Eigen::Vector3d o = c - h * u - h * v, p1 = c + h * u - h * v, p2 = c - h * u + h * v;
+    d.plane_source->SetOrigin(o.x(), o.y(), o.z());
+    d.plane_source->SetPoint1(p2.x(), p2.y(), p2.z());
+    d.plane_source->SetPoint2(p1.x(), p1.y(), p1.z());
+    d.plane_actor->SetVisibility(d.plane_wanted);
+  } else {
+    d.plane_actor->SetVisibility(false);
+  }
+  if (s.skull && (!had_skull || !d.camera_set)) {
+    set_standard_view(StandardView::Front);
+    d.camera_set = true;
+  }
+  if (!s.skull) d.camera_set = false;
+  update();
+}
+
+void SkullView::set_mirror_visible(bool visible) {
+  d_->mirror_wanted = visible;
+  d_->mirror.actor->SetVisibility(visible && d_->mirror.shown);
+  update();
+}
+
+void SkullView::set_mirror_opacity(double opacity) {
+  d_->mirror.actor->GetProperty()->SetOpacity(opacity);
+  update();
+}
+
+void SkullView::set_plane_visible(bool visible) {
+  d_->plane_wanted = visible;
+  d_->plane_actor->SetVisibility(visible && d_->plane_actor->GetVisibility());
+  update();
+}
+
+void SkullView::set_standard_view(StandardView view) {
+  Impl& d = *d_;
+  // Patient coordinates (LPS): +x the patient's left, +y posterior, +z superior.
+  Eigen::Vector3d dir = -Eigen::Vector3d::UnitY(), up = Eigen::Vector3d::UnitZ();
+  switch (view) {
+    case StandardView::Front:
+      dir = -Eigen::Vector3d::UnitY();
+      break;
+    case StandardView::Back:
+      dir = Eigen::Vector3d::UnitY();
+      break;
+    case StandardView::Left:
+      dir = Eigen::Vector3d::UnitX();
+      break;
+    case StandardView::Right:
+      dir = -Eigen::Vector3d::UnitX();
+      break;
+    case StandardView::Top:
+      dir = Eigen::Vector3d::UnitZ();
+      up = -Eigen::Vector3d::UnitY();
+      break;
+  }
+  vtkCamera* cam = d.renderer->GetActiveCamera();
+  const Eigen::Vector3d pos = d.center + 4.0 * d.radius * dir;
+  cam->SetFocalPoint(d.center.data());
+  cam->SetPosition(pos.x(), pos.y(), pos.z());
+  cam->SetViewUp(up.x(), up.y(), up.z());
+  d.renderer->ResetCamera();
+  cam->Zoom(1.5);  // ResetCamera fits the bounding sphere; the skull fills more of the view
+  d.renderer->ResetCameraClippingRange();
+  update();
+}
+
+void SkullView::reset_camera() { set_standard_view(StandardView::Front); }
+
+void SkullView::set_pick_target(PickTarget target) { d_->target = target; }
+
+void SkullView::set_markers_editable(bool editable) { d_->markers_editable = editable; }
+
+void SkullView::set_selected_marker(int id) {
+  Impl& d = *d_;
+  d.selected_id = 0;
+  std::vector<Eigen::Vector3d> p;
+  for (const auto& m : d.markers)
+    if (m.id == id) {
+      d.selected_id = id;
+      p.push_back(m.position);
+    }
+  d.selected.set(p);
+  update();
+}
+
+int SkullView::selected_marker() const { return d_->selected_id; }
+
+std::optional<QPoint> SkullView::project(const Eigen::Vector3d& world) {
+  Impl& d = *d_;
+  vtkNew<vtkCoordinate> c;
+  c->SetCoordinateSystemToWorld();
+  c->SetValue(world.x(), world.y(), world.z());
+  const double* px = c->GetComputedDoubleDisplayValue(d.renderer);
+  const double x = px[0] / d.dpr, y = (d.height_px() - 1 - px[1]) / d.dpr;
+  if (x < 0 || y < 0 || x >= width() || y >= height()) return std::nullopt;
+  return QPoint(static_cast<int>(std::lround(x)), static_cast<int>(std::lround(y)));
+}
+
+std::optional<Eigen::Vector3d> SkullView::pick(const QPoint& position, PickTarget target) {
+  Impl& d = *d_;
+  MeshLayer* layer = target == PickTarget::Mirrored && d.mirror.shown ? &d.mirror : &d.skull;
+  if (target == PickTarget::None || !layer->shown) return std::nullopt;
+  d.picker->InitializePickList();
+  d.picker->AddPickList(layer->actor);
+  d.picker->AddLocator(layer->locator);
+  const bool was_visible = layer->actor->GetVisibility();
+  layer->actor->SetVisibility(true);  // a hidden mirror can still take markers
+  const int hit = d.picker->Pick(d.display_x(position), d.display_y(position), 0, d.renderer);
+  layer->actor->SetVisibility(was_visible);
+  d.picker->RemoveAllLocators();
+  if (!hit || d.picker->GetCellId() < 0) return std::nullopt;
+  const double* p = d.picker->GetPickPosition();
+  return Eigen::Vector3d(p[0], p[1], p[2]);
+}
+
+namespace {
+
+int marker_near(SkullView& view, const std::vector<Marker>& markers, const QPoint& at) {
+  int best = 0;
+  double best_d2 = 10.0 * 10.0;
+  for (const auto& m : markers) {
+    const auto p = view.project(m.position);
+    if (!p) continue;
+    const double dx = p->x() - at.x(), dy = p->y() - at.y();
+    if (dx * dx + dy * dy < best_d2) {
+      best_d2 = dx * dx + dy * dy;
+      best = m.id;
+    }
+  }
+  return best;
+}
+
+}  // namespace
+
+void SkullView::mousePressEvent(QMouseEvent* e) {
+  Impl& d = *d_;
+  const QPoint pos = e->position().toPoint();
+  d.press_pos = pos;
+  d.moved = false;
+  if (e->button() == Qt::LeftButton && d.markers_editable) {
+    if (const int id = marker_near(*this, d.markers, pos)) {
+      d.drag_id = id;
+      set_selected_marker(id);
+      return;
+    }
+  }
+  d.interactor->SetEventInformationFlipY(d.display_x(pos), static_cast<int>(pos.y() * d.dpr),
+                                         e->modifiers() & Qt::ControlModifier,
+                                         e->modifiers() & Qt::ShiftModifier);
+  switch (e->button()) {
+    case Qt::LeftButton:
+      d.interactor->LeftButtonPressEvent();
+      break;
+    case Qt::RightButton:
+      d.interactor->RightButtonPressEvent();
+      break;
+    case Qt::MiddleButton:
+      d.interactor->MiddleButtonPressEvent();
+      break;
+    default:
+      break;
+  }
+}
+
+void SkullView::mouseMoveEvent(QMouseEvent* e) {
+  Impl& d = *d_;
+  const QPoint pos = e->position().toPoint();
+  if ((pos - d.press_pos).manhattanLength() > 3) d.moved = true;
+  if (d.drag_id) {
+    if (!d.moved) return;
+    const Marker* m = nullptr;
+    for (const auto& x : d.markers)
+      if (x.id == d.drag_id) m = &x;
+    if (!m) return;
+    const auto p = pick(pos, m->surface == MarkerSurface::Mirrored ? PickTarget::Mirrored
+                                                                   : PickTarget::Original);
+    if (p) emit markerDragged(d.drag_id, *p);
+    return;
+  }
+  d.interactor->SetEventInformationFlipY(d.display_x(pos), static_cast<int>(pos.y() * d.dpr),
+                                         e->modifiers() & Qt::ControlModifier,
+                                         e->modifiers() & Qt::ShiftModifier);
+  d.interactor->MouseMoveEvent();
+}
+
+void SkullView::mouseReleaseEvent(QMouseEvent* e) {
+  Impl& d = *d_;
+  const QPoint pos = e->position().toPoint();
+  if (d.drag_id) {
+    const int id = d.drag_id;
+    d.drag_id = 0;
+    if (d.moved)
+      emit markerDragFinished(id);
+    else
+      emit markerClicked(id);
+    return;
+  }
+  d.interactor->SetEventInformationFlipY(d.display_x(pos), static_cast<int>(pos.y() * d.dpr),
+                                         e->modifiers() & Qt::ControlModifier,
+                                         e->modifiers() & Qt::ShiftModifier);
+  switch (e->button()) {
+    case Qt::LeftButton:
+      d.interactor->LeftButtonReleaseEvent();
+      break;
+    case Qt::RightButton:
+      d.interactor->RightButtonReleaseEvent();
+      break;
+    case Qt::MiddleButton:
+      d.interactor->MiddleButtonReleaseEvent();
+      break;
+    default:
+      break;
+  }
+  if (e->button() != Qt::LeftButton || d.moved) return;
+  if (const int id = marker_near(*this, d.markers, pos)) {
+    set_selected_marker(id);
+    emit markerClicked(id);
+    return;
+  }
+  if (d.target != PickTarget::None)
+    if (const auto p = pick(pos, d.target)) emit surfaceClicked(*p);
+}
+
+void SkullView::wheelEvent(QWheelEvent* e) {
+  Impl& d = *d_;
+  const QPoint pos = e->position().toPoint();
+  d.interactor->SetEventInformationFlipY(d.display_x(pos), static_cast<int>(pos.y() * d.dpr));
+  if (e->angleDelta().y() > 0)
+    d.interactor->MouseWheelForwardEvent();
+  else if (e->angleDelta().y() < 0)
+    d.interactor->MouseWheelBackwardEvent();
+}
+
+}  // namespace cranioplan::gui

@@ -1,0 +1,65 @@
+#pragma once
+// The wizard's 3D view: VTK rendering inside a Qt6 QOpenGLWidget (a vtkGenericOpenGLRenderWindow
+// drawing with Qt's context). Shows a plan's state — skull, mirrored skull, landmarks, markers,
+// midsagittal plane, implant, clip plane — and turns clicks and drags into surface points. It
+// computes no geometry of the plan: the window turns its signals into session commands.
+#include <QOpenGLWidget>
+#include <memory>
+#include <optional>
+
+#include "cranioplan/model/marker.h"
+#include "cranioplan/sessions/plan_state.h"
+
+namespace cranioplan::gui {
+
+class SkullView : public QOpenGLWidget {
+  Q_OBJECT
+
+ public:
+  explicit SkullView(QWidget* parent = nullptr);
+  ~SkullView() override;
+
+  /// Shows the state (meshes are converted once per mesh and reused).
+  void show_state(const PlanState& state);
+  void set_mirror_visible(bool visible);
+  void set_mirror_opacity(double opacity);
+  void set_plane_visible(bool visible);
+
+  enum class StandardView { Front, Back, Left, Right, Top };
+  void set_standard_view(StandardView view);
+  void reset_camera();
+
+  /// Which surface a click places on (None: clicks only select markers).
+  enum class PickTarget { None, Original, Mirrored };
+  void set_pick_target(PickTarget target);
+  /// Whether markers can be dragged (steps 5, 6 and 8).
+  void set_markers_editable(bool editable);
+  void set_selected_marker(int id);
+  int selected_marker() const;
+
+  /// Where a world point shows in the widget (logical pixels), if in front of the camera.
+  std::optional<QPoint> project(const Eigen::Vector3d& world);
+  /// The surface point under a widget position, on the given surface.
+  std::optional<Eigen::Vector3d> pick(const QPoint& position, PickTarget target);
+
+ signals:
+  void surfaceClicked(const Eigen::Vector3d& point);
+  void markerClicked(int id);
+  void markerDragged(int id, const Eigen::Vector3d& point);
+  void markerDragFinished(int id);
+
+ protected:
+  void initializeGL() override;
+  void paintGL() override;
+  void resizeGL(int w, int h) override;
+  void mousePressEvent(QMouseEvent* event) override;
+  void mouseMoveEvent(QMouseEvent* event) override;
+  void mouseReleaseEvent(QMouseEvent* event) override;
+  void wheelEvent(QWheelEvent* event) override;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> d_;
+};
+
+}  // namespace cranioplan::gui
