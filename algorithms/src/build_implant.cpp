@@ -15,11 +15,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
 #include <functional>
 
 #include "cranioplan/algorithms/mesh_report.h"
 #include "cranioplan/algorithms/surface_locator.h"
 #include "cranioplan/algorithms/thin_plate_spline.h"
+#include "cranioplan/model/error.h"
 
 namespace cranioplan {
 
@@ -224,6 +226,22 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
     f.e1 = eig.eigenvectors().col(2);
     f.e2 = f.n.cross(f.e1);
   }
+  // Rays from the centre parametrise a cap, not more: a marker far off the axis (e.g. one
+  // placed on the far wall of the skull through the opening) would stretch the height field
+  // without bound.
+  if (f.radial) {
+    for (const auto& m : markers) {
+      const Eigen::Vector3d d = m.position - f.origin;
+      if (d.dot(f.n) < std::cos(75.0 * M_PI / 180.0) * d.norm()) {
+        result.status = ImplantResult::Status::Failed;
+        result.message = "marker " + std::to_string(m.id) +
+                         " lies more than 75° from the defect's axis, seen from inside the skull: "
+                         "it is probably on the far side of the skull (placed through the "
+                         "opening?) — move or delete it";
+        return result;
+      }
+    }
+  }
 
   // The outer surface: a spline of heights through the outer markers. The inner surface: the
   // outer one less a thickness field, a spline through the inner markers' depths below the
@@ -309,6 +327,22 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
                       marker_angles.end());
   std::vector<double> angles;
   std::vector<char> is_marker_angle;
+  double rim_length = 0.0;
+  for (size_t k = 0; k < marker_angles.size(); ++k) {
+    const double a0 = marker_angles[k];
+    const double a1 =
+        k + 1 < marker_angles.size() ? marker_angles[k + 1] : marker_angles[0] + kTwoPi;
+    rim_length += std::max((outer_poly.at(a1).first - outer_poly.at(a0).first).norm(),
+                           (inner_poly.at(a1).first - inner_poly.at(a0).first).norm());
+  }
+  if (rim_length / res > 1e5) {
+    result.status = ImplantResult::Status::Failed;
+    result.message = "the rim through the edge markers is " +
+                     format_count(std::lround(rim_length)) +
+                     " mm long: the markers span too large a region (check markers far from the "
+                     "defect)";
+    return result;
+  }
   for (size_t k = 0; k < marker_angles.size(); ++k) {
     const double a0 = marker_angles[k];
     const double a1 =
@@ -380,6 +414,17 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
   for (const auto& p : outer_rim) radius = std::max(radius, (f.uv(p) - center).norm());
   const int n_rings = std::max(2, static_cast<int>(std::ceil(radius / res)));
   const double start = angles.front() - 1e-6;
+  const double vertices = 2.0 * n_rings * static_cast<double>(n_rim);
+  if (vertices > 4e6) {
+    result.status = ImplantResult::Status::Failed;
+    char buf[200];
+    std::snprintf(buf, sizeof(buf),
+                  "the shell would need %.0f million vertices at %.2f mm: the markers span too "
+                  "large a region (check markers far from the defect)",
+                  vertices / 1e6, res);
+    result.message = buf;
+    return result;
+  }
 
   TriangleSoup soup;
   auto build_cap = [&](const std::vector<Eigen::Vector3d>& rim, const Height* tps,

@@ -2,21 +2,13 @@
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QFileInfo>
-#include <QSurfaceFormat>
 #include <QTimer>
 #include <cstdio>
 
 #include "main_window.h"
 
 int main(int argc, char** argv) {
-  // VTK's OpenGL2 back end needs a core profile of 3.2 or later.
-  QSurfaceFormat format;
-  format.setVersion(3, 2);
-  format.setProfile(QSurfaceFormat::CoreProfile);
-  format.setDepthBufferSize(24);
-  format.setStencilBufferSize(8);
-  format.setSamples(0);
-  QSurfaceFormat::setDefaultFormat(format);
+  cranioplan::gui::SkullView::set_default_surface_format();
 
   QApplication app(argc, argv);
   QApplication::setOrganizationName("Cranioplan");
@@ -33,7 +25,7 @@ int main(int argc, char** argv) {
   const QCommandLineOption step("step", "show a session as it was at step N (1-9)", "N");
   const QCommandLineOption screenshot("screenshot", "save a picture of the window", "OUT.png");
   const QCommandLineOption quit("quit", "quit when done (no dialogs)");
-  const QCommandLineOption view("view", "front, back, left, right or top", "VIEW");
+  const QCommandLineOption view("view", "front, back, left, right, top or markers", "VIEW");
   parser.addOptions({sample, step, screenshot, quit, view});
   parser.process(app);
 
@@ -61,11 +53,14 @@ int main(int argc, char** argv) {
   if (parser.isSet(view)) {
     const QString v = parser.value(view).toLower();
     using V = cranioplan::gui::SkullView::StandardView;
-    window.view().set_standard_view(v == "back"    ? V::Back
-                                    : v == "left"  ? V::Left
-                                    : v == "right" ? V::Right
-                                    : v == "top"   ? V::Top
-                                                   : V::Front);
+    if (v == "markers")
+      window.view().look_at_markers();
+    else
+      window.view().set_standard_view(v == "back"    ? V::Back
+                                      : v == "left"  ? V::Left
+                                      : v == "right" ? V::Right
+                                      : v == "top"   ? V::Top
+                                                     : V::Front);
   }
   if (parser.isSet(screenshot)) {
     const QString out = parser.value(screenshot);

@@ -73,12 +73,12 @@ QString quality_html(const QualityReport& r) {
   row(QObject::tr("Pieces"), QString::number(r.pieces));
   row(QObject::tr("Volume"), QString::number(r.volume_mm3, 'f', 0) + " mm³");
   row(QObject::tr("Area"), QString::number(r.area_mm2, 'f', 0) + " mm²");
-  row(QObject::tr("Thickness min / median / max"),
-      QStringLiteral("%1 / %2 / %3 mm")
-          .arg(r.thickness_min_mm, 0, 'f', 1)
-          .arg(r.thickness_median_mm, 0, 'f', 1)
-          .arg(r.thickness_max_mm, 0, 'f', 1));
-  if (r.rim_gap_mm >= 0) row(QObject::tr("Gap to bone (rim)"), QString::number(r.rim_gap_mm, 'f', 2) + " mm");
+  row(QObject::tr("Thickness min / median / max"), QStringLiteral("%1 / %2 / %3 mm")
+                                                       .arg(r.thickness_min_mm, 0, 'f', 1)
+                                                       .arg(r.thickness_median_mm, 0, 'f', 1)
+                                                       .arg(r.thickness_max_mm, 0, 'f', 1));
+  if (r.rim_gap_mm >= 0)
+    row(QObject::tr("Gap to bone (rim)"), QString::number(r.rim_gap_mm, 'f', 2) + " mm");
   if (r.penetration_mm3 >= 0)
     row(QObject::tr("Overlap with skull"), QString::number(r.penetration_mm3, 'f', 1) + " mm³");
   h += QStringLiteral("</table>");
@@ -235,14 +235,18 @@ void MainWindow::build_menus() {
 
   QMenu* view = menuBar()->addMenu(tr("&View"));
   const std::pair<QString, SkullView::StandardView> views[] = {
-      {tr("Front"), SkullView::StandardView::Front}, {tr("Back"), SkullView::StandardView::Back},
-      {tr("Left"), SkullView::StandardView::Left},   {tr("Right"), SkullView::StandardView::Right},
+      {tr("Front"), SkullView::StandardView::Front},
+      {tr("Back"), SkullView::StandardView::Back},
+      {tr("Left"), SkullView::StandardView::Left},
+      {tr("Right"), SkullView::StandardView::Right},
       {tr("Top"), SkullView::StandardView::Top}};
   int key = 0;
   for (const auto& [name, v] : views) {
     QAction* a = view->addAction(name, this, [this, v = v] { view_->set_standard_view(v); });
     a->setShortcut(QKeySequence(Qt::Key_F5 + key++));
   }
+  view->addAction(tr("Look at the markers"), this, [this] { view_->look_at_markers(); })
+      ->setShortcut(QKeySequence(Qt::Key_F10));
   view->addAction(tr("Reset"), this, [this] { view_->reset_camera(); })
       ->setShortcut(QKeySequence(Qt::Key_Home));
   view->addSeparator();
@@ -311,7 +315,8 @@ void MainWindow::build_steps_dock() {
   instructions_->setWordWrap(true);
   instructions_->setMinimumHeight(110);
   instructions_->setAlignment(Qt::AlignTop | Qt::AlignLeft);
-  instructions_->setStyleSheet("QLabel{background:#f4f1e8;color:#222;padding:6px;border-radius:4px}");
+  instructions_->setStyleSheet(
+      "QLabel{background:#f4f1e8;color:#222;padding:6px;border-radius:4px}");
   layout->addWidget(instructions_);
   pages_ = new QStackedWidget(panel);
   for (int step = 1; step <= 9; ++step) pages_->addWidget(make_page(step));
@@ -359,8 +364,8 @@ QWidget* MainWindow::make_page(int step) {
     case 2: {
       landmark_ = new QComboBox(page);
       landmark_->setObjectName("landmark");
-      landmark_->addItems({tr("Nasion"), tr("Left orbit centre"), tr("Right orbit centre"),
-                           tr("Midline point")});
+      landmark_->addItems(
+          {tr("Nasion"), tr("Left orbit centre"), tr("Right orbit centre"), tr("Midline point")});
       form->addRow(tr("Click places"), landmark_);
       auto* clear = button(tr("Clear landmarks"), "clearLandmarks", page);
       connect(clear, &QPushButton::clicked, this, [this] {
@@ -389,8 +394,8 @@ QWidget* MainWindow::make_page(int step) {
       adjust_shift_->setSuffix(" mm");
       auto* apply = button(tr("Apply"), "adjustPlane", box);
       connect(apply, &QPushButton::clicked, this, [this] {
-        const Eigen::Vector3d axis = adjust_axis_->currentIndex() == 0 ? Eigen::Vector3d::UnitZ()
-                                                                       : Eigen::Vector3d::UnitY();
+        const Eigen::Vector3d axis =
+            adjust_axis_->currentIndex() == 0 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitY();
         push(commands::adjust_plane(axis, adjust_angle_->value(), adjust_shift_->value()),
              tr("Moving the plane"));
       });
@@ -432,7 +437,7 @@ QWidget* MainWindow::make_page(int step) {
       auto* box = new QGroupBox(tr("Nudge the mirror"), page);
       auto* grid = new QHBoxLayout(box);
       const std::pair<QString, Eigen::Vector3d> moves[] = {
-          {"←", {-1, 0, 0}}, {"→", {1, 0, 0}}, {"front", {0, -1, 0}},
+          {"←", {-1, 0, 0}},   {"→", {1, 0, 0}}, {"front", {0, -1, 0}},
           {"back", {0, 1, 0}}, {"↑", {0, 0, 1}}, {"↓", {0, 0, -1}}};
       for (const auto& [label, delta] : moves) {
         auto* b = new QPushButton(label, box);
@@ -499,8 +504,8 @@ QWidget* MainWindow::make_page(int step) {
                                                             tr("Markers (*.json *.csv)"));
           if (path.isEmpty()) return;
           try {
-            push(commands::import_markers(read_markers_file(path.toStdString()),
-                                          path.toStdString(), sha256_file(path.toStdString())));
+            push(commands::import_markers(read_markers_file(path.toStdString()), path.toStdString(),
+                                          sha256_file(path.toStdString())));
           } catch (const Error& e) {
             show_message(QString::fromUtf8(e.what()), true);
           }
@@ -532,8 +537,8 @@ QWidget* MainWindow::make_page(int step) {
       auto* build = button(tr("Build implant"), "build", page);
       connect(build, &QPushButton::clicked, this, [this] {
         ImplantParams p;
-        p.method = implant_method_->currentIndex() == 0 ? ImplantMethod::Shell
-                                                        : ImplantMethod::Delaunay3D;
+        p.method =
+            implant_method_->currentIndex() == 0 ? ImplantMethod::Shell : ImplantMethod::Delaunay3D;
         p.resolution_mm = implant_resolution_->value();
         if (implant_thickness_->value() > 0) p.thickness_mm = implant_thickness_->value();
         p.surface_smoothing = 0.003;
@@ -568,10 +573,10 @@ QWidget* MainWindow::make_page(int step) {
       connect(smooth_iterations_, &QSpinBox::valueChanged, this, &MainWindow::preview_smoothing);
       auto* apply = button(tr("Apply smoothing"), "applySmoothing", page);
       connect(apply, &QPushButton::clicked, this, [this] {
-        push(commands::smooth_markers({static_cast<double>(smooth_radius_->value()),
-                                       static_cast<double>(smooth_weight_->value()),
-                                       smooth_iterations_->value()},
-                                      smooth_project_->isChecked()),
+        push(commands::smooth_markers(
+                 {static_cast<double>(smooth_radius_->value()),
+                  static_cast<double>(smooth_weight_->value()), smooth_iterations_->value()},
+                 smooth_project_->isChecked()),
              tr("Smoothing"));
       });
       form->addRow(tr("Radius"), smooth_radius_);
@@ -630,8 +635,8 @@ void MainWindow::build_plan_dock() {
   audit_verify_->setMaximumHeight(140);
   audit_table_ = new QTableWidget(audit_tab_);
   audit_table_->setColumnCount(5);
-  audit_table_->setHorizontalHeaderLabels({tr("time"), tr("user"), tr("step"), tr("event"),
-                                           tr("what")});
+  audit_table_->setHorizontalHeaderLabels(
+      {tr("time"), tr("user"), tr("step"), tr("event"), tr("what")});
   audit_table_->horizontalHeader()->setStretchLastSection(true);
   audit_table_->setEditTriggers(QAbstractItemView::NoEditTriggers);
   al->addWidget(audit_label_);
@@ -642,14 +647,13 @@ void MainWindow::build_plan_dock() {
     const PlanState& s = controller_->session().state_at(static_cast<size_t>(i));
     view_->show_state(s);
     const auto& stack = controller_->session().stack();
-    audit_label_->setText(
-        i == 0 ? tr("Before the first command")
-               : tr("After command %1 of %2: %3 (%4, %5)")
-                     .arg(i)
-                     .arg(stack.size())
-                     .arg(q(describe(stack[i - 1])))
-                     .arg(q(stack[i - 1].meta.user))
-                     .arg(q(stack[i - 1].meta.ended)));
+    audit_label_->setText(i == 0 ? tr("Before the first command")
+                                 : tr("After command %1 of %2: %3 (%4, %5)")
+                                       .arg(i)
+                                       .arg(stack.size())
+                                       .arg(q(describe(stack[i - 1])))
+                                       .arg(q(stack[i - 1].meta.user))
+                                       .arg(q(stack[i - 1].meta.ended)));
   });
   plan_tabs_->addTab(audit_tab_, tr("Audit"));
   plan_tabs_->setTabVisible(2, false);
@@ -664,6 +668,11 @@ void MainWindow::build_plan_dock() {
 void MainWindow::refresh() {
   const PlanState& s = controller_->state();
   if (!controller_->read_only()) view_->show_state(s);
+  // A new proposal: turn to the defect it found.
+  if (s.proposal_message != last_proposal_) {
+    last_proposal_ = s.proposal_message;
+    if (!s.markers.empty()) view_->look_at_markers();
+  }
   refresh_steps();
   refresh_history();
   refresh_quality();
@@ -678,9 +687,10 @@ void MainWindow::refresh() {
   if (!session.is_clean() && session.index() > 0) title += " *";
   if (controller_->read_only()) title += tr(" (audit, read-only)");
   setWindowTitle(title);
-  case_label_->setText(tr("Case: %1").arg(session.header().info.case_id.empty()
-                                               ? tr("none")
-                                               : q(session.header().info.case_id)));
+  case_label_->setText(tr("Case: %1")
+                           .arg(session.header().info.case_id.empty()
+                                    ? tr("none")
+                                    : q(session.header().info.case_id)));
   if (!s.message.empty()) show_message(q(s.message), false);
   finish_training_if_done();
   update_timers();
@@ -720,11 +730,13 @@ void MainWindow::refresh_steps() {
   const bool done = step_complete(s, s.current_step, &missing);
   QString keys;
   if (s.current_step == 5 || s.current_step == 6 || s.current_step == 8)
-    keys = tr("<br><i>Keys: 0–3 marker type, Del delete, drag a marker to move it, Ctrl+Z "
-              "undo, Ctrl+Shift+Z redo.</i>");
+    keys =
+        tr("<br><i>Keys: 0–3 marker type, Del delete, drag a marker to move it, Ctrl+Z "
+           "undo, Ctrl+Shift+Z redo.</i>");
   else
-    keys = tr("<br><i>Keys: Ctrl+Z undo, Ctrl+Shift+Z redo, F5–F9 standard views, M mirror "
-              "on/off.</i>");
+    keys =
+        tr("<br><i>Keys: Ctrl+Z undo, Ctrl+Shift+Z redo, F5–F9 standard views, M mirror "
+           "on/off.</i>");
   instructions_->setText(QStringLiteral("<b>%1. %2</b><br>%3<br><br>%4%5")
                              .arg(w.number)
                              .arg(tr(w.title))
@@ -746,8 +758,8 @@ void MainWindow::refresh_steps() {
   SkullView::PickTarget target = SkullView::PickTarget::None;
   if (st == 2 || st == 3) target = SkullView::PickTarget::Original;
   if (st == 5 || st == 6 || st == 8)
-    target = is_edge(marker_type_) ? SkullView::PickTarget::Original
-                                   : SkullView::PickTarget::Mirrored;
+    target =
+        is_edge(marker_type_) ? SkullView::PickTarget::Original : SkullView::PickTarget::Mirrored;
   view_->set_pick_target(controller_->read_only() ? SkullView::PickTarget::None : target);
   view_->set_markers_editable(!controller_->read_only() && (st == 5 || st == 6 || st == 8));
 }
@@ -792,9 +804,9 @@ void MainWindow::refresh_page() {
               .arg(q(s.plane_fit->initial_method));
     const int n = (s.landmarks.nasion ? 1 : 0) + (s.landmarks.orbit_left ? 1 : 0) +
                   (s.landmarks.orbit_right ? 1 : 0);
-    plane_info_->setText(tr("Landmarks: %1 of 3 set, %2 midline points.").arg(n).arg(
-                             s.landmarks.midline.size()) +
-                         (t.isEmpty() ? QString() : "<br>" + t));
+    plane_info_->setText(
+        tr("Landmarks: %1 of 3 set, %2 midline points.").arg(n).arg(s.landmarks.midline.size()) +
+        (t.isEmpty() ? QString() : "<br>" + t));
   }
   if (register_info_)
     register_info_->setText(
@@ -812,12 +824,12 @@ void MainWindow::refresh_page() {
     marker_counts_[1]->setText(
         tr("Outer surface: %1, inner surface: %2").arg(counts[2]).arg(counts[3]));
   if (implant_info_)
-    implant_info_->setText(s.implant ? tr("Implant: %1 triangles, %2")
-                                           .arg(s.implant->result().mesh.n_faces())
-                                           .arg(s.implant->result().watertight
-                                                    ? tr("watertight")
-                                                    : tr("not watertight"))
-                                     : tr("No implant yet."));
+    implant_info_->setText(
+        s.implant
+            ? tr("Implant: %1 triangles, %2")
+                  .arg(s.implant->result().mesh.n_faces())
+                  .arg(s.implant->result().watertight ? tr("watertight") : tr("not watertight"))
+            : tr("No implant yet."));
   if (clip_on_) {
     const QSignalBlocker b1(clip_on_);
     clip_on_->setChecked(s.clip_plane.has_value());
@@ -836,7 +848,8 @@ void MainWindow::update_timers() {
 }
 
 void MainWindow::show_message(const QString& text, bool problem) {
-  statusBar()->showMessage((problem ? QStringLiteral("⚠ ") : QString()) + text, problem ? 15000 : 8000);
+  statusBar()->showMessage((problem ? QStringLiteral("⚠ ") : QString()) + text,
+                           problem ? 15000 : 8000);
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -890,10 +903,10 @@ Command MainWindow::clip_command() const {
 
 void MainWindow::preview_smoothing() {
   if (!controller_->state().implant) return;
-  const Command c = commands::smooth_markers({static_cast<double>(smooth_radius_->value()),
-                                              static_cast<double>(smooth_weight_->value()),
-                                              smooth_iterations_->value()},
-                                             smooth_project_->isChecked());
+  const Command c = commands::smooth_markers(
+      {static_cast<double>(smooth_radius_->value()), static_cast<double>(smooth_weight_->value()),
+       smooth_iterations_->value()},
+      smooth_project_->isChecked());
   smooth_info_->setText(tr("Radius %1 mm, edge weight %2 — preview (Apply to keep it)")
                             .arg(smooth_radius_->value())
                             .arg(smooth_weight_->value()));
@@ -942,16 +955,17 @@ void MainWindow::open_sample() {
 bool MainWindow::open_session(const QString& path) {
   if (!confirm_discard()) return false;
   try {
-    bool recover = false;
+    // Without interaction (tests, --quit) nothing beside the plan is read or written.
+    OpenOptions options;
+    options.attach_autosave = interactive_;
     const RecoveryInfo info = Session::recovery_info(path.toStdString());
-    if (info.available) {
-      recover = !interactive_ ||
-                QMessageBox::question(this, tr("Recover unsaved changes?"),
-                                      tr("%1.\n\nRecover them?").arg(q(info.message))) ==
-                    QMessageBox::Yes;
-    }
+    if (info.available && interactive_)
+      options.recover_autosave =
+          QMessageBox::question(this, tr("Recover unsaved changes?"),
+                                tr("%1.\n\nRecover them?").arg(q(info.message))) ==
+          QMessageBox::Yes;
     QApplication::setOverrideCursor(Qt::WaitCursor);
-    Session s = Session::open(path.toStdString(), recover);
+    Session s = Session::open(path.toStdString(), options);
     QApplication::restoreOverrideCursor();
     controller_->set_read_only(false);
     controller_->set_session(std::move(s));
@@ -1021,7 +1035,7 @@ void MainWindow::open_audit(const QString& path) {
     QApplication::setOverrideCursor(Qt::WaitCursor);
     const VerifyReport verify = verify_session(path.toStdString());
     const SessionDocument doc = read_session_document(path.toStdString());
-    Session s = Session::open(path.toStdString(), false);
+    Session s = Session::open(path.toStdString());
     QApplication::restoreOverrideCursor();
     controller_->set_session(std::move(s));
     controller_->set_read_only(true);
@@ -1029,8 +1043,9 @@ void MainWindow::open_audit(const QString& path) {
     QString v = verify.ok() ? tr("<p style='color:#070'><b>This plan verifies.</b></p><ul>")
                             : tr("<p style='color:#b00'><b>This plan does NOT verify.</b></p><ul>");
     for (const auto& c : verify.checks)
-      v += QStringLiteral("<li>%1: %2 — %3</li>")
-               .arg(q(c.name), c.ok ? tr("holds") : tr("<b>fails</b>"), q(c.detail).toHtmlEscaped());
+      v +=
+          QStringLiteral("<li>%1: %2 — %3</li>")
+              .arg(q(c.name), c.ok ? tr("holds") : tr("<b>fails</b>"), q(c.detail).toHtmlEscaped());
     audit_verify_->setHtml(v + "</ul>");
     const auto rows = audit_rows(doc);
     audit_table_->setRowCount(static_cast<int>(rows.size()));
@@ -1077,7 +1092,8 @@ void MainWindow::finish_training_if_done() {
   if (!step_complete(controller_->state(), 9)) return;
   try {
     const Session reference = Session::open(training_reference_.toStdString());
-    training_html_ = q(cranioplan::training_report_html(training_report(controller_->session(), reference)));
+    training_html_ =
+        q(cranioplan::training_report_html(training_report(controller_->session(), reference)));
     show_message(tr("Training finished: Training → Show the training report."), false);
   } catch (const Error& e) {
     show_message(QString::fromUtf8(e.what()), true);
@@ -1094,18 +1110,18 @@ void MainWindow::offer_recovery() {
       dir.entryInfoList({"*.autosave"}, QDir::Files, QDir::Time);  // newest first
   if (found.isEmpty()) return;
   const QFileInfo& newest = found.front();
-  if (interactive_ &&
-      QMessageBox::question(this, tr("Recover a plan?"),
-                            tr("Cranioplan stopped before the plan \"%1\" was saved (last change "
-                               "%2).\n\nRecover it?")
-                                .arg(newest.completeBaseName(),
-                                     newest.lastModified().toString())) != QMessageBox::Yes)
+  if (interactive_ && QMessageBox::question(
+                          this, tr("Recover a plan?"),
+                          tr("Cranioplan stopped before the plan \"%1\" was saved (last change "
+                             "%2).\n\nRecover it?")
+                              .arg(newest.completeBaseName(), newest.lastModified().toString())) !=
+                          QMessageBox::Yes)
     return;
   try {
     controller_->set_session(Session::recover(newest.filePath().toStdString()));
-    show_message(tr("Recovered %1 commands of the unsaved plan.")
-                     .arg(controller_->session().index()),
-                 false);
+    show_message(
+        tr("Recovered %1 commands of the unsaved plan.").arg(controller_->session().index()),
+        false);
   } catch (const Error& e) {
     show_message(QString::fromUtf8(e.what()), true);
   }

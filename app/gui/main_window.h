@@ -45,8 +45,7 @@ class MainWindow : public QMainWindow {
   void set_interactive(bool interactive) { interactive_ = interactive; }
 
   // What the menus and buttons do, callable from tests and the command line.
-  void open_input(const QString& path,
-                  double threshold = std::numeric_limits<double>::quiet_NaN());
+  void open_input(const QString& path, double threshold = std::numeric_limits<double>::quiet_NaN());
   void open_sample();
   bool open_session(const QString& path);
   /// Shows the plan as it was when step `step` was current (commands of later steps undone).
@@ -155,6 +154,7 @@ class MainWindow : public QMainWindow {
   class QMenu* recent_menu_ = nullptr;
 
   QString session_path_;
+  std::string last_proposal_;
   QString training_reference_;
   QString training_html_;
 };

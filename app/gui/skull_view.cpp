@@ -30,6 +30,7 @@
 
 #include <Eigen/Geometry>
 #include <QMouseEvent>
+#include <QSurfaceFormat>
 #include <QWheelEvent>
 #include <array>
 
@@ -178,10 +179,19 @@ struct SkullView::Impl {
   double dpr = 1.0;
   int height_px() const { return window->GetSize()[1]; }
   int display_x(const QPoint& p) const { return static_cast<int>(p.x() * dpr); }
-  int display_y(const QPoint& p) const {
-    return height_px() - 1 - static_cast<int>(p.y() * dpr);
-  }
+  int display_y(const QPoint& p) const { return height_px() - 1 - static_cast<int>(p.y() * dpr); }
 };
+
+void SkullView::set_default_surface_format() {
+  QSurfaceFormat format;
+  format.setVersion(3, 2);
+  format.setProfile(QSurfaceFormat::CoreProfile);
+  format.setDepthBufferSize(24);
+  format.setStencilBufferSize(8);
+  format.setAlphaBufferSize(8);
+  format.setSamples(0);
+  QSurfaceFormat::setDefaultFormat(format);
+}
 
 SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_unique<Impl>()) {
   setMinimumSize(400, 300);
@@ -198,6 +208,13 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
   });
   d.interactor->AddObserver(vtkCommand::RenderEvent, on_render);
 
+  // Depth peeling for the translucent mirror and plane: order-independent transparency
+  // (VTK's default without it) draws wrong colours under Mesa's llvmpipe.
+  d.window->SetAlphaBitPlanes(1);
+  d.window->SetMultiSamples(0);
+  d.renderer->SetUseDepthPeeling(1);
+  d.renderer->SetMaximumNumberOfPeels(6);
+  d.renderer->SetOcclusionRatio(0.0);
   d.renderer->GradientBackgroundOn();
   d.renderer->SetBackground(0.10, 0.11, 0.14);
   d.renderer->SetBackground2(0.30, 0.33, 0.40);
@@ -212,10 +229,10 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
   d.plane_mapper->SetInputConnection(d.plane_source->GetOutputPort());
   d.plane_actor->GetProperty()->SetColor(0.30, 0.55, 1.0);
   d.plane_actor->GetProperty()->SetOpacity(0.25);
-  for (vtkActor* a : {d.skull.actor.Get(), d.mirror.actor.Get(), d.implant.actor.Get(),
-                      d.outer_edge.actor.Get(), d.inner_edge.actor.Get(),
-                      d.outer_surface.actor.Get(), d.inner_surface.actor.Get(),
-                      d.landmarks.actor.Get(), d.selected.actor.Get(), d.plane_actor.Get()}) {
+  for (vtkActor* a :
+       {d.skull.actor.Get(), d.mirror.actor.Get(), d.implant.actor.Get(), d.outer_edge.actor.Get(),
+        d.inner_edge.actor.Get(), d.outer_surface.actor.Get(), d.inner_surface.actor.Get(),
+        d.landmarks.actor.Get(), d.selected.actor.Get(), d.plane_actor.Get()}) {
     a->SetVisibility(false);
     d.renderer->AddActor(a);
   }
@@ -374,6 +391,26 @@ void SkullView::set_standard_view(StandardView view) {
 
 void SkullView::reset_camera() { set_standard_view(StandardView::Front); }
 
+void SkullView::look_at_markers() {
+  Impl& d = *d_;
+  if (d.markers.empty()) return;
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const auto& m : d.markers) c += m.position;
+  c /= static_cast<double>(d.markers.size());
+  Eigen::Vector3d dir = c - d.center;
+  if (dir.norm() < 1e-6) return;
+  dir.normalize();
+  const Eigen::Vector3d up = std::abs(dir.z()) > 0.9 ? Eigen::Vector3d(-Eigen::Vector3d::UnitY())
+                                                     : Eigen::Vector3d::UnitZ();
+  vtkCamera* cam = d.renderer->GetActiveCamera();
+  const Eigen::Vector3d pos = c + 2.6 * d.radius * dir;
+  cam->SetFocalPoint(c.x(), c.y(), c.z());
+  cam->SetPosition(pos.x(), pos.y(), pos.z());
+  cam->SetViewUp(up.x(), up.y(), up.z());
+  d.renderer->ResetCameraClippingRange();
+  update();
+}
+
 void SkullView::set_pick_target(PickTarget target) { d_->target = target; }
 
 void SkullView::set_markers_editable(bool editable) { d_->markers_editable = editable; }
@@ -480,9 +517,11 @@ void SkullView::mouseMoveEvent(QMouseEvent* e) {
     for (const auto& x : d.markers)
       if (x.id == d.drag_id) m = &x;
     if (!m) return;
-    const auto p = pick(pos, m->surface == MarkerSurface::Mirrored ? PickTarget::Mirrored
-                                                                   : PickTarget::Original);
-    if (p) emit markerDragged(d.drag_id, *p);
+    const auto p = pick(
+        pos, m->surface == MarkerSurface::Mirrored ? PickTarget::Mirrored : PickTarget::Original);
+    // A drag slides along the surface: a pick that jumps (through the opening onto the far
+    // wall, or off the skull's silhouette) is not followed.
+    if (p && (*p - m->position).norm() < 20.0) emit markerDragged(d.drag_id, *p);
     return;
   }
   d.interactor->SetEventInformationFlipY(d.display_x(pos), static_cast<int>(pos.y() * d.dpr),

@@ -16,6 +16,10 @@ class SkullView : public QOpenGLWidget {
   Q_OBJECT
 
  public:
+  /// The OpenGL surface VTK needs (core profile 3.2+, depth, stencil and alpha for depth
+  /// peeling). Call before the QApplication is made.
+  static void set_default_surface_format();
+
   explicit SkullView(QWidget* parent = nullptr);
   ~SkullView() override;
 
@@ -28,6 +32,8 @@ class SkullView : public QOpenGLWidget {
   enum class StandardView { Front, Back, Left, Right, Top };
   void set_standard_view(StandardView view);
   void reset_camera();
+  /// Looks at the markers (the defect) from outside the skull.
+  void look_at_markers();
 
   /// Which surface a click places on (None: clicks only select markers).
   enum class PickTarget { None, Original, Mirrored };

@@ -573,8 +573,11 @@ void Session::save(const std::string& path) {
   path_ = path;
   context_.session_dir = fs::path(path).parent_path().string();
   clean_index_ = index_;
-  autosave_path_ = autosave_for(path);
-  write_autosave_all();
+  // A session that autosaves (the wizard's) keeps doing so, now beside its file.
+  if (!autosave_path_.empty()) {
+    autosave_path_ = autosave_for(path);
+    write_autosave_all();
+  }
 }
 
 Session Session::from_journal(const SessionHeader& header, const std::vector<JournalEntry>& journal,
@@ -595,27 +598,31 @@ Session Session::from_journal(const SessionHeader& header, const std::vector<Jou
   return s;
 }
 
-Session Session::open(const std::string& path, bool use_autosave) {
+Session Session::open(const std::string& path, const OpenOptions& options) {
   const SessionDocument doc = read_session_document(path);
   check_document(doc);
   ApplyContext context;
   context.session_dir = fs::path(path).parent_path().string();
   std::vector<JournalEntry> journal = doc.journal;
   bool recovered = false;
-  const RecoveryInfo info = recovery_info(path);
-  if (info.available && use_autosave) {
-    journal = read_autosave(info.autosave_path)->entries;
-    recovered = true;
-  } else if (info.available) {
-    // Declined: keep the unsaved changes beside the plan rather than overwrite them.
-    std::error_code ec;
-    fs::rename(info.autosave_path, info.autosave_path + ".declined", ec);
+  if (options.recover_autosave || options.attach_autosave) {
+    const RecoveryInfo info = recovery_info(path);
+    if (info.available && options.recover_autosave) {
+      journal = read_autosave(info.autosave_path)->entries;
+      recovered = true;
+    } else if (info.available) {
+      // Declined: keep the unsaved changes beside the plan rather than overwrite them.
+      std::error_code ec;
+      fs::rename(info.autosave_path, info.autosave_path + ".declined", ec);
+    }
   }
   Session s = from_journal(doc.header, journal, path, context);
   s.header_.app_version = doc.header.app_version;
   if (!recovered) s.clean_index_ = s.index_;
-  s.autosave_path_ = autosave_for(path);
-  s.write_autosave_all();
+  if (options.attach_autosave) {
+    s.autosave_path_ = autosave_for(path);
+    s.write_autosave_all();
+  }
   return s;
 }
 

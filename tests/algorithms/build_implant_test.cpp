@@ -107,3 +107,24 @@ TEST(BuildImplant, TooFewMarkersGiveAStatus) {
 
 }  // namespace
 }  // namespace cranioplan
+
+namespace cranioplan {
+namespace {
+
+// A marker dragged through the opening onto the far wall of the skull must give a clear
+// failure, not a runaway computation.
+TEST(BuildImplant, AMarkerOnTheFarSideIsRefusedNotStretched) {
+  const SkullMesh head = test::make_symmetric_head(4);
+  const Eigen::Vector3d c = test::head_surface_point(Eigen::Vector3d(0.7, 0.1, 0.7).normalized());
+  std::vector<Marker> markers = test::round_defect_markers(c * 0.965, 20.0);
+  ASSERT_GT(markers.size(), 3u);
+  markers.front().position = -markers.front().position;  // through the skull to the far side
+  ImplantParams p;
+  p.radial_center = Eigen::Vector3d::Zero();
+  const ImplantResult r = build_implant(markers, &head, p);
+  EXPECT_EQ(r.status, ImplantResult::Status::Failed);
+  EXPECT_NE(r.message.find("far side"), std::string::npos) << r.message;
+}
+
+}  // namespace
+}  // namespace cranioplan

@@ -412,7 +412,7 @@ TEST(SessionFile, AutosaveOffersRecoveryOfUnsavedCommands) {
   const RecoveryInfo info = Session::recovery_info(path);
   ASSERT_TRUE(info.available) << info.message;
   EXPECT_EQ(info.extra_events, 3);
-  const Session recovered = Session::open(path, true);
+  const Session recovered = Session::open(path, OpenOptions{true, true});
   EXPECT_EQ(fingerprint(recovered.state()), fingerprint(s.state()));
   EXPECT_FALSE(recovered.is_clean());
   EXPECT_TRUE(recovered.can_redo());

@@ -98,6 +98,14 @@ struct RecoveryInfo {
   std::string message;  ///< plain words, for a dialog
 };
 
+struct OpenOptions {
+  /// Also take the events of a newer autosave file (recovery after a crash).
+  bool recover_autosave = false;
+  /// Append this session's new events to PATH.autosave (the wizard). Without it, opening
+  /// writes nothing: replay, verify and audit leave the files as they are.
+  bool attach_autosave = false;
+};
+
 class Session {
  public:
   explicit Session(SessionInfo info = {});
@@ -105,9 +113,8 @@ class Session {
   Session(Session&&) noexcept;
   Session& operator=(Session&&) noexcept;
 
-  /// Opens a saved session and replays it. With `use_autosave`, events in its autosave file
-  /// that extend the saved journal are recovered too. Throws SessionError / InputError.
-  static Session open(const std::string& path, bool use_autosave = false);
+  /// Opens a saved session and replays it. Throws SessionError / InputError.
+  static Session open(const std::string& path, const OpenOptions& options = {});
   /// Rebuilds a session from an autosave file alone (a plan that was never saved).
   static Session recover(const std::string& autosave_path);
   /// Whether `session_path`'s autosave holds more than the saved file.
@@ -146,8 +153,8 @@ class Session {
   const SessionHeader& header() const { return header_; }
   const std::string& path() const { return path_; }
 
-  /// Writes the session atomically and marks it clean. Its autosave file is `path` +
-  /// ".autosave" from now on.
+  /// Writes the session atomically and marks it clean. A session that autosaves continues in
+  /// `path` + ".autosave" from now on.
   void save(const std::string& path);
   /// True when the state equals the last saved one (drives "unsaved changes").
   bool is_clean() const { return clean_index_ && *clean_index_ == index_; }

@@ -1,0 +1,306 @@
+// The wizard driven like a user: buttons, menu actions, keys and clicks on the 3D view at known
+// surface points, on the sample case. Runs under Xvfb (see tests/CMakeLists.txt).
+#include <gtest/gtest.h>
+
+#include <QAction>
+#include <QApplication>
+#include <QCheckBox>
+#include <QDir>
+#include <QListWidget>
+#include <QMouseEvent>
+#include <QPushButton>
+#include <QSlider>
+#include <QTest>
+#include <filesystem>
+
+#include "cranioplan/algorithms/load_skull.h"
+#include "cranioplan/sessions/session.h"
+#include "cranioplan/sessions/sha256.h"
+#include "main_window.h"
+#include "support/test_files.h"
+
+namespace cranioplan::gui {
+namespace {
+
+namespace fs = std::filesystem;
+
+template <class T>
+T* child(QWidget& w, const char* name) {
+  T* c = w.findChild<T*>(name);
+  EXPECT_NE(c, nullptr) << "no " << name;
+  return c;
+}
+
+void click(QWidget& w, const char* button_name) {
+  QPushButton* b = child<QPushButton>(w, button_name);
+  ASSERT_TRUE(b);
+  ASSERT_TRUE(b->isEnabled()) << button_name << " is disabled";
+  QTest::mouseClick(b, Qt::LeftButton);
+}
+
+void trigger(QWidget& w, const char* action_name) {
+  QAction* a = child<QAction>(w, action_name);
+  ASSERT_TRUE(a);
+  a->trigger();
+}
+
+void mouse(QWidget* target, QEvent::Type type, const QPoint& at, Qt::MouseButtons buttons) {
+  QMouseEvent e(type, QPointF(at), target->mapToGlobal(QPointF(at)),
+                type == QEvent::MouseMove ? Qt::NoButton : Qt::LeftButton, buttons, Qt::NoModifier);
+  QApplication::sendEvent(target, &e);
+}
+
+void click_view(SkullView& view, const QPoint& at) {
+  mouse(&view, QEvent::MouseButtonPress, at, Qt::LeftButton);
+  mouse(&view, QEvent::MouseButtonRelease, at, Qt::NoButton);
+}
+
+// The view as an image, compared with a stored baseline: at most 1% of pixels may differ by
+// more than 40 in a channel. A missing baseline is written and the check fails.
+void expect_like_baseline(SkullView& view, const std::string& name) {
+  view.update();
+  QTest::qWait(50);
+  const QImage image = view.grabFramebuffer().convertToFormat(QImage::Format_RGB32);
+  const QString path = QString(CRANIOPLAN_SOURCE_DIR) + "/tests/gui/baselines/" +
+                       QString::fromStdString(name) + ".png";
+  QImage base;
+  if (!base.load(path)) {
+    QDir().mkpath(QFileInfo(path).path());
+    image.save(path);
+    ADD_FAILURE() << "no baseline " << path.toStdString() << ": written, check it and rerun";
+    return;
+  }
+  base = base.convertToFormat(QImage::Format_RGB32);
+  ASSERT_EQ(base.size(), image.size()) << name;
+  long long differing = 0;
+  for (int y = 0; y < image.height(); ++y) {
+    const QRgb* a = reinterpret_cast<const QRgb*>(image.constScanLine(y));
+    const QRgb* b = reinterpret_cast<const QRgb*>(base.constScanLine(y));
+    for (int x = 0; x < image.width(); ++x) {
+      const int d =
+          std::max({std::abs(qRed(a[x]) - qRed(b[x])), std::abs(qGreen(a[x]) - qGreen(b[x])),
+                    std::abs(qBlue(a[x]) - qBlue(b[x]))});
+      differing += d > 40;
+    }
+  }
+  const double fraction = static_cast<double>(differing) / (image.width() * image.height());
+  if (fraction > 0.01)
+    image.save(QString::fromStdString(test::TempDir().path(name + "_actual.png")));
+  EXPECT_LE(fraction, 0.01) << name << ": " << 100 * fraction << "% of pixels differ";
+}
+
+// The skull's most anterior point near the midline at the height of the orbits' roofs: a
+// surface point the front view shows unoccluded (near the nasion).
+Eigen::Vector3d anterior_midline_point(const PlanState& s) {
+  const SkullMesh& m = s.skull->surface->mesh;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e9), hi = -lo;
+  for (auto vh : m.vertices()) {
+    lo = lo.cwiseMin(to_eigen(m.point(vh)));
+    hi = hi.cwiseMax(to_eigen(m.point(vh)));
+  }
+  const Eigen::Vector3d c = (lo + hi) / 2;
+  Eigen::Vector3d best(0, 1e9, 0);
+  for (auto vh : m.vertices()) {
+    const Eigen::Vector3d p = to_eigen(m.point(vh));
+    if (std::abs(p.x() - c.x()) < 4 && std::abs(p.z() - c.z()) < 10 && p.y() < best.y()) best = p;
+  }
+  return best;
+}
+
+class Wizard : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!fs::exists(sample_case_path())) GTEST_SKIP() << "sample case not installed";
+  }
+};
+
+TEST_F(Wizard, AllNineStepsOnTheSampleReplayToTheSameImplant) {
+  test::TempDir tmp;
+  MainWindow w;
+  w.set_interactive(false);
+  w.resize(1500, 950);
+  w.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&w));
+  PlanController& plan = w.controller();
+  SkullView& view = w.view();
+
+  // Locked steps refuse.
+  QString refusal;
+  QObject::connect(&plan, &PlanController::refused, [&](const QString& m) { refusal = m; });
+  EXPECT_FALSE(plan.push(commands::build_implant()));
+  EXPECT_TRUE(refusal.contains("is locked")) << refusal.toStdString();
+  auto* steps = child<QListWidget>(w, "steps");
+  EXPECT_FALSE(steps->item(6)->flags() & Qt::ItemIsEnabled) << "step 7 shows locked";
+
+  // 1. Load the sample.
+  trigger(w, "openSample");
+  plan.wait();
+  ASSERT_TRUE(plan.state().skull);
+  EXPECT_EQ(plan.state().current_step, 2);
+  view.set_standard_view(SkullView::StandardView::Front);
+  expect_like_baseline(view, "sample_front");
+
+  // 2. A landmark by a click at a known surface point, then Fit. A cancelled fit changes nothing.
+  const Eigen::Vector3d target = anterior_midline_point(plan.state());
+  const auto at = view.project(target);
+  ASSERT_TRUE(at);
+  click_view(view, *at);
+  ASSERT_TRUE(plan.state().landmarks.nasion) << "the click placed no landmark";
+  EXPECT_LT((*plan.state().landmarks.nasion - target).norm(), 3.0);
+  const size_t before_cancel = plan.session().index();
+  click(w, "fitPlane");
+  EXPECT_TRUE(plan.busy());
+  click(w, "cancel");
+  plan.wait();
+  EXPECT_EQ(plan.session().index(), before_cancel) << "cancel leaves the plan unchanged";
+  EXPECT_FALSE(plan.state().plane);
+  click(w, "fitPlane");
+  plan.wait();
+  ASSERT_TRUE(plan.state().plane);
+  click(w, "done");
+  EXPECT_EQ(plan.state().current_step, 3);
+
+  // 3. Mirror and register.
+  click(w, "mirror");
+  plan.wait();
+  click(w, "register");
+  plan.wait();
+  ASSERT_TRUE(plan.state().registration && plan.state().registration->usable());
+  click(w, "done");
+
+  // 4. Clip to see the inner edge, then done.
+  auto* clip = child<QCheckBox>(w, "clipOn");
+  QTest::mouseClick(clip, Qt::LeftButton, {}, QPoint(8, clip->height() / 2));
+  EXPECT_TRUE(plan.state().clip_plane) << refusal.toStdString();
+  click(w, "done");
+  ASSERT_EQ(plan.state().current_step, 5);
+
+  // 5. Propose, drag a marker along the surface (one merged command), place and delete one.
+  click(w, "propose");
+  plan.wait();
+  ASSERT_GT(plan.state().markers.size(), 20u);
+  const Marker edge = plan.state().markers.front();
+  ASSERT_TRUE(is_edge(edge.type));
+  const size_t before_drag = plan.session().index();
+  const auto from = view.project(edge.position);
+  ASSERT_TRUE(from);
+  // Drag outwards, away from the opening, so the marker slides over intact bone.
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (const auto& m : plan.state().markers) centroid += m.position;
+  centroid /= static_cast<double>(plan.state().markers.size());
+  const auto middle = view.project(centroid);
+  ASSERT_TRUE(middle);
+  QPointF outward = QPointF(*from - *middle);
+  outward /= std::max(1.0, std::hypot(outward.x(), outward.y()));
+  mouse(&view, QEvent::MouseButtonPress, *from, Qt::LeftButton);
+  EXPECT_EQ(view.selected_marker(), edge.id) << "pressing on a marker grabs it";
+  QPoint to = *from;
+  for (int step = 2; step <= 12; step += 2) {
+    to = *from + (outward * step).toPoint();
+    mouse(&view, QEvent::MouseMove, to, Qt::LeftButton);
+  }
+  mouse(&view, QEvent::MouseButtonRelease, to, Qt::NoButton);
+  EXPECT_EQ(plan.session().index(), before_drag + 1) << "the drag is one command";
+  EXPECT_GT((plan.state().find_marker(edge.id)->position - edge.position).norm(), 0.5);
+  EXPECT_EQ(plan.session().stack().back().type, CommandType::MoveMarker);
+  QTest::keyClick(&w, Qt::Key_0);
+  const size_t n_markers = plan.state().markers.size();
+  const auto spot = view.project(plan.state().markers[plan.state().markers.size() / 2].position);
+  ASSERT_TRUE(spot);
+  click_view(view, *spot + QPoint(0, 40));
+  ASSERT_EQ(plan.state().markers.size(), n_markers + 1) << "a click adds a marker";
+  view.set_selected_marker(plan.state().markers.back().id);
+  trigger(w, "deleteMarker");
+  EXPECT_EQ(plan.state().markers.size(), n_markers);
+  click(w, "done");
+  click(w, "done");  // 6: the proposal's surface markers complete it
+  ASSERT_EQ(plan.state().current_step, 7);
+
+  // 7. Build.
+  click(w, "build");
+  plan.wait();
+  ASSERT_TRUE(plan.state().implant);
+  click(w, "done");
+
+  // 8. The slider previews without recording; Apply records.
+  const size_t before_preview = plan.session().index();
+  child<QSlider>(w, "smoothRadius")->setValue(14);
+  EXPECT_EQ(plan.session().index(), before_preview);
+  click(w, "applySmoothing");
+  plan.wait();
+  EXPECT_EQ(plan.session().stack().back().type, CommandType::SmoothMarkers);
+  click(w, "done");
+  ASSERT_EQ(plan.state().current_step, 9);
+
+  // 9. Export; undo and redo from the Edit menu.
+  const std::string implant = tmp.path("implant.stl");
+  ASSERT_TRUE(w.export_to(QString::fromStdString(implant)));
+  EXPECT_TRUE(step_complete(plan.state(), 9));
+  const size_t end = plan.session().index();
+  trigger(w, "undo");
+  EXPECT_EQ(plan.session().index(), end - 1);
+  EXPECT_FALSE(step_complete(plan.state(), 9));
+  trigger(w, "redo");
+  EXPECT_EQ(plan.session().index(), end);
+  view.look_at_markers();
+  expect_like_baseline(view, "sample_plan_markers");
+
+  // The saved session replays to the same implant, byte for byte.
+  const std::string session = tmp.path("plan.json");
+  ASSERT_TRUE(w.save_session_to(QString::fromStdString(session)));
+  const Session replayed = Session::open(session);
+  ASSERT_TRUE(replayed.state().implant);
+  EXPECT_EQ(replayed.state().implant->stl_sha256(), sha256_file(implant));
+
+  // Training against this plan as the reference: reopening it finishes the plan, so the report
+  // appears (the plan against itself agrees fully).
+  MainWindow trainee;
+  trainee.set_interactive(false);
+  trainee.start_training(QString::fromStdString(session));
+  ASSERT_TRUE(trainee.open_session(QString::fromStdString(session)));
+  EXPECT_TRUE(trainee.training_report_html().contains("Implant agreement"));
+  EXPECT_TRUE(trainee.training_report_html().contains("1.000"));
+
+  // Audit: read-only, a slider over the commands, the verification in plain words.
+  MainWindow audit;
+  audit.set_interactive(false);
+  audit.open_audit(QString::fromStdString(session));
+  EXPECT_TRUE(audit.controller().read_only());
+  EXPECT_FALSE(audit.controller().push(commands::note("not allowed")));
+  auto* slider = child<QSlider>(audit, "auditSlider");
+  EXPECT_EQ(slider->maximum(), static_cast<int>(replayed.stack().size()));
+  slider->setValue(3);
+  EXPECT_EQ(audit.controller().session().index(), replayed.index()) << "audit does not undo";
+}
+
+TEST_F(Wizard, CommandLineScreenshotOfASessionAtAStep) {
+  test::TempDir tmp;
+  const std::string session = tmp.path("auto.json"), implant = tmp.path("auto.stl");
+  std::string out;
+  ASSERT_EQ(test::run_command(std::string(CRANIOPLAN_CLI) + " autoplan " + sample_case_path() +
+                                  " -o " + implant + " --session " + session,
+                              &out),
+            0);
+  const std::string png = tmp.path("step5.png");
+  ASSERT_EQ(test::run_command(std::string(CRANIOPLAN_GUI) + " " + session +
+                                  " --step 5 --screenshot " + png + " --quit",
+                              &out),
+            0)
+      << out;
+  QImage image;
+  ASSERT_TRUE(image.load(QString::fromStdString(png)));
+  EXPECT_GT(image.width(), 800);
+  EXPECT_FALSE(fs::exists(session + ".autosave")) << "a screenshot writes nothing beside the plan";
+}
+
+}  // namespace
+}  // namespace cranioplan::gui
+
+int main(int argc, char** argv) {
+  cranioplan::gui::SkullView::set_default_surface_format();
+  QApplication app(argc, argv);
+  QApplication::setOrganizationName("CranioplanTests");
+  QApplication::setApplicationName("CranioplanTests");
+  ::testing::InitGoogleTest(&argc, argv);
+  return RUN_ALL_TESTS();
+}
