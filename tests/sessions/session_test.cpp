@@ -403,8 +403,10 @@ TEST(SessionFile, MissingOrChangedSkullIsNamed) {
 
 TEST(SessionFile, AutosaveOffersRecoveryOfUnsavedCommands) {
   Session s = session_at_markers();
+  s.set_autosave_path(test::scratch_path("unsaved.autosave"));  // as the wizard does
   const std::string path = test::scratch_path("autosaved.json");
   s.save(path);
+  EXPECT_EQ(s.autosave_path(), path + ".autosave") << "saving moves the autosave beside the plan";
   EXPECT_FALSE(Session::recovery_info(path).available);
   push_ok(s, commands::note("after save 1"));
   push_ok(s, commands::note("after save 2"));
