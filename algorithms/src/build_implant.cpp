@@ -21,6 +21,7 @@
 #include "cranioplan/algorithms/mesh_report.h"
 #include "cranioplan/algorithms/surface_locator.h"
 #include "cranioplan/algorithms/thin_plate_spline.h"
+#include "cranioplan/algorithms/trim_to_bone.h"
 #include "cranioplan/model/error.h"
 
 namespace cranioplan {
@@ -358,17 +359,29 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
   const size_t n_rim = angles.size();
   result.rim_points = static_cast<int>(n_rim);
 
+  const double fit_margin = skull && bone ? std::max(0.0, params.fit_to_bone_mm) : 0.0;
   // Rim points in 3D, snapped onto the bone between markers.
   auto rim_points = [&](const PolarPolygon& poly, const Height* tps) {
     std::vector<Eigen::Vector3d> pts(n_rim);
+    auto lift_rim = [&](const Eigen::Vector2d& q) {
+      if (tps) return f.lift(q, (*tps)(q));
+      // No inner markers: the outer rim offset inwards along the surface normal.
+      return Eigen::Vector3d(f.lift(q, outer_tps(q)) - offset(q) * outer_normal(q));
+    };
     for (size_t k = 0; k < n_rim; ++k) {
       const Eigen::Vector2d q = poly.at(angles[k]).first;
-      if (tps) {
-        pts[k] = f.lift(q, (*tps)(q));
-      } else {  // no inner markers: the outer rim offset inwards along the surface normal
-        pts[k] = f.lift(q, outer_tps(q)) - offset(q) * outer_normal(q);
+      pts[k] = lift_rim(q);
+      // Fitting to the bone: the rim goes beyond the opening, into the bone of the cut face,
+      // to be trimmed there — only where there is bone to meet (not over an orbit).
+      bool extended = false;
+      if (fit_margin > 0.0 && (q - center).norm() > 1e-9) {
+        const Eigen::Vector3d beyond = lift_rim(q + fit_margin * (q - center).normalized());
+        if (bone->closest(beyond).distance < 0.5 * fit_margin) {
+          pts[k] = beyond;
+          extended = true;
+        }
       }
-      const bool exact = is_marker_angle[k] && tps != nullptr;
+      const bool exact = (is_marker_angle[k] && tps != nullptr) || extended;
       // An inner rim set in from the outer one is not snapped: its nearest bone is often the
       // cut face far along the rim, and snapping it there makes spikes.
       if (bone && params.snap_rim_to_skull && !exact && tps != nullptr) {
@@ -575,6 +588,17 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
   ImplantResult r = params.method == ImplantMethod::Shell
                         ? build_shell(markers, skull, skull_locator, params)
                         : build_delaunay(markers, params);
+  if (r.usable() && params.method == ImplantMethod::Shell && params.fit_to_bone_mm > 0.0 && skull &&
+      skull->n_faces() > 0) {
+    TrimToBoneResult t = trim_to_bone(r.mesh, *skull, TrimToBoneParams{}, skull_locator);
+    if (t.usable()) {
+      r.mesh = std::move(t.mesh);
+      r.watertight = report_mesh(r.mesh).watertight;
+    } else {
+      r.status = ImplantResult::Status::Failed;
+      r.message = "fitting to the bone: " + t.message;
+    }
+  }
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return r;
 }

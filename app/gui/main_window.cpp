@@ -268,29 +268,33 @@ void MainWindow::build_menus() {
   });
   training->addAction(tr("Show the training report"), this, [this] {
     finish_training_if_done();
-    if (training_html_.isEmpty()) {
-      show_message(tr("No training report yet: start training and finish the plan."), true);
-      return;
-    }
-    QDialog dialog(this);
-    dialog.setWindowTitle(tr("Training report"));
-    auto* layout = new QVBoxLayout(&dialog);
-    auto* text = new QTextBrowser(&dialog);
-    text->setHtml(training_html_);
-    layout->addWidget(text);
-    auto* buttons = new QDialogButtonBox(QDialogButtonBox::Save | QDialogButtonBox::Close);
-    layout->addWidget(buttons);
-    connect(buttons, &QDialogButtonBox::rejected, &dialog, &QDialog::reject);
-    connect(buttons, &QDialogButtonBox::accepted, &dialog, [this, &dialog] {
-      const QString path = QFileDialog::getSaveFileName(&dialog, tr("Save the report"), QString(),
-                                                        tr("HTML (*.html)"));
-      if (path.isEmpty()) return;
-      QFile f(path);
-      if (f.open(QIODevice::WriteOnly)) f.write(training_html_.toUtf8());
-    });
-    dialog.resize(700, 600);
-    dialog.exec();
+    show_training_report();
   });
+}
+
+void MainWindow::show_training_report() {
+  if (training_html_.isEmpty()) {
+    show_message(tr("No training report yet: start training and finish the plan."), true);
+    return;
+  }
+  QDialog dialog(this);
+  dialog.setWindowTitle(tr("Training report"));
+  auto* layout = new QVBoxLayout(&dialog);
+  auto* text = new QTextBrowser(&dialog);
+  text->setHtml(training_html_);
+  layout->addWidget(text);
+  auto* buttons = new QDialogButtonBox(QDialogButtonBox::Save | QDialogButtonBox::Close);
+  layout->addWidget(buttons);
+  connect(buttons, &QDialogButtonBox::rejected, &dialog, &QDialog::reject);
+  connect(buttons, &QDialogButtonBox::accepted, &dialog, [this, &dialog] {
+    const QString path = QFileDialog::getSaveFileName(&dialog, tr("Save the report"), QString(),
+                                                      tr("HTML (*.html)"));
+    if (path.isEmpty()) return;
+    QFile f(path);
+    if (f.open(QIODevice::WriteOnly)) f.write(training_html_.toUtf8());
+  });
+  dialog.resize(700, 600);
+  dialog.exec();
 }
 
 void MainWindow::build_steps_dock() {
@@ -534,6 +538,15 @@ QWidget* MainWindow::make_page(int step) {
       implant_thickness_->setValue(0);
       implant_thickness_->setSpecialValueText(tr("measured at the rim"));
       implant_thickness_->setSuffix(" mm");
+      implant_fit_ = new QDoubleSpinBox(page);
+      implant_fit_->setObjectName("implantFit");
+      implant_fit_->setRange(0, 8);
+      implant_fit_->setSingleStep(0.5);
+      implant_fit_->setSpecialValueText(tr("off"));
+      implant_fit_->setSuffix(" mm");
+      implant_fit_->setToolTip(
+          tr("Build the shell this far over the bone and subtract the skull: the implant meets "
+             "the cut face all around and never enters the bone (about 1 s per rebuild)"));
       auto* build = button(tr("Build implant"), "build", page);
       connect(build, &QPushButton::clicked, this, [this] {
         ImplantParams p;
@@ -542,11 +555,13 @@ QWidget* MainWindow::make_page(int step) {
         p.resolution_mm = implant_resolution_->value();
         if (implant_thickness_->value() > 0) p.thickness_mm = implant_thickness_->value();
         p.surface_smoothing = 0.003;
+        p.fit_to_bone_mm = implant_fit_->value();
         push(commands::build_implant(p), tr("Building the implant"));
       });
       form->addRow(tr("Method"), implant_method_);
       form->addRow(tr("Resolution"), implant_resolution_);
       form->addRow(tr("Thickness without inner markers"), implant_thickness_);
+      form->addRow(tr("Fit to the bone"), implant_fit_);
       form->addRow(build);
       implant_info_ = new QLabel(page);
       implant_info_->setWordWrap(true);
@@ -1095,6 +1110,7 @@ void MainWindow::finish_training_if_done() {
     training_html_ =
         q(cranioplan::training_report_html(training_report(controller_->session(), reference)));
     show_message(tr("Training finished: Training → Show the training report."), false);
+    if (interactive_) QTimer::singleShot(0, this, [this] { show_training_report(); });
   } catch (const Error& e) {
     show_message(QString::fromUtf8(e.what()), true);
   }

@@ -86,6 +86,7 @@ class MainWindow : public QMainWindow {
   void refresh_recent_menu();
   void preview_smoothing();
   void finish_training_if_done();
+  void show_training_report();
   QString autosave_folder() const;
   Command clip_command() const;
 
@@ -119,6 +120,7 @@ class MainWindow : public QMainWindow {
   QComboBox* implant_method_ = nullptr;
   QDoubleSpinBox* implant_resolution_ = nullptr;
   QDoubleSpinBox* implant_thickness_ = nullptr;
+  QDoubleSpinBox* implant_fit_ = nullptr;
   QLabel* implant_info_ = nullptr;
   QSlider* smooth_radius_ = nullptr;
   QSlider* smooth_weight_ = nullptr;

@@ -115,14 +115,17 @@ Json run_bench(const BenchOptions& options) {
                                           : session.state().skull->surface->locator;
       int k = 0;
       out["session_move_marker_s"] = median_seconds(runs, [&] {
-        const Eigen::Vector3d to = surface.closest(m.position + Eigen::Vector3d(0, 0, 0.2 * ++k)).point;
+        const Eigen::Vector3d to =
+            surface.closest(m.position + Eigen::Vector3d(0, 0, 0.2 * ++k)).point;
         session.push(commands::note("separates the drags"));
         session.push(commands::move_marker(m.id, to));
       });
-      out["session_undo_s"] = median_seconds(runs, [&] {
-        session.undo();
-        session.redo();
-      }) / 2.0;
+      out["session_undo_s"] = median_seconds(runs,
+                                             [&] {
+                                               session.undo();
+                                               session.redo();
+                                             }) /
+                              2.0;
       out["session_commands"] = session.index();
     }
   }

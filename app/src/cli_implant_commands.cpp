@@ -79,6 +79,14 @@ Json autoplan_json(const AutoplanResult& r) {
   return j;
 }
 
+// --fit-to-bone MM: the automatic planner's implant built beyond the rim and trimmed by the bone.
+void add_fit_option(CLI::App* cmd, AutoplanParams& params) {
+  cmd->add_option("--fit-to-bone", params.implant.fit_to_bone_mm,
+                  "build the implant this far over the bone and subtract the skull (mm; 0: off)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10.0));
+}
+
 // autoplan --session: the plan made by session commands, saved for reopening and audit.
 int autoplan_with_session(const std::string& skull, const Landmarks& lm,
                           const AutoplanParams& params, const std::string& output,
@@ -314,6 +322,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
         ->check(CLI::IsMember({"auto", "mirror", "rim-only"}));
     cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
     cmd->add_option("--markers-out", o->markers_out, "proposed markers to write (.json or .csv)");
+    add_fit_option(cmd, o->params);
     cmd->add_option("--session", o->session,
                     "plan through session commands and save the session (.json): reopen, edit, "
                     "replay and audit it");
@@ -343,12 +352,14 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
   {  // evaluate
     struct Opts {
       std::string dir;
+      AutoplanParams params;
     };
     auto o = std::make_shared<Opts>();
     auto* cmd = app.add_subcommand(
         "evaluate", "Autoplan every NNN_defective_skull.* against its NNN_implant.*");
     cmd->add_option("CASES_DIR", o->dir, "folder of cases (meshes or NRRD/NIfTI masks)")
         ->required();
+    add_fit_option(cmd, o->params);
     out.push_back(
         {cmd, [o, &json] {
            namespace fs = std::filesystem;
@@ -369,7 +380,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
              if (files.first.empty() || files.second.empty()) continue;
              const auto t0 = std::chrono::steady_clock::now();
              const SkullMesh skull = load_skull(files.first).mesh;
-             const AutoplanResult r = autoplan(skull, Landmarks{}, AutoplanParams{});
+             const AutoplanResult r = autoplan(skull, Landmarks{}, o->params);
              const double seconds =
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
              Json row{{"case", id},
@@ -415,6 +426,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
       std::string skull;
       int count = 10;
       double min_size = 30.0, max_size = 50.0;
+      AutoplanParams params;
     };
     auto o = std::make_shared<Opts>();
     auto* cmd = app.add_subcommand(
@@ -426,6 +438,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
         ->check(CLI::PositiveNumber);
     cmd->add_option("--max-size", o->max_size, "largest sphere diameter (mm)")
         ->check(CLI::PositiveNumber);
+    add_fit_option(cmd, o->params);
     out.push_back(
         {cmd, [o, &json] {
            const SkullMesh skull = load_skull(o->skull).mesh;
@@ -454,7 +467,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
              ip.voxel_mm = 0.5;
              const InjectDefectResult d = inject_defect(skull, ip);
              if (!d.usable()) continue;
-             const AutoplanResult r = autoplan(d.defective, Landmarks{});
+             const AutoplanResult r = autoplan(d.defective, Landmarks{}, o->params);
              Json row{
                  {"center", to_json(ip.center)}, {"size_mm", ip.size_mm}, {"message", r.message}};
              if (r.planned()) {

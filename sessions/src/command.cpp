@@ -137,6 +137,7 @@ void implant_fields(V& v, P& p) {
   v("snap_rim_to_skull", p.snap_rim_to_skull);
   v("surface_smoothing", p.surface_smoothing);
   v("max_rim_snap_mm", p.max_rim_snap_mm);
+  v("fit_to_bone_mm", p.fit_to_bone_mm);
   v("delaunay_alpha", p.delaunay_alpha);
   v("delaunay_tolerance", p.delaunay_tolerance);
   v("delaunay_offset", p.delaunay_offset);

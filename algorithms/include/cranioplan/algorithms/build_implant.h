@@ -29,6 +29,10 @@ struct ImplantParams {
   /// met exactly. Automatic plans use a little, to ride over noise in sampled bone.
   double surface_smoothing = 0.0;
   double max_rim_snap_mm = 3.0;  ///< rim points farther than this from bone stay where they are
+  /// Fit to the bone: the shell is built this far beyond the rim (over the bone, mm), then the
+  /// skull is subtracted (trim_to_bone.h), so the implant meets the defect's cut face all
+  /// around and never enters the bone. 0: off (the rims pass through the edge markers).
+  double fit_to_bone_mm = 0.0;
   /// Radial needs a skull (its centroid is the centre) or `radial_center`; otherwise planar.
   ImplantFrame frame = ImplantFrame::Radial;
   std::optional<Eigen::Vector3d> radial_center;  ///< centre of the rays (inside the skull)

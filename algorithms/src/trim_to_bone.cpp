@@ -1,0 +1,176 @@
+#include "cranioplan/algorithms/trim_to_bone.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <vector>
+
+#include "cranioplan/algorithms/extract_bone_surface.h"
+#include "cranioplan/algorithms/surface_locator.h"
+#include "cranioplan/algorithms/voxelize_mesh.h"
+
+namespace cranioplan {
+
+namespace {
+
+using Mask = std::vector<uint8_t>;
+
+// One step of 6-neighbour erosion (grow = false) or dilation (grow = true).
+Mask morph(const Mask& in, const VoxelGrid& g, bool grow) {
+  Mask out(in.size(), 0);
+  const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const size_t c = g.index(i, j, k);
+        auto at = [&](int a, int b, int d) -> uint8_t {
+          if (a < 0 || b < 0 || d < 0 || a >= nx || b >= ny || d >= nz) return 0;
+          return in[g.index(a, b, d)];
+        };
+        const int n = at(i - 1, j, k) + at(i + 1, j, k) + at(i, j - 1, k) + at(i, j + 1, k) +
+                      at(i, j, k - 1) + at(i, j, k + 1);
+        out[c] = grow ? (in[c] || n > 0) : (in[c] && n == 6);
+      }
+  return out;
+}
+
+// Keeps the largest 6-connected piece.
+Mask largest_piece(const Mask& in, const VoxelGrid& g) {
+  std::vector<int> label(in.size(), 0);
+  std::vector<size_t> sizes{0};
+  std::vector<size_t> stack;
+  const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
+  for (size_t seed = 0; seed < in.size(); ++seed) {
+    if (!in[seed] || label[seed]) continue;
+    const int id = static_cast<int>(sizes.size());
+    sizes.push_back(0);
+    stack.push_back(seed);
+    label[seed] = id;
+    while (!stack.empty()) {
+      const size_t c = stack.back();
+      stack.pop_back();
+      ++sizes[id];
+      const int i = static_cast<int>(c % nx), j = static_cast<int>((c / nx) % ny),
+                k = static_cast<int>(c / (static_cast<size_t>(nx) * ny));
+      const int nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k},
+                            {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
+      for (const auto& n : nb) {
+        if (n[0] < 0 || n[1] < 0 || n[2] < 0 || n[0] >= nx || n[1] >= ny || n[2] >= nz) continue;
+        const size_t d = g.index(n[0], n[1], n[2]);
+        if (in[d] && !label[d]) {
+          label[d] = id;
+          stack.push_back(d);
+        }
+      }
+    }
+  }
+  const int best = static_cast<int>(std::max_element(sizes.begin(), sizes.end()) - sizes.begin());
+  Mask out(in.size(), 0);
+  for (size_t c = 0; c < in.size(); ++c) out[c] = best > 0 && label[c] == best;
+  return out;
+}
+
+// Separable Gaussian blur of a 0/1 mask along the three axes.
+std::vector<float> blur(const Mask& in, const VoxelGrid& g, double sigma_voxels) {
+  std::vector<float> a(in.begin(), in.end());
+  if (sigma_voxels <= 0.05) return a;
+  const int r = std::max(1, static_cast<int>(std::ceil(2.5 * sigma_voxels)));
+  std::vector<float> w(2 * r + 1);
+  float sum = 0;
+  for (int t = -r; t <= r; ++t)
+    sum += w[t + r] = std::exp(-0.5f * t * t / (sigma_voxels * sigma_voxels));
+  for (auto& x : w) x /= sum;
+  std::vector<float> b(a.size());
+  const int dims[3] = {g.dims[0], g.dims[1], g.dims[2]};
+  const size_t stride[3] = {1, static_cast<size_t>(dims[0]),
+                            static_cast<size_t>(dims[0]) * dims[1]};
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int k = 0; k < dims[2]; ++k)
+      for (int j = 0; j < dims[1]; ++j)
+        for (int i = 0; i < dims[0]; ++i) {
+          const int pos[3] = {i, j, k};
+          const size_t c = g.index(i, j, k);
+          float v = 0;
+          for (int t = -r; t <= r; ++t) {
+            const int q = pos[axis] + t;
+            if (q < 0 || q >= dims[axis]) continue;
+            v += w[t + r] *
+                 a[c + static_cast<std::ptrdiff_t>(t) * static_cast<std::ptrdiff_t>(stride[axis])];
+          }
+          b[c] = v;
+        }
+    a.swap(b);
+  }
+  return a;
+}
+
+}  // namespace
+
+TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
+                              const TrimToBoneParams& params, const SurfaceLocator* skull_locator) {
+  const auto t0 = std::chrono::steady_clock::now();
+  TrimToBoneResult result;
+  const double h = std::clamp(params.voxel_mm, 0.1, 1.0);
+  const auto [lo, hi] = mesh_bounds(implant);
+  const VoxelGrid grid = VoxelGrid::covering(lo, hi, h, 4);
+  Mask mask = voxelize_mesh(implant, grid);
+  const Mask bone = voxelize_mesh(skull, grid);
+  size_t before = 0;
+  for (size_t c = 0; c < mask.size(); ++c) {
+    before += mask[c];
+    mask[c] = mask[c] && !bone[c];
+  }
+  // Opening: slivers thinner than the feature size (left on top of intact bone) disappear.
+  const int steps = static_cast<int>(std::lround(params.min_feature_mm / (2.0 * h)));
+  for (int s = 0; s < steps; ++s) mask = morph(mask, grid, false);
+  for (int s = 0; s < steps; ++s) mask = morph(mask, grid, true);
+  // The opening must not give back bone.
+  for (size_t c = 0; c < mask.size(); ++c) mask[c] = mask[c] && !bone[c];
+  mask = largest_piece(mask, grid);
+  size_t after = 0;
+  for (uint8_t m : mask) after += m;
+  result.removed_mm3 = static_cast<double>(before - std::min(before, after)) * grid.voxel_volume();
+  result.volume_mm3 = static_cast<double>(after) * grid.voxel_volume();
+  if (after == 0) {
+    result.message = "nothing of the implant lies outside the bone";
+    result.mesh = implant;
+    return result;
+  }
+  Volume volume = mask_volume(mask, grid);
+  std::vector<float> smooth = blur(mask, grid, params.smoothing_mm / h);
+  // Smoothing must not carry the surface into the bone: bone voxels stay outside.
+  for (size_t c = 0; c < smooth.size(); ++c)
+    if (bone[c]) smooth[c] = 0.0f;
+  volume.data.assign(smooth.begin(), smooth.end());
+  ExtractBoneSurfaceParams surface;
+  surface.threshold = 0.5;
+  surface.largest_piece_only = true;
+  ExtractBoneSurfaceResult s = extract_bone_surface(volume, surface);
+  if (!s.usable()) {
+    result.message = s.message;
+    result.mesh = implant;
+    return result;
+  }
+  result.mesh = std::move(s.mesh);
+  // The grid places the cut surface within half a voxel of the bone, on either side: vertices
+  // inside the bone go back onto its surface (a little outside), so nothing enters the bone.
+  std::unique_ptr<SurfaceLocator> own;
+  if (!skull_locator) own = std::make_unique<SurfaceLocator>(skull);
+  const SurfaceLocator& locator = skull_locator ? *skull_locator : *own;
+  for (auto vh : result.mesh.vertices()) {
+    const Eigen::Vector3d p = to_eigen(result.mesh.point(vh));
+    const auto c = locator.closest(p);
+    if (c.distance > h) continue;
+    const Eigen::Vector3d n = locator.face_normal(c.face);
+    if ((p - c.point).dot(n) < params.clearance_mm) {
+      const Eigen::Vector3d q = c.point + params.clearance_mm * n;
+      result.mesh.set_point(vh, {q.x(), q.y(), q.z()});
+    }
+  }
+  result.status = TrimToBoneResult::Status::Trimmed;
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return result;
+}
+
+}  // namespace cranioplan

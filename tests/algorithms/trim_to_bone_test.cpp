@@ -1,0 +1,71 @@
+#include "cranioplan/algorithms/trim_to_bone.h"
+
+#include <gtest/gtest.h>
+
+#include "cranioplan/algorithms/check_implant.h"
+#include "cranioplan/algorithms/mesh_report.h"
+#include "cranioplan/algorithms/surface_locator.h"
+
+namespace cranioplan {
+namespace {
+
+// A closed, outward-oriented axis-aligned box.
+TriangleSoup box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  TriangleSoup s;
+  for (int c = 0; c < 8; ++c)
+    s.vertices.emplace_back(c & 1 ? hi.x() : lo.x(), c & 2 ? hi.y() : lo.y(),
+                            c & 4 ? hi.z() : lo.z());
+  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
+                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
+  for (const auto& q : quads) {
+    s.triangles.push_back({q[0], q[1], q[2]});
+    s.triangles.push_back({q[0], q[2], q[3]});
+  }
+  return s;
+}
+
+SkullMesh merge(const TriangleSoup& a, const TriangleSoup& b) {
+  TriangleSoup s = a;
+  const int n = static_cast<int>(s.vertices.size());
+  s.vertices.insert(s.vertices.end(), b.vertices.begin(), b.vertices.end());
+  for (auto t : b.triangles) s.triangles.push_back({t[0] + n, t[1] + n, t[2] + n});
+  return build_mesh(s);
+}
+
+// Bone: two plates 5 mm thick with a 10 mm wide gap (the defect) between them. The implant is
+// built 3 mm wider on both sides and 0.3 mm proud of the bone: trimmed, it fills the gap
+// exactly — flush with both cut faces, no overlap, and no sliver left on top of the bone.
+TEST(TrimToBone, FillsTheGapFlushWithTheCutFaces) {
+  const SkullMesh bone = merge(box({0, 0, 0}, {20, 20, 5}), box({30, 0, 0}, {50, 20, 5}));
+  const SkullMesh implant = build_mesh(box({17, 2, 0}, {33, 18, 5.3}));
+  const TrimToBoneResult r = trim_to_bone(implant, bone);
+  ASSERT_TRUE(r.usable()) << r.message;
+  EXPECT_TRUE(report_mesh(r.mesh).watertight);
+  EXPECT_GT(signed_volume(to_soup(r.mesh)), 0.0) << "outward";
+  // Truth: [20, 30] x [2, 18] x [0, 5.3] = 848 mm³.
+  EXPECT_NEAR(r.volume_mm3, 848.0, 0.05 * 848.0);
+  const auto [lo, hi] = [&] {
+    Eigen::Vector3d a = Eigen::Vector3d::Constant(1e9), b = -a;
+    for (auto vh : r.mesh.vertices()) {
+      a = a.cwiseMin(to_eigen(r.mesh.point(vh)));
+      b = b.cwiseMax(to_eigen(r.mesh.point(vh)));
+    }
+    return std::make_pair(a, b);
+  }();
+  EXPECT_NEAR(lo.x(), 20.0, 0.3) << "flush with the left cut face";
+  EXPECT_NEAR(hi.x(), 30.0, 0.3) << "flush with the right cut face";
+  const QualityReport q = check_implant(r.mesh, &bone);
+  EXPECT_LT(q.penetration_mm3, 1.0);
+}
+
+TEST(TrimToBone, AnImplantInsideTheBoneLeavesNothing) {
+  const SkullMesh bone = build_mesh(box({0, 0, 0}, {20, 20, 5}));
+  const SkullMesh implant = build_mesh(box({5, 5, 1}, {15, 15, 4}));
+  const TrimToBoneResult r = trim_to_bone(implant, bone);
+  EXPECT_EQ(r.status, TrimToBoneResult::Status::Empty);
+  EXPECT_FALSE(r.message.empty());
+  EXPECT_EQ(r.mesh.n_faces(), implant.n_faces()) << "the input is returned untouched";
+}
+
+}  // namespace
+}  // namespace cranioplan
