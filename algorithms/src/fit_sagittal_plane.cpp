@@ -183,13 +183,27 @@ Plane automatic_initial_plane(const SkullMesh& mesh) {
   const SurfaceSamples probe = subsample(all, 1500);
   Plane best = Plane::through(centroid, candidates[0]);
   double best_score = std::numeric_limits<double>::infinity();
+  // Each candidate's offset is searched too: a defect on one side moves the centroid off the
+  // midsagittal plane (by a millimetre or more), and a plane through it mirrors everything twice
+  // that far off — enough for a wrong axis to score better.
+  auto score = [&](const Eigen::Vector3d& n, double offset) {
+    return measure_symmetry(probe, index, all.normals, Plane{n, offset}, 1e9, 1.0).median_distance;
+  };
   for (const auto& n : candidates) {
-    const Plane plane = Plane::through(centroid, n);
-    const double score =
-        measure_symmetry(probe, index, all.normals, plane, 1e9, 1.0).median_distance;
-    if (score < best_score) {
-      best_score = score;
-      best = plane;
+    const double d0 = n.dot(centroid);
+    double best_d = d0, best_s = score(n, d0);
+    for (double step : {2.0, 0.5}) {
+      const double centre = best_d;
+      for (int k = -6; k <= 6; ++k) {
+        if (k == 0) continue;
+        const double d = centre + k * step;
+        const double sc = score(n, d);
+        if (sc < best_s) best_s = sc, best_d = d;
+      }
+    }
+    if (best_s < best_score) {
+      best_score = best_s;
+      best = Plane{n, best_d};
     }
   }
   // Orient the normal along the positive coordinate axis it is closest to, for stable output.

@@ -4,6 +4,8 @@
 
 #include <random>
 
+#include "cranioplan/algorithms/read_mesh.h"
+#include "support/session_cases.h"
 #include "support/synthetic.h"
 
 namespace cranioplan {
@@ -91,6 +93,25 @@ TEST(FitSagittalPlane, FailsWithAStatusWhenThereIsNothingToFit) {
   const PlaneFit fit = fit_sagittal_plane(SkullMesh{}, Landmarks{});
   EXPECT_FALSE(fit.usable());
   EXPECT_FALSE(fit.message.empty());
+}
+
+}  // namespace
+}  // namespace cranioplan
+
+namespace cranioplan {
+namespace {
+
+// A thick skull with a 45 mm defect on one side: the defect moves the centroid off the
+// midsagittal plane, and a candidate plane through the centroid once lost to a wrong axis
+// (the planner then mirrored across a near-horizontal plane). Offsets are searched now.
+TEST(FitSagittalPlane, AutomaticOnAThickSkullWithAOneSidedDefect) {
+  const SkullMesh skull = read_mesh(test::defect_skull_stl()).mesh;
+  const Plane initial = automatic_initial_plane(skull);
+  EXPECT_LT(initial.angle_to_deg(Plane{Eigen::Vector3d::UnitX(), 0.0}), 1.0);
+  const PlaneFit fit = fit_sagittal_plane(skull, Landmarks{});
+  ASSERT_TRUE(fit.usable()) << fit.message;
+  EXPECT_LT(fit.plane.angle_to_deg(Plane{Eigen::Vector3d::UnitX(), 0.0}), 0.5);
+  EXPECT_LT(std::abs(fit.plane.signed_distance(Eigen::Vector3d::Zero())), 0.5);
 }
 
 }  // namespace
