@@ -442,7 +442,13 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
   TriangleSoup soup;
   auto build_cap = [&](const std::vector<Eigen::Vector3d>& rim, const Height* tps,
                        bool offset_from_outer) {
-    const PolarPolygon poly = rim_polygon(rim, offset_from_outer ? &outer_height : tps);
+    // The rim's correction is measured from the surface the cap would have without it: for an
+    // inner surface set in from the outer one, that is the outer height less the offset (not
+    // the outer height, which counted the offset twice at the rim).
+    const Height offset_height = [&](const Eigen::Vector2d& q) {
+      return f.h(Eigen::Vector3d(f.lift(q, outer_tps(q)) - offset(q) * outer_normal(q)));
+    };
+    const PolarPolygon poly = rim_polygon(rim, offset_from_outer ? &offset_height : tps);
     auto surface_point = [&](const Eigen::Vector2d& q, double correction) {
       if (!offset_from_outer) return f.lift(q, (*tps)(q) + correction);
       return Eigen::Vector3d(f.lift(q, outer_tps(q) + correction) - offset(q) * outer_normal(q));
