@@ -477,6 +477,28 @@ int marker_near(SkullView& view, const std::vector<Marker>& markers, const QPoin
 
 }  // namespace
 
+void SkullView::forward_button(QMouseEvent* e, bool press) {
+  Impl& d = *d_;
+  const QPoint pos = e->position().toPoint();
+  d.interactor->SetEventInformationFlipY(d.display_x(pos), static_cast<int>(pos.y() * d.dpr),
+                                         e->modifiers() & Qt::ControlModifier,
+                                         e->modifiers() & Qt::ShiftModifier);
+  vtkGenericRenderWindowInteractor* i = d.interactor;
+  switch (e->button()) {
+    case Qt::LeftButton:
+      press ? i->LeftButtonPressEvent() : i->LeftButtonReleaseEvent();
+      break;
+    case Qt::RightButton:
+      press ? i->RightButtonPressEvent() : i->RightButtonReleaseEvent();
+      break;
+    case Qt::MiddleButton:
+      press ? i->MiddleButtonPressEvent() : i->MiddleButtonReleaseEvent();
+      break;
+    default:
+      break;
+  }
+}
+
 void SkullView::mousePressEvent(QMouseEvent* e) {
   Impl& d = *d_;
   const QPoint pos = e->position().toPoint();
@@ -489,22 +511,7 @@ void SkullView::mousePressEvent(QMouseEvent* e) {
       return;
     }
   }
-  d.interactor->SetEventInformationFlipY(d.display_x(pos), static_cast<int>(pos.y() * d.dpr),
-                                         e->modifiers() & Qt::ControlModifier,
-                                         e->modifiers() & Qt::ShiftModifier);
-  switch (e->button()) {
-    case Qt::LeftButton:
-      d.interactor->LeftButtonPressEvent();
-      break;
-    case Qt::RightButton:
-      d.interactor->RightButtonPressEvent();
-      break;
-    case Qt::MiddleButton:
-      d.interactor->MiddleButtonPressEvent();
-      break;
-    default:
-      break;
-  }
+  forward_button(e, true);
 }
 
 void SkullView::mouseMoveEvent(QMouseEvent* e) {
@@ -542,22 +549,7 @@ void SkullView::mouseReleaseEvent(QMouseEvent* e) {
       emit markerClicked(id);
     return;
   }
-  d.interactor->SetEventInformationFlipY(d.display_x(pos), static_cast<int>(pos.y() * d.dpr),
-                                         e->modifiers() & Qt::ControlModifier,
-                                         e->modifiers() & Qt::ShiftModifier);
-  switch (e->button()) {
-    case Qt::LeftButton:
-      d.interactor->LeftButtonReleaseEvent();
-      break;
-    case Qt::RightButton:
-      d.interactor->RightButtonReleaseEvent();
-      break;
-    case Qt::MiddleButton:
-      d.interactor->MiddleButtonReleaseEvent();
-      break;
-    default:
-      break;
-  }
+  forward_button(e, false);
   if (e->button() != Qt::LeftButton || d.moved) return;
   if (const int id = marker_near(*this, d.markers, pos)) {
     set_selected_marker(id);

@@ -64,6 +64,9 @@ class SkullView : public QOpenGLWidget {
   void wheelEvent(QWheelEvent* event) override;
 
  private:
+  /// A press or release of a mouse button, handed to VTK's interactor (camera control).
+  void forward_button(QMouseEvent* event, bool press);
+
   struct Impl;
   std::unique_ptr<Impl> d_;
 };

@@ -8,15 +8,8 @@
 namespace cranioplan {
 namespace {
 
-// A closed axis-aligned box, outward-oriented.
 SkullMesh box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
-  TriangleSoup s;
-  for (int i = 0; i < 8; ++i)
-    s.vertices.emplace_back(i & 1 ? hi.x() : lo.x(), i & 2 ? hi.y() : lo.y(),
-                            i & 4 ? hi.z() : lo.z());
-  s.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
-                 {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
-  return build_mesh(s);
+  return build_mesh(test::box_soup(lo, hi));
 }
 
 TEST(SelfIntersections, CrossingTrianglesAreCountedAndAClosedSurfaceHasNone) {

@@ -5,23 +5,13 @@
 #include "cranioplan/algorithms/check_implant.h"
 #include "cranioplan/algorithms/mesh_report.h"
 #include "cranioplan/algorithms/surface_locator.h"
+#include "support/synthetic.h"
 
 namespace cranioplan {
 namespace {
 
-// A closed, outward-oriented axis-aligned box.
 TriangleSoup box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
-  TriangleSoup s;
-  for (int c = 0; c < 8; ++c)
-    s.vertices.emplace_back(c & 1 ? hi.x() : lo.x(), c & 2 ? hi.y() : lo.y(),
-                            c & 4 ? hi.z() : lo.z());
-  const int quads[6][4] = {{0, 2, 3, 1}, {4, 5, 7, 6}, {0, 1, 5, 4},
-                           {2, 6, 7, 3}, {0, 4, 6, 2}, {1, 3, 7, 5}};
-  for (const auto& q : quads) {
-    s.triangles.push_back({q[0], q[1], q[2]});
-    s.triangles.push_back({q[0], q[2], q[3]});
-  }
-  return s;
+  return test::box_soup(lo, hi);
 }
 
 SkullMesh merge(const TriangleSoup& a, const TriangleSoup& b) {

@@ -18,6 +18,9 @@ SkullMesh make_symmetric_head(int subdivisions = 5);
 /// Landmarks of make_symmetric_head(): nasion on the midline, orbit centres mirrored.
 Landmarks head_landmarks();
 
+/// A closed, outward-oriented axis-aligned box as a triangle soup (12 triangles).
+TriangleSoup box_soup(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
+
 /// Removes every face whose centroid lies within `radius` of `center`.
 SkullMesh cut_hole(const SkullMesh& mesh, const Eigen::Vector3d& center, double radius);
 
