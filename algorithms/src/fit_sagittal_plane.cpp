@@ -180,7 +180,7 @@ Plane automatic_initial_plane(const SkullMesh& mesh) {
   for (int k = 0; k < 3; ++k) candidates.push_back(Eigen::Vector3d::Unit(k));
 
   const PointIndex index(all.points);
-  const SurfaceSamples probe = subsample(all, 1500);
+  const SurfaceSamples probe = subsample(all, 600);  // 6 axes x 25 offsets are scored
   Plane best = Plane::through(centroid, candidates[0]);
   double best_score = std::numeric_limits<double>::infinity();
   // Each candidate's offset is searched too: a defect on one side moves the centroid off the
