@@ -32,6 +32,14 @@ int main(int argc, char** argv) {
   cranioplan::gui::MainWindow window;
   const bool automated = parser.isSet(quit);
   window.set_interactive(!automated);
+  // Bad input is reported on stderr too (the window shows it in the status bar), and an
+  // automated run that met one exits with 3, like cranioplan-cli.
+  bool failed = false;
+  QObject::connect(&window.controller(), &cranioplan::gui::PlanController::failed,
+                   [&failed](const QString& message) {
+                     failed = true;
+                     std::fprintf(stderr, "cranioplan: %s\n", message.toLocal8Bit().constData());
+                   });
   window.show();
 
   const QStringList files = parser.positionalArguments();
@@ -64,14 +72,14 @@ int main(int argc, char** argv) {
   }
   if (parser.isSet(screenshot)) {
     const QString out = parser.value(screenshot);
-    QTimer::singleShot(300, &window, [&window, out, automated] {
+    QTimer::singleShot(300, &window, [&window, out, automated, ok, &failed] {
       const bool saved = window.screenshot().save(out);
       std::fprintf(saved ? stdout : stderr, "%s %s\n", saved ? "wrote" : "cannot write",
                    out.toLocal8Bit().constData());
-      if (automated) QApplication::exit(saved ? 0 : 3);
+      if (automated) QApplication::exit(saved && ok && !failed ? 0 : 3);
     });
   } else if (automated) {
-    QTimer::singleShot(0, &app, [ok] { QApplication::exit(ok ? 0 : 3); });
+    QTimer::singleShot(0, &app, [ok, &failed] { QApplication::exit(ok && !failed ? 0 : 3); });
   }
   return app.exec();
 }

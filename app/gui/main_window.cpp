@@ -990,8 +990,7 @@ bool MainWindow::open_session(const QString& path) {
     return true;
   } catch (const Error& e) {
     QApplication::restoreOverrideCursor();
-    show_message(QString::fromUtf8(e.what()), true);
-    if (interactive_) QMessageBox::warning(this, tr("Cannot open the plan"), e.what());
+    emit controller_->failed(QString::fromUtf8(e.what()));
     return false;
   }
 }
@@ -1080,8 +1079,7 @@ void MainWindow::open_audit(const QString& path) {
     refresh();
   } catch (const Error& e) {
     QApplication::restoreOverrideCursor();
-    show_message(QString::fromUtf8(e.what()), true);
-    if (interactive_) QMessageBox::warning(this, tr("Cannot audit the plan"), e.what());
+    emit controller_->failed(QString::fromUtf8(e.what()));
   }
 }
 

@@ -291,6 +291,14 @@ TEST_F(Wizard, CommandLineScreenshotOfASessionAtAStep) {
   ASSERT_TRUE(image.load(QString::fromStdString(png)));
   EXPECT_GT(image.width(), 800);
   EXPECT_FALSE(fs::exists(session + ".autosave")) << "a screenshot writes nothing beside the plan";
+
+  // Bad input: named in the window and on stderr, exit 3, no crash.
+  const std::string bad = tmp.path("bad.stl");
+  test::write_bytes(bad, "garbage");
+  EXPECT_EQ(test::run_command(std::string(CRANIOPLAN_GUI) + " " + bad + " --screenshot " +
+                                  tmp.path("bad.png") + " --quit",
+                              &out),
+            3);
 }
 
 }  // namespace
