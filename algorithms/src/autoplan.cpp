@@ -53,6 +53,17 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
     return r;
   }
 
+  if (params.local_registration_mm > 0.0 && r.registration.usable()) {
+    RegisterParams local = params.registration;
+    local.initial = r.registration.transform;
+    local.roi = local_registration_region(r.defect, params.local_registration_mm);
+    const RegisterResult lr = register_icp(mirrored, skull, local);
+    if (lr.usable()) {
+      r.registration = lr;
+      r.mirrored = transform_mesh(mirrored, lr.transform);
+    }
+    timer.stage("local register");
+  }
   const SurfaceLocator mirror(r.mirrored);
   MarkerProposal proposal = propose_markers_for_defect(r.defect, mirror, params.propose);
   r.mirror_coverage = proposal.mirror_coverage;

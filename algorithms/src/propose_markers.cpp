@@ -67,6 +67,19 @@ DefectRegion detect_defect_near_plane(const SkullMesh& skull, const SurfaceLocat
   return detect_defect(skull, bone, plane.project(centroid), params);
 }
 
+RegionOfInterest local_registration_region(const DefectRegion& defect, double margin_mm) {
+  RegionOfInterest roi;
+  roi.shape = RegionOfInterest::Shape::Sphere;
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const auto& p : defect.outer_rim) c += p;
+  if (!defect.outer_rim.empty()) c /= static_cast<double>(defect.outer_rim.size());
+  double r = 0.0;
+  for (const auto& p : defect.outer_rim) r = std::max(r, (p - c).norm());
+  roi.center = c;
+  roi.radius = r + margin_mm;
+  return roi;
+}
+
 MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const SurfaceLocator& mirror,
                                           const ProposeParams& params, int first_id) {
   MarkerProposal r;

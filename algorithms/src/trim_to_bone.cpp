@@ -3,11 +3,9 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <memory>
 #include <vector>
 
 #include "cranioplan/algorithms/extract_bone_surface.h"
-#include "cranioplan/algorithms/surface_locator.h"
 #include "cranioplan/algorithms/voxelize_mesh.h"
 
 namespace cranioplan {
@@ -108,7 +106,7 @@ std::vector<float> blur(const Mask& in, const VoxelGrid& g, double sigma_voxels)
 }  // namespace
 
 TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
-                              const TrimToBoneParams& params, const SurfaceLocator* skull_locator) {
+                              const TrimToBoneParams& params) {
   const auto t0 = std::chrono::steady_clock::now();
   TrimToBoneResult result;
   const double h = std::clamp(params.voxel_mm, 0.1, 1.0);
@@ -139,9 +137,11 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
   }
   Volume volume = mask_volume(mask, grid);
   std::vector<float> smooth = blur(mask, grid, params.smoothing_mm / h);
-  // Smoothing must not carry the surface into the bone: bone voxels stay outside.
+  // Neither the grid nor the smoothing may carry the surface into the bone: the bone grown by
+  // one voxel stays outside (the surface then lies a fraction of a voxel off the bone).
+  const Mask keep_out = morph(bone, grid, true);
   for (size_t c = 0; c < smooth.size(); ++c)
-    if (bone[c]) smooth[c] = 0.0f;
+    if (keep_out[c]) smooth[c] = 0.0f;
   volume.data.assign(smooth.begin(), smooth.end());
   ExtractBoneSurfaceParams surface;
   surface.threshold = 0.5;
@@ -153,21 +153,6 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
     return result;
   }
   result.mesh = std::move(s.mesh);
-  // The grid places the cut surface within half a voxel of the bone, on either side: vertices
-  // inside the bone go back onto its surface (a little outside), so nothing enters the bone.
-  std::unique_ptr<SurfaceLocator> own;
-  if (!skull_locator) own = std::make_unique<SurfaceLocator>(skull);
-  const SurfaceLocator& locator = skull_locator ? *skull_locator : *own;
-  for (auto vh : result.mesh.vertices()) {
-    const Eigen::Vector3d p = to_eigen(result.mesh.point(vh));
-    const auto c = locator.closest(p);
-    if (c.distance > h) continue;
-    const Eigen::Vector3d n = locator.face_normal(c.face);
-    if ((p - c.point).dot(n) < params.clearance_mm) {
-      const Eigen::Vector3d q = c.point + params.clearance_mm * n;
-      result.mesh.set_point(vh, {q.x(), q.y(), q.z()});
-    }
-  }
   result.status = TrimToBoneResult::Status::Trimmed;
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;

@@ -85,6 +85,10 @@ void add_fit_option(CLI::App* cmd, AutoplanParams& params) {
                   "build the implant this far over the bone and subtract the skull (mm; 0: off)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 10.0));
+  cmd->add_option("--local-registration", params.local_registration_mm,
+                  "register the mirror again within this margin of the opening (mm; 0: off)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 200.0));
 }
 
 // autoplan --session: the plan made by session commands, saved for reopening and audit.

@@ -2,6 +2,8 @@
 
 #include <filesystem>
 
+#include "cranioplan/algorithms/propose_markers.h"
+
 namespace cranioplan {
 
 AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks& landmarks,
@@ -31,6 +33,20 @@ AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks&
   if (!s.state().plane) return stop("midsagittal plane: " + s.state().message);
   run(commands::mirror());
   run(commands::register_mirror(params.registration));
+  // Registered again around the opening, as autoplan() does: the region is found here and
+  // recorded as the command's parameter, so replay needs no detection.
+  if (params.local_registration_mm > 0.0 && s.state().registration &&
+      s.state().registration->usable()) {
+    const PlanState& st = s.state();
+    const DefectRegion defect = detect_defect_near_plane(
+        st.skull->surface->mesh, st.skull->surface->locator, *st.plane, params.propose.detect);
+    if (defect.found()) {
+      RegisterParams local = params.registration;
+      local.initial = st.registration->transform;
+      local.roi = local_registration_region(defect, params.local_registration_mm);
+      run(commands::register_mirror(local));
+    }
+  }
   // An unusable registration leaves the mirror where mirroring put it, as autoplan() does.
   if (!step_complete(s.state(), 3)) run(commands::complete_step(3));
   run(commands::complete_step(4));

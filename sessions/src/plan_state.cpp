@@ -226,8 +226,16 @@ void update_mirrored(PlanState& s, const std::string& why) {
     }
 }
 
-void run_registration(PlanState& s) {
-  s.registration = register_icp(*s.mirror_base, s.skull->surface->mesh, *s.register_params);
+// Registers the mirror with `s.register_params`; false when the attempt failed and the previous
+// (working) registration was kept.
+bool run_registration(PlanState& s) {
+  RegisterResult result = register_icp(*s.mirror_base, s.skull->surface->mesh, *s.register_params);
+  if (!result.usable() && s.registration && s.registration->usable()) {
+    // A failed attempt does not throw away a working registration.
+    s.message = "registration failed: " + result.message + "; the previous registration is kept";
+    return false;
+  }
+  s.registration = std::move(result);
   s.manual = RigidTransform{};
   char buf[200];
   if (s.registration->usable())
@@ -238,6 +246,7 @@ void run_registration(PlanState& s) {
   else
     std::snprintf(buf, sizeof(buf), "registration failed: %s", s.registration->message.c_str());
   s.message = buf;
+  return true;
 }
 
 void rebuild_implant(PlanState& s) {
@@ -420,8 +429,12 @@ void apply_register(PlanState& s, const ParamReader& r) {
   if (!s.mirror_base) throw Refusal{"mirror the skull before registering it"};
   RegisterParams params;
   params_from_json(ParamReader(r.value("params"), r.where() + " params"), params);
+  const std::optional<RegisterParams> previous = s.register_params;
   s.register_params = params;
-  run_registration(s);
+  if (!run_registration(s)) {
+    s.register_params = previous;
+    return;
+  }
   update_mirrored(s, "the mirror was registered again");
 }
 

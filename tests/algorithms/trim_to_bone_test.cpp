@@ -23,8 +23,8 @@ SkullMesh merge(const TriangleSoup& a, const TriangleSoup& b) {
 }
 
 // Bone: two plates 5 mm thick with a 10 mm wide gap (the defect) between them. The implant is
-// built 3 mm wider on both sides and 0.3 mm proud of the bone: trimmed, it fills the gap
-// exactly — flush with both cut faces, no overlap, and no sliver left on top of the bone.
+// built 3 mm wider on both sides and 0.3 mm proud of the bone: trimmed, it fills the gap —
+// against both cut faces, no overlap, and no sliver left on top of the bone.
 TEST(TrimToBone, FillsTheGapFlushWithTheCutFaces) {
   const SkullMesh bone = merge(box({0, 0, 0}, {20, 20, 5}), box({30, 0, 0}, {50, 20, 5}));
   const SkullMesh implant = build_mesh(box({17, 2, 0}, {33, 18, 5.3}));
@@ -42,10 +42,14 @@ TEST(TrimToBone, FillsTheGapFlushWithTheCutFaces) {
     }
     return std::make_pair(a, b);
   }();
-  EXPECT_NEAR(lo.x(), 20.0, 0.3) << "flush with the left cut face";
-  EXPECT_NEAR(hi.x(), 30.0, 0.3) << "flush with the right cut face";
+  // Against both cut faces, never into the bone, at most half a millimetre off it (the rim-gap
+  // target); the grid's alignment decides where in that range.
+  EXPECT_GE(lo.x(), 20.0);
+  EXPECT_LE(lo.x(), 20.5) << "against the left cut face";
+  EXPECT_LE(hi.x(), 30.0);
+  EXPECT_GE(hi.x(), 29.5) << "against the right cut face";
   const QualityReport q = check_implant(r.mesh, &bone);
-  EXPECT_LT(q.penetration_mm3, 1.0);
+  EXPECT_EQ(q.penetration_mm3, 0.0);
 }
 
 TEST(TrimToBone, AnImplantInsideTheBoneLeavesNothing) {

@@ -20,6 +20,10 @@ struct AutoplanParams {
   PlaneFitParams plane;
   RegisterParams registration;
   ProposeParams propose;  ///< defect detection and marker proposal
+  /// After the defect is found, the mirror is registered again on the bone within this margin
+  /// of the opening (mm; 0: off), so the healthy side fits the defect's surroundings rather than
+  /// the whole skull.
+  double local_registration_mm = 25.0;
   ImplantParams implant = [] {
     ImplantParams p;
     p.surface_smoothing = 0.003;

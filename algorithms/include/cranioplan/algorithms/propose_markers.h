@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cranioplan/algorithms/detect_defect.h"
+#include "cranioplan/algorithms/register_icp.h"
 #include "cranioplan/algorithms/smooth_markers.h"
 #include "cranioplan/model/marker.h"
 #include "cranioplan/model/plane.h"
@@ -43,6 +44,10 @@ struct MarkerProposal {
 /// The defect seen from the skull's centroid moved onto the midsagittal plane.
 DefectRegion detect_defect_near_plane(const SkullMesh& skull, const SurfaceLocator& bone,
                                       const Plane& plane, const DetectDefectParams& params);
+
+/// The region for registering the mirror locally: a sphere around the opening's rim reaching
+/// `margin_mm` beyond it.
+RegionOfInterest local_registration_region(const DefectRegion& defect, double margin_mm);
 
 /// Markers for an already detected defect; `mirror` is the registered mirrored skull.
 MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const SurfaceLocator& mirror,

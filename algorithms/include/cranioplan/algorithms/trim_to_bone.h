@@ -10,10 +10,9 @@
 namespace cranioplan {
 
 struct TrimToBoneParams {
-  double voxel_mm = 0.25;       ///< grid of the subtraction, mm (0.1..1)
-  double min_feature_mm = 1.0;  ///< parts thinner than this (slivers on the bone) go, mm (≥ 0)
-  double smoothing_mm = 0.3;    ///< Gaussian blur of the mask before meshing (σ), mm (≥ 0)
-  double clearance_mm = 0.03;   ///< vertices put back onto the bone stay this far out of it, mm
+  double voxel_mm = 0.25;        ///< grid of the subtraction, mm (0.1..1)
+  double min_feature_mm = 1.25;  ///< parts thinner than this (slivers on the bone) go, mm (≥ 0)
+  double smoothing_mm = 0.3;     ///< Gaussian blur of the mask before meshing (σ), mm (≥ 0)
 };
 
 struct TrimToBoneResult {
@@ -27,13 +26,9 @@ struct TrimToBoneResult {
   bool usable() const { return status == Status::Trimmed; }
 };
 
-class SurfaceLocator;
-
-/// `implant` and `skull` must be closed surfaces (the skull's bone as a solid). Vertices of the
-/// result that the voxel grid left inside the bone (up to half a voxel) are put back onto the
-/// bone's surface, using `skull_locator` when given (else one is built).
+/// `implant` and `skull` must be closed surfaces (the skull's bone as a solid). The result
+/// keeps clear of the bone by a fraction of a voxel.
 TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
-                              const TrimToBoneParams& params = {},
-                              const SurfaceLocator* skull_locator = nullptr);
+                              const TrimToBoneParams& params = {});
 
 }  // namespace cranioplan
