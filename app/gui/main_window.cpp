@@ -403,9 +403,23 @@ QWidget* MainWindow::make_page(int step) {
         push(commands::adjust_plane(axis, adjust_angle_->value(), adjust_shift_->value()),
              tr("Moving the plane"));
       });
+      // Sliders beside the fields, in half-degree and half-millimetre steps.
+      auto linked_slider = [box](QDoubleSpinBox* field) {
+        auto* slider = new QSlider(Qt::Horizontal, box);
+        slider->setRange(-40, 40);
+        QObject::connect(slider, &QSlider::valueChanged, field,
+                         [field](int v) { field->setValue(0.5 * v); });
+        QObject::connect(field, &QDoubleSpinBox::valueChanged, slider, [slider](double v) {
+          const QSignalBlocker block(slider);
+          slider->setValue(static_cast<int>(std::lround(2.0 * v)));
+        });
+        return slider;
+      };
       bl->addRow(tr("Turn about"), adjust_axis_);
       bl->addRow(tr("Angle"), adjust_angle_);
+      bl->addRow(QString(), linked_slider(adjust_angle_));
       bl->addRow(tr("Shift"), adjust_shift_);
+      bl->addRow(QString(), linked_slider(adjust_shift_));
       bl->addRow(apply);
       layout->addWidget(box);
       break;

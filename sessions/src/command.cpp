@@ -179,7 +179,10 @@ std::optional<CommandType> command_type_from_tag(const std::string& tag) {
   return std::nullopt;
 }
 
-int current_version(CommandType) { return 1; }
+int current_version(CommandType type) {
+  // build_implant 2: ImplantParams gained fit_to_bone_mm (version 1 means no fitting).
+  return type == CommandType::BuildImplant ? 2 : 1;
+}
 
 // ---------------------------------------------------------------------------------------------
 // ParamReader

@@ -583,9 +583,13 @@ void apply_smooth(PlanState& s, const ParamReader& r) {
   if (implant_message != buf) s.message = std::string(buf) + "; " + implant_message;
 }
 
-void apply_build(PlanState& s, const ParamReader& r) {
+void apply_build(PlanState& s, const ParamReader& r, int version) {
+  Json recorded = r.value("params");
+  // Version 1 (before fitting to the bone existed) built the shell without it.
+  if (version < 2 && recorded.is_object() && !recorded.contains("fit_to_bone_mm"))
+    recorded["fit_to_bone_mm"] = 0.0;
   ImplantParams params;
-  params_from_json(ParamReader(r.value("params"), r.where() + " params"), params);
+  params_from_json(ParamReader(recorded, r.where() + " params"), params);
   s.implant_params = params;
   unacknowledge(s, 8, "the implant was built again");
   rebuild_implant(s);
@@ -690,7 +694,7 @@ ApplyOutcome apply_command(const PlanState& before, const Command& command,
         apply_smooth(s, r);
         break;
       case CommandType::BuildImplant:
-        apply_build(s, r);
+        apply_build(s, r, command.version);
         break;
       case CommandType::ExportImplant:
         apply_export(s, r);

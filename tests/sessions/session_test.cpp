@@ -113,6 +113,18 @@ TEST(Commands, EveryTypeRoundTripsThroughJson) {
   EXPECT_TRUE(std::isnan(implant_back.thickness_mm));
 }
 
+// A build_implant of version 1 (written before fitting to the bone existed) still applies:
+// read as recorded, built without the fit.
+TEST(Commands, BuildImplantVersionOneIsReadByItsOwnRules) {
+  Json v1 = to_json(commands::build_implant());
+  EXPECT_EQ(v1["version"], 2);
+  v1["version"] = 1;
+  v1["params"]["params"].erase("fit_to_bone_mm");
+  const Command c = command_from_json(v1, "old plan");
+  EXPECT_EQ(c.version, 1);
+  EXPECT_EQ(to_json(c), v1) << "kept as recorded: the journal's hashes cover it";
+}
+
 TEST(Commands, UnknownTypeVersionAndMissingParameterAreNamed) {
   Json j = to_json(commands::smooth_markers({8, 2, 1}));
   Json unknown = j;
@@ -174,6 +186,22 @@ TEST(StepLock, LaterStepsAreRefusedWithWhatIsMissing) {
   std::string missing;
   EXPECT_FALSE(step_complete(m.state(), 5, &missing));
   EXPECT_NE(missing.find("inner edge markers: 1 placed"), std::string::npos) << missing;
+}
+
+TEST(Session, AVersionOneBuildIsAppliedWithoutFitting) {
+  Session s = session_at_markers();
+  add_rim(s);
+  for (double a : {0.5, 2.6, 4.7})
+    push_ok(s,
+            commands::add_marker(MarkerType::OuterSurface,
+                                 on_head(0.7 + 0.1 * std::cos(a), 0.1 + 0.1 * std::sin(a), 0.7)));
+  Json v1 = to_json(commands::build_implant());
+  v1["version"] = 1;
+  v1["params"]["params"].erase("fit_to_bone_mm");
+  const PushResult r = s.push(command_from_json(v1, "old plan"));
+  ASSERT_TRUE(r.accepted) << r.message;
+  ASSERT_TRUE(s.state().implant_params);
+  EXPECT_EQ(s.state().implant_params->fit_to_bone_mm, 0.0);
 }
 
 TEST(Session, MarkersSnapToTheirSurfaceAndKeepStableIds) {

@@ -51,7 +51,8 @@ const std::vector<CommandType>& all_command_types();
 /// The JSON tag, e.g. "load_skull".
 const char* type_tag(CommandType type);
 std::optional<CommandType> command_type_from_tag(const std::string& tag);
-/// The version this program writes for the type (1 for all types so far).
+/// The version this program writes for the type (build_implant: 2, the others: 1). Older
+/// versions are read as recorded (the journal's hashes cover them) and applied by their rules.
 int current_version(CommandType type);
 
 /// When, by whom and in which wizard step a command was done. Not part of what the command
