@@ -123,6 +123,11 @@ MainWindow::MainWindow(QWidget* parent)
     show_message(tr("Cancelled: the plan is unchanged."), false);
   });
 
+  quality_timer_ = new QTimer(this);
+  quality_timer_->setSingleShot(true);
+  quality_timer_->setInterval(400);
+  connect(quality_timer_, &QTimer::timeout, this, &MainWindow::show_quality);
+
   clock_ = new QTimer(this);
   connect(clock_, &QTimer::timeout, this, &MainWindow::update_timers);
   clock_->start(1000);
@@ -812,6 +817,17 @@ void MainWindow::refresh_quality() {
     if (export_report_) export_report_->setHtml(tr("<p>Build the implant first (step 7).</p>"));
     return;
   }
+  // The report (overlap on a fine grid, thickness, self-intersections) takes a few tenths of a
+  // second on a real skull: while markers are dragged it is computed once the implant has
+  // stopped changing, not for every rebuild.
+  quality_->setHtml(tr("<p>Checking the implant…</p>"));
+  if (export_report_) export_report_->setHtml(tr("<p>Checking the implant…</p>"));
+  quality_timer_->start();
+}
+
+void MainWindow::show_quality() {
+  const PlanState& s = controller_->state();
+  if (!s.implant) return;
   const QString html = quality_html(s.implant->quality());
   quality_->setHtml(html);
   if (export_report_) export_report_->setHtml(html);
@@ -920,12 +936,7 @@ void MainWindow::on_marker_dragged(int id, const Eigen::Vector3d& p) {
 Command MainWindow::clip_command() const {
   if (!clip_on_->isChecked()) return commands::clear_clip_plane();
   const PlanState& s = controller_->state();
-  Eigen::Vector3d center = Eigen::Vector3d::Zero();
-  if (s.skull) {
-    const SkullMesh& m = s.skull->surface->mesh;
-    for (auto vh : m.vertices()) center += to_eigen(m.point(vh));
-    center /= static_cast<double>(std::max<size_t>(1, m.n_vertices()));
-  }
+  const Eigen::Vector3d center = s.skull ? s.skull->centroid : Eigen::Vector3d::Zero();
   Eigen::Vector3d n = Eigen::Vector3d::Unit(clip_axis_->currentIndex());
   return commands::set_clip_plane(Plane::through(center + clip_position_->value() * n, n));
 }
@@ -1198,6 +1209,10 @@ void MainWindow::refresh_recent_menu() {
 }
 
 QImage MainWindow::screenshot() {
+  if (quality_timer_->isActive()) {  // a picture shows the report, not "Checking…"
+    quality_timer_->stop();
+    show_quality();
+  }
   view_->update();
   QApplication::processEvents();
   return grab().toImage();

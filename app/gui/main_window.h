@@ -75,6 +75,7 @@ class MainWindow : public QMainWindow {
   void refresh_steps();
   void refresh_history();
   void refresh_quality();
+  void show_quality();
   void refresh_page();
   void update_timers();
   void on_surface_clicked(const Eigen::Vector3d& point);
@@ -147,6 +148,7 @@ class MainWindow : public QMainWindow {
   QProgressBar* progress_ = nullptr;
   QPushButton* cancel_ = nullptr;
   QTimer* clock_ = nullptr;
+  QTimer* quality_timer_ = nullptr;
   QElapsedTimer total_timer_, step_timer_;
   int timed_step_ = 0;
 

@@ -344,6 +344,9 @@ void apply_load(PlanState& s, const ParamReader& r, const ApplyContext& ctx) {
   input->description = loaded.description;
   input->warnings = loaded.warnings;
   input->surface = std::make_shared<const SharedSurface>(std::move(loaded.mesh));
+  const SkullMesh& mesh = input->surface->mesh;
+  for (auto vh : mesh.vertices()) input->centroid += to_eigen(mesh.point(vh));
+  input->centroid /= static_cast<double>(std::max<size_t>(1, mesh.n_vertices()));
   PlanState fresh;
   fresh.notes = s.notes;
   fresh.skull = std::move(input);
@@ -392,13 +395,6 @@ void apply_fit_plane(PlanState& s, const ParamReader& r) {
   plane_changed(s);
 }
 
-Eigen::Vector3d skull_centroid(const PlanState& s) {
-  const SkullMesh& m = s.skull->surface->mesh;
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (auto vh : m.vertices()) c += to_eigen(m.point(vh));
-  return c / static_cast<double>(std::max<size_t>(1, m.n_vertices()));
-}
-
 void apply_adjust_plane(PlanState& s, const ParamReader& r) {
   if (!s.plane) throw Refusal{"there is no plane to adjust yet: fit it first"};
   const Eigen::Vector3d axis = r.vector3("axis");
@@ -407,7 +403,7 @@ void apply_adjust_plane(PlanState& s, const ParamReader& r) {
   if (!std::isfinite(angle) || !std::isfinite(shift))
     throw Refusal{"angle and shift must be numbers"};
   if (angle != 0.0 && axis.norm() < 1e-9) throw Refusal{"the rotation axis has no direction"};
-  const Eigen::Vector3d pivot = s.plane->project(skull_centroid(s));
+  const Eigen::Vector3d pivot = s.plane->project(s.skull->centroid);
   Eigen::Vector3d normal = s.plane->normal;
   if (angle != 0.0) normal = Eigen::AngleAxisd(angle * M_PI / 180.0, axis.normalized()) * normal;
   s.plane = Plane::through(pivot + shift * normal.normalized(), normal);

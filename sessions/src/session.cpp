@@ -290,6 +290,28 @@ std::optional<Autosave> read_autosave(const std::string& path) {
 
 std::string autosave_for(const std::string& session_path) { return session_path + ".autosave"; }
 
+// What the autosave beside `session_path` holds beyond the saved journal `saved`.
+RecoveryInfo recovery_beyond(const std::string& session_path,
+                             const std::vector<JournalEntry>& saved) {
+  RecoveryInfo info;
+  info.autosave_path = autosave_for(session_path);
+  const auto a = read_autosave(info.autosave_path);
+  if (!a || a->entries.size() <= saved.size()) return info;
+  for (size_t i = 0; i < saved.size(); ++i)
+    if (a->entries[i].hash != saved[i].hash) {
+      info.message = "the autosave belongs to a different version of this plan";
+      return info;
+    }
+  info.available = true;
+  info.extra_events = static_cast<int>(a->entries.size() - saved.size());
+  info.last_time = a->entries.back().time;
+  info.message = std::to_string(info.extra_events) +
+                 " change(s) made after the plan was last saved can be recovered (the last at " +
+                 info.last_time + ")";
+  if (!a->note.empty()) info.message += "; " + a->note;
+  return info;
+}
+
 }  // namespace
 
 // ---------------------------------------------------------------------------------------------
@@ -606,7 +628,7 @@ Session Session::open(const std::string& path, const OpenOptions& options) {
   std::vector<JournalEntry> journal = doc.journal;
   bool recovered = false;
   if (options.recover_autosave || options.attach_autosave) {
-    const RecoveryInfo info = recovery_info(path);
+    const RecoveryInfo info = recovery_beyond(path, doc.journal);
     if (info.available && options.recover_autosave) {
       journal = read_autosave(info.autosave_path)->entries;
       recovered = true;
@@ -639,27 +661,10 @@ Session Session::recover(const std::string& autosave_path) {
 }
 
 RecoveryInfo Session::recovery_info(const std::string& session_path) {
-  RecoveryInfo info;
-  info.autosave_path = autosave_for(session_path);
-  const auto a = read_autosave(info.autosave_path);
-  if (!a) return info;
-  std::vector<JournalEntry> saved;
   std::error_code ec;
-  if (fs::exists(session_path, ec)) saved = read_session_document(session_path).journal;
-  if (a->entries.size() <= saved.size()) return info;
-  for (size_t i = 0; i < saved.size(); ++i)
-    if (a->entries[i].hash != saved[i].hash) {
-      info.message = "the autosave belongs to a different version of this plan";
-      return info;
-    }
-  info.available = true;
-  info.extra_events = static_cast<int>(a->entries.size() - saved.size());
-  info.last_time = a->entries.back().time;
-  info.message = std::to_string(info.extra_events) +
-                 " change(s) made after the plan was last saved can be recovered (the last at " +
-                 info.last_time + ")";
-  if (!a->note.empty()) info.message += "; " + a->note;
-  return info;
+  return recovery_beyond(session_path, fs::exists(session_path, ec)
+                                           ? read_session_document(session_path).journal
+                                           : std::vector<JournalEntry>{});
 }
 
 }  // namespace cranioplan

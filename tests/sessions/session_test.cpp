@@ -448,6 +448,21 @@ TEST(SessionFile, AutosaveOffersRecoveryOfUnsavedCommands) {
   EXPECT_TRUE(recovered.can_redo());
 }
 
+TEST(SessionFile, DeclinedRecoveryKeepsTheUnsavedChangesBesideThePlan) {
+  Session s = session_at_markers();
+  s.set_autosave_path(test::scratch_path("declined.autosave"));
+  const std::string path = test::scratch_path("declined.json");
+  s.save(path);
+  push_ok(s, commands::note("unsaved"));
+  ASSERT_TRUE(Session::recovery_info(path).available);
+  OpenOptions keep_saved;
+  keep_saved.attach_autosave = true;  // the wizard, answering No
+  const Session reopened = Session::open(path, keep_saved);
+  EXPECT_TRUE(reopened.state().notes.empty());
+  EXPECT_TRUE(fs::exists(path + ".autosave.declined")) << "the declined changes are kept";
+  EXPECT_FALSE(Session::recovery_info(path).available);
+}
+
 // The crash test: a process that plans and autosaves is killed with SIGKILL at random
 // points; every command it reported finished is recovered.
 TEST(SessionFile, KillMinusNineLosesNoCompletedCommand) {

@@ -35,6 +35,7 @@ struct SkullInput {
   std::string description;
   std::vector<std::string> warnings;
   std::shared_ptr<const SharedSurface> surface;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< of the vertices, mm
 };
 
 /// The implant and what is derived from it; the quality report is computed on first use.
