@@ -65,11 +65,16 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
     timer.stage("local register");
   }
   const SurfaceLocator mirror(r.mirrored);
-  MarkerProposal proposal = propose_markers_for_defect(r.defect, mirror, params.propose);
+  MarkerProposal proposal = propose_markers_for_defect(r.defect, bone, mirror, params.propose);
   r.mirror_coverage = proposal.mirror_coverage;
   r.method_used = proposal.method_used;
+  r.surfaces_message = proposal.surfaces_message;
   r.markers = std::move(proposal.markers);
   timer.stage("markers");
+  if (!proposal.proposed()) {
+    r.message = "markers: " + proposal.message;
+    return r;
+  }
 
   ImplantParams implant = params.implant;
   implant.radial_center = r.defect.center;  // the rays that found the opening
@@ -83,11 +88,11 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
   timer.stage("quality");
   r.status = AutoplanResult::Status::Planned;
   char buf[200];
-  std::snprintf(buf, sizeof(buf), "%s; %s (mirror covers %.0f%% of the opening)",
+  std::snprintf(buf, sizeof(buf), "%s; %s (mirror covers %.0f%% of the opening); ",
                 r.defect.message.c_str(),
                 r.method_used == PlanMethod::Mirror ? "mirror-guided" : "rim-only fitting",
                 100.0 * r.mirror_coverage);
-  r.message = buf;
+  r.message = buf + r.surfaces_message;
   return r;
 }
 

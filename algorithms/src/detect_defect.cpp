@@ -11,7 +11,6 @@
 #include "cranioplan/algorithms/surface_locator.h"
 
 namespace cranioplan {
-namespace {
 
 std::vector<Eigen::Vector3d> fibonacci_sphere(int n) {
   std::vector<Eigen::Vector3d> d(n);
@@ -23,7 +22,20 @@ std::vector<Eigen::Vector3d> fibonacci_sphere(int n) {
   return d;
 }
 
-}  // namespace
+RayThroughBone cast_through_bone(const SurfaceLocator& locator, const Eigen::Vector3d& center,
+                                 const Eigen::Vector3d& dir, double reach,
+                                 double min_thickness_mm, double max_thickness_mm) {
+  RayThroughBone h;
+  const auto in = locator.first_hit(center, center + reach * dir);
+  if (!in) return h;
+  h.inner = in->point;
+  const auto out = locator.first_hit(center + reach * dir, center);
+  if (!out) return h;
+  h.outer = out->point;
+  const double t = (*h.outer - *h.inner).norm();
+  h.paired = t >= min_thickness_mm && t <= max_thickness_mm;
+  return h;
+}
 
 DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator,
                            const Eigen::Vector3d& center, const DetectDefectParams& params) {
@@ -37,28 +49,14 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
 
   const int n = std::clamp(params.directions, 2000, 200000);
   const std::vector<Eigen::Vector3d> dirs = fibonacci_sphere(n);
-  // One ray: the first bone from the centre (inner table) and from outside (outer table);
-  // `paired` when both are met no more than a plausible skull thickness apart.
-  struct RayHits {
-    std::optional<Eigen::Vector3d> inner, outer;
-    bool paired = false;
-  };
   auto cast = [&](const Eigen::Vector3d& d) {
-    RayHits h;
-    const auto in = locator.first_hit(center, center + reach * d);
-    if (!in) return h;
-    h.inner = in->point;
-    const auto out = locator.first_hit(center + reach * d, center);
-    if (!out) return h;
-    h.outer = out->point;
-    const double t = (*h.outer - *h.inner).norm();
-    h.paired = t >= params.min_thickness_mm && t <= params.max_thickness_mm;
-    return h;
+    return cast_through_bone(locator, center, d, reach, params.min_thickness_mm,
+                             params.max_thickness_mm);
   };
   std::vector<std::optional<Eigen::Vector3d>> inner(n), outer(n);
   std::vector<char> paired(n, 0);
   for (int i = 0; i < n; ++i) {
-    const RayHits h = cast(dirs[i]);
+    const RayThroughBone h = cast(dirs[i]);
     inner[i] = h.inner;
     outer[i] = h.outer;
     paired[i] = h.paired;
@@ -159,7 +157,7 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
         Eigen::Vector3d bone_dir = dirs[j], open_dir = dirs[open_nbr];
         for (int it = 0; it < 6; ++it) {
           const Eigen::Vector3d mid = (bone_dir + open_dir).normalized();
-          const RayHits h = cast(mid);
+          const RayThroughBone h = cast(mid);
           if (h.paired) {
             bone_dir = mid;
             in_pt = *h.inner;
@@ -189,37 +187,6 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
     }
     region.outer_rim = std::move(sorted_outer);
     region.inner_rim = std::move(sorted_inner);
-    // Support ring: grow outwards from the rim, ring by ring, over the support width.
-    std::vector<int> frontier = rim;
-    std::vector<char> seen(n, 0);
-    for (int i : comp) seen[i] = 1;
-    for (int j : rim) seen[j] = 1;
-    const int rings =
-        std::max(1, static_cast<int>(std::ceil(params.support_width_mm / (spacing * radius))));
-    std::vector<int> support = rim;
-    for (int ring = 0; ring < rings; ++ring) {
-      std::vector<int> next;
-      for (int v : frontier)
-        for (int w : nbrs[v])
-          if (!seen[w] && paired[w]) {
-            seen[w] = 1;
-            next.push_back(w);
-          }
-      support.insert(support.end(), next.begin(), next.end());
-      frontier = std::move(next);
-    }
-    // Only rays through the full bone support the surfaces: rays that cross the bone obliquely
-    // near the cut face see it thinner and would pull the inner surface outwards.
-    std::vector<double> thickness;
-    for (int i = 0; i < n; ++i)
-      if (paired[i]) thickness.push_back((*outer[i] - *inner[i]).norm());
-    std::nth_element(thickness.begin(), thickness.begin() + thickness.size() / 2, thickness.end());
-    const double full = 0.7 * thickness[thickness.size() / 2];
-    for (int j : support) {
-      if ((*outer[j] - *inner[j]).norm() < full) continue;
-      region.outer_support.push_back(*outer[j]);
-      region.inner_support.push_back(*inner[j]);
-    }
     region.message = "opening of " + std::to_string(static_cast<long long>(area)) + " mm² found";
     break;
   }

@@ -1,5 +1,6 @@
 #include "cranioplan/algorithms/propose_markers.h"
 
+#include "cranioplan/algorithms/point_index.h"
 #include "cranioplan/algorithms/surface_locator.h"
 #include "cranioplan/model/mesh.h"
 
@@ -80,7 +81,8 @@ RegionOfInterest local_registration_region(const DefectRegion& defect, double ma
   return roi;
 }
 
-MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const SurfaceLocator& mirror,
+MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const SurfaceLocator& bone,
+                                          const SurfaceLocator& mirror,
                                           const ProposeParams& params, int first_id) {
   MarkerProposal r;
   r.defect = defect;
@@ -89,56 +91,96 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
     return r;
   }
   // Mirror coverage: rays through the opening that meet the mirrored bone (both tables).
-  std::vector<Eigen::Vector3d> mirror_outer, mirror_inner;
   const Eigen::Vector3d c = defect.center;
-  for (const auto& d : defect.hole_directions) {
-    const auto in = mirror.first_hit(c, c + 400.0 * d);
-    const auto out = mirror.first_hit(c + 400.0 * d, c);
-    const double gap = in && out ? (out->point - in->point).norm() : 0.0;
-    if (gap > 0.5 && gap <= params.detect.max_thickness_mm) {
-      mirror_inner.push_back(in->point);
-      mirror_outer.push_back(out->point);
-    }
-  }
-  r.mirror_coverage = defect.hole_directions.empty() ? 0.0
-                                                     : static_cast<double>(mirror_outer.size()) /
-                                                           defect.hole_directions.size();
+  size_t covered = 0;
+  for (const auto& d : defect.hole_directions)
+    if (cast_through_bone(mirror, c, d, 400.0, 0.5, params.detect.max_thickness_mm).paired)
+      ++covered;
+  r.mirror_coverage = defect.hole_directions.empty()
+                          ? 0.0
+                          : static_cast<double>(covered) / defect.hole_directions.size();
   r.method_used = params.method == PlanMethod::Auto
                       ? (r.mirror_coverage >= params.min_mirror_coverage ? PlanMethod::Mirror
                                                                          : PlanMethod::RimOnly)
                       : params.method;
 
-  // Proposed markers: edges along both rims, support from the intact ring, surface markers
-  // from the mirror.
+  const bool guided = r.method_used == PlanMethod::Mirror;
+  const DefectSurfaces surfaces =
+      fit_defect_surfaces(defect, bone, guided ? &mirror : nullptr, params.surfaces, params.detect);
+  r.surfaces_message = surfaces.message;
+  if (!surfaces.fitted()) {
+    r.status = MarkerProposal::Status::Failed;
+    r.message = defect.message + "; " + surfaces.message;
+    return r;
+  }
+  r.ring_rms_mm = surfaces.outer_rms_mm;
+  const MarkerSurface fitted_on = guided ? MarkerSurface::Mirrored : MarkerSurface::Original;
+
   int id = first_id;
-  // Outer edge markers only: at a cut face that is not along the rays, the inner table's end
-  // cannot be told from the rays that found the rim (they graze the cut); the inner rim is the
-  // outer one set in by the thickness the inner markers measure.
-  for (size_t i : along(defect.outer_rim, params.edge_spacing_mm))
+  // Outer edge markers along the rim. Where intact bone continues beyond the rim (the ring has
+  // bone just outside it), on the fitted outer surface: at a cut face that is not along the
+  // rays, the last bone the rays meet lies below where the outer table goes on. Where it does
+  // not (the rim runs along an orbit or the skull base), the fit only extrapolates there: at
+  // the last bone. No inner edge markers: the inner rim is the outer one set in by the
+  // thickness field of the inner markers (docs/IMPLANT.md).
+  const double clearance = params.surfaces.rim_clearance_mm;
+  std::vector<Eigen::Vector3d> near_ring;
+  for (size_t i = 0; i < surfaces.ring_outer.size(); ++i)
+    if (surfaces.ring_distance_mm[i] <= clearance + 8.0) near_ring.push_back(surfaces.ring_outer[i]);
+  const PointIndex near_index(near_ring.empty() ? std::vector<Eigen::Vector3d>{c} : near_ring);
+  auto bone_beyond = [&](const Eigen::Vector3d& rim) {
+    Eigen::Vector3d out = rim - c;
+    out -= out.dot(defect.axis) * defect.axis;  // away from the opening's axis
+    if (near_ring.empty() || out.norm() < 1e-9) return false;
+    const Eigen::Vector3d probe = rim + (clearance + 4.0) * out.normalized();
+    return near_index.within_radius(probe, 4.0).size() >= 2;
+  };
+  for (size_t i : along(defect.outer_rim, params.edge_spacing_mm)) {
+    const Eigen::Vector3d& rim = defect.outer_rim[i];
+    if (!bone_beyond(rim)) {
+      r.markers.push_back({id++, MarkerType::OuterEdge, rim, MarkerSurface::Original});
+    } else if (const auto p = surfaces.at(rim - c)) {
+      r.markers.push_back({id++, MarkerType::OuterEdge, p->first, MarkerSurface::Original});
+    }
+  }
+  // Support markers: the intact bone next to the rim (the ring's nearest band).
+  std::vector<Eigen::Vector3d> support_outer, support_inner;
+  const double band = params.surfaces.rim_clearance_mm + params.detect.support_width_mm;
+  for (size_t i = 0; i < surfaces.ring_outer.size(); ++i)
+    if (surfaces.ring_distance_mm[i] <= band) {
+      support_outer.push_back(surfaces.ring_outer[i]);
+      support_inner.push_back(surfaces.ring_inner[i]);
+    }
+  for (size_t i : thin_out(support_outer, params.surface_spacing_mm))
     r.markers.push_back(
-        {id++, MarkerType::OuterEdge, defect.outer_rim[i], MarkerSurface::Original});
-  for (size_t i : thin_out(defect.outer_support, params.surface_spacing_mm))
+        {id++, MarkerType::OuterSurface, support_outer[i], MarkerSurface::Original});
+  for (size_t i : thin_out(support_inner, params.surface_spacing_mm))
     r.markers.push_back(
-        {id++, MarkerType::OuterSurface, defect.outer_support[i], MarkerSurface::Original});
-  for (size_t i : thin_out(defect.inner_support, params.surface_spacing_mm))
-    r.markers.push_back(
-        {id++, MarkerType::InnerSurface, defect.inner_support[i], MarkerSurface::Original});
-  if (r.method_used == PlanMethod::Mirror) {
-    std::vector<Marker> mirror_markers;
-    for (size_t i : thin_out(mirror_outer, params.surface_spacing_mm))
-      mirror_markers.push_back(
-          {id++, MarkerType::OuterSurface, mirror_outer[i], MarkerSurface::Mirrored});
-    for (size_t i : thin_out(mirror_inner, params.surface_spacing_mm))
-      mirror_markers.push_back(
-          {id++, MarkerType::InnerSurface, mirror_inner[i], MarkerSurface::Mirrored});
-    // The paper's smoother on the mirror's markers with the rim fixed, back onto the mirror.
-    std::vector<Marker> to_smooth;
-    for (const auto& m : r.markers)
-      if (is_edge(m.type)) to_smooth.push_back(m);
-    to_smooth.insert(to_smooth.end(), mirror_markers.begin(), mirror_markers.end());
-    const SmoothResult s = smooth_markers(to_smooth, params.smooth, &mirror);
-    for (const auto& m : s.markers)
-      if (m.surface == MarkerSurface::Mirrored) r.markers.push_back(m);
+        {id++, MarkerType::InnerSurface, support_inner[i], MarkerSurface::Original});
+  // Surface markers over the opening, on the fitted surfaces.
+  std::vector<Eigen::Vector3d> hole_outer, hole_inner;
+  for (const auto& d : defect.hole_directions)
+    if (const auto p = surfaces.at(d)) {
+      hole_outer.push_back(p->first);
+      hole_inner.push_back(p->second);
+    }
+  std::vector<Marker> inside;
+  for (size_t i : thin_out(hole_outer, params.surface_spacing_mm))
+    inside.push_back({id++, MarkerType::OuterSurface, hole_outer[i], fitted_on});
+  for (size_t i : thin_out(hole_inner, params.surface_spacing_mm))
+    inside.push_back({id++, MarkerType::InnerSurface, hole_inner[i], fitted_on});
+  // The paper's smoother with the rim fixed evens out their spacing; each is then put back
+  // onto its fitted surface along its ray (the smoother alone would flatten the curvature).
+  std::vector<Marker> to_smooth;
+  for (const auto& m : r.markers)
+    if (is_edge(m.type)) to_smooth.push_back(m);
+  to_smooth.insert(to_smooth.end(), inside.begin(), inside.end());
+  for (Marker m : smooth_markers(to_smooth, params.smooth, nullptr).markers) {
+    if (is_edge(m.type)) continue;
+    const auto p = surfaces.at(m.position - c);
+    if (!p) continue;
+    m.position = is_outer(m.type) ? p->first : p->second;
+    r.markers.push_back(m);
   }
   r.status = MarkerProposal::Status::Proposed;
   r.message = defect.message;
@@ -149,7 +191,7 @@ MarkerProposal propose_markers(const SkullMesh& skull, const SurfaceLocator& bon
                                const Plane& plane, const SurfaceLocator& mirror,
                                const ProposeParams& params, int first_id) {
   return propose_markers_for_defect(detect_defect_near_plane(skull, bone, plane, params.detect),
-                                    mirror, params, first_id);
+                                    bone, mirror, params, first_id);
 }
 
 }  // namespace cranioplan

@@ -555,8 +555,8 @@ void apply_propose(PlanState& s, const ParamReader& r) {
       buf, sizeof(buf), "%zu markers proposed, %s (mirror covers %.0f%% of the opening); %s",
       s.markers.size(), p.method_used == PlanMethod::Mirror ? "mirror-guided" : "rim-only fitting",
       100.0 * p.mirror_coverage, p.message.c_str());
-  s.proposal_message = buf;
-  s.message = buf;
+  s.proposal_message = std::string(buf) + "; " + p.surfaces_message;
+  s.message = s.proposal_message;
   markers_changed(s);
 }
 

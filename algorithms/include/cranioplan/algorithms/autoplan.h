@@ -41,6 +41,7 @@ struct AutoplanResult {
   DefectRegion defect;
   PlanMethod method_used = PlanMethod::RimOnly;
   double mirror_coverage = 0.0;  ///< fraction of the opening's rays that meet mirrored bone
+  std::string surfaces_message;  ///< how the defect's surfaces were fitted to the intact ring
   std::vector<Marker> markers;   ///< proposed (after smoothing)
   ImplantResult implant;
   QualityReport quality;

@@ -3,6 +3,7 @@
 // openings; the skull base (or the cut of a scan) is the one straight down (−z: skulls are in
 // patient coordinates, superior up, as CT volumes give them), a defect the largest other one
 // that is large enough. Works whether or not the defect crosses the midline.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,7 +16,8 @@ class SurfaceLocator;
 struct DetectDefectParams {
   int directions = 20000;          ///< rays cast (Fibonacci sphere), 2,000..200,000
   double min_area_mm2 = 300.0;     ///< smaller openings are not defects (at the rim's radius)
-  double support_width_mm = 12.0;  ///< width of the ring of intact bone sampled around the rim
+  /// Width of the ring of intact bone around the rim on which support markers are proposed.
+  double support_width_mm = 12.0;
   /// Rays whose inner and outer bone are farther apart than this met other bone on the way
   /// (e.g. the orbital roof): not used for the rim or the support ring, mm.
   double max_thickness_mm = 15.0;
@@ -35,11 +37,24 @@ struct DefectRegion {
   /// The rim: the last bone met along rays next to the opening, outer and inner table, in
   /// order around the axis (same count, paired).
   std::vector<Eigen::Vector3d> outer_rim, inner_rim;
-  /// Intact bone in a ring around the rim (outer and inner table), for fitting the surfaces.
-  std::vector<Eigen::Vector3d> outer_support, inner_support;
   double seconds = 0.0;
   bool found() const { return status == Status::Found; }
 };
+
+/// `n` directions spread evenly over the unit sphere (a Fibonacci lattice).
+std::vector<Eigen::Vector3d> fibonacci_sphere(int n);
+
+/// What a ray from `center` (inside the skull) in direction `dir` meets: the first bone from
+/// the centre (inner table) and, coming back from `reach` mm out, the first bone from outside
+/// (outer table). `paired` when both are met between `min_thickness_mm` and `max_thickness_mm`
+/// apart (the ray crosses one plausible layer of bone).
+struct RayThroughBone {
+  std::optional<Eigen::Vector3d> inner, outer;
+  bool paired = false;
+};
+RayThroughBone cast_through_bone(const SurfaceLocator& locator, const Eigen::Vector3d& center,
+                                 const Eigen::Vector3d& dir, double reach,
+                                 double min_thickness_mm, double max_thickness_mm);
 
 /// `center`: a point inside the cranial cavity (e.g. the skull's centroid moved onto the
 /// midsagittal plane).

@@ -1,12 +1,16 @@
 #pragma once
-// Marker proposal for a detected defect: outer edge markers along the rim, support markers on
-// the intact ring around it, and — when the registered mirror covers the opening — surface
-// markers from the mirror, smoothed with the paper's smoother. The wizard's "Propose markers"
-// and the automatic planner both use it.
+// Marker proposal for a detected defect. The outer and inner surfaces of the missing bone are
+// fitted to the intact bone around the opening (fit_defect_surfaces.h) — guided by the
+// registered mirror where it covers the opening, from the ring alone otherwise — and sampled
+// as markers: outer edge markers along the rim, surface markers over the opening (smoothed with
+// the paper's smoother and put back onto the fitted surfaces), and support markers on the
+// intact bone next to the rim. The wizard's "Propose markers" and the automatic planner both
+// use it.
 #include <string>
 #include <vector>
 
 #include "cranioplan/algorithms/detect_defect.h"
+#include "cranioplan/algorithms/fit_defect_surfaces.h"
 #include "cranioplan/algorithms/register_icp.h"
 #include "cranioplan/algorithms/smooth_markers.h"
 #include "cranioplan/model/marker.h"
@@ -27,16 +31,19 @@ struct ProposeParams {
   double min_mirror_coverage = 0.8;      ///< Auto uses the mirror above this coverage, 0..1
   double edge_spacing_mm = 4.0;          ///< proposed edge markers along the rim, mm (>0)
   double surface_spacing_mm = 6.0;       ///< proposed surface and support markers, mm (>0)
-  SmoothParams smooth{10.0, 2.0, 1};     ///< applied to mirror surface markers (projected back)
+  SmoothParams smooth{10.0, 2.0, 1};     ///< applied to surface markers (put back after)
+  DefectSurfaceParams surfaces;          ///< fitting the surfaces to the intact ring
 };
 
 struct MarkerProposal {
-  enum class Status { Proposed, NoDefect };
+  enum class Status { Proposed, NoDefect, Failed };  ///< Failed: the surfaces could not be fitted
   Status status = Status::NoDefect;
   std::string message;
   DefectRegion defect;
   PlanMethod method_used = PlanMethod::RimOnly;
   double mirror_coverage = 0.0;  ///< fraction of the opening's rays that meet mirrored bone
+  std::string surfaces_message;  ///< how the surfaces were fitted (ring rays, residual)
+  double ring_rms_mm = 0.0;      ///< residual of the outer surface's fit on the intact ring
   std::vector<Marker> markers;   ///< ids from `first_id` on
   bool proposed() const { return status == Status::Proposed; }
 };
@@ -49,8 +56,10 @@ DefectRegion detect_defect_near_plane(const SkullMesh& skull, const SurfaceLocat
 /// `margin_mm` beyond it.
 RegionOfInterest local_registration_region(const DefectRegion& defect, double margin_mm);
 
-/// Markers for an already detected defect; `mirror` is the registered mirrored skull.
-MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const SurfaceLocator& mirror,
+/// Markers for an already detected defect; `bone` locates the skull it was found in, `mirror`
+/// the registered mirrored skull.
+MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const SurfaceLocator& bone,
+                                          const SurfaceLocator& mirror,
                                           const ProposeParams& params, int first_id = 1);
 
 /// Detects the defect, then proposes markers (status NoDefect when there is none).

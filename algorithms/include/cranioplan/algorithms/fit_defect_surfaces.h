@@ -1,0 +1,83 @@
+#pragma once
+// The outer and inner surfaces of the missing bone, fitted to the intact bone all around a
+// detected opening. Rays from inside the skull (the detection's centre) sample the outer and
+// inner table on a wide ring of intact bone. The outer surface is a radius field r(d) over the
+// ray directions d, a thin-plate spline with a quadratic trend (so the curvature of the
+// surroundings carries across the opening); the inner one lies a thickness field t(d) below it
+// (a spline with an affine trend: fitting the inner radius on its own lets the two surfaces'
+// trends drift apart across a wide opening).
+//
+// Mirror-guided: the registered mirror gives a first guess of both radii inside the opening;
+// the splines then fit only the mirror's mismatch with the original skull on the ring (smooth
+// correction fields), so the healthy side's shape is kept but bent to meet the bone around the
+// defect. Rim-only (the mirror does not cover the opening): the radii themselves are fitted.
+//
+// Rays that pass within `rim_clearance_mm` of the opening are not used: at a cut face that is
+// not along the rays they graze the bone and see neither table where it would continue.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cranioplan/algorithms/detect_defect.h"
+#include "cranioplan/algorithms/thin_plate_spline.h"
+
+namespace cranioplan {
+
+class SurfaceLocator;
+
+struct DefectSurfaceParams {
+  double ring_width_mm = 25.0;    ///< width of the intact ring the surfaces are fitted to, mm
+  double rim_clearance_mm = 3.0;  ///< rays nearer the opening are not used, mm (≥ 0)
+  double ray_spacing_mm = 2.0;    ///< between sampled rays at the rim's radius, mm (0.5..10)
+  double site_spacing_mm = 4.0;   ///< fitting sites on the ring at least this far apart, mm
+  /// Spline smoothing weight per site (dimensionless, ≥ 0): rides over the bone's roughness.
+  double smoothing = 0.03;
+  /// Sites whose residual after a first fit exceeds this many robust standard deviations
+  /// (and 1 mm) are dropped before the final fit: foramina, sutures, cut-face fragments.
+  double outlier_sigmas = 3.0;
+};
+
+class DefectSurfaces {
+ public:
+  enum class Status { Fitted, Failed };
+  Status status = Status::Failed;
+  std::string message;
+  bool mirror_guided = false;
+  int ring_rays = 0;           ///< intact rays on the ring (both tables met)
+  int sites = 0;               ///< fitting sites used (after thinning and outliers)
+  double outer_rms_mm = 0.0;   ///< residual of the fit over all ring rays, outer table
+  double thickness_rms_mm = 0.0;  ///< the same, bone thickness (inner table)
+  /// The ring's bone: outer and inner table points of the intact rays (both tables met) and
+  /// each ray's distance from the opening, mm.
+  std::vector<Eigen::Vector3d> ring_outer, ring_inner;
+  std::vector<double> ring_distance_mm;
+
+  bool fitted() const { return status == Status::Fitted; }
+  /// The fitted outer and inner surface points along the ray from the centre in direction
+  /// `dir` (unit); none when the direction is outside the fitted cap or, mirror-guided, the
+  /// mirror has no bone there.
+  std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> at(const Eigen::Vector3d& dir) const;
+
+ private:
+  friend DefectSurfaces fit_defect_surfaces(const DefectRegion&, const SurfaceLocator&,
+                                            const SurfaceLocator*, const DefectSurfaceParams&,
+                                            const DetectDefectParams&);
+  Eigen::Vector2d uv(const Eigen::Vector3d& dir) const;
+  Eigen::Vector3d center_ = Eigen::Vector3d::Zero(), axis_ = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d e1_ = Eigen::Vector3d::UnitX(), e2_ = Eigen::Vector3d::UnitY();
+  double scale_ = 1.0;        // mm per unit of the gnomonic projection
+  double max_cos_ = 0.0;      // cosine of the cap's half-angle
+  const SurfaceLocator* mirror_ = nullptr;  // prior (not owned); null: rim-only
+  double max_thickness_mm_ = 15.0;
+  ThinPlateSpline outer_, thickness_;
+};
+
+/// Fits the surfaces of `defect` (found by detect_defect on the skull that `bone` locates).
+/// `mirror`: the registered mirrored skull, or null for rim-only fitting; it must outlive the
+/// result. `detect` gives the plausible bone thickness of a ray.
+DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLocator& bone,
+                                   const SurfaceLocator* mirror,
+                                   const DefectSurfaceParams& params = {},
+                                   const DetectDefectParams& detect = {});
+
+}  // namespace cranioplan

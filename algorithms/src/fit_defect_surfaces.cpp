@@ -1,0 +1,186 @@
+#include "cranioplan/algorithms/fit_defect_surfaces.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+
+#include "cranioplan/algorithms/point_index.h"
+#include "cranioplan/algorithms/surface_locator.h"
+
+namespace cranioplan {
+namespace {
+
+constexpr double kReach = 400.0;  // mm: rays from inside the skull leave it well before this
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+  return v[v.size() / 2];
+}
+
+// Greedy thinning: indices of points at least `spacing` apart, in the given order.
+std::vector<size_t> thin(const std::vector<Eigen::Vector3d>& pts, double spacing) {
+  std::vector<Eigen::Vector3d> kept_pts;
+  std::vector<size_t> kept;
+  for (size_t i = 0; i < pts.size(); ++i) {
+    bool far = true;
+    for (const auto& k : kept_pts)
+      if ((k - pts[i]).squaredNorm() < spacing * spacing) {
+        far = false;
+        break;
+      }
+    if (far) {
+      kept.push_back(i);
+      kept_pts.push_back(pts[i]);
+    }
+  }
+  return kept;
+}
+
+}  // namespace
+
+Eigen::Vector2d DefectSurfaces::uv(const Eigen::Vector3d& dir) const {
+  const double z = dir.dot(axis_);
+  return scale_ * Eigen::Vector2d(dir.dot(e1_), dir.dot(e2_)) / z;
+}
+
+std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> DefectSurfaces::at(
+    const Eigen::Vector3d& dir_in) const {
+  if (!fitted()) return std::nullopt;
+  const Eigen::Vector3d dir = dir_in.normalized();
+  if (dir.dot(axis_) < max_cos_) return std::nullopt;
+  const Eigen::Vector2d q = uv(dir);
+  double r_out = outer_(q), t = thickness_(q);
+  if (mirror_) {
+    const RayThroughBone m =
+        cast_through_bone(*mirror_, center_, dir, kReach, 0.5, max_thickness_mm_);
+    if (!m.paired) return std::nullopt;
+    r_out += (*m.outer - center_).norm();
+    t += (*m.outer - *m.inner).norm();
+  }
+  // The bone is at least half a millimetre thick and no thicker than one layer can be.
+  const double r_in = r_out - std::clamp(t, 0.5, max_thickness_mm_);
+  return std::make_pair(Eigen::Vector3d(center_ + r_out * dir),
+                        Eigen::Vector3d(center_ + r_in * dir));
+}
+
+DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLocator& bone,
+                                   const SurfaceLocator* mirror, const DefectSurfaceParams& params,
+                                   const DetectDefectParams& detect) {
+  DefectSurfaces s;
+  if (!defect.found() || defect.hole_directions.empty() || defect.outer_rim.size() < 3) {
+    s.message = "no defect to fit surfaces to";
+    return s;
+  }
+  s.center_ = defect.center;
+  s.axis_ = defect.axis;
+  s.e1_ = s.axis_.unitOrthogonal();
+  s.e2_ = s.axis_.cross(s.e1_);
+  s.mirror_ = mirror;
+  s.mirror_guided = mirror != nullptr;
+  s.max_thickness_mm_ = detect.max_thickness_mm;
+  double rim_radius = 0.0;
+  for (const auto& p : defect.outer_rim) rim_radius += (p - s.center_).norm();
+  rim_radius /= static_cast<double>(defect.outer_rim.size());
+  s.scale_ = rim_radius;
+
+  // The cap: the opening's widest angle from its axis plus the ring, capped at 70° (the
+  // gnomonic projection stretches without bound towards 90°).
+  double hole_cos = 1.0;
+  for (const auto& d : defect.hole_directions) hole_cos = std::min(hole_cos, d.dot(s.axis_));
+  const double clearance = std::max(0.0, params.rim_clearance_mm);
+  const double width = std::max(1.0, params.ring_width_mm);
+  const double cap_angle = std::min(std::acos(std::clamp(hole_cos, -1.0, 1.0)) +
+                                        (clearance + width) / rim_radius * 1.2,
+                                    70.0 * M_PI / 180.0);
+  s.max_cos_ = std::cos(cap_angle);
+
+  // Rays over the cap, spaced about `ray_spacing_mm` apart at the rim's radius.
+  const double spacing = std::clamp(params.ray_spacing_mm, 0.5, 10.0) / rim_radius;
+  const int n = std::clamp(static_cast<int>(4.0 * M_PI / (spacing * spacing)), 2000, 400000);
+  const PointIndex hole(defect.hole_directions);
+  struct Sample {
+    Eigen::Vector3d dir;
+    double r_out, t;  // outer radius and thickness: original, or original − mirror (guided)
+  };
+  std::vector<Sample> ring;
+  for (const Eigen::Vector3d& d : fibonacci_sphere(n)) {
+    if (d.dot(s.axis_) < s.max_cos_) continue;
+    const RayThroughBone o = cast_through_bone(bone, s.center_, d, kReach,
+                                               detect.min_thickness_mm, detect.max_thickness_mm);
+    if (!o.paired) continue;
+    double chord2 = 0.0;
+    hole.nearest(d, &chord2);
+    const double r_out = (*o.outer - s.center_).norm(), r_in = (*o.inner - s.center_).norm();
+    const double dist = 2.0 * std::asin(std::min(1.0, 0.5 * std::sqrt(chord2))) * r_out;
+    if (dist < clearance || dist > clearance + width) continue;
+    Sample smp{d, r_out, r_out - r_in};
+    if (mirror) {
+      const RayThroughBone m =
+          cast_through_bone(*mirror, s.center_, d, kReach, 0.5, detect.max_thickness_mm);
+      if (!m.paired) continue;
+      smp.r_out -= (*m.outer - s.center_).norm();
+      smp.t -= (*m.outer - *m.inner).norm();
+    }
+    ring.push_back(smp);
+    s.ring_outer.push_back(*o.outer);
+    s.ring_inner.push_back(*o.inner);
+    s.ring_distance_mm.push_back(dist);
+  }
+  s.ring_rays = static_cast<int>(ring.size());
+  if (ring.size() < 12) {
+    s.message = "too little intact bone around the opening to fit its surfaces (" +
+                std::to_string(ring.size()) + " rays)";
+    return s;
+  }
+
+  // Fitting sites: the ring thinned to the site spacing (on the outer table).
+  std::vector<size_t> sites = thin(s.ring_outer, std::max(0.5, params.site_spacing_mm));
+  auto fit = [&](ThinPlateSpline& tps, bool outer, const std::vector<size_t>& use) {
+    std::vector<Eigen::Vector2d> uv;
+    std::vector<double> h;
+    for (size_t i : use) {
+      uv.push_back(s.uv(ring[i].dir));
+      h.push_back(outer ? ring[i].r_out : ring[i].t);
+    }
+    const std::vector<double> lambda(uv.size(), std::max(0.0, params.smoothing));
+    return tps.fit(uv, h, lambda, 1e-3);
+  };
+  auto residual = [&](const ThinPlateSpline& tps, bool outer, size_t i) {
+    return (outer ? ring[i].r_out : ring[i].t) - tps(s.uv(ring[i].dir));
+  };
+  for (bool outer : {true, false}) {
+    ThinPlateSpline& tps = outer ? s.outer_ : s.thickness_;
+    // The outer radius keeps the ring's curvature across the opening with a quadratic trend.
+    // A thickness, and a correction of the mirror, vary gently: an affine trend suffices and
+    // stays calm where the ring is open on one side (next to an orbit).
+    tps.set_quadratic_trend(outer && mirror == nullptr);
+    if (!fit(tps, outer, sites)) {
+      s.message = "the intact bone around the opening lies on a line: no surface can be fitted";
+      return s;
+    }
+    // One round of outlier removal: sites far off the first fit.
+    std::vector<double> abs_res;
+    for (size_t i : sites) abs_res.push_back(std::abs(residual(tps, outer, i)));
+    const double limit = std::max(1.0, params.outlier_sigmas * 1.4826 * median(abs_res));
+    std::vector<size_t> kept;
+    for (size_t i : sites)
+      if (std::abs(residual(tps, outer, i)) <= limit) kept.push_back(i);
+    if (kept.size() < sites.size() && kept.size() >= 12) fit(tps, outer, kept);
+    s.sites = static_cast<int>(kept.size());
+    double sum = 0.0;
+    for (size_t i = 0; i < ring.size(); ++i) sum += std::pow(residual(tps, outer, i), 2);
+    (outer ? s.outer_rms_mm : s.thickness_rms_mm) = std::sqrt(sum / static_cast<double>(ring.size()));
+  }
+  s.status = DefectSurfaces::Status::Fitted;
+  char buf[200];
+  std::snprintf(buf, sizeof(buf),
+                "surfaces fitted to %d rays of intact bone (%s; residual %.2f mm outer surface, "
+                "%.2f mm thickness)",
+                s.ring_rays, mirror ? "mirror corrected" : "rim only", s.outer_rms_mm,
+                s.thickness_rms_mm);
+  s.message = buf;
+  return s;
+}
+
+}  // namespace cranioplan
