@@ -84,7 +84,7 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
     r.message = "implant: " + r.implant.message;
     return r;
   }
-  r.quality = check_implant(r.implant.mesh, &skull);
+  r.quality = check_implant(r.implant.mesh, &skull, &bone, QualityParams{});
   timer.stage("quality");
   r.status = AutoplanResult::Status::Planned;
   char buf[200];

@@ -106,6 +106,14 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
       break;
     }
   }
+  // The openings large enough to be defects, largest first (area at the radius of the rim):
+  // each with its rim (bone rays next to it) and area.
+  struct Candidate {
+    size_t r;
+    std::vector<int> rim;
+    double area;
+  };
+  std::vector<Candidate> candidates;
   for (size_t r = 0; r < order.size(); ++r) {
     if (r == base) continue;
     const std::vector<int>& comp = comps[order[r]];
@@ -121,8 +129,28 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
     radius /= static_cast<double>(rim.size());
     const double area = static_cast<double>(comp.size()) * 4.0 * M_PI / n * radius * radius;
     if (area < params.min_area_mm2) break;  // sorted by size: the rest are smaller
-
+    candidates.push_back({r, std::move(rim), area});
+  }
+  // Asked for the one towards a point: the opening holding the ray nearest that direction.
+  if (params.near && candidates.size() > 1 && (*params.near - center).norm() > 1e-9) {
+    const Eigen::Vector3d want = (*params.near - center).normalized();
+    auto closeness = [&](const Candidate& c) {
+      double best = -2.0;
+      for (int i : comps[order[c.r]]) best = std::max(best, dirs[i].dot(want));
+      return best;
+    };
+    std::stable_sort(candidates.begin(), candidates.end(),
+                     [&](const Candidate& a, const Candidate& b) {
+                       return closeness(a) > closeness(b);
+                     });
+  }
+  for (const Candidate& cand : candidates) {
+    const size_t r = cand.r;
+    const std::vector<int>& comp = comps[order[r]];
+    const std::vector<int>& rim = cand.rim;
+    const double area = cand.area;
     region.status = DefectRegion::Status::Found;
+    region.other_openings = static_cast<int>(candidates.size()) - 1;
     region.area_mm2 = area;
     Eigen::Vector3d axis = Eigen::Vector3d::Zero();
     for (int i : comp) {
@@ -188,6 +216,10 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
     region.outer_rim = std::move(sorted_outer);
     region.inner_rim = std::move(sorted_inner);
     region.message = "opening of " + std::to_string(static_cast<long long>(area)) + " mm² found";
+    if (region.other_openings > 0)
+      region.message += " (" + std::to_string(region.other_openings) +
+                        (region.other_openings == 1 ? " other opening" : " other openings") +
+                        " not planned: choose with a point near the defect)";
     break;
   }
   if (!region.found())

@@ -109,8 +109,11 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
                               const TrimToBoneParams& params) {
   const auto t0 = std::chrono::steady_clock::now();
   TrimToBoneResult result;
-  const double h = std::clamp(params.voxel_mm, 0.1, 1.0);
   const auto [lo, hi] = mesh_bounds(implant);
+  const Eigen::Vector3d extent = (hi - lo).array() + 8.0 * params.voxel_mm;
+  const double h = std::clamp(
+      std::max(params.voxel_mm, std::cbrt(extent.prod() / std::max(1e5, params.max_voxels))), 0.1,
+      1.0);
   const VoxelGrid grid = VoxelGrid::covering(lo, hi, h, 4);
   Mask mask = voxelize_mesh(implant, grid);
   const Mask bone = voxelize_mesh(skull, grid);

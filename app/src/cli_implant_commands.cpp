@@ -315,6 +315,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
   {  // autoplan
     struct Opts {
       std::string skull, landmarks, output, markers_out, session, method = "auto";
+      std::vector<double> near;
       AutoplanParams params;
     };
     auto o = std::make_shared<Opts>();
@@ -326,11 +327,18 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
         ->check(CLI::IsMember({"auto", "mirror", "rim-only"}));
     cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
     cmd->add_option("--markers-out", o->markers_out, "proposed markers to write (.json or .csv)");
+    cmd->add_option("--near", o->near,
+                    "X Y Z (mm): with several openings, plan the one in this point's direction "
+                    "(default: the largest)")
+        ->expected(3);
     add_fit_option(cmd, o->params);
     cmd->add_option("--session", o->session,
                     "plan through session commands and save the session (.json): reopen, edit, "
                     "replay and audit it");
     out.push_back({cmd, [o, &json]() -> int {
+                     if (o->near.size() == 3)
+                       o->params.propose.detect.near =
+                           Eigen::Vector3d(o->near[0], o->near[1], o->near[2]);
                      const Landmarks lm =
                          o->landmarks.empty() ? Landmarks{} : read_landmarks_file(o->landmarks);
                      plan_method_from_string(o->method, o->params.propose.method);
@@ -471,7 +479,11 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
              ip.voxel_mm = 0.5;
              const InjectDefectResult d = inject_defect(skull, ip);
              if (!d.usable()) continue;
-             const AutoplanResult r = autoplan(d.defective, Landmarks{}, o->params);
+             // The skull may have a defect of its own (the sample has): the planner is told
+             // which opening is meant, as a user would point at it.
+             AutoplanParams params = o->params;
+             params.propose.detect.near = ip.center;
+             const AutoplanResult r = autoplan(d.defective, Landmarks{}, params);
              Json row{
                  {"center", to_json(ip.center)}, {"size_mm", ip.size_mm}, {"message", r.message}};
              if (r.planned()) {

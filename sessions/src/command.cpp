@@ -130,6 +130,17 @@ void propose_fields(V& v, P& p) {
   v("surface_spacing_mm", p.surface_spacing_mm);
 }
 
+// propose_markers version 2: how the defect's surfaces are fitted to the intact ring.
+template <class V, class P>
+void surface_fit_fields(V& v, P& p) {
+  v("ring_width_mm", p.ring_width_mm);
+  v("rim_clearance_mm", p.rim_clearance_mm);
+  v("ray_spacing_mm", p.ray_spacing_mm);
+  v("site_spacing_mm", p.site_spacing_mm);
+  v("smoothing", p.smoothing);
+  v("outlier_sigmas", p.outlier_sigmas);
+}
+
 template <class V, class P>
 void implant_fields(V& v, P& p) {
   v("resolution_mm", p.resolution_mm);
@@ -181,7 +192,10 @@ std::optional<CommandType> command_type_from_tag(const std::string& tag) {
 
 int current_version(CommandType type) {
   // build_implant 2: ImplantParams gained fit_to_bone_mm (version 1 means no fitting).
-  return type == CommandType::BuildImplant ? 2 : 1;
+  // propose_markers 2: the surfaces fitted to the intact ring ("surfaces"), the opening chosen
+  // near a point ("detect.near"); version 1 is read with their defaults.
+  if (type == CommandType::BuildImplant || type == CommandType::ProposeMarkers) return 2;
+  return 1;
 }
 
 // ---------------------------------------------------------------------------------------------
@@ -262,7 +276,9 @@ Json params_to_json(const ProposeParams& p) {
   Json j = write_fields([](auto& v, auto& q) { propose_fields(v, q); }, p);
   j["method"] = to_string(p.method);
   j["detect"] = write_fields([](auto& v, auto& q) { detect_fields(v, q); }, p.detect);
+  j["detect"]["near"] = p.detect.near ? to_json(*p.detect.near) : Json(nullptr);
   j["smooth"] = params_to_json(p.smooth);
+  j["surfaces"] = write_fields([](auto& v, auto& q) { surface_fit_fields(v, q); }, p.surfaces);
   return j;
 }
 
@@ -317,7 +333,15 @@ void params_from_json(const ParamReader& r, ProposeParams& p) {
   const ParamReader detect(r.value("detect"), r.where() + " detect");
   Reader dv{detect};
   detect_fields(dv, p.detect);
+  p.detect.near.reset();
+  if (detect.has("near") && !detect.value("near").is_null()) p.detect.near = detect.vector3("near");
   params_from_json(ParamReader(r.value("smooth"), r.where() + " smooth"), p.smooth);
+  // Version 1 (before the surfaces were fitted to the ring) has no "surfaces": the defaults.
+  if (r.has("surfaces")) {
+    const ParamReader surfaces(r.value("surfaces"), r.where() + " surfaces");
+    Reader sv{surfaces};
+    surface_fit_fields(sv, p.surfaces);
+  }
 }
 
 void params_from_json(const ParamReader& r, ImplantParams& p) {

@@ -27,7 +27,9 @@ ImplantData::ImplantData(ImplantResult result, std::shared_ptr<const SkullInput>
 
 const QualityReport& ImplantData::quality() const {
   std::call_once(quality_once_, [this] {
-    quality_ = check_implant(result_.mesh, skull_ ? &skull_->surface->mesh : nullptr);
+    quality_ = skull_ ? check_implant(result_.mesh, &skull_->surface->mesh,
+                                      &skull_->surface->locator, QualityParams{})
+                      : check_implant(result_.mesh, nullptr);
   });
   return quality_;
 }

@@ -56,6 +56,36 @@ TEST(Autoplan, DefectAcrossTheMidlineIsBridgedByRimFitting) {
   EXPECT_EQ(r.quality.self_intersections, 0);
 }
 
+// Two openings: the larger is planned unless a point near the other one says which is meant.
+TEST(Autoplan, WithTwoOpeningsAPointChoosesWhichIsPlanned) {
+  InjectDefectParams big;
+  big.center = test::head_surface_point(Eigen::Vector3d(0.75, 0.2, 0.6).normalized()) * 0.965;
+  big.size_mm = 45;
+  big.voxel_mm = 0.5;
+  const InjectDefectResult first = inject_defect(thick_head(), big);
+  ASSERT_TRUE(first.usable());
+  InjectDefectParams small = big;
+  small.center = test::head_surface_point(Eigen::Vector3d(-0.6, -0.5, 0.6).normalized()) * 0.965;
+  small.size_mm = 35;
+  const InjectDefectResult both = inject_defect(first.defective, small);
+  ASSERT_TRUE(both.usable());
+
+  const AutoplanResult largest = autoplan(both.defective, Landmarks{});
+  ASSERT_TRUE(largest.planned()) << largest.message;
+  EXPECT_EQ(largest.defect.other_openings, 1);
+  EXPECT_NE(largest.message.find("1 other opening not planned"), std::string::npos)
+      << largest.message;
+  EXPECT_GT(largest.defect.axis.x(), 0.5) << "the larger opening is on the right (+x)";
+
+  AutoplanParams params;
+  params.propose.detect.near = small.center;
+  const AutoplanResult chosen = autoplan(both.defective, Landmarks{}, params);
+  ASSERT_TRUE(chosen.planned()) << chosen.message;
+  EXPECT_LT(chosen.defect.axis.x(), -0.3) << "the smaller opening, on the left";
+  const CompareResult c = compare_implants(chosen.implant.mesh, both.implant, &both.defective);
+  EXPECT_GE(c.dice, 0.85);
+}
+
 TEST(Autoplan, IntactSkullGivesNoDefect) {
   const AutoplanResult r = autoplan(thick_head(), Landmarks{});
   EXPECT_EQ(r.status, AutoplanResult::Status::NoDefect);

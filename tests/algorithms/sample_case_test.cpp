@@ -69,30 +69,9 @@ TEST(SampleCase, AutoplanFillsTheRealDefect) {
   EXPECT_LT(r.plane.plane.signed_distance(c + 100.0 * r.defect.axis) * r.plane.plane.normal.x(),
             0.0);
   EXPECT_LT(r.defect.axis.y(), 0.0);
-  EXPECT_TRUE(r.quality.watertight);
-  EXPECT_TRUE(r.quality.manifold);
-  // Not yet printable as it stands: a few crossing triangles near the orbital roof, and the rim
-  // gap and overlap of docs/AUTOPLAN.md. These bounds guard what works.
-  EXPECT_LT(r.quality.self_intersections, 20);
-  EXPECT_LT(r.quality.penetration_mm3, 100.0);
-  RecordProperty("self_intersections", std::to_string(r.quality.self_intersections));
-  RecordProperty("rim_gap_mm", std::to_string(r.quality.rim_gap_mm));
-  RecordProperty("penetration_mm3", std::to_string(r.quality.penetration_mm3));
-}
-
-// The target on the sample's real defect: a watertight shell with a rim gap of at most
-// 0.5 mm and no penetration into the skull. The markers are the proposal's (edge markers along
-// the rim, surface markers from the mirror and the intact ring), the shell is fitted to the
-// bone (built 4 mm over the bone and trimmed by it).
-TEST(SampleCase, ShellFittedToTheBoneMeetsTheRimWithoutPenetration) {
-  const std::string path = sample_case_path();
-  if (!std::filesystem::exists(path))
-    GTEST_SKIP() << path << " not installed (scripts/install-deps)";
-  const LoadedSkull skull = load_skull(path);
-  AutoplanParams params;
-  params.implant.fit_to_bone_mm = 4.0;
-  const AutoplanResult r = autoplan(skull.mesh, Landmarks{}, params);
-  ASSERT_TRUE(r.planned()) << r.message;
+  // The target on the sample's real defect, from autoplan alone: a watertight shell
+  // with a rim gap of at most 0.5 mm and no penetration into the skull (the shell is fitted to
+  // the bone: built 4 mm over it and trimmed by it).
   EXPECT_TRUE(r.quality.watertight);
   EXPECT_TRUE(r.quality.manifold);
   EXPECT_EQ(r.quality.self_intersections, 0);

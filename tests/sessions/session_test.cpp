@@ -125,6 +125,34 @@ TEST(Commands, BuildImplantVersionOneIsReadByItsOwnRules) {
   EXPECT_EQ(to_json(c), v1) << "kept as recorded: the journal's hashes cover it";
 }
 
+// propose_markers 2 records how the surfaces are fitted and which opening was asked for; a
+// version-1 command (neither) is read with their defaults.
+TEST(Commands, ProposeMarkersVersionTwoRoundTripsAndVersionOneGetsDefaults) {
+  ProposeParams p;
+  p.surfaces.ring_width_mm = 31.0;
+  p.surfaces.smoothing = 0.07;
+  p.detect.near = Eigen::Vector3d(1.5, -2.0, 70.25);
+  const Json j = to_json(commands::propose_markers(p));
+  EXPECT_EQ(j["version"], 2);
+  ProposeParams back;
+  params_from_json(ParamReader(j["params"]["params"], "test"), back);
+  EXPECT_EQ(back.surfaces.ring_width_mm, 31.0);
+  EXPECT_EQ(back.surfaces.smoothing, 0.07);
+  ASSERT_TRUE(back.detect.near.has_value());
+  EXPECT_EQ(*back.detect.near, *p.detect.near);
+
+  Json v1 = j;
+  v1["version"] = 1;
+  v1["params"]["params"].erase("surfaces");
+  v1["params"]["params"]["detect"].erase("near");
+  const Command c = command_from_json(v1, "old plan");
+  EXPECT_EQ(c.version, 1);
+  ProposeParams old;
+  params_from_json(ParamReader(c.params["params"], "test"), old);
+  EXPECT_FALSE(old.detect.near.has_value());
+  EXPECT_EQ(old.surfaces.ring_width_mm, DefectSurfaceParams{}.ring_width_mm);
+}
+
 TEST(Commands, UnknownTypeVersionAndMissingParameterAreNamed) {
   Json j = to_json(commands::smooth_markers({8, 2, 1}));
   Json unknown = j;

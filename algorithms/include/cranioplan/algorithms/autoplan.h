@@ -24,9 +24,12 @@ struct AutoplanParams {
   /// of the opening (mm; 0: off), so the healthy side fits the defect's surroundings rather than
   /// the whole skull.
   double local_registration_mm = 25.0;
+  /// The shell, fitted to the bone (built 4 mm over it and the skull subtracted), so that the
+  /// automatic implant meets the cut face all around without entering the bone.
   ImplantParams implant = [] {
     ImplantParams p;
     p.surface_smoothing = 0.003;
+    p.fit_to_bone_mm = 4.0;
     return p;
   }();
 };

@@ -12,6 +12,8 @@ struct QualityParams {
   double max_rim_gap_mm = 1.0;       ///< a larger gap to the bone is not printable, mm
   double max_penetration_mm3 = 5.0;  ///< more overlap with the skull is not printable, mm³
   double overlap_voxel_mm = 0.25;    ///< voxel size of the overlap measurement, mm
+  /// A large implant's overlap grid is coarsened to at most this many voxels.
+  double overlap_max_voxels = 8e6;
 };
 
 struct QualityReport {
@@ -32,12 +34,19 @@ struct QualityReport {
 /// Checks an implant, optionally against the (defective) skull it is made for.
 ///
 /// Thickness: from the centre of each face of the implant's two large surfaces (faces whose
-/// normal is within 45° of the implant's thinnest principal axis), along the inward normal to
+/// normal is within 45° of the implant's thinnest principal axis; of an implant with more than
+/// 60,000 faces, every k-th face so that about 60,000 are measured), along the inward normal to
 /// the opposite surface. Rim: the side wall (the other faces). Rim gap: around the implant's
 /// axis in 5° sectors, the distance from the sector's side-wall vertex nearest the bone to the
 /// bone; the largest over the sectors (a gap anywhere along the rim shows in its sector).
 /// Penetration: the volume inside both the implant and the skull, on a voxel grid.
 QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
                             const QualityParams& params = {});
+
+class SurfaceLocator;
+/// The same with the skull's locator built once by the caller (building it for a skull of two
+/// million triangles costs more than the rest of the check).
+QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
+                            const SurfaceLocator* skull_locator, const QualityParams& params);
 
 }  // namespace cranioplan

@@ -24,6 +24,9 @@ struct DetectDefectParams {
   /// Rays that only graze bone (at the cut face of a defect) pass through less than this; the
   /// rim is placed where rays still cross this much bone, mm.
   double min_thickness_mm = 1.5;
+  /// With several openings large enough, the one seen in the direction of this point (e.g. a
+  /// click near the defect, mm) rather than the largest.
+  std::optional<Eigen::Vector3d> near;
 };
 
 struct DefectRegion {
@@ -33,6 +36,7 @@ struct DefectRegion {
   Eigen::Vector3d center = Eigen::Vector3d::Zero();  ///< where the rays start (inside the skull)
   Eigen::Vector3d axis = Eigen::Vector3d::Zero();    ///< mean direction of the opening (unit)
   double area_mm2 = 0.0;                             ///< opening area at the rim's radius
+  int other_openings = 0;  ///< further openings large enough to be defects (not planned)
   std::vector<Eigen::Vector3d> hole_directions;      ///< unit rays through the opening
   /// The rim: the last bone met along rays next to the opening, outer and inner table, in
   /// order around the axis (same count, paired).
