@@ -205,9 +205,20 @@ TEST_F(Wizard, AllNineStepsOnTheSampleReplayToTheSameImplant) {
   EXPECT_EQ(plan.session().stack().back().type, CommandType::MoveMarker);
   QTest::keyClick(&w, Qt::Key_0);
   const size_t n_markers = plan.state().markers.size();
-  const auto spot = view.project(plan.state().markers[plan.state().markers.size() / 2].position);
-  ASSERT_TRUE(spot);
-  click_view(view, *spot + QPoint(0, 40));
+  // A click on intact bone: beside the support marker farthest from the opening, further out.
+  const Marker* far = nullptr;
+  for (const auto& m : plan.state().markers)
+    if (!is_edge(m.type) && m.surface == MarkerSurface::Original &&
+        (!far || (m.position - *plan.state().defect_center).norm() >
+                     (far->position - *plan.state().defect_center).norm()))
+      far = &m;
+  ASSERT_TRUE(far);
+  const auto spot = view.project(far->position);
+  const auto opening = view.project(*plan.state().defect_center);
+  ASSERT_TRUE(spot && opening);
+  QPointF away = QPointF(*spot - *opening);
+  away /= std::max(1.0, std::hypot(away.x(), away.y()));
+  click_view(view, *spot + (away * 25).toPoint());
   ASSERT_EQ(plan.state().markers.size(), n_markers + 1) << "a click adds a marker";
   view.set_selected_marker(plan.state().markers.back().id);
   trigger(w, "deleteMarker");
