@@ -128,6 +128,19 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
   for (int s = 0; s < steps; ++s) mask = morph(mask, grid, true);
   // The opening must not give back bone.
   for (size_t c = 0; c < mask.size(); ++c) mask[c] = mask[c] && !bone[c];
+  // Bridging: where the implant stops short of the bone by less than twice the bridge width
+  // (ragged thin bone, e.g. by an orbit), the space within that width of both is filled, so the
+  // implant rests on the bone instead of leaving a crack.
+  const int bridge = static_cast<int>(std::lround(params.bridge_mm / h));
+  if (bridge > 0) {
+    Mask near_implant = mask, near_bone = bone;
+    for (int s = 0; s < bridge; ++s) {
+      near_implant = morph(near_implant, grid, true);
+      near_bone = morph(near_bone, grid, true);
+    }
+    for (size_t c = 0; c < mask.size(); ++c)
+      mask[c] = mask[c] || (near_implant[c] && near_bone[c] && !bone[c]);
+  }
   mask = largest_piece(mask, grid);
   size_t after = 0;
   for (uint8_t m : mask) after += m;
