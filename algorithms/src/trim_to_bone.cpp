@@ -116,7 +116,7 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
       1.0);
   const VoxelGrid grid = VoxelGrid::covering(lo, hi, h, 4);
   Mask mask = voxelize_mesh(implant, grid);
-  const Mask bone = voxelize_mesh(skull, grid);
+  Mask bone = voxelize_mesh(skull, grid);
   size_t before = 0;
   for (size_t c = 0; c < mask.size(); ++c) {
     before += mask[c];
@@ -129,8 +129,9 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
   // The opening must not give back bone.
   for (size_t c = 0; c < mask.size(); ++c) mask[c] = mask[c] && !bone[c];
   // Bridging: where the implant stops short of the bone by less than twice the bridge width
-  // (ragged thin bone, e.g. by an orbit), the space within that width of both is filled, so the
-  // implant rests on the bone instead of leaving a crack.
+  // (ragged thin bone, e.g. by an orbit), what lies within the width of both is filled, so the
+  // implant rests on the bone instead of leaving a crack. Where the implant's wall meets the
+  // top of the bone at a concave corner this leaves a fillet of up to the width.
   const int bridge = static_cast<int>(std::lround(params.bridge_mm / h));
   if (bridge > 0) {
     Mask near_implant = mask, near_bone = bone;
@@ -151,14 +152,18 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
     result.mesh = implant;
     return result;
   }
-  Volume volume = mask_volume(mask, grid);
   std::vector<float> smooth = blur(mask, grid, params.smoothing_mm / h);
+  Mask().swap(mask);
   // Neither the grid nor the smoothing may carry the surface into the bone: the bone grown by
   // one voxel stays outside (the surface then lies a fraction of a voxel off the bone).
-  const Mask keep_out = morph(bone, grid, true);
-  for (size_t c = 0; c < smooth.size(); ++c)
-    if (keep_out[c]) smooth[c] = 0.0f;
-  volume.data.assign(smooth.begin(), smooth.end());
+  {
+    const Mask keep_out = morph(bone, grid, true);
+    for (size_t c = 0; c < smooth.size(); ++c)
+      if (keep_out[c]) smooth[c] = 0.0f;
+  }
+  Mask().swap(bone);
+  Volume volume = mask_volume({}, grid);
+  volume.data = std::move(smooth);
   ExtractBoneSurfaceParams surface;
   surface.threshold = 0.5;
   surface.largest_piece_only = true;

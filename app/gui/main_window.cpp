@@ -868,6 +868,17 @@ void MainWindow::refresh_page() {
   if (marker_counts_[1])
     marker_counts_[1]->setText(
         tr("Outer surface: %1, inner surface: %2").arg(counts[2]).arg(counts[3]));
+  // The build controls show the parameters the plan's implant was built with (an automatic
+  // plan is fitted to the bone), so pressing Build again keeps them unless changed.
+  if (implant_fit_ && s.implant_params) {
+    const ImplantParams& p = *s.implant_params;
+    const QSignalBlocker b1(implant_method_), b2(implant_resolution_), b3(implant_thickness_),
+        b4(implant_fit_);
+    implant_method_->setCurrentIndex(p.method == ImplantMethod::Shell ? 0 : 1);
+    implant_resolution_->setValue(p.resolution_mm);
+    implant_thickness_->setValue(std::isnan(p.thickness_mm) ? 0.0 : p.thickness_mm);
+    implant_fit_->setValue(p.fit_to_bone_mm);
+  }
   if (implant_info_)
     implant_info_->setText(
         s.implant

@@ -10,6 +10,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <unordered_set>
 
 #include "cranioplan/algorithms/file_io.h"
 #include "cranioplan/algorithms/write_mesh.h"
@@ -380,10 +381,20 @@ const PlanState& Session::state_at(size_t index) {
   return s;
 }
 
+size_t Session::cached_implant_triangles() const {
+  // Unchanged states share one implant: each is counted once.
+  std::unordered_set<const ImplantData*> seen;
+  size_t total = 0;
+  for (size_t i = 1; i < states_.size(); ++i)
+    if (states_[i] && states_[i]->implant && seen.insert(states_[i]->implant.get()).second)
+      total += states_[i]->implant->result().mesh.n_faces();
+  return total;
+}
+
 void Session::trim_cache() {
   size_t cached = 0;
   for (size_t i = 1; i < states_.size(); ++i) cached += states_[i] != nullptr;
-  while (cached > cache_limit_) {
+  while (cached > cache_limit_ || cached_implant_triangles() > cache_triangles_) {
     size_t far = 0, far_distance = 0;
     for (size_t i = 1; i < states_.size(); ++i) {
       if (!states_[i] || i == index_) continue;

@@ -32,8 +32,10 @@ TEST(TrimToBone, FillsTheGapFlushWithTheCutFaces) {
   ASSERT_TRUE(r.usable()) << r.message;
   EXPECT_TRUE(report_mesh(r.mesh).watertight);
   EXPECT_GT(signed_volume(to_soup(r.mesh)), 0.0) << "outward";
-  // Truth: [20, 30] x [2, 18] x [0, 5.3] = 848 mm³.
-  EXPECT_NEAR(r.volume_mm3, 848.0, 0.05 * 848.0);
+  // Truth: [20, 30] x [2, 18] x [0, 5.3] = 848 mm³, and the bridge's fillets where the walls
+  // meet the plates' tops (at most 1 mm × 1 mm along 2 × 16 mm: under 32 mm³).
+  EXPECT_GE(r.volume_mm3, 0.95 * 848.0);
+  EXPECT_LE(r.volume_mm3, 1.05 * 848.0 + 32.0);
   const auto [lo, hi] = [&] {
     Eigen::Vector3d a = Eigen::Vector3d::Constant(1e9), b = -a;
     for (auto vh : r.mesh.vertices()) {
@@ -44,12 +46,34 @@ TEST(TrimToBone, FillsTheGapFlushWithTheCutFaces) {
   }();
   // Against both cut faces, never into the bone, at most half a millimetre off it (the rim-gap
   // target); the grid's alignment decides where in that range.
-  EXPECT_GE(lo.x(), 20.0);
+  // The fillet over the plates' tops reaches at most the bridge's 1 mm beyond them.
+  EXPECT_GE(lo.x(), 19.0);
   EXPECT_LE(lo.x(), 20.5) << "against the left cut face";
-  EXPECT_LE(hi.x(), 30.0);
+  EXPECT_LE(hi.x(), 31.0);
   EXPECT_GE(hi.x(), 29.5) << "against the right cut face";
   const QualityReport q = check_implant(r.mesh, &bone);
   EXPECT_EQ(q.penetration_mm3, 0.0);
+}
+
+// An implant that stops 1.2 mm short of a cut face (ragged bone it was not extended to) is
+// bridged onto it; without the bridge the crack stays.
+TEST(TrimToBone, BridgesANarrowGapToTheBone) {
+  const SkullMesh bone = merge(box({0, 0, 0}, {20, 20, 5}), box({30, 0, 0}, {50, 20, 5}));
+  const SkullMesh implant = build_mesh(box({17, 2, 0.5}, {28.8, 18, 4.5}));
+  const TrimToBoneResult bridged = trim_to_bone(implant, bone);
+  TrimToBoneParams off;
+  off.bridge_mm = 0.0;
+  const TrimToBoneResult cracked = trim_to_bone(implant, bone, off);
+  ASSERT_TRUE(bridged.usable() && cracked.usable());
+  auto right_end = [](const SkullMesh& m) {
+    double x = -1e9;
+    for (auto vh : m.vertices()) x = std::max(x, static_cast<double>(m.point(vh)[0]));
+    return x;
+  };
+  EXPECT_GE(right_end(bridged.mesh), 29.5) << "rests on the right cut face";
+  EXPECT_LE(right_end(bridged.mesh), 30.0) << "never into it";
+  EXPECT_LE(right_end(cracked.mesh), 29.0) << "without the bridge, the crack stays";
+  EXPECT_EQ(check_implant(bridged.mesh, &bone).penetration_mm3, 0.0);
 }
 
 TEST(TrimToBone, AnImplantInsideTheBoneLeavesNothing) {

@@ -354,6 +354,35 @@ TEST(Session, RandomWalkEqualsFreshReplay) {
   EXPECT_EQ(test::validate_session_schema(path), "") << path;
 }
 
+// Implants fitted to the bone are large: the cached states keep at most a budget of implant
+// triangles, and states evicted for it are recomputed exactly on undo.
+TEST(Session, CachedImplantsStayWithinTheirTriangleBudget) {
+  Session s = session_at_markers();
+  add_rim(s);
+  for (double a : {0.5, 2.6, 4.7})
+    push_ok(s, commands::add_marker(MarkerType::OuterSurface,
+                                    on_head(0.7 + 0.1 * std::cos(a), 0.1 + 0.1 * std::sin(a), 0.72)));
+  push_ok(s, commands::build_implant());
+  ASSERT_TRUE(s.state().implant);
+  const size_t one = s.state().implant->result().mesh.n_faces();
+  const size_t budget = 3 * one;
+  s.set_cache_implant_triangles(budget);
+  const int id = s.state().markers.back().id;
+  std::vector<Json> states;
+  for (int k = 0; k < 12; ++k) {
+    push_ok(s, commands::note("separates the drags"));  // one drag each, not merged
+    push_ok(s, commands::move_marker(id, on_head(0.7 + 0.01 * k, 0.1, 0.72)));
+    ASSERT_TRUE(s.state().implant);
+    states.push_back(fingerprint(s.state()));
+    EXPECT_LE(s.cached_implant_triangles(), budget) << "after move " << k;
+  }
+  for (int k = 10; k >= 0; --k) {
+    ASSERT_TRUE(s.undo());  // the note
+    ASSERT_TRUE(s.undo());  // the move
+    EXPECT_EQ(fingerprint(s.state()), states[k]) << "state after move " << k;
+  }
+}
+
 TEST(Session, ChangingThePlaneRecomputesTheMirrorAndMarksLaterStepsStale) {
   Session s = session_at_markers();
   const Json mirror_before = fingerprint(s.state())["mirror"];

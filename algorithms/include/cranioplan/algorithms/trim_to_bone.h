@@ -12,8 +12,8 @@ namespace cranioplan {
 struct TrimToBoneParams {
   double voxel_mm = 0.25;        ///< grid of the subtraction, mm (0.1..1)
   /// A large implant gets a coarser grid so that it has no more voxels than this (memory and
-  /// time grow with the count; 8 million is about 0.4 mm over a 110 × 90 × 60 mm implant).
-  double max_voxels = 8e6;
+  /// time grow with the count; 6 million is about 0.45 mm over a 110 × 90 × 60 mm implant).
+  double max_voxels = 6e6;
   double min_feature_mm = 1.25;  ///< parts thinner than this (slivers on the bone) go, mm (≥ 0)
   double smoothing_mm = 0.3;     ///< Gaussian blur of the mask before meshing (σ), mm (≥ 0)
   /// Gaps narrower than twice this between the implant and the bone are filled, mm (0: off).

@@ -167,6 +167,12 @@ class Session {
   Json to_json() const;
   /// Cap on cached states besides the first (older ones are recomputed from the nearest one).
   void set_cache_limit(size_t limit) { cache_limit_ = limit; }
+  /// Cap on the triangles of the distinct implants the cached states hold (an implant fitted to
+  /// the bone has a hundred thousand or more; a plan edited for an hour would otherwise keep
+  /// gigabytes). The states farthest from the current one go first.
+  void set_cache_implant_triangles(size_t triangles) { cache_triangles_ = triangles; }
+  /// Triangles of the distinct implants the cached states hold now.
+  size_t cached_implant_triangles() const;
 
  private:
   void append_event(const std::string& event, const std::optional<Command>& command);
@@ -188,6 +194,7 @@ class Session {
   std::FILE* autosave_ = nullptr;
   ApplyContext context_;
   size_t cache_limit_ = 200;
+  size_t cache_triangles_ = 2'000'000;
 };
 
 /// Now as ISO-8601 UTC with milliseconds.
