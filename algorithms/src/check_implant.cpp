@@ -1,13 +1,12 @@
 #include "cranioplan/algorithms/check_implant.h"
 
-#include <memory>
-
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 
 #include "cranioplan/algorithms/mesh_report.h"
 #include "cranioplan/algorithms/self_intersections.h"

@@ -23,8 +23,8 @@ std::vector<Eigen::Vector3d> fibonacci_sphere(int n) {
 }
 
 RayThroughBone cast_through_bone(const SurfaceLocator& locator, const Eigen::Vector3d& center,
-                                 const Eigen::Vector3d& dir, double reach,
-                                 double min_thickness_mm, double max_thickness_mm) {
+                                 const Eigen::Vector3d& dir, double reach, double min_thickness_mm,
+                                 double max_thickness_mm) {
   RayThroughBone h;
   const auto in = locator.first_hit(center, center + reach * dir);
   if (!in) return h;
@@ -139,10 +139,9 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
       for (int i : comps[order[c.r]]) best = std::max(best, dirs[i].dot(want));
       return best;
     };
-    std::stable_sort(candidates.begin(), candidates.end(),
-                     [&](const Candidate& a, const Candidate& b) {
-                       return closeness(a) > closeness(b);
-                     });
+    std::stable_sort(
+        candidates.begin(), candidates.end(),
+        [&](const Candidate& a, const Candidate& b) { return closeness(a) > closeness(b); });
   }
   for (const Candidate& cand : candidates) {
     const size_t r = cand.r;

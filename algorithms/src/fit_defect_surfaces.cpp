@@ -90,9 +90,9 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
   for (const auto& d : defect.hole_directions) hole_cos = std::min(hole_cos, d.dot(s.axis_));
   const double clearance = std::max(0.0, params.rim_clearance_mm);
   const double width = std::max(1.0, params.ring_width_mm);
-  const double cap_angle = std::min(std::acos(std::clamp(hole_cos, -1.0, 1.0)) +
-                                        (clearance + width) / rim_radius * 1.2,
-                                    70.0 * M_PI / 180.0);
+  const double cap_angle =
+      std::min(std::acos(std::clamp(hole_cos, -1.0, 1.0)) + (clearance + width) / rim_radius * 1.2,
+               70.0 * M_PI / 180.0);
   s.max_cos_ = std::cos(cap_angle);
 
   // Rays over the cap, spaced about `ray_spacing_mm` apart at the rim's radius.
@@ -106,8 +106,8 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
   std::vector<Sample> ring;
   for (const Eigen::Vector3d& d : fibonacci_sphere(n)) {
     if (d.dot(s.axis_) < s.max_cos_) continue;
-    const RayThroughBone o = cast_through_bone(bone, s.center_, d, kReach,
-                                               detect.min_thickness_mm, detect.max_thickness_mm);
+    const RayThroughBone o = cast_through_bone(bone, s.center_, d, kReach, detect.min_thickness_mm,
+                                               detect.max_thickness_mm);
     if (!o.paired) continue;
     double chord2 = 0.0;
     hole.nearest(d, &chord2);
@@ -170,7 +170,8 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
     s.sites = static_cast<int>(kept.size());
     double sum = 0.0;
     for (size_t i = 0; i < ring.size(); ++i) sum += std::pow(residual(tps, outer, i), 2);
-    (outer ? s.outer_rms_mm : s.thickness_rms_mm) = std::sqrt(sum / static_cast<double>(ring.size()));
+    (outer ? s.outer_rms_mm : s.thickness_rms_mm) =
+        std::sqrt(sum / static_cast<double>(ring.size()));
   }
   s.status = DefectSurfaces::Status::Fitted;
   char buf[200];

@@ -82,8 +82,8 @@ RegionOfInterest local_registration_region(const DefectRegion& defect, double ma
 }
 
 MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const SurfaceLocator& bone,
-                                          const SurfaceLocator& mirror,
-                                          const ProposeParams& params, int first_id) {
+                                          const SurfaceLocator& mirror, const ProposeParams& params,
+                                          int first_id) {
   MarkerProposal r;
   r.defect = defect;
   if (!defect.found()) {
@@ -126,7 +126,8 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
   const double clearance = params.surfaces.rim_clearance_mm;
   std::vector<Eigen::Vector3d> near_ring;
   for (size_t i = 0; i < surfaces.ring_outer.size(); ++i)
-    if (surfaces.ring_distance_mm[i] <= clearance + 8.0) near_ring.push_back(surfaces.ring_outer[i]);
+    if (surfaces.ring_distance_mm[i] <= clearance + 8.0)
+      near_ring.push_back(surfaces.ring_outer[i]);
   const PointIndex near_index(near_ring.empty() ? std::vector<Eigen::Vector3d>{c} : near_ring);
   auto bone_beyond = [&](const Eigen::Vector3d& rim) {
     Eigen::Vector3d out = rim - c;

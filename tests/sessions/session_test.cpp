@@ -360,8 +360,9 @@ TEST(Session, CachedImplantsStayWithinTheirTriangleBudget) {
   Session s = session_at_markers();
   add_rim(s);
   for (double a : {0.5, 2.6, 4.7})
-    push_ok(s, commands::add_marker(MarkerType::OuterSurface,
-                                    on_head(0.7 + 0.1 * std::cos(a), 0.1 + 0.1 * std::sin(a), 0.72)));
+    push_ok(s,
+            commands::add_marker(MarkerType::OuterSurface,
+                                 on_head(0.7 + 0.1 * std::cos(a), 0.1 + 0.1 * std::sin(a), 0.72)));
   push_ok(s, commands::build_implant());
   ASSERT_TRUE(s.state().implant);
   const size_t one = s.state().implant->result().mesh.n_faces();

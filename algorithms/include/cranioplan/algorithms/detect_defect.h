@@ -14,8 +14,8 @@ namespace cranioplan {
 class SurfaceLocator;
 
 struct DetectDefectParams {
-  int directions = 20000;          ///< rays cast (Fibonacci sphere), 2,000..200,000
-  double min_area_mm2 = 300.0;     ///< smaller openings are not defects (at the rim's radius)
+  int directions = 20000;       ///< rays cast (Fibonacci sphere), 2,000..200,000
+  double min_area_mm2 = 300.0;  ///< smaller openings are not defects (at the rim's radius)
   /// Width of the ring of intact bone around the rim on which support markers are proposed.
   double support_width_mm = 12.0;
   /// Rays whose inner and outer bone are farther apart than this met other bone on the way
@@ -37,7 +37,7 @@ struct DefectRegion {
   Eigen::Vector3d axis = Eigen::Vector3d::Zero();    ///< mean direction of the opening (unit)
   double area_mm2 = 0.0;                             ///< opening area at the rim's radius
   int other_openings = 0;  ///< further openings large enough to be defects (not planned)
-  std::vector<Eigen::Vector3d> hole_directions;      ///< unit rays through the opening
+  std::vector<Eigen::Vector3d> hole_directions;  ///< unit rays through the opening
   /// The rim: the last bone met along rays next to the opening, outer and inner table, in
   /// order around the axis (same count, paired).
   std::vector<Eigen::Vector3d> outer_rim, inner_rim;
@@ -57,8 +57,8 @@ struct RayThroughBone {
   bool paired = false;
 };
 RayThroughBone cast_through_bone(const SurfaceLocator& locator, const Eigen::Vector3d& center,
-                                 const Eigen::Vector3d& dir, double reach,
-                                 double min_thickness_mm, double max_thickness_mm);
+                                 const Eigen::Vector3d& dir, double reach, double min_thickness_mm,
+                                 double max_thickness_mm);
 
 /// `center`: a point inside the cranial cavity (e.g. the skull's centroid moved onto the
 /// midsagittal plane).

@@ -43,9 +43,9 @@ class DefectSurfaces {
   Status status = Status::Failed;
   std::string message;
   bool mirror_guided = false;
-  int ring_rays = 0;           ///< intact rays on the ring (both tables met)
-  int sites = 0;               ///< fitting sites used (after thinning and outliers)
-  double outer_rms_mm = 0.0;   ///< residual of the fit over all ring rays, outer table
+  int ring_rays = 0;              ///< intact rays on the ring (both tables met)
+  int sites = 0;                  ///< fitting sites used (after thinning and outliers)
+  double outer_rms_mm = 0.0;      ///< residual of the fit over all ring rays, outer table
   double thickness_rms_mm = 0.0;  ///< the same, bone thickness (inner table)
   /// The ring's bone: outer and inner table points of the intact rays (both tables met) and
   /// each ray's distance from the opening, mm.
@@ -65,8 +65,8 @@ class DefectSurfaces {
   Eigen::Vector2d uv(const Eigen::Vector3d& dir) const;
   Eigen::Vector3d center_ = Eigen::Vector3d::Zero(), axis_ = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d e1_ = Eigen::Vector3d::UnitX(), e2_ = Eigen::Vector3d::UnitY();
-  double scale_ = 1.0;        // mm per unit of the gnomonic projection
-  double max_cos_ = 0.0;      // cosine of the cap's half-angle
+  double scale_ = 1.0;                      // mm per unit of the gnomonic projection
+  double max_cos_ = 0.0;                    // cosine of the cap's half-angle
   const SurfaceLocator* mirror_ = nullptr;  // prior (not owned); null: rim-only
   double max_thickness_mm_ = 15.0;
   ThinPlateSpline outer_, thickness_;

@@ -59,8 +59,8 @@ RegionOfInterest local_registration_region(const DefectRegion& defect, double ma
 /// Markers for an already detected defect; `bone` locates the skull it was found in, `mirror`
 /// the registered mirrored skull.
 MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const SurfaceLocator& bone,
-                                          const SurfaceLocator& mirror,
-                                          const ProposeParams& params, int first_id = 1);
+                                          const SurfaceLocator& mirror, const ProposeParams& params,
+                                          int first_id = 1);
 
 /// Detects the defect, then proposes markers (status NoDefect when there is none).
 MarkerProposal propose_markers(const SkullMesh& skull, const SurfaceLocator& bone,

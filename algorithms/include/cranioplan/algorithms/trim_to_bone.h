@@ -10,7 +10,7 @@
 namespace cranioplan {
 
 struct TrimToBoneParams {
-  double voxel_mm = 0.25;        ///< grid of the subtraction, mm (0.1..1)
+  double voxel_mm = 0.25;  ///< grid of the subtraction, mm (0.1..1)
   /// A large implant gets a coarser grid so that it has no more voxels than this (memory and
   /// time grow with the count; 6 million is about 0.45 mm over a 110 × 90 × 60 mm implant).
   double max_voxels = 6e6;
