@@ -37,17 +37,23 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
     r.message = "midsagittal plane: " + r.plane.message;
     return r;
   }
-  const SkullMesh mirrored = mirror_mesh(skull, r.plane.plane);
+  SkullMesh mirrored = mirror_mesh(skull, r.plane.plane);
   timer.stage("mirror");
   r.registration = register_icp(mirrored, skull, params.registration);
-  r.mirrored =
-      r.registration.usable() ? transform_mesh(mirrored, r.registration.transform) : mirrored;
   timer.stage("register");
+  // The registered mirror is made once the registration is final, and the unregistered one is
+  // let go then: on a skull of two million triangles each copy is a few hundred megabytes.
+  auto place_mirror = [&] {
+    r.mirrored = r.registration.usable() ? transform_mesh(mirrored, r.registration.transform)
+                                         : std::move(mirrored);
+    mirrored = SkullMesh();
+  };
 
   const SurfaceLocator bone(skull);
   r.defect = detect_defect_near_plane(skull, bone, r.plane.plane, params.propose.detect);
   timer.stage("detect");
   if (!r.defect.found()) {
+    place_mirror();
     r.status = AutoplanResult::Status::NoDefect;
     r.message = r.defect.message;
     return r;
@@ -58,12 +64,10 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
     local.initial = r.registration.transform;
     local.roi = local_registration_region(r.defect, params.local_registration_mm);
     const RegisterResult lr = register_icp(mirrored, skull, local);
-    if (lr.usable()) {
-      r.registration = lr;
-      r.mirrored = transform_mesh(mirrored, lr.transform);
-    }
+    if (lr.usable()) r.registration = lr;
     timer.stage("local register");
   }
+  place_mirror();
   const SurfaceLocator mirror(r.mirrored);
   MarkerProposal proposal = propose_markers_for_defect(r.defect, bone, mirror, params.propose);
   r.mirror_coverage = proposal.mirror_coverage;

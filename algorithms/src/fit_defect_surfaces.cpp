@@ -3,6 +3,8 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
+#include <string>
 
 #include "cranioplan/algorithms/point_index.h"
 #include "cranioplan/algorithms/surface_locator.h"
