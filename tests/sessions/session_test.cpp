@@ -48,6 +48,13 @@ void add_rim(Session& s) {
                                                                    0.1 + 0.2 * std::sin(a), 0.7)));
 }
 
+// Three outer surface markers inside the rim, at height `z` of the head's direction.
+void add_surface_markers(Session& s, double z) {
+  for (double a : {0.5, 2.6, 4.7})
+    push_ok(s, commands::add_marker(MarkerType::OuterSurface,
+                                    on_head(0.7 + 0.1 * std::cos(a), 0.1 + 0.1 * std::sin(a), z)));
+}
+
 std::string expect_session_error(const std::string& path) {
   try {
     Session::open(path);
@@ -219,10 +226,7 @@ TEST(StepLock, LaterStepsAreRefusedWithWhatIsMissing) {
 TEST(Session, AVersionOneBuildIsAppliedWithoutFitting) {
   Session s = session_at_markers();
   add_rim(s);
-  for (double a : {0.5, 2.6, 4.7})
-    push_ok(s,
-            commands::add_marker(MarkerType::OuterSurface,
-                                 on_head(0.7 + 0.1 * std::cos(a), 0.1 + 0.1 * std::sin(a), 0.7)));
+  add_surface_markers(s, 0.7);
   Json v1 = to_json(commands::build_implant());
   v1["version"] = 1;
   v1["params"]["params"].erase("fit_to_bone_mm");
@@ -359,10 +363,7 @@ TEST(Session, RandomWalkEqualsFreshReplay) {
 TEST(Session, CachedImplantsStayWithinTheirTriangleBudget) {
   Session s = session_at_markers();
   add_rim(s);
-  for (double a : {0.5, 2.6, 4.7})
-    push_ok(s,
-            commands::add_marker(MarkerType::OuterSurface,
-                                 on_head(0.7 + 0.1 * std::cos(a), 0.1 + 0.1 * std::sin(a), 0.72)));
+  add_surface_markers(s, 0.72);
   push_ok(s, commands::build_implant());
   ASSERT_TRUE(s.state().implant);
   const size_t one = s.state().implant->result().mesh.n_faces();
