@@ -108,12 +108,9 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
     for (double g : sector)
       if (std::isfinite(g)) q.rim_gap_mm = std::max(q.rim_gap_mm, g);
     const auto [lo, hi] = mesh_bounds(implant);
-    const double volume = (hi - lo).prod();
-    const VoxelGrid grid = VoxelGrid::covering(
-        lo, hi,
-        std::clamp(std::max(params.overlap_voxel_mm,
-                            std::cbrt(volume / std::max(1e5, params.overlap_max_voxels))),
-                   0.05, 2.0));
+    const VoxelGrid grid =
+        VoxelGrid::covering_at_most(lo, hi, std::clamp(params.overlap_voxel_mm, 0.05, 2.0),
+                                    std::max(1e5, params.overlap_max_voxels));
     const auto a = voxelize_mesh(implant, grid), b = voxelize_mesh(*skull, grid);
     long long both = 0;
     for (size_t i = 0; i < a.size(); ++i) both += a[i] && b[i];

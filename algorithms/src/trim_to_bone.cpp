@@ -110,11 +110,9 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
   const auto t0 = std::chrono::steady_clock::now();
   TrimToBoneResult result;
   const auto [lo, hi] = mesh_bounds(implant);
-  const Eigen::Vector3d extent = (hi - lo).array() + 8.0 * params.voxel_mm;
-  const double h = std::clamp(
-      std::max(params.voxel_mm, std::cbrt(extent.prod() / std::max(1e5, params.max_voxels))), 0.1,
-      1.0);
-  const VoxelGrid grid = VoxelGrid::covering(lo, hi, h, 4);
+  const VoxelGrid grid = VoxelGrid::covering_at_most(lo, hi, std::clamp(params.voxel_mm, 0.1, 1.0),
+                                                     std::max(1e5, params.max_voxels), 4);
+  const double h = grid.spacing;
   Mask mask = voxelize_mesh(implant, grid);
   Mask bone = voxelize_mesh(skull, grid);
   size_t before = 0;
@@ -147,9 +145,13 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
   for (uint8_t m : mask) after += m;
   result.removed_mm3 = static_cast<double>(before - std::min(before, after)) * grid.voxel_volume();
   result.volume_mm3 = static_cast<double>(after) * grid.voxel_volume();
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
   if (after == 0) {
     result.message = "nothing of the implant lies outside the bone";
     result.mesh = implant;
+    result.seconds = elapsed();
     return result;
   }
   std::vector<float> smooth = blur(mask, grid, params.smoothing_mm / h);
@@ -171,11 +173,12 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
   if (!s.usable()) {
     result.message = s.message;
     result.mesh = implant;
+    result.seconds = elapsed();
     return result;
   }
   result.mesh = std::move(s.mesh);
   result.status = TrimToBoneResult::Status::Trimmed;
-  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  result.seconds = elapsed();
   return result;
 }
 

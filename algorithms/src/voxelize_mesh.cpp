@@ -16,6 +16,16 @@ VoxelGrid VoxelGrid::covering(const Eigen::Vector3d& lo, const Eigen::Vector3d& 
   return g;
 }
 
+VoxelGrid VoxelGrid::covering_at_most(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                      double spacing, double max_voxels, int pad) {
+  const double budget = std::max(1e3, max_voxels);
+  const Eigen::Vector3d extent = (hi - lo).array() + 2.0 * pad * spacing;
+  VoxelGrid g = covering(lo, hi, std::max(spacing, std::cbrt(extent.prod() / budget)), pad);
+  // The padding and rounding up add a few voxels per axis: coarsen until within the budget.
+  while (static_cast<double>(g.size()) > budget) g = covering(lo, hi, g.spacing * 1.01, pad);
+  return g;
+}
+
 std::pair<Eigen::Vector3d, Eigen::Vector3d> mesh_bounds(const SkullMesh& mesh) {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
   Eigen::Vector3d hi = -lo;

@@ -522,14 +522,7 @@ QWidget* MainWindow::make_page(int step) {
           // With several openings in the skull, the one where the user has put edge markers is
           // meant (otherwise the largest).
           ProposeParams params;
-          Eigen::Vector3d sum = Eigen::Vector3d::Zero();
-          int edges = 0;
-          for (const auto& m : controller_->state().markers)
-            if (is_edge(m.type)) {
-              sum += m.position;
-              ++edges;
-            }
-          if (edges > 0) params.detect.near = sum / edges;
+          params.detect.near = edge_marker_centre(controller_->state().markers);
           push(commands::propose_markers(params), tr("Finding the defect and proposing markers"));
         });
         auto* import = button(tr("Import markers…"), "importMarkers", page);

@@ -5,6 +5,7 @@
 #include "cranioplan/algorithms/check_implant.h"
 #include "cranioplan/algorithms/mesh_report.h"
 #include "cranioplan/algorithms/surface_locator.h"
+#include "cranioplan/algorithms/voxelize_mesh.h"
 #include "support/synthetic.h"
 
 namespace cranioplan {
@@ -74,6 +75,17 @@ TEST(TrimToBone, BridgesANarrowGapToTheBone) {
   EXPECT_LE(right_end(bridged.mesh), 30.0) << "never into it";
   EXPECT_LE(right_end(cracked.mesh), 29.0) << "without the bridge, the crack stays";
   EXPECT_EQ(check_implant(bridged.mesh, &bone).penetration_mm3, 0.0);
+}
+
+// A large box on a fine grid is coarsened to the voxel budget; a small one keeps the spacing.
+TEST(VoxelGrid, CoveringAtMostKeepsToTheVoxelBudget) {
+  const Eigen::Vector3d lo(0, 0, 0), big(110, 90, 60), small(10, 10, 10);
+  const VoxelGrid coarse = VoxelGrid::covering_at_most(lo, big, 0.25, 6e6, 4);
+  EXPECT_GT(coarse.spacing, 0.25);
+  EXPECT_LE(static_cast<double>(coarse.size()), 6e6);
+  EXPECT_GE(static_cast<double>(coarse.size()), 6e6 * 0.8);
+  const VoxelGrid fine = VoxelGrid::covering_at_most(lo, small, 0.25, 6e6, 4);
+  EXPECT_EQ(fine.spacing, 0.25);
 }
 
 TEST(TrimToBone, AnImplantInsideTheBoneLeavesNothing) {

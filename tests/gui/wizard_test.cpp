@@ -182,18 +182,13 @@ TEST_F(Wizard, AllNineStepsOnTheSampleReplayToTheSameImplant) {
   EXPECT_TRUE(plan.session().stack().back().params["params"]["detect"]["near"].is_null())
       << "no markers yet: the largest opening";
   // Proposing again with edge markers placed asks for the opening where they are.
-  Eigen::Vector3d edge_sum = Eigen::Vector3d::Zero();
-  int edge_count = 0;
-  for (const auto& m : plan.state().markers)
-    if (is_edge(m.type)) {
-      edge_sum += m.position;
-      ++edge_count;
-    }
+  const auto edge_centre = edge_marker_centre(plan.state().markers);
+  ASSERT_TRUE(edge_centre);
   click(w, "propose");
   plan.wait();
   const Json& near = plan.session().stack().back().params["params"]["detect"]["near"];
   ASSERT_TRUE(near.is_array()) << "the edge markers' centre is recorded as the point";
-  EXPECT_NEAR(near[0].get<double>(), edge_sum.x() / edge_count, 1e-9);
+  EXPECT_NEAR(near[0].get<double>(), edge_centre->x(), 1e-9);
   ASSERT_GT(plan.state().markers.size(), 20u);
   const Marker edge = plan.state().markers.front();
   ASSERT_TRUE(is_edge(edge.type));

@@ -1,6 +1,7 @@
 #include <gtest/gtest.h>
 
 #include "cranioplan/model/error.h"
+#include "cranioplan/model/marker.h"
 #include "cranioplan/model/mesh.h"
 #include "cranioplan/model/plane.h"
 #include "cranioplan/model/rigid_transform.h"
@@ -52,4 +53,22 @@ TEST(Error, InputErrorNamesFileFirstAndCountsReadably) {
   EXPECT_EQ(format_count(999), "999");
 }
 
+}  // namespace cranioplan
+
+namespace cranioplan {
+namespace {
+
+TEST(Markers, EdgeMarkerCentreAveragesOnlyEdgeMarkers) {
+  EXPECT_FALSE(edge_marker_centre({}).has_value());
+  const std::vector<Marker> markers = {
+      {1, MarkerType::OuterEdge, {0, 0, 0}, MarkerSurface::Original},
+      {2, MarkerType::InnerEdge, {4, 2, 0}, MarkerSurface::Original},
+      {3, MarkerType::OuterSurface, {100, 100, 100}, MarkerSurface::Mirrored}};
+  const auto c = edge_marker_centre(markers);
+  ASSERT_TRUE(c.has_value());
+  EXPECT_TRUE(c->isApprox(Eigen::Vector3d(2, 1, 0)));
+  EXPECT_FALSE(edge_marker_centre({markers[2]}).has_value()) << "surface markers only";
+}
+
+}  // namespace
 }  // namespace cranioplan

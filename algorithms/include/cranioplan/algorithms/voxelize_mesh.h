@@ -29,6 +29,10 @@ struct VoxelGrid {
   /// The grid that covers [lo, hi] with `pad` extra voxels on every side.
   static VoxelGrid covering(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double spacing,
                             int pad = 2);
+  /// The same, coarser than `spacing` where needed so that it has at most `max_voxels`
+  /// voxels (memory and time grow with the count).
+  static VoxelGrid covering_at_most(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
+                                    double spacing, double max_voxels, int pad = 2);
 };
 
 /// Bounding box of a mesh's vertices.

@@ -1,5 +1,6 @@
 #pragma once
 #include <Eigen/Core>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -29,6 +30,9 @@ inline bool is_outer(MarkerType t) {
 inline MarkerSurface default_surface(MarkerType t) {
   return is_edge(t) ? MarkerSurface::Original : MarkerSurface::Mirrored;
 }
+/// Centre of the edge markers (types 0 and 1); none when there are none.
+std::optional<Eigen::Vector3d> edge_marker_centre(const std::vector<Marker>& markers);
+
 const char* to_string(MarkerType t);
 const char* to_string(MarkerSurface s);
 
