@@ -37,23 +37,28 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
     r.message = "midsagittal plane: " + r.plane.message;
     return r;
   }
-  SkullMesh mirrored = mirror_mesh(skull, r.plane.plane);
-  timer.stage("mirror");
-  r.registration = register_icp(mirrored, skull, params.registration);
-  timer.stage("register");
-  // The registered mirror is made once the registration is final, and the unregistered one is
-  // let go then: on a skull of two million triangles each copy is a few hundred megabytes.
-  auto place_mirror = [&] {
-    r.mirrored = r.registration.usable() ? transform_mesh(mirrored, r.registration.transform)
-                                         : std::move(mirrored);
-    mirrored = SkullMesh();
+  // The mirror is never built as a mesh here: it is the skull moved by the reflection and then
+  // the registration, so it is registered as the skull with the reflection as the starting
+  // transform, and its locator is the skull's locator moved (on a skull of two million
+  // triangles a mesh and a locator are a few hundred megabytes each).
+  const RigidTransform reflection = reflection_across(r.plane.plane);
+  RegisterParams global = params.registration;
+  global.initial = params.registration.initial * reflection;
+  auto registration_of_mirror = [&](RegisterResult result) {
+    result.transform = result.transform * reflection;  // the reflection is its own inverse
+    return result;
   };
+  r.registration = registration_of_mirror(register_icp(skull, skull, global));
+  timer.stage("register");
 
   const SurfaceLocator bone(skull);
   r.defect = detect_defect_near_plane(skull, bone, r.plane.plane, params.propose.detect);
   timer.stage("detect");
+  auto mirror_motion = [&] {
+    return r.registration.usable() ? r.registration.transform * reflection : reflection;
+  };
   if (!r.defect.found()) {
-    place_mirror();
+    r.mirror_motion = mirror_motion();
     r.status = AutoplanResult::Status::NoDefect;
     r.message = r.defect.message;
     return r;
@@ -61,14 +66,14 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
 
   if (params.local_registration_mm > 0.0 && r.registration.usable()) {
     RegisterParams local = params.registration;
-    local.initial = r.registration.transform;
+    local.initial = r.registration.transform * reflection;
     local.roi = local_registration_region(r.defect, params.local_registration_mm);
-    const RegisterResult lr = register_icp(mirrored, skull, local);
+    const RegisterResult lr = registration_of_mirror(register_icp(skull, skull, local));
     if (lr.usable()) r.registration = lr;
     timer.stage("local register");
   }
-  place_mirror();
-  const SurfaceLocator mirror(r.mirrored);
+  r.mirror_motion = mirror_motion();
+  const SurfaceLocator mirror = bone.moved(r.mirror_motion);
   MarkerProposal proposal = propose_markers_for_defect(r.defect, bone, mirror, params.propose);
   r.mirror_coverage = proposal.mirror_coverage;
   r.method_used = proposal.method_used;

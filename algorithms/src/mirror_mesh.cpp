@@ -9,4 +9,11 @@ SkullMesh mirror_mesh(const SkullMesh& mesh, const Plane& plane) {
   return build_mesh(soup);
 }
 
+RigidTransform reflection_across(const Plane& plane) {
+  RigidTransform t;
+  t.rotation = Eigen::Matrix3d::Identity() - 2.0 * plane.normal * plane.normal.transpose();
+  t.translation = 2.0 * plane.offset * plane.normal;
+  return t;
+}
+
 }  // namespace cranioplan

@@ -96,7 +96,7 @@ Json run_bench(const BenchOptions& options) {
       dense.propose.edge_spacing_mm = std::min(4.0, spacing);
       plan = autoplan(skull.mesh, Landmarks{}, dense);
     }
-    const SurfaceLocator bone(skull.mesh), mirror(plan.mirrored);
+    const SurfaceLocator bone(skull.mesh), mirror = bone.moved(plan.mirror_motion);
     out["edit_markers"] = plan.markers.size();
     // While markers are edited the shell is rebuilt as it stands (the wizard's live preview);
     // fitting it to the bone (automatic plans, and the wizard's "Fit to the bone") costs more.

@@ -6,6 +6,7 @@
 
 #include "cranioplan/algorithms/compare_implants.h"
 #include "cranioplan/algorithms/inject_defect.h"
+#include "cranioplan/algorithms/mirror_mesh.h"
 #include "cranioplan/algorithms/surface_locator.h"
 #include "support/synthetic.h"
 
@@ -101,7 +102,10 @@ TEST(Autoplan, StagesAreConsistent) {
   const AutoplanResult r = autoplan(d.defective, Landmarks{});
   ASSERT_TRUE(r.planned()) << r.message;
   EXPECT_EQ(r.method_used, PlanMethod::Mirror);
-  const SurfaceLocator bone(d.defective), mirror(r.mirrored);
+  // The mirror built as a mesh, as the wizard shows it: autoplan only moved the skull's locator.
+  const SurfaceLocator bone(d.defective),
+      mirror(transform_mesh(mirror_mesh(d.defective, r.plane.plane), r.registration.transform));
+  const SurfaceLocator moved = bone.moved(r.mirror_motion);
   int edges = 0, support = 0, inside = 0;
   for (const auto& m : r.markers) {
     if (is_edge(m.type)) {
@@ -118,6 +122,7 @@ TEST(Autoplan, StagesAreConsistent) {
     } else {
       ++inside;
       EXPECT_LT(mirror.closest(m.position).distance, 0.5) << "surface marker " << m.id;
+      EXPECT_NEAR(moved.closest(m.position).distance, mirror.closest(m.position).distance, 1e-9);
     }
   }
   EXPECT_GE(edges, 10);

@@ -40,7 +40,11 @@ struct AutoplanResult {
   std::string message;
   PlaneFit plane;
   RegisterResult registration;
-  SkullMesh mirrored;  ///< mirrored and registered onto the skull
+  /// The skull's motion onto its mirror image, registered: the reflection across the plane, then
+  /// the registration (an improper transform). The mirrored skull is
+  /// `transform_mesh(mirror_mesh(skull, plane.plane), registration.transform)`, and its locator
+  /// `SurfaceLocator(skull).moved(mirror_motion)`; autoplan builds neither mesh.
+  RigidTransform mirror_motion;
   DefectRegion defect;
   PlanMethod method_used = PlanMethod::RimOnly;
   double mirror_coverage = 0.0;  ///< fraction of the opening's rays that meet mirrored bone

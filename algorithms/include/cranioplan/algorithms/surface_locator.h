@@ -1,11 +1,13 @@
 #pragma once
-// Closest points on, and ray hits with, a triangle mesh (VTK's static cell locator stays
-// private). Built once per mesh. Queries share scratch space: one thread at a time.
+// Closest points on, and segment hits with, a triangle mesh: a bounding-volume hierarchy over
+// the faces (float boxes rounded outward, double-precision geometry), built once per mesh.
+// Queries are const and keep no scratch space, so threads may share a locator.
 #include <Eigen/Core>
 #include <memory>
 #include <optional>
 
 #include "cranioplan/model/mesh.h"
+#include "cranioplan/model/rigid_transform.h"
 
 namespace cranioplan {
 
@@ -13,8 +15,16 @@ class SurfaceLocator {
  public:
   explicit SurfaceLocator(const SkullMesh& mesh);
   ~SurfaceLocator();
+  SurfaceLocator(const SurfaceLocator&);
+  SurfaceLocator& operator=(const SurfaceLocator&);
   SurfaceLocator(SurfaceLocator&&) noexcept;
   SurfaceLocator& operator=(SurfaceLocator&&) noexcept;
+
+  /// The same surface moved by `motion`, sharing this locator's tree (nothing is copied): the
+  /// locator of a mirrored and registered skull is its skull's locator moved. `motion` must be
+  /// an isometry; a reflection is allowed for meshes whose faces were reversed with it (as
+  /// mirror_mesh() does), so that outward normals stay outward. Face indices are the original's.
+  SurfaceLocator moved(const RigidTransform& motion) const;
 
   struct Closest {
     Eigen::Vector3d point;  ///< closest point on the surface, mm
@@ -32,12 +42,18 @@ class SurfaceLocator {
   /// First intersection of the segment from `from` to `to` with the surface, if any.
   std::optional<Hit> first_hit(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const;
 
-  /// Unit normal of face `face` (counter-clockwise orientation).
+  /// Unit normal of face `face` (counter-clockwise orientation; zero for a degenerate face).
   Eigen::Vector3d face_normal(int face) const;
 
+  /// Bytes held by the shared tree and geometry.
+  size_t memory_bytes() const;
+
  private:
-  struct Impl;
-  std::unique_ptr<Impl> impl_;
+  struct Tree;
+  SurfaceLocator(std::shared_ptr<const Tree> tree, const RigidTransform& motion, bool moved);
+  std::shared_ptr<const Tree> tree_;
+  RigidTransform motion_;  // world = motion_(tree coordinates)
+  bool moved_ = false;
 };
 
 }  // namespace cranioplan

@@ -25,6 +25,7 @@ namespace cranioplan {
 /// A mesh with its locator, built once and shared by every state that uses it.
 struct SharedSurface {
   explicit SharedSurface(SkullMesh m);
+  SharedSurface(SkullMesh m, SurfaceLocator l);  ///< `l` must answer for `m`
   SkullMesh mesh;
   SurfaceLocator locator;
 };
