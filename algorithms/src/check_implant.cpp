@@ -8,6 +8,7 @@
 #include <limits>
 #include <memory>
 
+#include "cranioplan/algorithms/distance_transform.h"
 #include "cranioplan/algorithms/mesh_report.h"
 #include "cranioplan/algorithms/self_intersections.h"
 #include "cranioplan/algorithms/surface_locator.h"
@@ -20,6 +21,41 @@ std::string fmt(const char* f, double a, double b) {
   std::snprintf(buf, sizeof(buf), f, a, b);
   return buf;
 }
+std::string fmt1(const char* f, double a) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), f, a);
+  return buf;
+}
+// Material thinner than the minimum: the solid minus its opening by a ball of that diameter
+// (the union of the balls that fit inside). Where it lies within its own thinness of the bone
+// it is the tapered edge of an implant resting on the bone; how far it reaches from the thick
+// part is the width of that taper.
+void measure_thin_material(const std::vector<uint8_t>& solid, const VoxelGrid& grid,
+                           const std::vector<float>& bone_distance, const QualityParams& params,
+                           QualityReport& q) {
+  const double r = 0.5 * std::max(0.0, params.min_thickness_mm), h = grid.spacing;
+  const std::vector<uint8_t> centres = ball_centres(solid, grid, r);
+  if (std::find(centres.begin(), centres.end(), 1) == centres.end()) {
+    q.taper_reach_mm = q.corner_reach_mm = -1.0;
+    return;
+  }
+  const std::vector<float> to_core = distance_to_mask(centres, grid);
+  size_t thin = 0, off_bone = 0;
+  for (size_t c = 0; c < solid.size(); ++c) {
+    if (!solid[c] || to_core[c] <= r + h) continue;  // within a ball that fits (one voxel slack)
+    ++thin;
+    const double reach = static_cast<double>(to_core[c]) - r;
+    if (!bone_distance.empty() && bone_distance[c] <= params.min_thickness_mm + 1.5 * h) {
+      q.taper_reach_mm = std::max(q.taper_reach_mm, reach);
+    } else {
+      ++off_bone;
+      q.corner_reach_mm = std::max(q.corner_reach_mm, reach);
+    }
+  }
+  q.thin_volume_mm3 = static_cast<double>(thin) * grid.voxel_volume();
+  q.thin_off_bone_mm3 = static_cast<double>(off_bone) * grid.voxel_volume();
+}
+
 }  // namespace
 
 QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
@@ -87,6 +123,13 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
     q.thickness_median_mm = thickness[thickness.size() / 2];
     q.thickness_max_mm = thickness.back();
   }
+  // The implant as a solid on a grid (thin material and, with a skull, the overlap).
+  const auto [lo, hi] = mesh_bounds(implant);
+  const VoxelGrid grid =
+      VoxelGrid::covering_at_most(lo, hi, std::clamp(params.overlap_voxel_mm, 0.05, 2.0),
+                                  std::max(1e5, params.overlap_max_voxels));
+  const std::vector<uint8_t> solid = voxelize_mesh(implant, grid);
+  std::vector<float> bone_distance;  // empty without a skull
   if (skull && skull->n_faces() > 0) {
     std::unique_ptr<SurfaceLocator> own;
     if (!skull_locator) own = std::make_unique<SurfaceLocator>(*skull);
@@ -107,15 +150,13 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
     q.rim_gap_mm = 0.0;
     for (double g : sector)
       if (std::isfinite(g)) q.rim_gap_mm = std::max(q.rim_gap_mm, g);
-    const auto [lo, hi] = mesh_bounds(implant);
-    const VoxelGrid grid =
-        VoxelGrid::covering_at_most(lo, hi, std::clamp(params.overlap_voxel_mm, 0.05, 2.0),
-                                    std::max(1e5, params.overlap_max_voxels));
-    const auto a = voxelize_mesh(implant, grid), b = voxelize_mesh(*skull, grid);
+    const std::vector<uint8_t> b = voxelize_mesh(*skull, grid);
     long long both = 0;
-    for (size_t i = 0; i < a.size(); ++i) both += a[i] && b[i];
+    for (size_t i = 0; i < solid.size(); ++i) both += solid[i] && b[i];
     q.penetration_mm3 = static_cast<double>(both) * grid.voxel_volume();
+    bone_distance = distance_to_mask(b, grid);
   }
+  measure_thin_material(solid, grid, bone_distance, params, q);
 
   if (!q.watertight)
     q.reasons.push_back("not watertight (" + std::to_string(rep.boundary_edges) +
@@ -126,11 +167,19 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
   if (q.self_intersections > 0)
     q.reasons.push_back(std::to_string(q.self_intersections) +
                         " pairs of triangles cross each other");
-  if (thickness.empty())
-    q.reasons.push_back("thickness could not be measured");
-  else if (q.thickness_min_mm < params.min_thickness_mm)
-    q.reasons.push_back(
-        fmt("thinnest part %.2f mm is below %.2f mm", q.thickness_min_mm, params.min_thickness_mm));
+  if (q.taper_reach_mm < 0)
+    q.reasons.push_back(fmt("nowhere is the implant %.2f mm thick (thickest %.2f mm)",
+                            params.min_thickness_mm, q.thickness_max_mm));
+  if (q.corner_reach_mm > params.max_corner_mm)
+    q.reasons.push_back(fmt("away from the bone it is thinner than %.2f mm for %.1f mm",
+                            params.min_thickness_mm, q.corner_reach_mm) +
+                        " (" + fmt1("%.1f", q.thin_off_bone_mm3) + " mm³; a sharp corner may be " +
+                        fmt1("%.1f", params.max_corner_mm) + " mm)");
+  if (q.taper_reach_mm > params.max_taper_mm)
+    q.reasons.push_back(fmt("its edge stays thinner than %.2f mm for %.1f mm",
+                            params.min_thickness_mm, q.taper_reach_mm) +
+                        " (a tapered edge on the bone may be " + fmt1("%.1f", params.max_taper_mm) +
+                        " mm wide)");
   if (q.rim_gap_mm > params.max_rim_gap_mm)
     q.reasons.push_back(fmt("gap of %.2f mm between the rim and the bone (limit %.2f mm)",
                             q.rim_gap_mm, params.max_rim_gap_mm));

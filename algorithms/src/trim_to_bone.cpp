@@ -5,6 +5,7 @@
 #include <cmath>
 #include <vector>
 
+#include "cranioplan/algorithms/distance_transform.h"
 #include "cranioplan/algorithms/extract_bone_surface.h"
 #include "cranioplan/algorithms/voxelize_mesh.h"
 
@@ -69,6 +70,53 @@ Mask largest_piece(const Mask& in, const VoxelGrid& g) {
   return out;
 }
 
+// What `implant` and `bone` have on either side of voxel (i,j,k) along (di,dj,dk): 1 implant,
+// 2 bone, 0 nothing within `reach` steps (the first non-empty voxel decides).
+int first_along(const Mask& implant, const Mask& bone, const VoxelGrid& g, int i, int j, int k,
+                int di, int dj, int dk, int reach) {
+  for (int s = 1; s <= reach; ++s) {
+    const int a = i + s * di, b = j + s * dj, c = k + s * dk;
+    if (a < 0 || b < 0 || c < 0 || a >= g.dims[0] || b >= g.dims[1] || c >= g.dims[2]) return 0;
+    const size_t v = g.index(a, b, c);
+    if (implant[v]) return 1;
+    if (bone[v]) return 2;
+  }
+  return 0;
+}
+
+// Fills the voxels of cracks narrower than twice `steps` voxels between implant and bone.
+Mask bridge_cracks(const Mask& implant, const Mask& bone, const VoxelGrid& g, int steps) {
+  // Candidates: within `steps` (6-neighbour steps) of both.
+  Mask near_implant = implant, near_bone = bone;
+  for (int s = 0; s < steps; ++s) {
+    near_implant = morph(near_implant, g, true);
+    near_bone = morph(near_bone, g, true);
+  }
+  static const int dirs[13][3] = {{1, 0, 0},  {0, 1, 0},  {0, 0, 1}, {1, 1, 0},  {1, -1, 0},
+                                  {1, 0, 1},  {1, 0, -1}, {0, 1, 1}, {0, 1, -1}, {1, 1, 1},
+                                  {1, 1, -1}, {1, -1, 1}, {-1, 1, 1}};
+  Mask out = implant;
+  for (int k = 0; k < g.dims[2]; ++k)
+    for (int j = 0; j < g.dims[1]; ++j)
+      for (int i = 0; i < g.dims[0]; ++i) {
+        const size_t c = g.index(i, j, k);
+        if (implant[c] || bone[c] || !near_implant[c] || !near_bone[c]) continue;
+        for (const auto& d : dirs) {
+          // Steps along a diagonal are longer: the width is kept in millimetres.
+          const double len = std::sqrt(double(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
+          const int reach = std::max(1, static_cast<int>(std::floor(steps / len + 1e-9)));
+          const int ahead = first_along(implant, bone, g, i, j, k, d[0], d[1], d[2], reach);
+          if (ahead == 0) continue;
+          const int behind = first_along(implant, bone, g, i, j, k, -d[0], -d[1], -d[2], reach);
+          if (behind != 0 && behind != ahead) {
+            out[c] = 1;
+            break;
+          }
+        }
+      }
+  return out;
+}
+
 // Separable Gaussian blur of a 0/1 mask along the three axes.
 std::vector<float> blur(const Mask& in, const VoxelGrid& g, double sigma_voxels) {
   std::vector<float> a(in.begin(), in.end());
@@ -120,26 +168,19 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
     before += mask[c];
     mask[c] = mask[c] && !bone[c];
   }
-  // Opening: slivers thinner than the feature size (left on top of intact bone) disappear.
-  const int steps = static_cast<int>(std::lround(params.min_feature_mm / (2.0 * h)));
-  for (int s = 0; s < steps; ++s) mask = morph(mask, grid, false);
-  for (int s = 0; s < steps; ++s) mask = morph(mask, grid, true);
+  // Opening by a ball: slivers thinner than the feature size (left on top of intact bone, and
+  // the thin lip where the shell's outer surface grazes the bone's) disappear, so the implant
+  // ends in an edge at least that thick instead of a feather.
+  if (params.min_feature_mm > 0) mask = open_by_ball(mask, grid, 0.5 * params.min_feature_mm);
   // The opening must not give back bone.
   for (size_t c = 0; c < mask.size(); ++c) mask[c] = mask[c] && !bone[c];
   // Bridging: where the implant stops short of the bone by less than twice the bridge width
-  // (ragged thin bone, e.g. by an orbit), what lies within the width of both is filled, so the
-  // implant rests on the bone instead of leaving a crack. Where the implant's wall meets the
-  // top of the bone at a concave corner this leaves a fillet of up to the width.
+  // (ragged thin bone, e.g. by an orbit), the crack between them is filled, so the implant
+  // rests on the bone. A voxel is in a crack when, along one of 13 directions, the implant lies
+  // on one side and the bone on the other, each within the width with nothing between; so a
+  // concave corner where the implant's wall meets the top of the bone gets no fillet.
   const int bridge = static_cast<int>(std::lround(params.bridge_mm / h));
-  if (bridge > 0) {
-    Mask near_implant = mask, near_bone = bone;
-    for (int s = 0; s < bridge; ++s) {
-      near_implant = morph(near_implant, grid, true);
-      near_bone = morph(near_bone, grid, true);
-    }
-    for (size_t c = 0; c < mask.size(); ++c)
-      mask[c] = mask[c] || (near_implant[c] && near_bone[c] && !bone[c]);
-  }
+  if (bridge > 0) mask = bridge_cracks(mask, bone, grid, bridge);
   mask = largest_piece(mask, grid);
   size_t after = 0;
   for (uint8_t m : mask) after += m;

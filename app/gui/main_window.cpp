@@ -77,6 +77,12 @@ QString quality_html(const QualityReport& r) {
                                                        .arg(r.thickness_min_mm, 0, 'f', 1)
                                                        .arg(r.thickness_median_mm, 0, 'f', 1)
                                                        .arg(r.thickness_max_mm, 0, 'f', 1));
+  row(QObject::tr("Thinner than the minimum"),
+      r.taper_reach_mm < 0 ? QObject::tr("everywhere")
+                           : QObject::tr("%1 mm³: edge on the bone %2 mm wide, elsewhere %3 mm")
+                                 .arg(r.thin_volume_mm3, 0, 'f', 1)
+                                 .arg(r.taper_reach_mm, 0, 'f', 1)
+                                 .arg(r.corner_reach_mm, 0, 'f', 1));
   if (r.rim_gap_mm >= 0)
     row(QObject::tr("Gap to bone (rim)"), QString::number(r.rim_gap_mm, 'f', 2) + " mm");
   if (r.penetration_mm3 >= 0)

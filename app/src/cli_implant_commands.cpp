@@ -233,6 +233,8 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
     cmd->add_option("IMPLANT", o->implant, "implant mesh")->required();
     cmd->add_option("--skull", o->skull, "the (defective) skull it is made for");
     cmd->add_option("--min-thickness", o->params.min_thickness_mm, "thinnest printable (mm)");
+    cmd->add_option("--max-taper", o->params.max_taper_mm,
+                    "widest edge on the bone that may be thinner (mm)");
     cmd->add_option("--max-rim-gap", o->params.max_rim_gap_mm, "largest acceptable rim gap (mm)");
     cmd->add_option("--max-penetration", o->params.max_penetration_mm3,
                     "largest acceptable overlap (mm³)");

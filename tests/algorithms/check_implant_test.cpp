@@ -12,6 +12,16 @@ SkullMesh box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   return build_mesh(test::box_soup(lo, hi));
 }
 
+bool has_reason(const QualityReport& q, const std::string& part) {
+  for (const auto& r : q.reasons)
+    if (r.find(part) != std::string::npos) return true;
+  return false;
+}
+
+bool judged_thin(const QualityReport& q) {
+  return has_reason(q, "thinner than") || has_reason(q, "nowhere is the implant");
+}
+
 TEST(SelfIntersections, CrossingTrianglesAreCountedAndAClosedSurfaceHasNone) {
   TriangleSoup s;
   s.vertices = {{0, 0, 0}, {4, 0, 0}, {0, 4, 0}, {1, 1, -1}, {1, 1, 1}, {3, 3, 0.5}};
@@ -37,13 +47,62 @@ TEST(CheckImplant, ThicknessVolumeAndReasonsOnKnownBoxes) {
   const QualityReport q = check_implant(thin, &skull);
   EXPECT_FALSE(q.printable);
   EXPECT_NEAR(q.penetration_mm3, 180.0, 60.0);
-  bool thin_reason = false, overlap_reason = false;
-  for (const auto& r : q.reasons) {
-    thin_reason |= r.find("thinnest part") != std::string::npos;
-    overlap_reason |= r.find("overlap the skull") != std::string::npos;
+  EXPECT_TRUE(has_reason(q, "nowhere is the implant 1.00 mm thick")) << q.reasons[0];
+  EXPECT_TRUE(has_reason(q, "overlap the skull"));
+}
+
+// A wedge lying on the bone: the cross-section (x, z) is the quadrilateral (0,0), (L,0), (L,H),
+// (H/tan θ, H), extruded over y in [−w, w], so its only sharp edge is the apex of angle θ at
+// x = 0, resting on the bone's top face z = 0 (lifted by `lift`).
+SkullMesh wedge(double angle_deg, double lift) {
+  const double L = 30.0, H = 6.0, w = 10.0, x_top = H / std::tan(angle_deg * M_PI / 180.0);
+  const std::vector<Eigen::Vector2d> section = {{0, 0}, {L, 0}, {L, H}, {x_top, H}};
+  TriangleSoup s;
+  for (double y : {-w, w})
+    for (const auto& p : section) s.vertices.push_back({p.x(), y, p.y() + lift});
+  s.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 6, 5}, {4, 7, 6}};  // caps
+  for (int i = 0; i < 4; ++i) {
+    const int j = (i + 1) % 4;
+    s.triangles.push_back({i, i + 4, j + 4});
+    s.triangles.push_back({i, j + 4, j});
   }
-  EXPECT_TRUE(thin_reason);
-  EXPECT_TRUE(overlap_reason);
+  SkullMesh m = build_mesh(s);
+  if (signed_volume(m) < 0) flip_orientation(m);
+  return m;
+}
+
+// Thin material is the wedge's tip: a ball of 1 mm fits at r / sin(θ/2) from the apex, so the
+// tapered edge reaches r / sin(θ/2) − r beyond the thick part (0.96 mm at 40°, 3.3 mm at 15°).
+// On 0.25 mm voxels the last of the tip, thinner than about half a voxel, has no voxel: the
+// measure falls short by up to h / tan θ.
+TEST(CheckImplant, ATaperedEdgeOnTheBoneIsPrintableUpToItsWidth) {
+  const SkullMesh bone = box({-50, -50, -10}, {50, 50, 0});
+  const double r = 0.5, h = 0.25;
+  auto expect_reach = [&](double reach, double angle_deg) {
+    const double a = angle_deg * M_PI / 180, truth = r / std::sin(a / 2) - r;
+    EXPECT_GT(reach, truth - h / std::tan(a) - 0.2) << angle_deg << "°";
+    EXPECT_LT(reach, truth + 0.3) << angle_deg << "°";
+  };
+  const QualityReport blunt = check_implant(wedge(40, 0), &bone);
+  expect_reach(blunt.taper_reach_mm, 40);
+  EXPECT_LT(blunt.corner_reach_mm, 0.5);
+  EXPECT_GT(blunt.thin_volume_mm3, 0.0);
+  EXPECT_FALSE(judged_thin(blunt)) << blunt.reasons[0];
+
+  const QualityReport sharp = check_implant(wedge(15, 0), &bone);
+  expect_reach(sharp.taper_reach_mm, 15);
+  EXPECT_TRUE(has_reason(sharp, "its edge stays thinner than 1.00 mm"));
+
+  // The same blunt wedge 5 mm above the bone: its thin tip is not an edge resting on the bone.
+  const QualityReport lifted = check_implant(wedge(40, 5), &bone);
+  expect_reach(lifted.corner_reach_mm, 40);
+  EXPECT_NEAR(lifted.thin_off_bone_mm3, lifted.thin_volume_mm3, 1e-9);
+  EXPECT_TRUE(has_reason(lifted, "away from the bone it is thinner than 1.00 mm"));
+
+  // A box's 90° corners are not thin material.
+  const QualityReport plate = check_implant(box({0, 0, 0.1}, {30, 30, 4.1}), &bone);
+  EXPECT_LT(plate.corner_reach_mm, 0.5);
+  EXPECT_FALSE(judged_thin(plate));
 }
 
 }  // namespace

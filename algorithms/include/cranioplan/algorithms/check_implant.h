@@ -8,7 +8,14 @@
 namespace cranioplan {
 
 struct QualityParams {
-  double min_thickness_mm = 1.0;     ///< thinner than this is not printable, mm
+  double min_thickness_mm = 1.0;  ///< thinner than this is not printable, mm (but see max_taper_mm)
+  /// An implant fitted to the bone ends in a tapered edge where it meets the bone's outer
+  /// surface at a grazing angle; that edge may be thinner than min_thickness over this width
+  /// (the printer rounds it off), mm. Thin material elsewhere is never printable.
+  double max_taper_mm = 2.0;
+  /// Away from the bone, thin material may reach this far from the thick part: the tip of a
+  /// sharp corner (0.5 mm: corners of 55° and more at 1 mm), mm.
+  double max_corner_mm = 0.5;
   double max_rim_gap_mm = 1.0;       ///< a larger gap to the bone is not printable, mm
   double max_penetration_mm3 = 5.0;  ///< more overlap with the skull is not printable, mm³
   double overlap_voxel_mm = 0.25;    ///< voxel size of the overlap measurement, mm
@@ -25,6 +32,11 @@ struct QualityReport {
   double volume_mm3 = 0.0;
   double area_mm2 = 0.0;
   double thickness_min_mm = 0.0, thickness_median_mm = 0.0, thickness_max_mm = 0.0;
+  double thin_volume_mm3 = 0.0;    ///< material thinner than min_thickness_mm
+  double thin_off_bone_mm3 = 0.0;  ///< of it, farther than its thinness from the bone
+  /// How far thin material reaches from the thick part: on the bone (the tapered edge) and
+  /// away from it (corners); −1 when no part is thick.
+  double taper_reach_mm = 0.0, corner_reach_mm = 0.0;
   double rim_gap_mm = -1.0;       ///< −1 without a skull
   double penetration_mm3 = -1.0;  ///< −1 without a skull
   bool printable = false;
@@ -40,6 +52,11 @@ struct QualityReport {
 /// axis in 5° sectors, the distance from the sector's side-wall vertex nearest the bone to the
 /// bone; the largest over the sectors (a gap anywhere along the rim shows in its sector).
 /// Penetration: the volume inside both the implant and the skull, on a voxel grid.
+/// Thin material: on the same grid, the implant minus its opening by a ball of diameter
+/// min_thickness_mm (exact distance transforms; one voxel of slack). It is printable when the
+/// implant has a thick part, its tapered edge on the bone is at most max_taper_mm wide and
+/// thin material elsewhere (sharp corners) reaches at most max_corner_mm. (thickness_min_mm,
+/// measured along face normals, goes to zero at any tapered edge and is reported but not judged.)
 QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
                             const QualityParams& params = {});
 

@@ -16,7 +16,8 @@ struct TrimToBoneParams {
   double max_voxels = 6e6;
   double min_feature_mm = 1.25;  ///< parts thinner than this (slivers on the bone) go, mm (≥ 0)
   double smoothing_mm = 0.3;     ///< Gaussian blur of the mask before meshing (σ), mm (≥ 0)
-  /// Gaps narrower than twice this between the implant and the bone are filled, mm (0: off).
+  /// Cracks narrower than twice this between the implant and the bone (the implant on one side,
+  /// the bone on the other, along one of 13 directions) are filled, mm (0: off).
   double bridge_mm = 1.0;
 };
 
