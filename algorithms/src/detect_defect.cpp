@@ -29,9 +29,11 @@ RayThroughBone cast_through_bone(const SurfaceLocator& locator, const Eigen::Vec
   const auto in = locator.first_hit(center, center + reach * dir);
   if (!in) return h;
   h.inner = in->point;
+  h.inner_normal = locator.face_normal(in->face);
   const auto out = locator.first_hit(center + reach * dir, center);
   if (!out) return h;
   h.outer = out->point;
+  h.outer_normal = locator.face_normal(out->face);
   const double t = (*h.outer - *h.inner).norm();
   h.paired = t >= min_thickness_mm && t <= max_thickness_mm;
   return h;

@@ -85,7 +85,7 @@ TEST(CheckImplant, ATaperedEdgeOnTheBoneIsPrintableUpToItsWidth) {
   };
   const QualityReport blunt = check_implant(wedge(40, 0), &bone);
   expect_reach(blunt.taper_reach_mm, 40);
-  EXPECT_LT(blunt.corner_reach_mm, 0.5);
+  EXPECT_LT(blunt.corner_reach_mm, 0.8);
   EXPECT_GT(blunt.thin_volume_mm3, 0.0);
   EXPECT_FALSE(judged_thin(blunt)) << blunt.reasons[0];
 
@@ -93,15 +93,19 @@ TEST(CheckImplant, ATaperedEdgeOnTheBoneIsPrintableUpToItsWidth) {
   expect_reach(sharp.taper_reach_mm, 15);
   EXPECT_TRUE(has_reason(sharp, "its edge stays thinner than 1.00 mm"));
 
-  // The same blunt wedge 5 mm above the bone: its thin tip is not an edge resting on the bone.
-  const QualityReport lifted = check_implant(wedge(40, 5), &bone);
-  expect_reach(lifted.corner_reach_mm, 40);
+  // A 30° wedge: on the bone its taper (1.4 mm) is printable; 5 mm above the bone its thin tip
+  // is a sharp corner, not an edge resting on the bone (at most 0.8 mm: 45° and more).
+  const QualityReport resting = check_implant(wedge(30, 0), &bone);
+  expect_reach(resting.taper_reach_mm, 30);
+  EXPECT_FALSE(judged_thin(resting)) << resting.reasons[0];
+  const QualityReport lifted = check_implant(wedge(30, 5), &bone);
+  expect_reach(lifted.corner_reach_mm, 30);
   EXPECT_NEAR(lifted.thin_off_bone_mm3, lifted.thin_volume_mm3, 1e-9);
   EXPECT_TRUE(has_reason(lifted, "away from the bone it is thinner than 1.00 mm"));
 
   // A box's 90° corners are not thin material.
   const QualityReport plate = check_implant(box({0, 0, 0.1}, {30, 30, 4.1}), &bone);
-  EXPECT_LT(plate.corner_reach_mm, 0.5);
+  EXPECT_LT(plate.corner_reach_mm, 0.8);
   EXPECT_FALSE(judged_thin(plate));
 }
 

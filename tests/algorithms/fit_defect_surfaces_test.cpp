@@ -114,6 +114,58 @@ TEST(FitDefectSurfaces, MirrorGuidedCorrectsTheMirrorsMismatch) {
   expect_near_truth(e);
 }
 
+// A SkullFix-like cut: an axis-aligned 60 mm cube over the upper right of a head with bone about
+// 8 mm thick (as SkullFix's occiput), whose faces meet the vault at about 45°. Rays near the
+// opening then enter or leave the bone through a cut face instead of a table and see it too
+// thin, and the spline carries that inwards (measured: the fitted bone 0.7 mm too thin at the
+// median); rays whose entry and exit surfaces are not parallel are left out of the thickness
+// (0.1 mm), and rays that leave through a surface tilted far from them out of both fits (the
+// outer surface: −0.11 → 0.03 mm).
+TEST(FitDefectSurfaces, ObliqueCutFacesDoNotThinTheFittedBone) {
+  const SkullMesh intact = test::make_thick_head(0.89);
+  InjectDefectParams p;
+  p.shape = InjectDefectParams::Shape::Cube;
+  p.center = test::head_surface_point(Eigen::Vector3d(0.7, 0.1, 0.7).normalized());
+  p.size_mm = 60;
+  p.voxel_mm = 0.5;
+  const SkullMesh defective = inject_defect(intact, p).defective;
+  const SurfaceLocator bone(defective), truth(intact);
+  const DefectRegion defect = detect_defect(defective, bone, Eigen::Vector3d::Zero());
+  ASSERT_TRUE(defect.found()) << defect.message;
+  // Median errors of the fitted thickness and outer radius over the opening, mm (fitted − true).
+  auto median_errors = [&](double max_table_angle_deg, double max_outer_tilt_deg) {
+    DefectSurfaceParams params;
+    params.max_table_angle_deg = max_table_angle_deg;
+    params.max_outer_tilt_deg = max_outer_tilt_deg;
+    const DefectSurfaces s = fit_defect_surfaces(defect, bone, nullptr, params);
+    EXPECT_TRUE(s.fitted()) << s.message;
+    std::vector<double> thick, outer;
+    for (const auto& d : defect.hole_directions) {
+      const auto f = s.at(d);
+      const RayThroughBone t = cast_through_bone(truth, defect.center, d, 400.0, 0.5, 15.0);
+      if (!f || !t.paired) continue;
+      thick.push_back((f->first - f->second).norm() - (*t.outer - *t.inner).norm());
+      outer.push_back((f->first - defect.center).norm() - (*t.outer - defect.center).norm());
+    }
+    EXPECT_GT(thick.size(), defect.hole_directions.size() / 2);
+    auto med = [](std::vector<double> v) {
+      if (v.empty()) return 0.0;
+      std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
+      return v[v.size() / 2];
+    };
+    return std::make_pair(med(thick), med(outer));
+  };
+  const auto [thick, outer] = median_errors(30.0, 50.0);
+  const auto [thick_unfiltered, outer_unfiltered] = median_errors(0.0, 0.0);
+  RecordProperty("median_thickness_error_mm", std::to_string(thick));
+  RecordProperty("median_thickness_error_unfiltered_mm", std::to_string(thick_unfiltered));
+  RecordProperty("median_outer_error_mm", std::to_string(outer));
+  RecordProperty("median_outer_error_unfiltered_mm", std::to_string(outer_unfiltered));
+  EXPECT_LT(std::abs(thick), 0.3);
+  EXPECT_LT(std::abs(outer), 0.3);
+  EXPECT_LT(thick_unfiltered, thick - 0.2) << "cut-face rays thin the bone when not left out";
+}
+
 TEST(FitDefectSurfaces, WithoutIntactBoneAroundItSaysSo) {
   const Case& c = the_case();
   DefectSurfaceParams p;

@@ -14,8 +14,8 @@ struct QualityParams {
   /// (the printer rounds it off), mm. Thin material elsewhere is never printable.
   double max_taper_mm = 2.0;
   /// Away from the bone, thin material may reach this far from the thick part: the tip of a
-  /// sharp corner (0.5 mm: corners of 55° and more at 1 mm), mm.
-  double max_corner_mm = 0.5;
+  /// corner (0.8 mm: corners of 45° and more at 1 mm, e.g. a free edge over an orbit), mm.
+  double max_corner_mm = 0.8;
   double max_rim_gap_mm = 1.0;       ///< a larger gap to the bone is not printable, mm
   double max_penetration_mm3 = 5.0;  ///< more overlap with the skull is not printable, mm³
   double overlap_voxel_mm = 0.25;    ///< voxel size of the overlap measurement, mm

@@ -54,6 +54,9 @@ std::vector<Eigen::Vector3d> fibonacci_sphere(int n);
 /// apart (the ray crosses one plausible layer of bone).
 struct RayThroughBone {
   std::optional<Eigen::Vector3d> inner, outer;
+  /// The surface's outward normals where the ray meets it (zero when not met): parallel tables
+  /// give opposite normals; a cut face met instead of a table does not.
+  Eigen::Vector3d inner_normal = Eigen::Vector3d::Zero(), outer_normal = Eigen::Vector3d::Zero();
   bool paired = false;
 };
 RayThroughBone cast_through_bone(const SurfaceLocator& locator, const Eigen::Vector3d& center,

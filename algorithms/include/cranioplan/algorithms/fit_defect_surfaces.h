@@ -28,8 +28,15 @@ class SurfaceLocator;
 struct DefectSurfaceParams {
   double ring_width_mm = 25.0;    ///< width of the intact ring the surfaces are fitted to, mm
   double rim_clearance_mm = 3.0;  ///< rays nearer the opening are not used, mm (≥ 0)
-  double ray_spacing_mm = 2.0;    ///< between sampled rays at the rim's radius, mm (0.5..10)
-  double site_spacing_mm = 4.0;   ///< fitting sites on the ring at least this far apart, mm
+  /// Rays whose entry and exit surfaces are further from parallel than this are not used, deg:
+  /// near an oblique cut face a ray enters or leaves through the cut instead of a table, and
+  /// its thickness is too small (0: off).
+  double max_table_angle_deg = 30.0;
+  /// Rays that leave the bone through a surface tilted more than this from the ray are not
+  /// used at all, deg: they left through a cut face, below the outer table (0: off).
+  double max_outer_tilt_deg = 50.0;
+  double ray_spacing_mm = 2.0;   ///< between sampled rays at the rim's radius, mm (0.5..10)
+  double site_spacing_mm = 4.0;  ///< fitting sites on the ring at least this far apart, mm
   /// Spline smoothing weight per site (dimensionless, ≥ 0): rides over the bone's roughness.
   double smoothing = 0.03;
   /// Sites whose residual after a first fit exceeds this many robust standard deviations
