@@ -77,30 +77,35 @@ ExtractBoneSurfaceResult extract_bone_surface(const Volume& volume,
 
   // Pad by one sample below the threshold on every side so the surface is closed where bone
   // touches the edge of the scan. Index space: sample (i,j,k) of the volume sits at (i,j,k).
-  const int nx = volume.dims[0] + 2, ny = volume.dims[1] + 2, nz = volume.dims[2] + 2;
-  const float pad = static_cast<float>(std::min<double>(*lo_it, threshold - 1.0));
-  vtkNew<vtkFloatArray> scalars;
-  scalars->SetNumberOfTuples(static_cast<vtkIdType>(nx) * ny * nz);
-  float* dst = scalars->GetPointer(0);
-  std::fill(dst, dst + static_cast<size_t>(nx) * ny * nz, pad);
-  for (int k = 0; k < volume.dims[2]; ++k)
-    for (int j = 0; j < volume.dims[1]; ++j)
-      std::copy_n(&volume.data[volume.index(0, j, k)], volume.dims[0],
-                  dst + ((static_cast<size_t>(k) + 1) * ny + j + 1) * nx + 1);
-  vtkNew<vtkImageData> image;
-  image->SetDimensions(nx, ny, nz);
-  image->SetOrigin(-1, -1, -1);
-  image->SetSpacing(1, 1, 1);
-  image->GetPointData()->SetScalars(scalars);
+  // The padded copy of the volume and VTK's output are let go as soon as the triangles are out
+  // (a SkullFix volume is 240 MB as floats): they are not needed while the mesh is built.
+  TriangleSoup soup;
+  {
+    const int nx = volume.dims[0] + 2, ny = volume.dims[1] + 2, nz = volume.dims[2] + 2;
+    const float pad = static_cast<float>(std::min<double>(*lo_it, threshold - 1.0));
+    vtkNew<vtkFloatArray> scalars;
+    scalars->SetNumberOfTuples(static_cast<vtkIdType>(nx) * ny * nz);
+    float* dst = scalars->GetPointer(0);
+    std::fill(dst, dst + static_cast<size_t>(nx) * ny * nz, pad);
+    for (int k = 0; k < volume.dims[2]; ++k)
+      for (int j = 0; j < volume.dims[1]; ++j)
+        std::copy_n(&volume.data[volume.index(0, j, k)], volume.dims[0],
+                    dst + ((static_cast<size_t>(k) + 1) * ny + j + 1) * nx + 1);
+    vtkNew<vtkImageData> image;
+    image->SetDimensions(nx, ny, nz);
+    image->SetOrigin(-1, -1, -1);
+    image->SetSpacing(1, 1, 1);
+    image->GetPointData()->SetScalars(scalars);
 
-  vtkNew<vtkFlyingEdges3D> fe;
-  fe->SetInputData(image);
-  fe->SetValue(0, threshold);
-  fe->ComputeNormalsOff();
-  fe->ComputeGradientsOff();
-  fe->ComputeScalarsOff();
-  fe->Update();
-  TriangleSoup soup = soup_from_vtk(fe->GetOutput());
+    vtkNew<vtkFlyingEdges3D> fe;
+    fe->SetInputData(image);
+    fe->SetValue(0, threshold);
+    fe->ComputeNormalsOff();
+    fe->ComputeGradientsOff();
+    fe->ComputeScalarsOff();
+    fe->Update();
+    soup = soup_from_vtk(fe->GetOutput());
+  }
   for (auto& p : soup.vertices) p = volume.world(p);
 
   const SoupComponents comps = soup_components(soup);

@@ -71,13 +71,16 @@ TEST(SampleCase, AutoplanFillsTheRealDefect) {
   EXPECT_LT(r.defect.axis.y(), 0.0);
   // The target on the sample's real defect, from autoplan alone: a watertight shell
   // with a rim gap of at most 0.5 mm and no penetration into the skull (the shell is fitted to
-  // the bone: built 4 mm over it and trimmed by it). The rim gap holds on the STL of
-  // scripts/run-sample (0.45 mm) but not on this mesh straight from the CT (1.15 mm, two 5°
-  // sectors by the ragged orbital roof; docs/AUTOPLAN.md): guarded here, not yet met.
+  // the bone: built 4 mm over it and trimmed by it), and printable by the quality report (its
+  // edge on the bone tapers over 1.3 mm; docs/IMPLANT.md). Measured 0.16 mm on this mesh
+  // straight from the CT and 0.17 mm on the STL of scripts/run-sample (it was 0.50 / 0.19 mm
+  // before the ring's rays through cut faces were left out; the figure is a maximum over 72
+  // sectors and moves by tenths of a millimetre).
   EXPECT_TRUE(r.quality.watertight);
   EXPECT_TRUE(r.quality.manifold);
   EXPECT_EQ(r.quality.self_intersections, 0);
-  EXPECT_LE(r.quality.rim_gap_mm, 1.5);
+  EXPECT_LE(r.quality.rim_gap_mm, 0.5);
+  EXPECT_TRUE(r.quality.printable) << (r.quality.reasons.empty() ? "" : r.quality.reasons[0]);
   // "None" at the resolution of the measurement: the overlap is counted in 0.25 mm voxels and a
   // flush contact is placed within half a voxel (TrimToBone tests), so 0.25 mm³ (16 voxels)
   // is the floor; the unfitted shell overlaps the bone by about 43 mm³.
