@@ -171,10 +171,15 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
     q.reasons.push_back(fmt("nowhere is the implant %.2f mm thick (thickest %.2f mm)",
                             params.min_thickness_mm, q.thickness_max_mm));
   if (q.corner_reach_mm > params.max_corner_mm)
-    q.reasons.push_back(fmt("away from the bone it is thinner than %.2f mm for %.1f mm",
-                            params.min_thickness_mm, q.corner_reach_mm) +
-                        " (" + fmt1("%.1f", q.thin_off_bone_mm3) + " mm³; a sharp corner may be " +
-                        fmt1("%.1f", params.max_corner_mm) + " mm)");
+    q.reasons.push_back(
+        fmt(bone_distance.empty() ? "it is thinner than %.2f mm for %.1f mm"
+                                  : "away from the bone it is thinner than %.2f mm for %.1f mm",
+            params.min_thickness_mm, q.corner_reach_mm) +
+        " (" + fmt1("%.1f", q.thin_off_bone_mm3) + " mm³; a sharp corner may be " +
+        fmt1("%.1f", params.max_corner_mm) + " mm" +
+        (bone_distance.empty() ? "; without the skull a tapered edge on the bone cannot be told"
+                                 " from a corner: check with the skull)"
+                               : ")"));
   if (q.taper_reach_mm > params.max_taper_mm)
     q.reasons.push_back(fmt("its edge stays thinner than %.2f mm for %.1f mm",
                             params.min_thickness_mm, q.taper_reach_mm) +

@@ -98,6 +98,8 @@ TEST(CheckImplant, ATaperedEdgeOnTheBoneIsPrintableUpToItsWidth) {
   const QualityReport resting = check_implant(wedge(30, 0), &bone);
   expect_reach(resting.taper_reach_mm, 30);
   EXPECT_FALSE(judged_thin(resting)) << resting.reasons[0];
+  // Without the skull the same taper cannot be told from a corner, and the report says so.
+  EXPECT_TRUE(has_reason(check_implant(wedge(30, 0), nullptr), "without the skull"));
   const QualityReport lifted = check_implant(wedge(30, 5), &bone);
   expect_reach(lifted.corner_reach_mm, 30);
   EXPECT_NEAR(lifted.thin_off_bone_mm3, lifted.thin_volume_mm3, 1e-9);
