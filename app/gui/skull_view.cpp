@@ -8,15 +8,16 @@
 #include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
-#include <vtkCellPicker.h>
 #include <vtkCoordinate.h>
 #include <vtkCubeSource.h>
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkGenericRenderWindowInteractor.h>
 #include <vtkGlyph3DMapper.h>
 #include <vtkInteractorStyleTrackballCamera.h>
+#include <vtkMatrix4x4.h>
 #include <vtkNew.h>
 #include <vtkPlane.h>
+#include <vtkPlaneCollection.h>
 #include <vtkPlaneSource.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -26,7 +27,6 @@
 #include <vtkRenderer.h>
 #include <vtkSmartPointer.h>
 #include <vtkSphereSource.h>
-#include <vtkStaticCellLocator.h>
 
 #include <Eigen/Geometry>
 #include <QMouseEvent>
@@ -78,28 +78,42 @@ struct MeshLayer {
   std::shared_ptr<const void> keep;  // keeps the shown mesh alive so its address stays unique
   vtkNew<vtkPolyDataMapper> mapper;
   vtkNew<vtkActor> actor;
-  vtkNew<vtkStaticCellLocator> locator;
+  // Picking: the plan's own locator of the shown mesh (kept alive with it by `keep`), so the
+  // view builds no second search structure (a VTK cell locator of a 2-million-triangle skull
+  // is about 300 MB).
+  const SurfaceLocator* locator = nullptr;
 
   MeshLayer() {
     actor->SetMapper(mapper);
     mapper->ScalarVisibilityOff();
   }
-  void show(const SkullMesh* mesh, std::shared_ptr<const void> owner) {
+  void show(const SkullMesh* mesh, std::shared_ptr<const void> owner,
+            const SurfaceLocator* mesh_locator = nullptr) {
     if (!mesh) {
       actor->SetVisibility(false);
       shown = nullptr;
+      locator = nullptr;
       keep.reset();
       return;
     }
     if (mesh != shown) {
       vtkSmartPointer<vtkPolyData> poly = to_polydata(*mesh);
       mapper->SetInputData(poly);
-      locator->SetDataSet(poly);
-      locator->BuildLocator();
       shown = mesh;
-      keep = std::move(owner);
     }
+    // The owner may be new with the same mesh (the mirror moved): its locator answers now.
+    locator = mesh_locator;
+    keep = std::move(owner);
     actor->SetVisibility(true);
+  }
+  /// Draws the mesh moved by `motion` (the mirror's registration) without copying it.
+  void set_motion(const RigidTransform& motion) {
+    vtkNew<vtkMatrix4x4> m;
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) m->SetElement(r, c, motion.rotation(r, c));
+      m->SetElement(r, 3, motion.translation(r));
+    }
+    actor->SetUserMatrix(m);
   }
   bool visible() const { return shown && actor->GetVisibility(); }
 };
@@ -157,7 +171,6 @@ struct SkullView::Impl {
   vtkNew<vtkRenderer> renderer;
   vtkNew<vtkGenericRenderWindowInteractor> interactor;
   vtkNew<vtkInteractorStyleTrackballCamera> style;
-  vtkNew<vtkCellPicker> picker;
   vtkNew<vtkPlane> clip;
   MeshLayer skull, mirror, implant;
   GlyphLayer outer_edge{sphere(1.6), kEdge}, inner_edge{cube(2.4), kEdge},
@@ -236,8 +249,6 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
     a->SetVisibility(false);
     d.renderer->AddActor(a);
   }
-  d.picker->SetTolerance(0.0005);
-  d.picker->PickFromListOn();
 }
 
 SkullView::~SkullView() {
@@ -277,8 +288,11 @@ void SkullView::show_state(const PlanState& s) {
   Impl& d = *d_;
   const bool had_skull = d.skull.shown != nullptr;
   d.skull.show(s.skull ? &s.skull->surface->mesh : nullptr,
-               s.skull ? std::shared_ptr<const void>(s.skull) : nullptr);
-  d.mirror.show(s.mirrored ? &s.mirrored->mesh : nullptr, s.mirrored);
+               s.skull ? std::shared_ptr<const void>(s.skull) : nullptr,
+               s.skull ? &s.skull->surface->locator : nullptr);
+  d.mirror.show(s.mirrored ? s.mirrored->base.get() : nullptr, s.mirrored,
+                s.mirrored ? &s.mirrored->locator : nullptr);
+  if (s.mirrored) d.mirror.set_motion(s.mirrored->motion);
   d.mirror.actor->SetVisibility(d.mirror.shown && d.mirror_wanted);
   d.implant.show(s.implant ? &s.implant->result().mesh : nullptr, s.implant);
 
@@ -444,18 +458,34 @@ std::optional<QPoint> SkullView::project(const Eigen::Vector3d& world) {
 std::optional<Eigen::Vector3d> SkullView::pick(const QPoint& position, PickTarget target) {
   Impl& d = *d_;
   MeshLayer* layer = target == PickTarget::Mirrored && d.mirror.shown ? &d.mirror : &d.skull;
-  if (target == PickTarget::None || !layer->shown) return std::nullopt;
-  d.picker->InitializePickList();
-  d.picker->AddPickList(layer->actor);
-  d.picker->AddLocator(layer->locator);
-  const bool was_visible = layer->actor->GetVisibility();
-  layer->actor->SetVisibility(true);  // a hidden mirror can still take markers
-  const int hit = d.picker->Pick(d.display_x(position), d.display_y(position), 0, d.renderer);
-  layer->actor->SetVisibility(was_visible);
-  d.picker->RemoveAllLocators();
-  if (!hit || d.picker->GetCellId() < 0) return std::nullopt;
-  const double* p = d.picker->GetPickPosition();
-  return Eigen::Vector3d(p[0], p[1], p[2]);
+  if (target == PickTarget::None || !layer->shown || !layer->locator) return std::nullopt;
+  // The ray under the cursor, from the near to the far end of the view (a hidden mirror can
+  // still take markers).
+  const double x = d.display_x(position), y = d.display_y(position);
+  auto world = [&](double z) {
+    d.renderer->SetDisplayPoint(x, y, z);
+    d.renderer->DisplayToWorld();
+    double w[4];
+    d.renderer->GetWorldPoint(w);
+    return Eigen::Vector3d(w[0] / w[3], w[1] / w[3], w[2] / w[3]);
+  };
+  Eigen::Vector3d from = world(0.0), to = world(1.0);
+  // Only what the clip plane keeps can be picked: the segment is cut to the kept side.
+  if (layer->mapper->GetClippingPlanes() &&
+      layer->mapper->GetClippingPlanes()->GetNumberOfItems() > 0) {
+    double n[3], o[3];
+    d.clip->GetNormal(n);
+    d.clip->GetOrigin(o);
+    const Eigen::Vector3d normal(n[0], n[1], n[2]), origin(o[0], o[1], o[2]);
+    const double fa = normal.dot(from - origin), fb = normal.dot(to - origin);
+    if (fa < 0 && fb < 0) return std::nullopt;
+    const Eigen::Vector3d crossing = from + (to - from) * (fa / (fa - fb));
+    if (fa < 0) from = crossing;
+    if (fb < 0) to = crossing;
+  }
+  const auto hit = layer->locator->first_hit(from, to);
+  if (!hit) return std::nullopt;
+  return hit->point;
 }
 
 namespace {

@@ -19,8 +19,6 @@
 namespace cranioplan {
 
 SharedSurface::SharedSurface(SkullMesh m) : mesh(std::move(m)), locator(mesh) {}
-SharedSurface::SharedSurface(SkullMesh m, SurfaceLocator l)
-    : mesh(std::move(m)), locator(std::move(l)) {}
 
 ImplantData::ImplantData(ImplantResult result, std::shared_ptr<const SkullInput> skull)
     : result_(std::move(result)),
@@ -221,12 +219,13 @@ void update_mirrored(PlanState& s, const std::string& why) {
     return;
   }
   // The mirror base is always the skull reflected across the current plane (plane_changed makes
-  // it again), so the mirror's locator is the skull's, moved: no second tree.
-  SkullMesh mesh = transform_mesh(*s.mirror_base, s.mirror_transform());
+  // it again), so the mirror's locator is the skull's tree, moved: no second tree, no mesh.
+  const RigidTransform motion = s.mirror_transform();
   SurfaceLocator locator =
-      s.plane ? s.skull->surface->locator.moved(s.mirror_transform() * reflection_across(*s.plane))
-              : SurfaceLocator(mesh);
-  s.mirrored = std::make_shared<const SharedSurface>(std::move(mesh), std::move(locator));
+      s.plane ? s.skull->surface->locator.moved(motion * reflection_across(*s.plane))
+              : SurfaceLocator(*s.mirror_base).moved(motion);
+  s.mirrored =
+      std::make_shared<const MovedSurface>(MovedSurface{s.mirror_base, motion, std::move(locator)});
   unacknowledge(s, 4, why);
   for (const auto& m : s.markers)
     if (m.surface == MarkerSurface::Mirrored) {

@@ -25,9 +25,18 @@ namespace cranioplan {
 /// A mesh with its locator, built once and shared by every state that uses it.
 struct SharedSurface {
   explicit SharedSurface(SkullMesh m);
-  SharedSurface(SkullMesh m, SurfaceLocator l);  ///< `l` must answer for `m`
   SkullMesh mesh;
   SurfaceLocator locator;
+};
+
+/// The mirrored skull where the plan has put it: the mirror base moved, not a mesh of its own
+/// (on a skull of two million triangles each copy is about 280 MB, and every registration
+/// kept in the session's history would hold one). The view draws the base with the motion;
+/// the locator answers in place (the skull's own tree, moved).
+struct MovedSurface {
+  std::shared_ptr<const SkullMesh> base;  ///< the skull mirrored across the plane
+  RigidTransform motion;                  ///< from the base to where the mirror is
+  SurfaceLocator locator;                 ///< answers for the moved base
 };
 
 struct SkullInput {
@@ -76,8 +85,8 @@ struct PlanState {
   std::shared_ptr<const SkullMesh> mirror_base;   ///< the skull mirrored across `plane`
   std::optional<RegisterParams> register_params;  ///< re-run when the plane changes
   std::optional<RegisterResult> registration;
-  RigidTransform manual;                          ///< hand moves, applied after the registration
-  std::shared_ptr<const SharedSurface> mirrored;  ///< base carried by manual ∘ registration
+  RigidTransform manual;                         ///< hand moves, applied after the registration
+  std::shared_ptr<const MovedSurface> mirrored;  ///< base carried by manual ∘ registration
   // Step 4
   std::optional<Plane> clip_plane;
   // Steps 5, 6, 8
