@@ -172,6 +172,38 @@ TEST_F(Wizard, AllNineStepsOnTheSampleReplayToTheSameImplant) {
   auto* clip = child<QCheckBox>(w, "clipOn");
   QTest::mouseClick(clip, Qt::LeftButton, {}, QPoint(8, clip->height() / 2));
   EXPECT_TRUE(plan.state().clip_plane) << refusal.toStdString();
+  // Picking sees only what the clip plane keeps (the side its normal points away from): aimed
+  // at bone that is clipped away, a pick lands on kept bone behind it or on nothing (here,
+  // looking along the plane, on nothing); aimed at kept bone, it lands.
+  if (plan.state().clip_plane) {
+    const Plane cut = *plan.state().clip_plane;
+    const SkullMesh& mesh = plan.state().skull->surface->mesh;
+    int aimed = 0;
+    for (auto vh : mesh.vertices()) {
+      if (vh.idx() % 499 != 0) continue;
+      const Eigen::Vector3d p = to_eigen(mesh.point(vh));
+      if (cut.signed_distance(p) < 5.0) continue;
+      const auto at = view.project(p);
+      if (!at) continue;
+      ++aimed;
+      const auto hit = view.pick(*at, SkullView::PickTarget::Original);
+      if (!hit) continue;
+      EXPECT_LE(cut.signed_distance(*hit), 1e-6) << "picked bone the clip plane removes";
+    }
+    int kept_aimed = 0, kept_hits = 0;
+    for (auto vh : mesh.vertices()) {
+      if (vh.idx() % 499 != 0) continue;
+      const Eigen::Vector3d p = to_eigen(mesh.point(vh));
+      if (cut.signed_distance(p) > -5.0) continue;
+      const auto at = view.project(p);
+      if (!at) continue;
+      ++kept_aimed;
+      kept_hits += view.pick(*at, SkullView::PickTarget::Original).has_value();
+    }
+    EXPECT_GT(aimed, 0);
+    EXPECT_GT(kept_aimed, 0);
+    EXPECT_GE(kept_hits, kept_aimed * 9 / 10) << "kept bone is picked";
+  }
   click(w, "done");
   ASSERT_EQ(plan.state().current_step, 5);
 
