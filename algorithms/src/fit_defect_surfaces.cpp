@@ -157,8 +157,10 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
       through_tables.push_back(i);
       through_tables_outer.push_back(s.ring_outer[i]);
     }
+  // Too few rays through both tables (a ring that is all cut faces): the thickness from all.
+  const bool thickness_from_all = through_tables.size() < 12;
   std::vector<size_t> thickness_sites = outer_sites;
-  if (through_tables.size() >= 12) {
+  if (!thickness_from_all) {
     thickness_sites.clear();
     for (size_t k : thin(through_tables_outer, site_spacing))
       thickness_sites.push_back(through_tables[k]);
@@ -199,7 +201,7 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
     double sum = 0.0;
     size_t count = 0;
     for (size_t i = 0; i < ring.size(); ++i)
-      if (outer || ring[i].tables_parallel || through_tables.size() < 12) {
+      if (outer || thickness_from_all || ring[i].tables_parallel) {
         sum += std::pow(residual(tps, outer, i), 2);
         ++count;
       }

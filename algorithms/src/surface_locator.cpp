@@ -261,7 +261,8 @@ std::optional<SurfaceLocator::Hit> SurfaceLocator::first_hit(
   int top = 0;
   if (!t.nodes.empty()) stack[top++] = 0;
   while (top > 0) {
-    const Node& node = t.nodes[stack[--top]];
+    const int index = stack[--top];
+    const Node& node = t.nodes[index];
     if (!node.box.meets(o, inv_d, best_t)) continue;
     if (node.count > 0) {
       for (int i = node.first; i < node.first + node.count; ++i) {
@@ -274,7 +275,6 @@ std::optional<SurfaceLocator::Hit> SurfaceLocator::first_hit(
       }
       continue;
     }
-    const int index = static_cast<int>(&node - t.nodes.data());
     stack[top++] = node.first;  // right
     stack[top++] = index + 1;   // left
   }

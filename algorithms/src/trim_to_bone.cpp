@@ -15,8 +15,8 @@ namespace {
 
 using Mask = std::vector<uint8_t>;
 
-// One step of 6-neighbour erosion (grow = false) or dilation (grow = true).
-Mask morph(const Mask& in, const VoxelGrid& g, bool grow) {
+// One step of 6-neighbour dilation.
+Mask dilate(const Mask& in, const VoxelGrid& g) {
   Mask out(in.size(), 0);
   const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
   for (int k = 0; k < nz; ++k)
@@ -27,9 +27,8 @@ Mask morph(const Mask& in, const VoxelGrid& g, bool grow) {
           if (a < 0 || b < 0 || d < 0 || a >= nx || b >= ny || d >= nz) return 0;
           return in[g.index(a, b, d)];
         };
-        const int n = at(i - 1, j, k) + at(i + 1, j, k) + at(i, j - 1, k) + at(i, j + 1, k) +
-                      at(i, j, k - 1) + at(i, j, k + 1);
-        out[c] = grow ? (in[c] || n > 0) : (in[c] && n == 6);
+        out[c] = in[c] || at(i - 1, j, k) || at(i + 1, j, k) || at(i, j - 1, k) ||
+                 at(i, j + 1, k) || at(i, j, k - 1) || at(i, j, k + 1);
       }
   return out;
 }
@@ -89,25 +88,30 @@ Mask bridge_cracks(const Mask& implant, const Mask& bone, const VoxelGrid& g, in
   // Candidates: within `steps` (6-neighbour steps) of both.
   Mask near_implant = implant, near_bone = bone;
   for (int s = 0; s < steps; ++s) {
-    near_implant = morph(near_implant, g, true);
-    near_bone = morph(near_bone, g, true);
+    near_implant = dilate(near_implant, g);
+    near_bone = dilate(near_bone, g);
   }
   static const int dirs[13][3] = {{1, 0, 0},  {0, 1, 0},  {0, 0, 1}, {1, 1, 0},  {1, -1, 0},
                                   {1, 0, 1},  {1, 0, -1}, {0, 1, 1}, {0, 1, -1}, {1, 1, 1},
                                   {1, 1, -1}, {1, -1, 1}, {-1, 1, 1}};
+  // Steps along a diagonal are longer: the width is kept in millimetres.
+  int reach[13];
+  for (int n = 0; n < 13; ++n) {
+    const int* d = dirs[n];
+    const double len = std::sqrt(double(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
+    reach[n] = std::max(1, static_cast<int>(std::floor(steps / len + 1e-9)));
+  }
   Mask out = implant;
   for (int k = 0; k < g.dims[2]; ++k)
     for (int j = 0; j < g.dims[1]; ++j)
       for (int i = 0; i < g.dims[0]; ++i) {
         const size_t c = g.index(i, j, k);
         if (implant[c] || bone[c] || !near_implant[c] || !near_bone[c]) continue;
-        for (const auto& d : dirs) {
-          // Steps along a diagonal are longer: the width is kept in millimetres.
-          const double len = std::sqrt(double(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
-          const int reach = std::max(1, static_cast<int>(std::floor(steps / len + 1e-9)));
-          const int ahead = first_along(implant, bone, g, i, j, k, d[0], d[1], d[2], reach);
+        for (int n = 0; n < 13; ++n) {
+          const int* d = dirs[n];
+          const int ahead = first_along(implant, bone, g, i, j, k, d[0], d[1], d[2], reach[n]);
           if (ahead == 0) continue;
-          const int behind = first_along(implant, bone, g, i, j, k, -d[0], -d[1], -d[2], reach);
+          const int behind = first_along(implant, bone, g, i, j, k, -d[0], -d[1], -d[2], reach[n]);
           if (behind != 0 && behind != ahead) {
             out[c] = 1;
             break;
@@ -200,7 +204,7 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
   // Neither the grid nor the smoothing may carry the surface into the bone: the bone grown by
   // one voxel stays outside (the surface then lies a fraction of a voxel off the bone).
   {
-    const Mask keep_out = morph(bone, grid, true);
+    const Mask keep_out = dilate(bone, grid);
     for (size_t c = 0; c < smooth.size(); ++c)
       if (keep_out[c]) smooth[c] = 0.0f;
   }

@@ -292,7 +292,7 @@ void SkullView::show_state(const PlanState& s) {
                s.skull ? &s.skull->surface->locator : nullptr);
   d.mirror.show(s.mirrored ? s.mirrored->base.get() : nullptr, s.mirrored,
                 s.mirrored ? &s.mirrored->locator : nullptr);
-  if (s.mirrored) d.mirror.set_motion(s.mirrored->motion);
+  if (s.mirrored) d.mirror.set_motion(s.mirror_transform());
   d.mirror.actor->SetVisibility(d.mirror.shown && d.mirror_wanted);
   d.implant.show(s.implant ? &s.implant->result().mesh : nullptr, s.implant);
 

@@ -97,6 +97,7 @@ Json run_bench(const BenchOptions& options) {
       plan = autoplan(skull.mesh, Landmarks{}, dense);
     }
     const SurfaceLocator bone(skull.mesh), mirror = bone.moved(plan.mirror_motion);
+    out["skull_locator_mb"] = static_cast<double>(bone.memory_bytes()) / 1e6;
     out["edit_markers"] = plan.markers.size();
     // While markers are edited the shell is rebuilt as it stands (the wizard's live preview);
     // fitting it to the bone (automatic plans, and the wizard's "Fit to the bone") costs more.

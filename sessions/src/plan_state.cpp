@@ -225,7 +225,7 @@ void update_mirrored(PlanState& s, const std::string& why) {
       s.plane ? s.skull->surface->locator.moved(motion * reflection_across(*s.plane))
               : SurfaceLocator(*s.mirror_base).moved(motion);
   s.mirrored =
-      std::make_shared<const MovedSurface>(MovedSurface{s.mirror_base, motion, std::move(locator)});
+      std::make_shared<const MovedSurface>(MovedSurface{s.mirror_base, std::move(locator)});
   unacknowledge(s, 4, why);
   for (const auto& m : s.markers)
     if (m.surface == MarkerSurface::Mirrored) {

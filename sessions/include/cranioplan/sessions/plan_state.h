@@ -31,12 +31,11 @@ struct SharedSurface {
 
 /// The mirrored skull where the plan has put it: the mirror base moved, not a mesh of its own
 /// (on a skull of two million triangles each copy is about 280 MB, and every registration
-/// kept in the session's history would hold one). The view draws the base with the motion;
-/// the locator answers in place (the skull's own tree, moved).
+/// kept in the session's history would hold one). The view draws the base moved by the state's
+/// mirror_transform(); the locator answers in place (the skull's own tree, moved).
 struct MovedSurface {
   std::shared_ptr<const SkullMesh> base;  ///< the skull mirrored across the plane
-  RigidTransform motion;                  ///< from the base to where the mirror is
-  SurfaceLocator locator;                 ///< answers for the moved base
+  SurfaceLocator locator;                 ///< answers for the base moved by mirror_transform()
 };
 
 struct SkullInput {
