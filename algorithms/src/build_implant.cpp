@@ -35,6 +35,8 @@ namespace {
 constexpr double kTwoPi = 2.0 * M_PI;
 // Markers closer than this (mm, in the parametrisation) to an earlier one are not fitted.
 constexpr double kMinMarkerSeparation = 1.0;
+// Fitting to the bone seeks the bone to meet up to this many times the margin beyond the rim.
+constexpr double kFitReach = 3.0;
 
 // The parametrisation of the defect's surfaces as height fields h(u, v).
 // Planar: (u, v) in the plane of the outer markers, h along its normal n.
@@ -372,13 +374,19 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
       const Eigen::Vector2d q = poly.at(angles[k]).first;
       pts[k] = lift_rim(q);
       // Fitting to the bone: the rim goes beyond the opening, into the bone of the cut face,
-      // to be trimmed there — only where there is bone to meet (not over an orbit).
+      // to be trimmed there — only where there is bone to meet (not over an orbit). Where the
+      // cut face is oblique, the surface beyond the rim first passes over the missing wedge:
+      // the bone is sought further out, up to kFitReach times the margin.
       bool extended = false;
       if (fit_margin > 0.0 && (q - center).norm() > 1e-9) {
-        const Eigen::Vector3d beyond = lift_rim(q + fit_margin * (q - center).normalized());
-        if (bone->closest(beyond).distance < 0.5 * fit_margin) {
-          pts[k] = beyond;
-          extended = true;
+        const Eigen::Vector2d out = (q - center).normalized();
+        for (double d = fit_margin; d <= kFitReach * fit_margin + 1e-9; d += 1.0) {
+          const Eigen::Vector3d beyond = lift_rim(q + d * out);
+          if (bone->closest(beyond).distance < 0.5 * fit_margin) {
+            pts[k] = beyond;
+            extended = true;
+            break;
+          }
         }
       }
       const bool exact = (is_marker_angle[k] && tps != nullptr) || extended;

@@ -172,7 +172,8 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
       uv.push_back(s.uv(ring[i].dir));
       h.push_back(outer ? ring[i].r_out : ring[i].t);
     }
-    const std::vector<double> lambda(uv.size(), std::max(0.0, params.smoothing));
+    const double smoothing = outer && mirror == nullptr ? params.outer_smoothing : params.smoothing;
+    const std::vector<double> lambda(uv.size(), std::max(0.0, smoothing));
     return tps.fit(uv, h, lambda, 1e-3);
   };
   auto residual = [&](const ThinPlateSpline& tps, bool outer, size_t i) {

@@ -123,18 +123,21 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
   // not (the rim runs along an orbit or the skull base), the fit only extrapolates there: at
   // the last bone. No inner edge markers: the inner rim is the outer one set in by the
   // thickness field of the inner markers (docs/IMPLANT.md).
+  // Compared by direction from the centre, not by position: at an oblique cut face the rim's
+  // last bone is the cut's inner corner, a table's thickness below the ring's outer table.
   const double clearance = params.surfaces.rim_clearance_mm;
   std::vector<Eigen::Vector3d> near_ring;
   for (size_t i = 0; i < surfaces.ring_outer.size(); ++i)
     if (surfaces.ring_distance_mm[i] <= clearance + 8.0)
-      near_ring.push_back(surfaces.ring_outer[i]);
+      near_ring.push_back((surfaces.ring_outer[i] - c).normalized());
   const PointIndex near_index(near_ring.empty() ? std::vector<Eigen::Vector3d>{c} : near_ring);
   auto bone_beyond = [&](const Eigen::Vector3d& rim) {
     Eigen::Vector3d out = rim - c;
     out -= out.dot(defect.axis) * defect.axis;  // away from the opening's axis
-    if (near_ring.empty() || out.norm() < 1e-9) return false;
-    const Eigen::Vector3d probe = rim + (clearance + 4.0) * out.normalized();
-    return near_index.within_radius(probe, 4.0).size() >= 2;
+    const double radius = (rim - c).norm();
+    if (near_ring.empty() || out.norm() < 1e-9 || radius < 1e-9) return false;
+    const Eigen::Vector3d probe = (rim + (clearance + 4.0) * out.normalized() - c).normalized();
+    return near_index.within_radius(probe, 4.0 / radius).size() >= 2;
   };
   for (size_t i : along(defect.outer_rim, params.edge_spacing_mm)) {
     const Eigen::Vector3d& rim = defect.outer_rim[i];

@@ -365,7 +365,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
 
   {  // evaluate
     struct Opts {
-      std::string dir;
+      std::string dir, implants_out;
       AutoplanParams params;
     };
     auto o = std::make_shared<Opts>();
@@ -373,11 +373,15 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
         "evaluate", "Autoplan every NNN_defective_skull.* against its NNN_implant.*");
     cmd->add_option("CASES_DIR", o->dir, "folder of cases (meshes or NRRD/NIfTI masks)")
         ->required();
+    cmd->add_option("--implants-out", o->implants_out,
+                    "folder to write each planned implant to (NNN_planned_implant.stl)");
     add_fit_option(cmd, o->params);
     out.push_back(
         {cmd, [o, &json] {
            namespace fs = std::filesystem;
            if (!fs::is_directory(o->dir)) throw InputError(o->dir, "is not a folder");
+           if (!o->implants_out.empty() && !fs::is_directory(o->implants_out))
+             throw InputError(o->implants_out, "is not a folder (--implants-out)");
            std::map<std::string, std::pair<std::string, std::string>>
                cases;  // id → (defective, implant)
            for (const auto& e : fs::directory_iterator(o->dir)) {
@@ -404,6 +408,12 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
              if (r.planned()) {
                const SkullMesh truth = load_any(files.second);
                const CompareResult c = compare_implants(r.implant.mesh, truth, &skull);
+               if (!o->implants_out.empty()) {
+                 const std::string path =
+                     (fs::path(o->implants_out) / (id + "_planned_implant.stl")).string();
+                 write_mesh(r.implant.mesh, path);
+                 row["implant"] = path;
+               }
                row["method"] = to_string(r.method_used);
                row["dice"] = c.dice;
                row["boundary_dice"] = c.boundary_dice;

@@ -31,7 +31,10 @@ struct ImplantParams {
   double max_rim_snap_mm = 3.0;  ///< rim points farther than this from bone stay where they are
   /// Fit to the bone: the shell is built this far beyond the rim (over the bone, mm), then the
   /// skull is subtracted (trim_to_bone.h), so the implant meets the defect's cut face all
-  /// around and never enters the bone. 0: off (the rims pass through the edge markers).
+  /// around and never enters the bone. Where no bone lies that far out (an oblique cut face,
+  /// whose missing wedge the surface passes over first), up to three times as far; where there
+  /// is none even then (an orbit), the rim stays at the edge markers. 0: off (the rims pass
+  /// through the edge markers).
   double fit_to_bone_mm = 0.0;
   /// Radial needs a skull (its centroid is the centre) or `radial_center`; otherwise planar.
   ImplantFrame frame = ImplantFrame::Radial;
