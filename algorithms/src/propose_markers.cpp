@@ -123,21 +123,35 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
   // not (the rim runs along an orbit or the skull base), the fit only extrapolates there: at
   // the last bone. No inner edge markers: the inner rim is the outer one set in by the
   // thickness field of the inner markers (docs/IMPLANT.md).
-  // Compared by direction from the centre, not by position: at an oblique cut face the rim's
-  // last bone is the cut's inner corner, a table's thickness below the ring's outer table.
+  // The ring is probed by direction from the centre, not by position (at an oblique cut face
+  // the rim's last bone is the cut's inner corner, a table's thickness below the ring's outer
+  // table), 5 and 7 mm out, with the ring's bone up to 15 mm out (the rays that leave through
+  // such a face are not in the ring, so it may begin several millimetres beyond the rim; probing
+  // further out found bone across the sample's orbit: rim gap 3 mm). Only ring bone on the
+  // fitted outer surface counts: bone met far below it is not the outer table going on.
   const double clearance = params.surfaces.rim_clearance_mm;
   std::vector<Eigen::Vector3d> near_ring;
+  std::vector<char> on_surface;
   for (size_t i = 0; i < surfaces.ring_outer.size(); ++i)
-    if (surfaces.ring_distance_mm[i] <= clearance + 8.0)
-      near_ring.push_back((surfaces.ring_outer[i] - c).normalized());
+    if (surfaces.ring_distance_mm[i] <= clearance + 12.0) {
+      const Eigen::Vector3d d = (surfaces.ring_outer[i] - c).normalized();
+      const auto fitted = surfaces.at(d);
+      near_ring.push_back(d);
+      on_surface.push_back(fitted && (fitted->first - surfaces.ring_outer[i]).norm() < 1.5);
+    }
   const PointIndex near_index(near_ring.empty() ? std::vector<Eigen::Vector3d>{c} : near_ring);
   auto bone_beyond = [&](const Eigen::Vector3d& rim) {
     Eigen::Vector3d out = rim - c;
     out -= out.dot(defect.axis) * defect.axis;  // away from the opening's axis
     const double radius = (rim - c).norm();
     if (near_ring.empty() || out.norm() < 1e-9 || radius < 1e-9) return false;
-    const Eigen::Vector3d probe = (rim + (clearance + 4.0) * out.normalized() - c).normalized();
-    return near_index.within_radius(probe, 4.0 / radius).size() >= 2;
+    for (double step = 2.0; step <= 4.0; step += 2.0) {
+      const Eigen::Vector3d probe = (rim + (clearance + step) * out.normalized() - c).normalized();
+      int count = 0;
+      for (size_t k : near_index.within_radius(probe, 4.0 / radius)) count += on_surface[k];
+      if (count >= 2) return true;
+    }
+    return false;
   };
   for (size_t i : along(defect.outer_rim, params.edge_spacing_mm)) {
     const Eigen::Vector3d& rim = defect.outer_rim[i];

@@ -57,6 +57,44 @@ TEST(Autoplan, DefectAcrossTheMidlineIsBridgedByRimFitting) {
   EXPECT_EQ(r.quality.self_intersections, 0);
 }
 
+// A SkullFix-like cut across the midline: a 60 mm cube whose faces meet the vault obliquely.
+// Next to such a face the rays from inside meet the bone's inner corner while the outer table
+// goes on a few millimetres further out: the outer edge markers belong on the outer table (the
+// fitted outer surface), else the implant tapers down to the corner and leaves the wedge
+// between the cut face and the rays empty. Before session 5, 3 of 33 markers here (and on
+// SkullFix whole sides of the cube) sat at the inner corner, 7.4 mm below the outer table.
+TEST(Autoplan, OuterEdgeMarkersAtAnObliqueCutStayOnTheOuterTable) {
+  const SkullMesh intact = test::make_thick_head(0.89);
+  InjectDefectParams p;
+  p.shape = InjectDefectParams::Shape::Cube;
+  p.center = test::head_surface_point(Eigen::Vector3d(0.15, -0.6, 0.8).normalized());
+  p.size_mm = 60;
+  p.voxel_mm = 0.5;
+  const InjectDefectResult d = inject_defect(intact, p);
+  ASSERT_TRUE(d.usable());
+  const AutoplanResult r = autoplan(d.defective, Landmarks{});
+  ASSERT_TRUE(r.planned()) << r.message;
+  EXPECT_EQ(r.method_used, PlanMethod::RimOnly);
+  const SurfaceLocator truth(intact);
+  int edges = 0;
+  for (const auto& m : r.markers) {
+    if (m.type != MarkerType::OuterEdge) continue;
+    ++edges;
+    const Eigen::Vector3d ray = (m.position - r.defect.center).normalized();
+    const RayThroughBone t = cast_through_bone(truth, r.defect.center, ray, 400.0, 0.5, 15.0);
+    ASSERT_TRUE(t.paired) << "edge marker " << m.id;
+    EXPECT_NEAR((m.position - r.defect.center).norm(), (*t.outer - r.defect.center).norm(), 1.0)
+        << "edge marker " << m.id << " is not on the outer table";
+  }
+  EXPECT_GE(edges, 20);
+  const CompareResult c = compare_implants(r.implant.mesh, d.implant, &d.defective);
+  RecordProperty("dice", std::to_string(c.dice));
+  RecordProperty("boundary_dice", std::to_string(c.boundary_dice));
+  EXPECT_GE(c.dice, 0.92) << "HD95 " << c.hd95_mm;
+  EXPECT_TRUE(r.quality.watertight);
+  EXPECT_DOUBLE_EQ(r.quality.penetration_mm3, 0.0);
+}
+
 // Two openings: the larger is planned unless a point near the other one says which is meant.
 TEST(Autoplan, WithTwoOpeningsAPointChoosesWhichIsPlanned) {
   InjectDefectParams big;
