@@ -161,13 +161,15 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
       r.markers.push_back({id++, MarkerType::OuterEdge, p->first, MarkerSurface::Original});
     }
   }
-  // Support markers: the intact bone next to the rim (the ring's nearest band).
+  // Support markers: the intact bone next to the rim (the ring's nearest band). Inner ones only
+  // where the ray met both tables: next to an oblique cut face the ray's inner point is not
+  // a table's depth below the outer one, and the implant's thickness follows the inner markers.
   std::vector<Eigen::Vector3d> support_outer, support_inner;
   const double band = params.surfaces.rim_clearance_mm + params.detect.support_width_mm;
   for (size_t i = 0; i < surfaces.ring_outer.size(); ++i)
     if (surfaces.ring_distance_mm[i] <= band) {
       support_outer.push_back(surfaces.ring_outer[i]);
-      support_inner.push_back(surfaces.ring_inner[i]);
+      if (surfaces.ring_through_tables[i]) support_inner.push_back(surfaces.ring_inner[i]);
     }
   for (size_t i : thin_out(support_outer, params.surface_spacing_mm))
     r.markers.push_back(
