@@ -44,9 +44,22 @@ struct DefectSurfaceParams {
   /// only guide across the opening, and smoothing it flattens the vault (on SkullFix the
   /// middle of the openings came out 0.3–1 mm low with 0.03).
   double outer_smoothing = 0.003;
+  /// Rim-only: the outer radius as it is, with the spline's quadratic trend (Quadratic), or as
+  /// its excess over the sphere fitted to the ring (Sphere); Best: whichever predicts the
+  /// ring's band next to the opening better from the rest of the ring.
+  enum class Vault { Best, Quadratic, Sphere };
+  Vault vault = Vault::Best;
   /// Sites whose residual after a first fit exceeds this many robust standard deviations
   /// (and 1 mm) are dropped before the final fit: foramina, sutures, cut-face fragments.
   double outlier_sigmas = 3.0;
+};
+
+/// A sphere fitted to the vault around an opening.
+struct VaultSphere {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  double radius = 0.0;
+  /// Distance from `from` (inside the sphere) along unit `dir` to the sphere.
+  double radius_along(const Eigen::Vector3d& from, const Eigen::Vector3d& dir) const;
 };
 
 class DefectSurfaces {
@@ -59,6 +72,9 @@ class DefectSurfaces {
   int sites = 0;                  ///< fitting sites used (after thinning and outliers)
   double outer_rms_mm = 0.0;      ///< residual of the fit over all ring rays, outer table
   double thickness_rms_mm = 0.0;  ///< the same, bone thickness (inner table)
+  /// Rim-only: the sphere the outer surface was fitted beyond, when the ring preferred it to
+  /// the spline's quadratic trend alone.
+  const std::optional<VaultSphere>& vault() const { return vault_; }
   /// The ring's bone: outer and inner table points of the intact rays (both tables met) and
   /// each ray's distance from the opening, mm.
   std::vector<Eigen::Vector3d> ring_outer, ring_inner;
@@ -85,6 +101,7 @@ class DefectSurfaces {
   const SurfaceLocator* mirror_ = nullptr;  // prior (not owned); null: rim-only
   double max_thickness_mm_ = 15.0;
   ThinPlateSpline outer_, thickness_;
+  std::optional<VaultSphere> vault_;  // set: outer_ fits the radius beyond this sphere
 };
 
 /// Fits the surfaces of `defect` (found by detect_defect on the skull that `bone` locates).
