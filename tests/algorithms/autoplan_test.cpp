@@ -44,7 +44,7 @@ TEST(Autoplan, OneSidedDefectInASymmetricSkullIsFilled) {
 }
 
 // Across the midline the mirror cannot help: rim-only fitting bridges the opening (the issue's
-// target, DSC >= 0.85; 0.87 today).
+// target, DSC >= 0.85; 0.96 in session 5).
 TEST(Autoplan, DefectAcrossTheMidlineIsBridgedByRimFitting) {
   const InjectDefectResult d = defect_at({0.0, -0.3, 1.0}, 50);
   ASSERT_TRUE(d.usable());
