@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <functional>
 #include <limits>
 #include <string>
 
@@ -66,6 +67,60 @@ std::optional<VaultSphere> fit_sphere(const std::vector<Eigen::Vector3d>& points
 // The ring's band next to the opening (beyond the clearance) that tells the vault's models apart.
 constexpr double kNearBandMm = 8.0;
 
+// One ray through the ring's intact bone.
+struct Sample {
+  Eigen::Vector3d dir;
+  double r_out, t;  // outer radius and thickness: original, or original − mirror (guided)
+  bool tables_parallel;
+};
+
+// Rim-only, the outer radius is fitted either as it is (the spline's quadratic trend keeps the
+// ring's curvature) or as its excess over the sphere that fits the ring (the vault keeps
+// bending as around the opening): whichever predicts the ring's band next to the opening
+// better from the rest of the ring. A quadratic trend sags over wide openings (a synthetic
+// 100 mm cut: Dice 0.82 against 0.89 over the sphere); a sphere bulges where the vault
+// flattens (SkullFix 003: 0.917 against 0.875), and the band tells them apart. `uv` projects a
+// ray's direction as the fit does; `distance` is each ray's distance from the opening.
+std::optional<VaultSphere> choose_vault(
+    const std::vector<Sample>& ring, const std::vector<Eigen::Vector3d>& outer,
+    const std::vector<double>& distance, const Eigen::Vector3d& center,
+    const std::function<Eigen::Vector2d(const Eigen::Vector3d&)>& uv, double near_limit_mm,
+    const DefectSurfaceParams& params) {
+  if (params.vault == DefectSurfaceParams::Vault::Quadratic) return std::nullopt;
+  std::vector<size_t> all(ring.size()), far, near;
+  for (size_t i = 0; i < ring.size(); ++i) {
+    all[i] = i;
+    (distance[i] > near_limit_mm ? far : near).push_back(i);
+  }
+  if (params.vault == DefectSurfaceParams::Vault::Sphere) return fit_sphere(outer, all, center);
+  const std::optional<VaultSphere> from_far = fit_sphere(outer, far, center);
+  if (!from_far || near.empty()) return std::nullopt;
+  std::vector<Eigen::Vector3d> far_pts;
+  for (size_t i : far) far_pts.push_back(outer[i]);
+  std::vector<size_t> far_sites;
+  for (size_t k : thin(far_pts, std::max(0.5, params.site_spacing_mm))) far_sites.push_back(far[k]);
+  // RMS error over the near band of a spline fitted to the far part of the ring.
+  auto band_error = [&](const std::optional<VaultSphere>& sphere) {
+    auto height = [&](size_t i) {
+      return ring[i].r_out - (sphere ? sphere->radius_along(center, ring[i].dir) : 0.0);
+    };
+    std::vector<Eigen::Vector2d> sites;
+    std::vector<double> h;
+    for (size_t i : far_sites) {
+      sites.push_back(uv(ring[i].dir));
+      h.push_back(height(i));
+    }
+    ThinPlateSpline tps;
+    if (!tps.fit(sites, h, std::vector<double>(sites.size(), params.outer_smoothing), 1e-3))
+      return std::numeric_limits<double>::infinity();
+    double sum = 0.0;
+    for (size_t i : near) sum += std::pow(height(i) - tps(uv(ring[i].dir)), 2);
+    return std::sqrt(sum / static_cast<double>(near.size()));
+  };
+  if (band_error(from_far) >= band_error(std::nullopt)) return std::nullopt;
+  return fit_sphere(outer, all, center);
+}
+
 }  // namespace
 
 Eigen::Vector2d DefectSurfaces::uv(const Eigen::Vector3d& dir) const {
@@ -86,8 +141,7 @@ std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> DefectSurfaces::at(
   const Eigen::Vector3d dir = dir_in.normalized();
   if (dir.dot(axis_) < max_cos_) return std::nullopt;
   const Eigen::Vector2d q = uv(dir);
-  double r_out = outer_(q) + (vault_ ? vault_->radius_along(center_, dir) : 0.0),
-         t = thickness_(q);
+  double r_out = outer_(q) + (vault_ ? vault_->radius_along(center_, dir) : 0.0), t = thickness_(q);
   if (mirror_) {
     const RayThroughBone m =
         cast_through_bone(*mirror_, center_, dir, kReach, 0.5, max_thickness_mm_);
@@ -136,11 +190,6 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
   const double spacing = std::clamp(params.ray_spacing_mm, 0.5, 10.0) / rim_radius;
   const int n = std::clamp(static_cast<int>(4.0 * M_PI / (spacing * spacing)), 2000, 400000);
   const PointIndex hole(defect.hole_directions);
-  struct Sample {
-    Eigen::Vector3d dir;
-    double r_out, t;  // outer radius and thickness: original, or original − mirror (guided)
-    bool tables_parallel;
-  };
   std::vector<Sample> ring;
   for (const Eigen::Vector3d& d : fibonacci_sphere(n)) {
     if (d.dot(s.axis_) < s.max_cos_) continue;
@@ -182,49 +231,12 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
     return s;
   }
 
-  // Rim-only, the outer radius is fitted either as it is (the spline's quadratic trend keeps
-  // the ring's curvature) or as its excess over the sphere that fits the ring (the vault keeps
-  // bending as around the opening): whichever predicts the ring's band next to the opening
-  // better from the rest of the ring. A quadratic trend sags over wide openings (a synthetic
-  // 100 mm cut: Dice 0.82 against 0.89 over the sphere); a sphere bulges where the vault
-  // flattens (SkullFix 003: 0.917 against 0.875), and the band tells them apart.
-  if (!mirror && params.vault != DefectSurfaceParams::Vault::Quadratic) {
-    std::vector<size_t> all(ring.size()), far, near;
-    for (size_t i = 0; i < ring.size(); ++i) {
-      all[i] = i;
-      (s.ring_distance_mm[i] > clearance + kNearBandMm ? far : near).push_back(i);
-    }
-    const std::optional<VaultSphere> from_far = fit_sphere(s.ring_outer, far, s.center_);
-    std::vector<Eigen::Vector3d> far_pts;
-    for (size_t i : far) far_pts.push_back(s.ring_outer[i]);
-    std::vector<size_t> far_sites;
-    for (size_t k : thin(far_pts, std::max(0.5, params.site_spacing_mm)))
-      far_sites.push_back(far[k]);
-    // RMS error over the near band of a spline fitted to the far part of the ring.
-    auto band_error = [&](const std::optional<VaultSphere>& sphere) {
-      auto height = [&](size_t i) {
-        return ring[i].r_out - (sphere ? sphere->radius_along(s.center_, ring[i].dir) : 0.0);
-      };
-      std::vector<Eigen::Vector2d> uv;
-      std::vector<double> h;
-      for (size_t i : far_sites) {
-        uv.push_back(s.uv(ring[i].dir));
-        h.push_back(height(i));
-      }
-      ThinPlateSpline tps;
-      if (near.empty() ||
-          !tps.fit(uv, h, std::vector<double>(uv.size(), params.outer_smoothing), 1e-3))
-        return std::numeric_limits<double>::infinity();
-      double sum = 0.0;
-      for (size_t i : near) sum += std::pow(height(i) - tps(s.uv(ring[i].dir)), 2);
-      return std::sqrt(sum / static_cast<double>(near.size()));
-    };
-    if (params.vault == DefectSurfaceParams::Vault::Sphere ||
-        (from_far && band_error(from_far) < band_error(std::nullopt))) {
-      s.vault_ = fit_sphere(s.ring_outer, all, s.center_);
-      if (s.vault_)
-        for (auto& smp : ring) smp.r_out -= s.vault_->radius_along(s.center_, smp.dir);
-    }
+  if (!mirror) {
+    s.vault_ = choose_vault(
+        ring, s.ring_outer, s.ring_distance_mm, s.center_,
+        [&s](const Eigen::Vector3d& d) { return s.uv(d); }, clearance + kNearBandMm, params);
+    if (s.vault_)
+      for (auto& smp : ring) smp.r_out -= s.vault_->radius_along(s.center_, smp.dir);
   }
   // Fitting sites: the ring thinned to the site spacing (on the outer table); for the thickness,
   // only rays through both tables.

@@ -180,8 +180,9 @@ TEST(FitDefectSurfaces, VaultModelIsChosenByTheRingsBandNextToTheOpening) {
     for (const auto& d : defect.hole_directions) {
       const auto f = s.at(d);
       const RayThroughBone t = cast_through_bone(truth, defect.center, d, 400.0, 0.5, 15.0);
-      if (f && t.paired) e.push_back(std::abs((f->first - defect.center).norm() -
-                                              (*t.outer - defect.center).norm()));
+      if (f && t.paired)
+        e.push_back(
+            std::abs((f->first - defect.center).norm() - (*t.outer - defect.center).norm()));
     }
     EXPECT_GT(e.size(), defect.hole_directions.size() / 2);
     if (e.empty()) return 1e9;
@@ -213,11 +214,12 @@ TEST(FitDefectSurfaces, VaultModelIsChosenByTheRingsBandNextToTheOpening) {
       return s;
     };
     const DefectSurfaces chosen = fit(DefectSurfaceParams::Vault::Best);
-    EXPECT_EQ(chosen.vault().has_value(), cut.sphere_expected) << cut.name << ": " << chosen.message;
+    EXPECT_EQ(chosen.vault().has_value(), cut.sphere_expected)
+        << cut.name << ": " << chosen.message;
     const double e_chosen = median_outer_error(defect, chosen);
-    const double e_other = median_outer_error(
-        defect, fit(cut.sphere_expected ? DefectSurfaceParams::Vault::Quadratic
-                                        : DefectSurfaceParams::Vault::Sphere));
+    const double e_other =
+        median_outer_error(defect, fit(cut.sphere_expected ? DefectSurfaceParams::Vault::Quadratic
+                                                           : DefectSurfaceParams::Vault::Sphere));
     RecordProperty(std::string(cut.name) + "_chosen_mm", std::to_string(e_chosen));
     RecordProperty(std::string(cut.name) + "_other_mm", std::to_string(e_other));
     // Measured: top 0.23 mm against 0.50 with the quadratic trend; back 0.26 against 0.32
