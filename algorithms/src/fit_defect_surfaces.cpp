@@ -222,7 +222,6 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
     s.ring_outer.push_back(*o.outer);
     s.ring_inner.push_back(*o.inner);
     s.ring_distance_mm.push_back(dist);
-    s.ring_through_tables.push_back(parallel);
   }
   s.ring_rays = static_cast<int>(ring.size());
   if (ring.size() < 12) {

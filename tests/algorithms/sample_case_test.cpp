@@ -72,7 +72,7 @@ TEST(SampleCase, AutoplanFillsTheRealDefect) {
   // The target on the sample's real defect, from autoplan alone: a watertight shell
   // with a rim gap of at most 0.5 mm and no penetration into the skull (the shell is fitted to
   // the bone: built 4 mm over it and trimmed by it), and printable by the quality report (its
-  // edge on the bone tapers over 1.3 mm; docs/IMPLANT.md). Measured 0.16 mm on this mesh
+  // edge on the bone tapers over 1.3 mm; docs/IMPLANT.md). Measured 0.15 mm on this mesh
   // straight from the CT and 0.17 mm on the STL of scripts/run-sample (it was 0.50 / 0.19 mm
   // before the ring's rays through cut faces were left out; the figure is a maximum over 72
   // sectors and moves by tenths of a millimetre).
@@ -88,6 +88,30 @@ TEST(SampleCase, AutoplanFillsTheRealDefect) {
   RecordProperty("rim_gap_mm", std::to_string(r.quality.rim_gap_mm));
   RecordProperty("penetration_mm3", std::to_string(r.quality.penetration_mm3));
   RecordProperty("thickness_min_mm", std::to_string(r.quality.thickness_min_mm));
+}
+
+// The same defect planned from the rim alone, as for a defect the mirror cannot fill: the
+// implant must still meet the real bone all round. Next to a real defect's rim the bone thins
+// and bends, and the support markers there carry that to the implant (session 5 briefly kept
+// only rays through both tables for them, which suits SkullFix's cube cuts: here the rim gap
+// opened to 4 mm).
+TEST(SampleCase, RimOnlyPlanMeetsTheRealBone) {
+  const std::string path = sample_case_path();
+  if (!std::filesystem::exists(path))
+    GTEST_SKIP() << path << " not installed (scripts/install-deps)";
+  const LoadedSkull skull = load_skull(path);
+  AutoplanParams params;
+  params.propose.method = PlanMethod::RimOnly;
+  const AutoplanResult r = autoplan(skull.mesh, Landmarks{}, params);
+  ASSERT_TRUE(r.planned()) << r.message;
+  EXPECT_EQ(r.method_used, PlanMethod::RimOnly);
+  EXPECT_TRUE(r.quality.watertight);
+  EXPECT_LE(r.quality.rim_gap_mm, 0.5);
+  EXPECT_LT(r.quality.penetration_mm3, 0.25);
+  // Not asserted: printable. On this mesh the quality check flags a thin corner away from the
+  // bone, 1.1 mm long (1.8 mm³; 0.8 mm allowed); on the STL of scripts/run-sample it passes.
+  RecordProperty("rim_gap_mm", std::to_string(r.quality.rim_gap_mm));
+  RecordProperty("printable", r.quality.printable ? "yes" : "no");
 }
 
 }  // namespace

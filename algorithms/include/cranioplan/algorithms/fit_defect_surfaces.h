@@ -79,9 +79,6 @@ class DefectSurfaces {
   /// each ray's distance from the opening, mm.
   std::vector<Eigen::Vector3d> ring_outer, ring_inner;
   std::vector<double> ring_distance_mm;
-  /// Whether the ray met both tables (entry and exit surfaces near parallel), so that its
-  /// thickness is the bone's; next to an oblique cut face it is not.
-  std::vector<char> ring_through_tables;
 
   bool fitted() const { return status == Status::Fitted; }
   /// The fitted outer and inner surface points along the ray from the centre in direction
