@@ -100,7 +100,7 @@ TEST(Autoplan, OuterEdgeMarkersAtAnObliqueCutStayOnTheOuterTable) {
 // Real data when present (../shared/data/skullfix; skipped otherwise): SkullFix case 000, a
 // cube cut across the midline at the back of the head, planned from its NRRD mask alone against
 // the ground-truth implant. Session 4 gave DSC 0.863 / HD95 2.83 mm (whole sides of the cube
-// left as wedges); session 5 0.906 / 1.80 mm.
+// left as wedges); session 5 0.908 / 1.50 mm.
 TEST(Autoplan, SkullFixCaseAcrossTheMidlineMatchesTheGroundTruth) {
   const std::string dir = CRANIOPLAN_SKULLFIX_DIR;
   if (!std::filesystem::exists(dir + "/000_defective_skull.nrrd") ||
