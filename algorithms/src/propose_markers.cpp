@@ -164,7 +164,7 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
   // Support markers: the intact bone next to the rim (the ring's nearest band). Inner ones from
   // every ray, also those that did not meet both tables: next to a real defect's rim the bone
   // thins and bends, and the implant meets it only if its inner surface follows it (session 5
-  // tried the inner ones only where both tables were met: SkullFix's cube cuts 0.904 -> 0.917
+  // tried the inner ones only where both tables were met: SkullFix's cube cuts 0.908 -> 0.917
   // median Dice, but the sample's defect planned rim-only opened a 4 mm gap at the rim).
   std::vector<Eigen::Vector3d> support_outer, support_inner;
   const double band = params.surfaces.rim_clearance_mm + params.detect.support_width_mm;
