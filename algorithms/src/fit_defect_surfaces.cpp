@@ -23,25 +23,6 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// Greedy thinning: indices of points at least `spacing` apart, in the given order.
-std::vector<size_t> thin(const std::vector<Eigen::Vector3d>& pts, double spacing) {
-  std::vector<Eigen::Vector3d> kept_pts;
-  std::vector<size_t> kept;
-  for (size_t i = 0; i < pts.size(); ++i) {
-    bool far = true;
-    for (const auto& k : kept_pts)
-      if ((k - pts[i]).squaredNorm() < spacing * spacing) {
-        far = false;
-        break;
-      }
-    if (far) {
-      kept.push_back(i);
-      kept_pts.push_back(pts[i]);
-    }
-  }
-  return kept;
-}
-
 // Least-squares sphere through points[idx] (algebraic fit: |p|² = 2 c·p + k); none when it
 // does not enclose `inside` (the rays' centre) or the points are degenerate.
 std::optional<VaultSphere> fit_sphere(const std::vector<Eigen::Vector3d>& points,
@@ -79,8 +60,9 @@ struct Sample {
 // bending as around the opening): whichever predicts the ring's band next to the opening
 // better from the rest of the ring. A quadratic trend sags over wide openings (a synthetic
 // 100 mm cut: Dice 0.82 against 0.89 over the sphere); a sphere bulges where the vault
-// flattens (SkullFix 003: 0.917 against 0.875), and the band tells them apart. `uv` projects a
-// ray's direction as the fit does; `distance` is each ray's distance from the opening.
+// flattens (SkullFix 003 with an intermediate planner of session 5: 0.917 against 0.875), and
+// the band tells them apart. `uv` projects a ray's direction as the fit does; `distance` is
+// each ray's distance from the opening.
 std::optional<VaultSphere> choose_vault(
     const std::vector<Sample>& ring, const std::vector<Eigen::Vector3d>& outer,
     const std::vector<double>& distance, const Eigen::Vector3d& center,
@@ -98,7 +80,8 @@ std::optional<VaultSphere> choose_vault(
   std::vector<Eigen::Vector3d> far_pts;
   for (size_t i : far) far_pts.push_back(outer[i]);
   std::vector<size_t> far_sites;
-  for (size_t k : thin(far_pts, std::max(0.5, params.site_spacing_mm))) far_sites.push_back(far[k]);
+  for (size_t k : thin_points(far_pts, std::max(0.5, params.site_spacing_mm)))
+    far_sites.push_back(far[k]);
   // RMS error over the near band of a spline fitted to the far part of the ring.
   auto band_error = [&](const std::optional<VaultSphere>& sphere) {
     auto height = [&](size_t i) {
@@ -240,7 +223,7 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
   // Fitting sites: the ring thinned to the site spacing (on the outer table); for the thickness,
   // only rays through both tables.
   const double site_spacing = std::max(0.5, params.site_spacing_mm);
-  const std::vector<size_t> outer_sites = thin(s.ring_outer, site_spacing);
+  const std::vector<size_t> outer_sites = thin_points(s.ring_outer, site_spacing);
   std::vector<size_t> through_tables;
   std::vector<Eigen::Vector3d> through_tables_outer;
   for (size_t i = 0; i < ring.size(); ++i)
@@ -253,7 +236,7 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
   std::vector<size_t> thickness_sites = outer_sites;
   if (!thickness_from_all) {
     thickness_sites.clear();
-    for (size_t k : thin(through_tables_outer, site_spacing))
+    for (size_t k : thin_points(through_tables_outer, site_spacing))
       thickness_sites.push_back(through_tables[k]);
   }
   auto fit = [&](ThinPlateSpline& tps, bool outer, const std::vector<size_t>& use) {

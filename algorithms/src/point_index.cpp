@@ -58,4 +58,18 @@ std::vector<int> PointIndex::within_radius(const Eigen::Vector3d& query, double 
 
 const std::vector<Eigen::Vector3d>& PointIndex::points() const { return impl_->points; }
 
+std::vector<size_t> thin_points(const std::vector<Eigen::Vector3d>& points, double spacing) {
+  std::vector<size_t> kept;
+  for (size_t i = 0; i < points.size(); ++i) {
+    bool far = true;
+    for (size_t k : kept)
+      if ((points[k] - points[i]).squaredNorm() < spacing * spacing) {
+        far = false;
+        break;
+      }
+    if (far) kept.push_back(i);
+  }
+  return kept;
+}
+
 }  // namespace cranioplan

@@ -29,21 +29,6 @@ bool plan_method_from_string(const std::string& text, PlanMethod& out) {
 
 namespace {
 
-// Points at least `spacing` apart, greedily in the given order.
-std::vector<size_t> thin_out(const std::vector<Eigen::Vector3d>& pts, double spacing) {
-  std::vector<size_t> kept;
-  for (size_t i = 0; i < pts.size(); ++i) {
-    bool far = true;
-    for (size_t k : kept)
-      if ((pts[k] - pts[i]).squaredNorm() < spacing * spacing) {
-        far = false;
-        break;
-      }
-    if (far) kept.push_back(i);
-  }
-  return kept;
-}
-
 // Along an ordered closed polyline, indices every `spacing` mm of arc length.
 std::vector<size_t> along(const std::vector<Eigen::Vector3d>& loop, double spacing) {
   std::vector<size_t> out;
@@ -173,10 +158,10 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
       support_outer.push_back(surfaces.ring_outer[i]);
       support_inner.push_back(surfaces.ring_inner[i]);
     }
-  for (size_t i : thin_out(support_outer, params.surface_spacing_mm))
+  for (size_t i : thin_points(support_outer, params.surface_spacing_mm))
     r.markers.push_back(
         {id++, MarkerType::OuterSurface, support_outer[i], MarkerSurface::Original});
-  for (size_t i : thin_out(support_inner, params.surface_spacing_mm))
+  for (size_t i : thin_points(support_inner, params.surface_spacing_mm))
     r.markers.push_back(
         {id++, MarkerType::InnerSurface, support_inner[i], MarkerSurface::Original});
   // Surface markers over the opening, on the fitted surfaces.
@@ -187,9 +172,9 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
       hole_inner.push_back(p->second);
     }
   std::vector<Marker> inside;
-  for (size_t i : thin_out(hole_outer, params.surface_spacing_mm))
+  for (size_t i : thin_points(hole_outer, params.surface_spacing_mm))
     inside.push_back({id++, MarkerType::OuterSurface, hole_outer[i], fitted_on});
-  for (size_t i : thin_out(hole_inner, params.surface_spacing_mm))
+  for (size_t i : thin_points(hole_inner, params.surface_spacing_mm))
     inside.push_back({id++, MarkerType::InnerSurface, hole_inner[i], fitted_on});
   // The paper's smoother with the rim fixed evens out their spacing; each is then put back
   // onto its fitted surface along its ray (the smoother alone would flatten the curvature).

@@ -1,6 +1,9 @@
 // The command-line contract: exit codes, --json, and messages for bad input.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <filesystem>
+
 #include "cranioplan/algorithms/write_mesh.h"
 #include "cranioplan/sessions/plan_files.h"
 #include "support/synthetic.h"
@@ -133,6 +136,41 @@ TEST(Cli, StudyInjectsPlansAndScoresDefects) {
     EXPECT_EQ(row["method"].get<std::string>(), "mirror");
     EXPECT_GT(row["dice"].get<double>(), 0.6);
   }
+}
+
+// evaluate: a folder in the SkullFix layout (here one case injected into the synthetic head)
+// is planned and scored, and --implants-out writes each planned implant beside the table.
+TEST(Cli, EvaluateScoresAFolderOfCasesAndWritesTheImplants) {
+  test::TempDir dir;
+  write_mesh(test::make_thick_head(), dir.path("thick.stl"));
+  std::filesystem::create_directories(dir.path("cases"));
+  std::filesystem::create_directories(dir.path("out"));
+  const Eigen::Vector3d c =
+      test::head_surface_point(Eigen::Vector3d(0.75, 0.2, 0.6).normalized()) * 0.965;
+  char center[96];
+  std::snprintf(center, sizeof(center), "%.3f,%.3f,%.3f", c.x(), c.y(), c.z());
+  ASSERT_EQ(
+      test::run_command(kCli + " inject-defect " + dir.path("thick.stl") + " --center " + center +
+                        " --size 45 -o " + dir.path("cases/007_defective_skull.stl") +
+                        " --implant " + dir.path("cases/007_implant.stl")),
+      0);
+  std::string out;
+  ASSERT_EQ(test::run_command(kCli + " evaluate --json " + dir.path("cases") + " --implants-out " +
+                                  dir.path("out"),
+                              &out),
+            0);
+  const Json j = Json::parse(out);
+  ASSERT_EQ(j["cases"].size(), 1u);
+  EXPECT_EQ(j["cases"][0]["case"].get<std::string>(), "007");
+  EXPECT_GT(j["cases"][0]["dice"].get<double>(), 0.85);
+  EXPECT_GT(j["median"]["median_dice"].get<double>(), 0.85);
+  EXPECT_TRUE(std::filesystem::exists(dir.path("out/007_planned_implant.stl")));
+  // --implants-out that is not a folder: bad input (exit 3), naming it.
+  ASSERT_EQ(test::run_command(kCli + " evaluate --json " + dir.path("cases") + " --implants-out " +
+                                  dir.path("missing"),
+                              &out),
+            3);
+  EXPECT_NE(Json::parse(out)["error"].get<std::string>().find("missing"), std::string::npos);
 }
 
 }  // namespace

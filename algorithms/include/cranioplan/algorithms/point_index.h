@@ -25,4 +25,8 @@ class PointIndex {
   std::unique_ptr<Impl> impl_;
 };
 
+/// Greedy thinning: indices of the points kept, in the given order, each at least `spacing` mm
+/// from every point kept before it (earlier points win).
+std::vector<size_t> thin_points(const std::vector<Eigen::Vector3d>& points, double spacing);
+
 }  // namespace cranioplan
