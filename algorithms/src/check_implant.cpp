@@ -139,7 +139,14 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
     std::sort(wall_vertices.begin(), wall_vertices.end());
     wall_vertices.erase(std::unique(wall_vertices.begin(), wall_vertices.end()),
                         wall_vertices.end());
-    const Eigen::Vector3d e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
+    // Sectors start towards the first wall vertex: the same on the implant in any pose.
+    Eigen::Vector3d e1 = axis.unitOrthogonal();
+    if (!wall_vertices.empty()) {
+      const Eigen::Vector3d w =
+          to_eigen(implant.point(SkullMesh::VertexHandle(wall_vertices.front()))) - c;
+      if ((w - w.dot(axis) * axis).norm() > 1e-9) e1 = (w - w.dot(axis) * axis).normalized();
+    }
+    const Eigen::Vector3d e2 = axis.cross(e1);
     std::vector<double> sector(72, std::numeric_limits<double>::infinity());
     for (int v : wall_vertices) {
       const Eigen::Vector3d p = to_eigen(implant.point(SkullMesh::VertexHandle(v)));

@@ -148,7 +148,7 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
   }
   s.center_ = defect.center;
   s.axis_ = defect.axis;
-  s.e1_ = s.axis_.unitOrthogonal();
+  s.e1_ = across_axis(s.axis_, defect.frame);
   s.e2_ = s.axis_.cross(s.e1_);
   s.mirror_ = mirror;
   s.mirror_guided = mirror != nullptr;
@@ -174,7 +174,8 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
   const int n = std::clamp(static_cast<int>(4.0 * M_PI / (spacing * spacing)), 2000, 400000);
   const PointIndex hole(defect.hole_directions);
   std::vector<Sample> ring;
-  for (const Eigen::Vector3d& d : fibonacci_sphere(n)) {
+  for (const Eigen::Vector3d& lattice : fibonacci_sphere(n)) {
+    const Eigen::Vector3d d = defect.frame * lattice;  // in the skull's frame, as the rim's rays
     if (d.dot(s.axis_) < s.max_cos_) continue;
     const RayThroughBone o = cast_through_bone(bone, s.center_, d, kReach, detect.min_thickness_mm,
                                                detect.max_thickness_mm);

@@ -50,7 +50,10 @@ DefectRegion detect_defect_near_plane(const SkullMesh& skull, const SurfaceLocat
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (auto vh : skull.vertices()) centroid += to_eigen(skull.point(vh));
   centroid /= static_cast<double>(std::max<size_t>(1, skull.n_vertices()));
-  return detect_defect(skull, bone, plane.project(centroid), params);
+  const Eigen::Vector3d center = plane.project(centroid);
+  DetectDefectParams framed = params;
+  if (!framed.frame) framed.frame = skull_frame(skull, center, plane.normal);
+  return detect_defect(skull, bone, center, framed);
 }
 
 RegionOfInterest local_registration_region(const DefectRegion& defect, double margin_mm) {

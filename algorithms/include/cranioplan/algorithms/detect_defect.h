@@ -1,8 +1,9 @@
 #pragma once
 // Where is the defect? Rays from inside the skull: the directions in which no bone is met form
-// openings; the skull base (or the cut of a scan) is the one straight down (−z: skulls are in
-// patient coordinates, superior up, as CT volumes give them), a defect the largest other one
-// that is large enough. Works whether or not the defect crosses the midline.
+// openings; the skull base (or the cut of a scan) is the one that points away from the vault, a
+// defect the largest other one that is large enough. The vault's direction is read from the
+// skull itself (the rays that cross a regular two-table shell), so the skull may come in any
+// pose. Works whether or not the defect crosses the midline.
 #include <optional>
 #include <string>
 #include <vector>
@@ -27,6 +28,10 @@ struct DetectDefectParams {
   /// With several openings large enough, the one seen in the direction of this point (e.g. a
   /// click near the defect, mm) rather than the largest.
   std::optional<Eigen::Vector3d> near;
+  /// The rays' lattice is turned by this rotation (columns: its axes in the skull's
+  /// coordinates). With the skull's own frame (skull_frame) the rays meet the same anatomy
+  /// whatever pose the file came in, and so the plan is the same.
+  std::optional<Eigen::Matrix3d> frame;
 };
 
 struct DefectRegion {
@@ -36,6 +41,12 @@ struct DefectRegion {
   Eigen::Vector3d center = Eigen::Vector3d::Zero();  ///< where the rays start (inside the skull)
   Eigen::Vector3d axis = Eigen::Vector3d::Zero();    ///< mean direction of the opening (unit)
   double area_mm2 = 0.0;                             ///< opening area at the rim's radius
+  /// The skull's superior direction as the rays saw it: the mean direction of the rays that
+  /// cross a regular shell (both tables, facing the ray) or an opening — the vault. Unit; zero
+  /// on a shell closed all round (no direction, and no base).
+  Eigen::Vector3d up = Eigen::Vector3d::Zero();
+  /// The axes the rays were laid out in (DetectDefectParams::frame; identity without one).
+  Eigen::Matrix3d frame = Eigen::Matrix3d::Identity();
   int other_openings = 0;  ///< further openings large enough to be defects (not planned)
   std::vector<Eigen::Vector3d> hole_directions;  ///< unit rays through the opening
   /// The rim: the last bone met along rays next to the opening, outer and inner table, in
@@ -44,6 +55,17 @@ struct DefectRegion {
   double seconds = 0.0;
   bool found() const { return status == Status::Found; }
 };
+
+/// The skull's own axes, the same on the skull in any pose: the principal axis of the vertices
+/// within the midsagittal plane, the other axis within it, and the plane's normal (columns,
+/// right-handed). Each in-plane axis points where the vertices are skewed (a skull is lopsided
+/// both ways: the face in front, the base below). `center` lies on the plane.
+Eigen::Matrix3d skull_frame(const SkullMesh& skull, const Eigen::Vector3d& center,
+                            const Eigen::Vector3d& plane_normal);
+
+/// A unit vector across `axis`, taken from `frame`'s axes (the last one not nearly along it),
+/// so that angles around the axis start from the same anatomy in any pose.
+Eigen::Vector3d across_axis(const Eigen::Vector3d& axis, const Eigen::Matrix3d& frame);
 
 /// `n` directions spread evenly over the unit sphere (a Fibonacci lattice).
 std::vector<Eigen::Vector3d> fibonacci_sphere(int n);
