@@ -23,6 +23,7 @@
 #include "cranioplan/algorithms/thin_plate_spline.h"
 #include "cranioplan/algorithms/trim_to_bone.h"
 #include "cranioplan/model/error.h"
+#include "cranioplan/model/plane.h"
 
 namespace cranioplan {
 
@@ -217,9 +218,7 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
     f.n = axis.normalized();
     f.scale /= static_cast<double>(outer_edges.size());
     // Across the axis towards the first edge marker: the same on the skull in any pose.
-    const Eigen::Vector3d first = outer_edges.front() - f.origin;
-    f.e1 = first - first.dot(f.n) * f.n;
-    f.e1 = f.e1.norm() > 1e-9 ? f.e1.normalized() : f.n.unitOrthogonal();
+    f.e1 = unit_across(outer_edges.front() - f.origin, f.n);
     f.e2 = f.n.cross(f.e1);
   } else {
     // The plane of the outer markers, normal pointing away from the skull's centre.

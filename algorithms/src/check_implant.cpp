@@ -13,6 +13,7 @@
 #include "cranioplan/algorithms/self_intersections.h"
 #include "cranioplan/algorithms/surface_locator.h"
 #include "cranioplan/algorithms/voxelize_mesh.h"
+#include "cranioplan/model/plane.h"
 
 namespace cranioplan {
 namespace {
@@ -140,12 +141,12 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
     wall_vertices.erase(std::unique(wall_vertices.begin(), wall_vertices.end()),
                         wall_vertices.end());
     // Sectors start towards the first wall vertex: the same on the implant in any pose.
-    Eigen::Vector3d e1 = axis.unitOrthogonal();
-    if (!wall_vertices.empty()) {
-      const Eigen::Vector3d w =
-          to_eigen(implant.point(SkullMesh::VertexHandle(wall_vertices.front()))) - c;
-      if ((w - w.dot(axis) * axis).norm() > 1e-9) e1 = (w - w.dot(axis) * axis).normalized();
-    }
+    const Eigen::Vector3d e1 =
+        wall_vertices.empty()
+            ? axis.unitOrthogonal()
+            : unit_across(
+                  to_eigen(implant.point(SkullMesh::VertexHandle(wall_vertices.front()))) - c,
+                  axis);
     const Eigen::Vector3d e2 = axis.cross(e1);
     std::vector<double> sector(72, std::numeric_limits<double>::infinity());
     for (int v : wall_vertices) {

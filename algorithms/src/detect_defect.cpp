@@ -10,14 +10,14 @@
 
 #include "cranioplan/algorithms/point_index.h"
 #include "cranioplan/algorithms/surface_locator.h"
+#include "cranioplan/model/plane.h"
 
 namespace cranioplan {
 
 Eigen::Vector3d across_axis(const Eigen::Vector3d& axis, const Eigen::Matrix3d& frame) {
-  for (int k = 2; k >= 0; --k) {
-    const Eigen::Vector3d v = frame.col(k) - frame.col(k).dot(axis) * axis;
-    if (v.norm() > 0.3) return v.normalized();
-  }
+  constexpr double kNearlyAlong = 0.9539;  // within 17.5° of the axis: its part across is < 0.3
+  for (int k = 2; k >= 0; --k)
+    if (std::abs(frame.col(k).dot(axis)) < kNearlyAlong) return unit_across(frame.col(k), axis);
   return axis.unitOrthogonal();
 }
 

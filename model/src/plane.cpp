@@ -20,4 +20,9 @@ double Plane::angle_to_deg(const Plane& other) const {
   return std::acos(c) * 180.0 / M_PI;
 }
 
+Eigen::Vector3d unit_across(const Eigen::Vector3d& v, const Eigen::Vector3d& axis) {
+  const Eigen::Vector3d across = v - v.dot(axis) * axis;
+  return across.norm() > 1e-9 ? Eigen::Vector3d(across.normalized()) : axis.unitOrthogonal();
+}
+
 }  // namespace cranioplan

@@ -19,6 +19,19 @@ TEST(Plane, ReflectIsAnInvolutionAndFixesThePlane) {
   EXPECT_NEAR(p.angle_to_deg(p.flipped()), 0.0, 1e-9);
 }
 
+// Angles around an axis start from a direction given by the caller (anatomy, a marker), not
+// from the coordinate axes; along the axis there is none, and any unit vector across will do.
+TEST(Plane, UnitAcrossAnAxisDropsThePartAlongIt) {
+  const Eigen::Vector3d axis = Eigen::Vector3d(1, 2, 2) / 3.0;
+  const Eigen::Vector3d e = unit_across(Eigen::Vector3d(3, 0, 0), axis);
+  EXPECT_NEAR(e.norm(), 1.0, 1e-12);
+  EXPECT_NEAR(e.dot(axis), 0.0, 1e-12);
+  EXPECT_NEAR(e.dot(Eigen::Vector3d(8, -2, -2).normalized()), 1.0, 1e-12);  // (3,0,0) − 1·(1,2,2)
+  const Eigen::Vector3d any = unit_across(-2.0 * axis, axis);
+  EXPECT_NEAR(any.norm(), 1.0, 1e-12);
+  EXPECT_NEAR(any.dot(axis), 0.0, 1e-12);
+}
+
 TEST(RigidTransform, InverseAndComposition) {
   const RigidTransform t = RigidTransform::from_axis_angle({1, 2, 3}, 30, {4, 5, 6});
   const Eigen::Vector3d x(1, -1, 2);

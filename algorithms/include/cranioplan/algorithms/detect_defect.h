@@ -3,7 +3,8 @@
 // openings; the skull base (or the cut of a scan) is the one that points away from the vault, a
 // defect the largest other one that is large enough. The vault's direction is read from the
 // skull itself (the rays that cross a regular two-table shell or an opening), and the rays are
-// laid out in the skull's own frame, so the skull may come in any pose. Works whether or not the defect crosses the midline.
+// laid out in the skull's own frame, so the skull may come in any pose. Works whether or not the
+// defect crosses the midline.
 #include <optional>
 #include <string>
 #include <vector>

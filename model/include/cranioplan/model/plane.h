@@ -27,4 +27,8 @@ struct Plane {
   double angle_to_deg(const Plane& other) const;
 };
 
+/// The unit direction of `v` across the unit `axis` (its projection onto the plane through the
+/// origin normal to the axis), or any unit vector across the axis when `v` lies along it.
+Eigen::Vector3d unit_across(const Eigen::Vector3d& v, const Eigen::Vector3d& axis);
+
 }  // namespace cranioplan
