@@ -194,7 +194,10 @@ int current_version(CommandType type) {
   // build_implant 2: ImplantParams gained fit_to_bone_mm (version 1 means no fitting).
   // propose_markers 2: the surfaces fitted to the intact ring ("surfaces"), the opening chosen
   // near a point ("detect.near"); version 1 is read with their defaults.
-  if (type == CommandType::BuildImplant || type == CommandType::ProposeMarkers) return 2;
+  // propose_markers 3: the command records its result (the proposed markers) when it is first
+  // done, and a replay applies that instead of proposing again; versions 1 and 2 recompute.
+  if (type == CommandType::ProposeMarkers) return 3;
+  if (type == CommandType::BuildImplant) return 2;
   return 1;
 }
 

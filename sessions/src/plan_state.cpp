@@ -545,25 +545,59 @@ void apply_marker_edit(PlanState& s, CommandType type, const ParamReader& r) {
   markers_changed(s);
 }
 
-void apply_propose(PlanState& s, const ParamReader& r) {
+// A proposal's result: whether markers were proposed, the markers (with their ids), the
+// opening's centre and the message. Recorded in the command when it is first done, so a replay
+// applies what the surgeon saw and edited rather than what a later planner would propose.
+Json proposal_to_json(const PlanState& s, bool proposed) {
+  Json j{{"proposed", proposed}};
+  j["markers"] = markers_to_json(proposed ? s.markers : std::vector<Marker>{})["markers"];
+  j["defect_center"] = proposed && s.defect_center ? to_json(*s.defect_center) : Json(nullptr);
+  j["message"] = proposed ? s.proposal_message : s.message;
+  return j;
+}
+
+// Applies a recorded result; false when it says nothing was proposed (s.message says why).
+bool proposal_from_json(PlanState& s, const ParamReader& r) {
+  const ParamReader result(r.value("result"), r.where() + " result");
+  if (!result.boolean("proposed")) {
+    s.message = result.string("message");
+    return false;
+  }
+  s.markers = markers_from_json(Json{{"markers", result.value("markers")}}, result.where());
+  s.defect_center.reset();
+  if (!result.value("defect_center").is_null()) s.defect_center = result.vector3("defect_center");
+  s.proposal_message = result.string("message");
+  return true;
+}
+
+// Proposes markers, or applies the proposal the command recorded when it was first done.
+// A proposal replaces the markers; a failed one leaves them as they were.
+void apply_propose(PlanState& s, const ParamReader& r, Json& record) {
   ProposeParams params;
   params_from_json(ParamReader(r.value("params"), r.where() + " params"), params);
-  const SurfaceLocator& mirror = s.mirrored ? s.mirrored->locator : s.skull->surface->locator;
-  MarkerProposal p = propose_markers(s.skull->surface->mesh, s.skull->surface->locator, *s.plane,
-                                     mirror, params, s.next_marker_id);
-  if (!p.proposed()) {
-    s.message = "no markers proposed: " + p.message;
-    return;
+  if (r.has("result")) {
+    if (!proposal_from_json(s, r)) return;
+  } else {
+    const SurfaceLocator& mirror = s.mirrored ? s.mirrored->locator : s.skull->surface->locator;
+    MarkerProposal p = propose_markers(s.skull->surface->mesh, s.skull->surface->locator, *s.plane,
+                                       mirror, params, s.next_marker_id);
+    if (!p.proposed()) {
+      s.message = "no markers proposed: " + p.message;
+      record["result"] = proposal_to_json(s, false);
+      return;
+    }
+    s.markers = std::move(p.markers);
+    s.defect_center = p.defect.center;
+    char buf[300];
+    std::snprintf(buf, sizeof(buf),
+                  "%zu markers proposed, %s (mirror covers %.0f%% of the opening); %s",
+                  s.markers.size(),
+                  p.method_used == PlanMethod::Mirror ? "mirror-guided" : "rim-only fitting",
+                  100.0 * p.mirror_coverage, p.message.c_str());
+    s.proposal_message = std::string(buf) + "; " + p.surfaces_message;
+    record["result"] = proposal_to_json(s, true);
   }
-  s.markers = std::move(p.markers);
   for (const auto& m : s.markers) s.next_marker_id = std::max(s.next_marker_id, m.id + 1);
-  s.defect_center = p.defect.center;
-  char buf[300];
-  std::snprintf(
-      buf, sizeof(buf), "%zu markers proposed, %s (mirror covers %.0f%% of the opening); %s",
-      s.markers.size(), p.method_used == PlanMethod::Mirror ? "mirror-guided" : "rim-only fitting",
-      100.0 * p.mirror_coverage, p.message.c_str());
-  s.proposal_message = std::string(buf) + "; " + p.surfaces_message;
   s.message = s.proposal_message;
   markers_changed(s);
 }
@@ -692,7 +726,7 @@ ApplyOutcome apply_command(const PlanState& before, const Command& command,
         apply_marker_edit(s, command.type, r);
         break;
       case CommandType::ProposeMarkers:
-        apply_propose(s, r);
+        apply_propose(s, r, out.record);
         break;
       case CommandType::SmoothMarkers:
         apply_smooth(s, r);

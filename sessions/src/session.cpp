@@ -465,6 +465,9 @@ PushResult Session::commit(const PreparedCommand& prepared, ApplyOutcome out) {
     return result;
   }
   Command command = prepared.command;
+  // What the command found that a replay must reuse (a proposal's markers) becomes part of it,
+  // and so of what the journal's hashes cover.
+  for (const auto& [key, value] : out.record.items()) command.params[key] = value;
   command.meta.ended = now_iso8601();
   if (command.meta.duration_ms <= 0.0) {
     const double span = parse_iso8601(command.meta.ended) - parse_iso8601(command.meta.started);

@@ -7,6 +7,7 @@
 #include "cranioplan/algorithms/write_mesh.h"
 #include "cranioplan/model/error.h"
 #include "cranioplan/sessions/autoplan_session.h"
+#include "cranioplan/sessions/marker_files.h"
 #include "cranioplan/sessions/sha256.h"
 #include "support/session_cases.h"
 #include "support/test_files.h"
@@ -52,6 +53,25 @@ TEST(AutoplanSession, ReplayReproducesTheExportByteForByte) {
   const VerifyReport v = verify_session(c.session_path);
   EXPECT_TRUE(v.ok());
   for (const auto& check : v.checks) EXPECT_TRUE(check.ok) << check.name << ": " << check.detail;
+}
+
+// The proposal is recorded in its command (what a replay applies): the markers, with their
+// ids, are those of the plan.
+TEST(AutoplanSession, TheProposalIsRecordedInItsCommand) {
+  const Session s = Session::open(planned().session_path);
+  const std::vector<Command> commands = s.effective_commands();
+  const auto propose = std::find_if(commands.begin(), commands.end(), [](const Command& c) {
+    return c.type == CommandType::ProposeMarkers;
+  });
+  ASSERT_NE(propose, commands.end());
+  EXPECT_EQ(propose->version, 3);
+  ASSERT_TRUE(propose->params.contains("result"));
+  const Json& result = propose->params["result"];
+  EXPECT_EQ(result["proposed"], true);
+  EXPECT_EQ(result["markers"], markers_to_json(s.state().markers)["markers"]);
+  EXPECT_EQ(result["message"], s.state().proposal_message);
+  ASSERT_TRUE(s.state().defect_center);
+  EXPECT_EQ(result["defect_center"], to_json(*s.state().defect_center));
 }
 
 TEST(AutoplanSession, UndoOfTheLastCommandUsesTheCache) {

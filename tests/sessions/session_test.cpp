@@ -5,7 +5,9 @@
 #include <filesystem>
 #include <random>
 
+#include "cranioplan/model/error.h"
 #include "cranioplan/sessions/audit.h"
+#include "cranioplan/sessions/marker_files.h"
 #include "cranioplan/sessions/session_error.h"
 #include "support/session_cases.h"
 #include "support/synthetic.h"
@@ -140,7 +142,7 @@ TEST(Commands, ProposeMarkersVersionTwoRoundTripsAndVersionOneGetsDefaults) {
   p.surfaces.smoothing = 0.07;
   p.detect.near = Eigen::Vector3d(1.5, -2.0, 70.25);
   const Json j = to_json(commands::propose_markers(p));
-  EXPECT_EQ(j["version"], 2);
+  EXPECT_EQ(j["version"], 3);
   ProposeParams back;
   params_from_json(ParamReader(j["params"]["params"], "test"), back);
   EXPECT_EQ(back.surfaces.ring_width_mm, 31.0);
@@ -234,6 +236,68 @@ TEST(Session, AVersionOneBuildIsAppliedWithoutFitting) {
   ASSERT_TRUE(r.accepted) << r.message;
   ASSERT_TRUE(s.state().implant_params);
   EXPECT_EQ(s.state().implant_params->fit_to_bone_mm, 0.0);
+}
+
+// A proposal is recorded in its command when it is first done, and a replay applies the
+// recorded markers: a plan reopened with a later planner stays the plan the surgeon edited.
+TEST(Session, AProposalIsRecordedAndReplayedAsRecorded) {
+  // The small head's hole is too small to propose for: the failure is what is recorded.
+  Session s = session_at_markers();
+  push_ok(s, commands::propose_markers());
+  const Json result = s.effective_commands().back().params.value("result", Json());
+  EXPECT_EQ(result["proposed"], false);
+  EXPECT_EQ(result["message"], s.state().message);
+  EXPECT_NE(s.state().message.find("no markers proposed"), std::string::npos);
+  const std::string path = test::scratch_path("proposed.json");
+  s.save(path);
+  EXPECT_EQ(fingerprint(Session::open(path).state()), fingerprint(s.state()));
+  EXPECT_EQ(test::validate_session_schema(path), "");
+
+  // What is recorded is what is applied: markers the planner would never propose, as they are.
+  Session t = session_at_markers();
+  push_ok(t, commands::add_marker(MarkerType::OuterEdge, on_head(0.7, 0.3, 0.7)));
+  Command recorded = commands::propose_markers();
+  Json markers = Json::array();
+  for (int i = 0; i < 3; ++i)
+    markers.push_back(
+        to_json(Marker{40 + i, MarkerType::OuterEdge,
+                       on_head(0.7 + 0.2 * std::cos(2.1 * i), 0.1 + 0.2 * std::sin(2.1 * i), 0.7),
+                       MarkerSurface::Original}));
+  recorded.params["result"] = {{"proposed", true},
+                               {"markers", markers},
+                               {"defect_center", to_json(Eigen::Vector3d(1, 2, 3))},
+                               {"message", "3 markers recorded"}};
+  push_ok(t, recorded);
+  ASSERT_EQ(t.state().markers.size(), 3u);
+  for (int i = 0; i < 3; ++i) {
+    EXPECT_EQ(t.state().markers[i].id, 40 + i);
+    EXPECT_EQ(to_json(t.state().markers[i].position), markers[i]["position"]);
+  }
+  EXPECT_EQ(t.state().next_marker_id, 43);
+  EXPECT_EQ(*t.state().defect_center, Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(t.state().proposal_message, "3 markers recorded");
+  EXPECT_EQ(t.effective_commands().back().params["result"], recorded.params["result"])
+      << "a recorded result is kept, not recorded again";
+
+  // A recorded failure leaves the markers as they were and says why.
+  Command failed = commands::propose_markers();
+  failed.params["result"] = {{"proposed", false},
+                             {"markers", Json::array()},
+                             {"defect_center", nullptr},
+                             {"message", "no markers proposed: no opening found"}};
+  push_ok(t, failed);
+  EXPECT_EQ(t.state().markers.size(), 3u);
+  EXPECT_EQ(t.state().message, "no markers proposed: no opening found");
+
+  // A malformed recorded result is named, not a crash.
+  Command broken = commands::propose_markers();
+  broken.params["result"] = {{"proposed", true}, {"markers", 7}};
+  try {
+    t.push(broken);
+    ADD_FAILURE() << "a malformed result was applied";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("result"), std::string::npos) << e.what();
+  }
 }
 
 TEST(Session, MarkersSnapToTheirSurfaceAndKeepStableIds) {

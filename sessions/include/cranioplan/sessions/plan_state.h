@@ -131,6 +131,10 @@ struct ApplyOutcome {
   bool accepted = false;
   std::string message;  ///< why it was refused, or what it did
   PlanState state;      ///< the new state (the old one when refused)
+  /// What the command found that a replay must reuse rather than recompute, merged into the
+  /// command's params when it is recorded (propose_markers: "result", the proposed markers).
+  /// Empty when there is nothing to record or the command already carried it.
+  Json record = Json::object();
 };
 
 /// Applies one command. A command of a locked step, or one that refers to something that does
