@@ -31,11 +31,11 @@ std::string fmt1(const char* f, double a) {
 // (the union of the balls that fit inside). Where it lies within its own thinness of the bone
 // it is the tapered edge of an implant resting on the bone; how far it reaches from the thick
 // part is the width of that taper.
-void measure_thin_material(const std::vector<uint8_t>& solid, const VoxelGrid& grid,
-                           const std::vector<float>& bone_distance, const QualityParams& params,
-                           QualityReport& q) {
+void measure_thin_material(const std::vector<uint8_t>& solid, const std::vector<float>& depth,
+                           const VoxelGrid& grid, const std::vector<float>& bone_distance,
+                           const QualityParams& params, QualityReport& q) {
   const double r = 0.5 * std::max(0.0, params.min_thickness_mm), h = grid.spacing;
-  const std::vector<uint8_t> centres = ball_centres(solid, grid, r);
+  const std::vector<uint8_t> centres = ball_centres(depth, grid, r);
   if (std::find(centres.begin(), centres.end(), 1) == centres.end()) {
     q.taper_reach_mm = q.corner_reach_mm = -1.0;
     return;
@@ -55,6 +55,22 @@ void measure_thin_material(const std::vector<uint8_t>& solid, const VoxelGrid& g
   }
   q.thin_volume_mm3 = static_cast<double>(thin) * grid.voxel_volume();
   q.thin_off_bone_mm3 = static_cast<double>(off_bone) * grid.voxel_volume();
+}
+
+// The deepest voxel along the segment from `a` to `b` (sampled every half voxel), in mm.
+double deepest_along(const std::vector<float>& depth, const VoxelGrid& grid,
+                     const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const int steps = 1 + static_cast<int>((b - a).norm() / (0.5 * grid.spacing));
+  double deepest = 0.0;
+  for (int t = 0; t <= steps; ++t) {
+    const Eigen::Vector3d v = (a + (b - a) * (double(t) / steps) - grid.origin) / grid.spacing;
+    const int i = static_cast<int>(std::lround(v.x())), j = static_cast<int>(std::lround(v.y())),
+              k = static_cast<int>(std::lround(v.z()));
+    if (i < 0 || j < 0 || k < 0 || i >= grid.dims[0] || j >= grid.dims[1] || k >= grid.dims[2])
+      continue;
+    deepest = std::max(deepest, static_cast<double>(depth[grid.index(i, j, k)]));
+  }
+  return deepest;
 }
 
 }  // namespace
@@ -92,6 +108,15 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
   const Eigen::Vector3d axis =
       Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
 
+  // The implant as a solid on a grid: its depth bounds the thickness, and it gives the thin
+  // material and, with a skull, the overlap.
+  const auto [lo, hi] = mesh_bounds(implant);
+  const VoxelGrid grid =
+      VoxelGrid::covering_at_most(lo, hi, std::clamp(params.overlap_voxel_mm, 0.05, 2.0),
+                                  std::max(1e5, params.overlap_max_voxels));
+  const std::vector<uint8_t> solid = voxelize_mesh(implant, grid);
+  const std::vector<float> depth = depth_in_mask(solid, grid);
+
   const SurfaceLocator self(implant);
   std::vector<double> thickness;
   std::vector<int> wall_vertices;
@@ -113,7 +138,14 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
       if (!measure) continue;
       const Eigen::Vector3d centre = (p[0] + p[1] + p[2]) / 3.0;
       const auto hit = self.first_hit(centre - 1e-4 * n, centre - 200.0 * n);
-      if (hit) thickness.push_back(hit->distance + 1e-4);
+      if (!hit) continue;
+      // Where the plate curves, a normal can leave it at a grazing angle and run along it (on
+      // the sample's frontal implant up to 27 mm through a plate 8 mm at its thickest): the
+      // thickness there is at most the diameter of the deepest ball the ray passes, twice the
+      // deepest voxel's depth plus a voxel for the sampling.
+      const double along = hit->distance + 1e-4;
+      const double ball = 2.0 * deepest_along(depth, grid, centre, hit->point) + grid.spacing;
+      thickness.push_back(std::min(along, ball));
     } else {
       wall_vertices.insert(wall_vertices.end(), ids, ids + 3);
     }
@@ -124,12 +156,6 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
     q.thickness_median_mm = thickness[thickness.size() / 2];
     q.thickness_max_mm = thickness.back();
   }
-  // The implant as a solid on a grid (thin material and, with a skull, the overlap).
-  const auto [lo, hi] = mesh_bounds(implant);
-  const VoxelGrid grid =
-      VoxelGrid::covering_at_most(lo, hi, std::clamp(params.overlap_voxel_mm, 0.05, 2.0),
-                                  std::max(1e5, params.overlap_max_voxels));
-  const std::vector<uint8_t> solid = voxelize_mesh(implant, grid);
   std::vector<float> bone_distance;  // empty without a skull
   if (skull && skull->n_faces() > 0) {
     std::unique_ptr<SurfaceLocator> own;
@@ -164,7 +190,7 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
     q.penetration_mm3 = static_cast<double>(both) * grid.voxel_volume();
     bone_distance = distance_to_mask(b, grid);
   }
-  measure_thin_material(solid, grid, bone_distance, params, q);
+  measure_thin_material(solid, depth, grid, bone_distance, params, q);
 
   if (!q.watertight)
     q.reasons.push_back("not watertight (" + std::to_string(rep.boundary_edges) +

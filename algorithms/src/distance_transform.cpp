@@ -70,8 +70,7 @@ std::vector<float> distance_to_mask(const std::vector<uint8_t>& mask, const Voxe
   return d;
 }
 
-std::vector<uint8_t> ball_centres(const std::vector<uint8_t>& mask, const VoxelGrid& grid,
-                                  double radius) {
+std::vector<float> depth_in_mask(const std::vector<uint8_t>& mask, const VoxelGrid& grid) {
   std::vector<uint8_t> out(mask.size());
   for (size_t c = 0; c < mask.size(); ++c) out[c] = !mask[c];
   // The grid's outermost layer stands for the outside beyond it.
@@ -81,10 +80,20 @@ std::vector<uint8_t> ball_centres(const std::vector<uint8_t>& mask, const VoxelG
       for (int i = 0; i < nx; ++i)
         if (i == 0 || j == 0 || k == 0 || i == nx - 1 || j == ny - 1 || k == nz - 1)
           out[grid.index(i, j, k)] = 1;
-  const std::vector<float> depth = distance_to_mask(out, grid);
+  return distance_to_mask(out, grid);
+}
+
+std::vector<uint8_t> ball_centres(const std::vector<float>& depth, const VoxelGrid& grid,
+                                  double radius) {
   const double need = radius + 0.5 * grid.spacing;
-  for (size_t c = 0; c < mask.size(); ++c) out[c] = mask[c] && depth[c] >= need;
+  std::vector<uint8_t> out(depth.size());
+  for (size_t c = 0; c < depth.size(); ++c) out[c] = depth[c] >= need;
   return out;
+}
+
+std::vector<uint8_t> ball_centres(const std::vector<uint8_t>& mask, const VoxelGrid& grid,
+                                  double radius) {
+  return ball_centres(depth_in_mask(mask, grid), grid, radius);
 }
 
 std::vector<uint8_t> open_by_ball(const std::vector<uint8_t>& mask, const VoxelGrid& grid,

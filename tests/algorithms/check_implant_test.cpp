@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include "cranioplan/algorithms/extract_bone_surface.h"
 #include "cranioplan/algorithms/self_intersections.h"
+#include "cranioplan/algorithms/voxelize_mesh.h"
 #include "support/synthetic.h"
 
 namespace cranioplan {
@@ -49,6 +51,29 @@ TEST(CheckImplant, ThicknessVolumeAndReasonsOnKnownBoxes) {
   EXPECT_NEAR(q.penetration_mm3, 180.0, 60.0);
   EXPECT_TRUE(has_reason(q, "nowhere is the implant 1.00 mm thick")) << q.reasons[0];
   EXPECT_TRUE(has_reason(q, "overlap the skull"));
+}
+
+// A 4 mm spherical cap (radii 60 and 64 mm, 50° around +z) meshed from a 0.5 mm voxel mask, as
+// trimmed implants are: the staircase tilts facets by up to 45° from the plate, and their
+// normals run along it (on the sample's implant up to 27 mm). The thickness is still 4 mm.
+TEST(CheckImplant, ThicknessOfAVoxelMeshedCurvedPlateIsItsThickness) {
+  const VoxelGrid grid = VoxelGrid::covering({-60, -60, 30}, {60, 60, 66}, 0.5);
+  std::vector<uint8_t> cap(grid.size());
+  for (int k = 0; k < grid.dims[2]; ++k)
+    for (int j = 0; j < grid.dims[1]; ++j)
+      for (int i = 0; i < grid.dims[0]; ++i) {
+        const Eigen::Vector3d p = grid.center(i, j, k);
+        const double r = p.norm();
+        cap[grid.index(i, j, k)] = r >= 60 && r <= 64 && p.z() >= r * std::cos(50 * M_PI / 180);
+      }
+  const SkullMesh plate = extract_bone_surface(mask_volume(cap, grid)).mesh;
+  ASSERT_GT(plate.n_faces(), 10000u);
+  const QualityReport q = check_implant(plate, nullptr);
+  EXPECT_TRUE(q.watertight);
+  EXPECT_NEAR(q.thickness_median_mm, 4.0, 0.5);
+  EXPECT_GT(q.thickness_max_mm, 4.0);
+  EXPECT_LT(q.thickness_max_mm, 5.5) << "a normal that ran along the plate was taken for its "
+                                        "thickness";
 }
 
 // A wedge lying on the bone: the cross-section (x, z) is the quadrilateral (0,0), (L,0), (L,H),

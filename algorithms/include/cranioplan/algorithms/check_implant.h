@@ -48,10 +48,12 @@ struct QualityReport {
 /// Thickness: from the centre of each face of the implant's two large surfaces (faces whose
 /// normal is within 45° of the implant's thinnest principal axis; of an implant with more than
 /// 60,000 faces, every k-th face so that about 60,000 are measured), along the inward normal to
-/// the opposite surface. Rim: the side wall (the other faces). Rim gap: around the implant's
-/// axis in 5° sectors, the distance from the sector's side-wall vertex nearest the bone to the
-/// bone; the largest over the sectors (a gap anywhere along the rim shows in its sector).
-/// Penetration: the volume inside both the implant and the skull, on a voxel grid.
+/// the opposite surface, but at most the diameter of the deepest ball the ray passes (twice the
+/// deepest voxel's depth on the grid below, plus a voxel): a facet of a voxel-trimmed curved
+/// implant may have a normal that runs along the plate. Rim: the side wall (the other faces). Rim
+/// gap: around the implant's axis in 5° sectors, the distance from the sector's side-wall vertex
+/// nearest the bone to the bone; the largest over the sectors (a gap anywhere along the rim shows
+/// in its sector). Penetration: the volume inside both the implant and the skull, on a voxel grid.
 /// Thin material: on the same grid, the implant minus its opening by a ball of diameter
 /// min_thickness_mm (exact distance transforms; one voxel of slack). It is printable when the
 /// implant has a thick part, its tapered edge on the bone is at most max_taper_mm wide and
