@@ -3,6 +3,7 @@
 #include <ceres/ceres.h>
 
 #include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cassert>
 #include <chrono>
@@ -165,6 +166,98 @@ Plane initial_plane_from_landmarks(const Landmarks& lm) {
   return Plane{Eigen::Vector3d(n[0], n[1], n[2]).normalized(), d};
 }
 
+namespace {
+
+// How far the mirrored surface lies from the surface, for one candidate plane. Each probe is
+// reflected; its distance is to the tangent plane of the nearest sparse sample when that is near
+// (within kTangentReach) and faces the same way as the mirrored probe, else to the sample itself,
+// so that a sparse index has no distance floor. The score is the 80th percentile: the median
+// ignores the face and the back of the head, which are what tell the midsagittal plane from a
+// coronal one through a round head; the top fifth is left for the defect and its mirror.
+class SymmetryScore {
+ public:
+  SymmetryScore(const SurfaceSamples& all, const Eigen::Vector3d& centroid)
+      : sparse_(subsample(all, 30000)),
+        probe_(subsample(all, 300)),
+        index_(sparse_.points),
+        centroid_(centroid) {}
+
+  double operator()(const Plane& plane) const {
+    std::vector<double> d;
+    d.reserve(probe_.points.size());
+    for (size_t i = 0; i < probe_.points.size(); ++i) {
+      const Eigen::Vector3d q = plane.reflect(probe_.points[i]);
+      double d2;
+      const int c = index_.nearest(q, &d2);
+      double dist = std::sqrt(d2);
+      const Eigen::Vector3d& m = probe_.normals[i];
+      const Eigen::Vector3d mirrored = m - 2.0 * plane.normal.dot(m) * plane.normal;
+      if (dist < kTangentReach && mirrored.dot(sparse_.normals[c]) > 0.3)
+        dist = std::abs(sparse_.normals[c].dot(q - sparse_.points[c]));
+      d.push_back(dist);
+    }
+    const auto at = d.begin() + static_cast<std::ptrdiff_t>(0.8 * static_cast<double>(d.size()));
+    std::nth_element(d.begin(), at, d.end());
+    return *at;
+  }
+
+  // The best plane with normal `n` among offsets `centre` ± k·step, k = 0..count.
+  Plane best_offset(const Eigen::Vector3d& n, double centre, double step, int count,
+                    double* score) const {
+    Plane best{n, centre};
+    *score = std::numeric_limits<double>::infinity();
+    for (int k = -count; k <= count; ++k) {
+      const Plane p{n, centre + k * step};
+      const double sc = (*this)(p);
+      if (sc < *score) *score = sc, best = p;
+    }
+    return best;
+  }
+
+  const Eigen::Vector3d& centroid() const { return centroid_; }
+
+ private:
+  static constexpr double kTangentReach = 3.0;  // mm
+  SurfaceSamples sparse_, probe_;
+  PointIndex index_;
+  Eigen::Vector3d centroid_;
+};
+
+struct Candidate {
+  Plane plane;
+  double score;
+};
+
+// Pattern search on the plane's tilt (8 directions, turning about the plane's point nearest the
+// centroid, so a skull far from the origin turns in place) and its offset, with steps of 4°
+// and 2 mm down to 0.25° and 0.125 mm; each round takes the best of the 10 moves.
+Candidate polish(const SymmetryScore& score, Candidate c) {
+  for (double step_deg = 4.0; step_deg >= 0.25; step_deg /= 2) {
+    const double step_mm = 0.5 * step_deg;
+    for (int round = 0; round < 12; ++round) {
+      const Eigen::Vector3d pivot = c.plane.project(score.centroid());
+      const Eigen::Vector3d e1 = c.plane.normal.unitOrthogonal(), e2 = c.plane.normal.cross(e1);
+      Candidate next = c;
+      auto consider = [&](const Plane& p) {
+        const double sc = score(p);
+        if (sc < next.score) next = {p, sc};
+      };
+      for (int a = 0; a < 8; ++a) {
+        const Eigen::Vector3d axis = std::cos(a * M_PI / 4) * e1 + std::sin(a * M_PI / 4) * e2;
+        const Eigen::Vector3d n = Eigen::AngleAxisd(step_deg * M_PI / 180.0, axis) * c.plane.normal;
+        consider(Plane{n, n.dot(pivot)});
+      }
+      consider(Plane{c.plane.normal, c.plane.offset + step_mm});
+      consider(Plane{c.plane.normal, c.plane.offset - step_mm});
+      if (next.score >= c.score) break;
+      c = next;
+    }
+  }
+  return c;
+}
+
+}  // namespace
+
 Plane automatic_initial_plane(const SkullMesh& mesh) {
   const SurfaceSamples all = all_vertex_samples(mesh);
   assert(!all.points.empty());
@@ -175,42 +268,54 @@ Plane automatic_initial_plane(const SkullMesh& mesh) {
   for (const auto& p : all.points) cov += (p - centroid) * (p - centroid).transpose();
   const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
 
-  std::vector<Eigen::Vector3d> candidates;
-  for (int k = 0; k < 3; ++k) candidates.push_back(eig.eigenvectors().col(k));
-  for (int k = 0; k < 3; ++k) candidates.push_back(Eigen::Vector3d::Unit(k));
-
-  const PointIndex index(all.points);
-  const SurfaceSamples probe = subsample(all, 600);  // 6 axes x 25 offsets are scored
-  Plane best = Plane::through(centroid, candidates[0]);
-  double best_score = std::numeric_limits<double>::infinity();
-  // Each candidate's offset is searched too: a defect on one side moves the centroid off the
-  // midsagittal plane (by a millimetre or more), and a plane through it mirrors everything twice
-  // that far off — enough for a wrong axis to score better.
-  auto score = [&](const Eigen::Vector3d& n, double offset) {
-    return measure_symmetry(probe, index, all.normals, Plane{n, offset}, 1e9, 1.0).median_distance;
-  };
-  for (const auto& n : candidates) {
-    const double d0 = n.dot(centroid);
-    double best_d = d0, best_s = score(n, d0);
-    for (double step : {2.0, 0.5}) {
-      const double centre = best_d;
-      for (int k = -6; k <= 6; ++k) {
-        if (k == 0) continue;
-        const double d = centre + k * step;
-        const double sc = score(n, d);
-        if (sc < best_s) best_s = sc, best_d = d;
-      }
-    }
-    if (best_s < best_score) {
-      best_score = best_s;
-      best = Plane{n, best_d};
-    }
+  // Candidate normals: 200 spread evenly over the half sphere (about 10° apart; a normal and its
+  // opposite are the same plane), the principal axes and the file's axes. A skull is nearly as
+  // wide as it is high, so its principal axes can lie 20° or more off the midsagittal normal,
+  // and in an unseen pose the file's axes mean nothing.
+  std::vector<Eigen::Vector3d> normals;
+  constexpr int kSpread = 200;
+  const double golden = M_PI * (3.0 - std::sqrt(5.0));
+  for (int i = 0; i < kSpread; ++i) {
+    const double z = 1.0 - (i + 0.5) / kSpread, r = std::sqrt(1.0 - z * z);
+    normals.emplace_back(r * std::cos(i * golden), r * std::sin(i * golden), z);
   }
+  for (int k = 0; k < 3; ++k) normals.push_back(eig.eigenvectors().col(k));
+  for (int k = 0; k < 3; ++k) normals.push_back(Eigen::Vector3d::Unit(k));
+
+  // Each through the centroid or up to 6 mm beside it: a defect on one side moves the centroid
+  // off the midsagittal plane. Then the best candidate of each basin (candidates more than 20°
+  // apart), up to six basins, is polished and the best polished one wins: a candidate a few
+  // degrees off the midsagittal normal mirrors the far side of the head millimetres off and can
+  // rank below a wrong plane through a round head until it is polished.
+  const SymmetryScore score(all, centroid);
+  std::vector<Candidate> candidates;
+  for (const auto& n : normals) {
+    double sc;
+    const Plane p = score.best_offset(n, n.dot(centroid), 3.0, 2, &sc);
+    candidates.push_back({p, sc});
+  }
+  std::sort(candidates.begin(), candidates.end(),
+            [](const Candidate& a, const Candidate& b) { return a.score < b.score; });
+  const double apart = std::cos(20.0 * M_PI / 180.0);
+  std::vector<Candidate> basins;
+  for (const auto& c : candidates) {
+    if (basins.size() == 6) break;
+    const bool new_basin = std::none_of(basins.begin(), basins.end(), [&](const Candidate& b) {
+      return std::abs(b.plane.normal.dot(c.plane.normal)) > apart;
+    });
+    if (new_basin) basins.push_back(c);
+  }
+  Candidate best{candidates.front().plane, std::numeric_limits<double>::infinity()};
+  for (const auto& b : basins) {
+    const Candidate c = polish(score, b);
+    if (c.score < best.score) best = c;
+  }
+  Plane plane = best.plane;
   // Orient the normal along the positive coordinate axis it is closest to, for stable output.
   int axis;
-  best.normal.cwiseAbs().maxCoeff(&axis);
-  if (best.normal[axis] < 0) best = best.flipped();
-  return best;
+  plane.normal.cwiseAbs().maxCoeff(&axis);
+  if (plane.normal[axis] < 0) plane = plane.flipped();
+  return plane;
 }
 
 PlaneFit fit_sagittal_plane(const SkullMesh& mesh, const Landmarks& landmarks,

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <random>
 
 #include "cranioplan/algorithms/read_mesh.h"
@@ -112,6 +113,40 @@ TEST(FitSagittalPlane, AutomaticOnAThickSkullWithAOneSidedDefect) {
   ASSERT_TRUE(fit.usable()) << fit.message;
   EXPECT_LT(fit.plane.angle_to_deg(Plane{Eigen::Vector3d::UnitX(), 0.0}), 0.5);
   EXPECT_LT(std::abs(fit.plane.signed_distance(Eigen::Vector3d::Zero())), 0.5);
+}
+
+// The same skull in poses with nothing to go by: turned so its defect faces down (its principal
+// axes then mix left-right with up-down: the head is nearly as wide as it is high), upside
+// down, and lying on its side, each far from the origin. The automatic plane finds the midline
+// in every one, and the refined plane does not depend on where it started.
+TEST(FitSagittalPlane, AutomaticPlaneFindsTheMidlineInAnyPose) {
+  const SkullMesh skull = read_mesh(test::defect_skull_stl()).mesh;
+  const PlaneFit upright = fit_sagittal_plane(skull, Landmarks{});
+  ASSERT_TRUE(upright.usable()) << upright.message;
+  const Eigen::Vector3d defect = Eigen::Vector3d(0.75, 0.2, 0.6).normalized();
+  const Eigen::Matrix3d down =
+      Eigen::Quaterniond::FromTwoVectors(defect, -Eigen::Vector3d::UnitZ()).toRotationMatrix();
+  const std::vector<Eigen::Matrix3d> turns = {
+      Eigen::AngleAxisd(0.7, Eigen::Vector3d::UnitZ()) * down,
+      Eigen::AngleAxisd(M_PI, Eigen::Vector3d(1, 0, 0)).toRotationMatrix(),
+      (Eigen::AngleAxisd(M_PI / 2, Eigen::Vector3d::UnitY()) *
+       Eigen::AngleAxisd(0.4, Eigen::Vector3d::UnitX()))
+          .toRotationMatrix(),
+  };
+  for (size_t i = 0; i < turns.size(); ++i) {
+    RigidTransform pose;
+    pose.rotation = turns[i];
+    pose.translation = {120.0, -40.0, 300.0};
+    const SkullMesh turned = test::transformed(skull, pose);
+    const Plane truth = test::transformed(Plane{Eigen::Vector3d::UnitX(), 0.0}, pose);
+    EXPECT_LT(automatic_initial_plane(turned).angle_to_deg(truth), 2.0) << "pose " << i;
+    const PlaneFit fit = fit_sagittal_plane(turned, Landmarks{});
+    ASSERT_TRUE(fit.usable()) << fit.message;
+    const Plane back = test::transformed(fit.plane, pose.inverse());
+    EXPECT_LT(back.angle_to_deg(upright.plane), 0.2) << "pose " << i;
+    const Plane aligned = back.normal.dot(upright.plane.normal) < 0 ? back.flipped() : back;
+    EXPECT_LT(std::abs(aligned.offset - upright.plane.offset), 0.2) << "pose " << i;
+  }
 }
 
 }  // namespace
