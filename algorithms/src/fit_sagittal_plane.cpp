@@ -358,7 +358,9 @@ PlaneFit fit_sagittal_plane(const SkullMesh& mesh, const Landmarks& landmarks,
       if (use_surface) {
         const auto corr = find_correspondences(samples, *index, all.normals, before,
                                                params.max_correspondence_mm);
-        ceres::LossFunction* loss = new ceres::CauchyLoss(params.robust_scale_mm);  // shared
+        const bool coarse = it < params.coarse_iterations;
+        ceres::LossFunction* loss =  // shared by the residuals
+            new ceres::CauchyLoss(coarse ? params.coarse_robust_scale_mm : params.robust_scale_mm);
         for (const auto& c : corr)
           problem.AddResidualBlock(SymmetryCost::Create(c.p, c.c, c.m), loss, n, &d);
         used = corr.size();
@@ -386,7 +388,8 @@ PlaneFit fit_sagittal_plane(const SkullMesh& mesh, const Landmarks& landmarks,
         break;
       }
       const Plane after{Eigen::Vector3d(n[0], n[1], n[2]).normalized(), d};
-      converged = after.angle_to_deg(before) < params.convergence_deg &&
+      converged = it >= params.coarse_iterations &&
+                  after.angle_to_deg(before) < params.convergence_deg &&
                   std::abs(after.offset - before.offset) < params.convergence_mm;
       fit.plane = after;
     }

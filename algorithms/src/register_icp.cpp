@@ -30,12 +30,13 @@ struct Pair {
   double r;           // signed point-to-plane residual
 };
 
-RigidTransform small_motion(const Eigen::Matrix<double, 6, 1>& x) {
+// The motion x = (rotation vector, translation) about `pivot`: p ↦ R·(p − pivot) + pivot + t.
+RigidTransform small_motion(const Eigen::Matrix<double, 6, 1>& x, const Eigen::Vector3d& pivot) {
   const Eigen::Vector3d w = x.head<3>();
   const double angle = w.norm();
   RigidTransform t;
   if (angle > 0) t.rotation = Eigen::AngleAxisd(angle, w / angle).toRotationMatrix();
-  t.translation = x.tail<3>();
+  t.translation = x.tail<3>() + pivot - t.rotation * pivot;
   return t;
 }
 }  // namespace
@@ -98,12 +99,18 @@ RegisterResult register_icp(const SkullMesh& moving, const SkullMesh& fixed,
                        [](const Pair& a, const Pair& b) { return std::abs(a.r) < std::abs(b.r); });
       pairs.resize(keep);
     }
+    // Rotations about the pairs' centroid, not the file's origin: the steps, and so where the
+    // iteration stops, are the same in any pose (about a far origin a rotation and a
+    // translation nearly cancel, and the system is badly conditioned).
+    Eigen::Vector3d pivot = Eigen::Vector3d::Zero();
+    for (const auto& pr : pairs) pivot += pr.p;
+    pivot /= static_cast<double>(pairs.size());
     Eigen::Matrix<double, 6, 6> A = Eigen::Matrix<double, 6, 6>::Zero();
     Eigen::Matrix<double, 6, 1> b = Eigen::Matrix<double, 6, 1>::Zero();
     double sum2 = 0.0;
     for (const auto& pr : pairs) {
       Eigen::Matrix<double, 6, 1> J;
-      J.head<3>() = pr.p.cross(pr.n);
+      J.head<3>() = (pr.p - pivot).cross(pr.n);
       J.tail<3>() = pr.n;
       const double w = std::abs(pr.r) <= params.huber_mm ? 1.0 : params.huber_mm / std::abs(pr.r);
       A += w * J * J.transpose();
@@ -119,7 +126,7 @@ RegisterResult register_icp(const SkullMesh& moving, const SkullMesh& fixed,
       result.message = "the registration is degenerate (the overlap constrains too few directions)";
       return result;
     }
-    const RigidTransform step = small_motion(x);
+    const RigidTransform step = small_motion(x, pivot);
     T = step * T;
     // Largest displacement of a sample point by this step.
     double moved = 0.0;

@@ -90,6 +90,8 @@ void plane_fields(V& v, P& p) {
   v("sample_count", p.sample_count);
   v("outer_iterations", p.outer_iterations);
   v("robust_scale_mm", p.robust_scale_mm);
+  v("coarse_robust_scale_mm", p.coarse_robust_scale_mm);
+  v("coarse_iterations", p.coarse_iterations);
   v("max_correspondence_mm", p.max_correspondence_mm);
   v("inlier_threshold_mm", p.inlier_threshold_mm);
   v("landmark_weight", p.landmark_weight);
@@ -196,8 +198,11 @@ int current_version(CommandType type) {
   // near a point ("detect.near"); version 1 is read with their defaults.
   // propose_markers 3: the command records its result (the proposed markers) when it is first
   // done, and a replay applies that instead of proposing again; versions 1 and 2 recompute.
+  // fit_plane 2: the refinement starts at a coarse robust scale ("coarse_robust_scale_mm",
+  // "coarse_iterations"; version 1 is read without: 0 coarse updates), and the command records
+  // the fit it gave ("result"), which a replay applies instead of fitting again.
   if (type == CommandType::ProposeMarkers) return 3;
-  if (type == CommandType::BuildImplant) return 2;
+  if (type == CommandType::BuildImplant || type == CommandType::FitPlane) return 2;
   return 1;
 }
 

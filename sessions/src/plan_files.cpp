@@ -175,6 +175,49 @@ Landmarks landmarks_from_json(const Json& j, const std::string& source) {
   return lm;
 }
 
+PlaneFit plane_fit_from_json(const Json& j, const std::string& source) {
+  if (!j.is_object()) throw InputError(source, "a plane fit must be a JSON object");
+  auto need = [&](const char* key) -> const Json& {
+    if (!j.contains(key)) throw InputError(source, std::string("plane fit has no '") + key + "'");
+    return j[key];
+  };
+  auto number = [&](const char* key) {
+    const Json& v = need(key);
+    if (!v.is_number()) throw InputError(source, std::string("'") + key + "' must be a number");
+    return v.get<double>();
+  };
+  auto text = [&](const char* key) {
+    const Json& v = need(key);
+    if (!v.is_string()) throw InputError(source, std::string("'") + key + "' must be text");
+    return v.get<std::string>();
+  };
+  PlaneFit fit;
+  // As recorded, not normalised again: a replay gives the same plane to the bit.
+  fit.plane.normal = vector_from_json(need("normal"), source, "normal");
+  if (fit.plane.normal.norm() < 0.5)
+    throw InputError(source, "plane 'normal' is not a unit vector");
+  fit.plane.offset = number("offset_mm");
+  fit.initial = plane_from_json(need("initial"), source);
+  fit.symmetry_rms_mm = number("symmetry_rms_mm");
+  fit.inlier_fraction = number("inlier_fraction");
+  fit.iterations = static_cast<int>(number("iterations"));
+  fit.solver_iterations = static_cast<int>(number("solver_iterations"));
+  const std::string status = text("status");
+  if (status == "converged")
+    fit.status = PlaneFit::Status::Converged;
+  else if (status == "max_iterations")
+    fit.status = PlaneFit::Status::MaxIterations;
+  else if (status == "failed")
+    fit.status = PlaneFit::Status::Failed;
+  else
+    throw InputError(source, "unknown plane fit status \"" + status + "\"");
+  fit.message = text("message");
+  fit.termination = text("termination");
+  fit.initial_method = text("initial_method");
+  fit.seconds = number("seconds");
+  return fit;
+}
+
 Json read_json_file(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::exists(path, ec)) throw InputError(path, "file not found");

@@ -386,10 +386,24 @@ void apply_landmark(PlanState& s, const ParamReader& r, bool set) {
   s.message = (set ? "set " : "cleared ") + name;
 }
 
-void apply_fit_plane(PlanState& s, const ParamReader& r) {
+// Fits the plane, or applies the fit the command recorded when it was first done (version 2),
+// so a replay gives the same plane whatever later versions do to the fit.
+void apply_fit_plane(PlanState& s, const ParamReader& r, int version, Json& record) {
+  Json recorded = r.value("params");
+  // Version 1 (before the coarse start) refined at one robust scale throughout.
+  if (version < 2 && recorded.is_object() && !recorded.contains("coarse_iterations")) {
+    recorded["coarse_iterations"] = 0;
+    recorded["coarse_robust_scale_mm"] = recorded.value("robust_scale_mm", 1.0);
+  }
   PlaneFitParams params;
-  params_from_json(ParamReader(r.value("params"), r.where() + " params"), params);
-  const PlaneFit fit = fit_sagittal_plane(s.skull->surface->mesh, s.landmarks, params);
+  params_from_json(ParamReader(recorded, r.where() + " params"), params);
+  PlaneFit fit;
+  if (r.has("result")) {
+    fit = plane_fit_from_json(r.value("result"), r.where() + " result");
+  } else {
+    fit = fit_sagittal_plane(s.skull->surface->mesh, s.landmarks, params);
+    if (version >= 2) record["result"] = to_json(fit);
+  }
   s.plane_fit = fit;
   if (!fit.usable()) {
     s.message = "plane fit failed: " + fit.message;
@@ -700,7 +714,7 @@ ApplyOutcome apply_command(const PlanState& before, const Command& command,
         apply_landmark(s, r, false);
         break;
       case CommandType::FitPlane:
-        apply_fit_plane(s, r);
+        apply_fit_plane(s, r, command.version, out.record);
         break;
       case CommandType::AdjustPlane:
         apply_adjust_plane(s, r);

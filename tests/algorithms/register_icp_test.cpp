@@ -41,6 +41,32 @@ TEST(RegisterIcp, TrimmedIcpIgnoresADefectInTheFixedMesh) {
   expect_transform_near(r.transform, truth, 0.1, 0.1, moving);
 }
 
+// Where the file puts the skull does not matter: the same pair moved 400 mm from the origin
+// takes the same steps (each turns about the pairs' centroid, not the origin, about which a
+// turn and a shift nearly cancel), so it stops at the same place. Checked after every one of
+// the first iterations, where the path shows.
+TEST(RegisterIcp, TheSamePairFarFromTheOriginGivesTheSameMotion) {
+  const SkullMesh full = test::make_symmetric_head(5);
+  const SkullMesh fixed = test::cut_hole(full, {55, 30, 35}, 30.0);
+  const RigidTransform truth =
+      RigidTransform::from_axis_angle({1, 0.3, 0.1}, 4.0, {-2.0, 1.5, 2.5});
+  const SkullMesh moving = test::transformed(full, truth.inverse());
+  const RigidTransform shift = RigidTransform::from_axis_angle({0, 0, 1}, 0.0, {150, -300, 220});
+  const SkullMesh moving_far = test::transformed(moving, shift);
+  const SkullMesh fixed_far = test::transformed(fixed, shift);
+  for (int iterations : {1, 2, 3, 60}) {
+    RegisterParams params;
+    params.max_iterations = iterations;
+    const RegisterResult near = register_icp(moving, fixed, params);
+    const RegisterResult far = register_icp(moving_far, fixed_far, params);
+    ASSERT_TRUE(near.usable() && far.usable());
+    EXPECT_EQ(far.iterations, near.iterations);
+    // The far motion, brought back, is the near one.
+    expect_transform_near(shift.inverse() * far.transform * shift, near.transform, 1e-4, 1e-4,
+                          moving);
+  }
+}
+
 TEST(RegisterIcp, RegionOfInterestRestrictsTheFit) {
   const SkullMesh fixed = test::make_symmetric_head(5);
   const RigidTransform truth = RigidTransform::from_axis_angle({0, 0, 1}, 2.0, {1.0, 1.0, -1.0});

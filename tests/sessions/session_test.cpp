@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <filesystem>
 #include <random>
 
@@ -236,6 +237,45 @@ TEST(Session, AVersionOneBuildIsAppliedWithoutFitting) {
   ASSERT_TRUE(r.accepted) << r.message;
   ASSERT_TRUE(s.state().implant_params);
   EXPECT_EQ(s.state().implant_params->fit_to_bone_mm, 0.0);
+}
+
+// The plane fit is recorded in its command (fit_plane 2) and a replay applies the recorded
+// plane; a version-1 fit_plane (before the coarse start) is still read and fitted.
+TEST(Session, APlaneFitIsRecordedAndReplayedAsRecorded) {
+  Session s = session_at_markers();
+  const std::vector<Command> done = s.effective_commands();
+  const auto fit = std::find_if(done.begin(), done.end(),
+                                [](const Command& c) { return c.type == CommandType::FitPlane; });
+  ASSERT_NE(fit, done.end());
+  EXPECT_EQ(fit->version, 2);
+  ASSERT_TRUE(fit->params.contains("result"));
+  EXPECT_EQ(fit->params["result"], to_json(*s.state().plane_fit));
+
+  Session t(SessionInfo{"small", "tester", ""});
+  push_ok(t, commands::load_skull(test::small_skull_stl()));
+  Command recorded = commands::fit_plane();
+  PlaneFit chosen;
+  chosen.status = PlaneFit::Status::Converged;
+  chosen.plane = Plane{Eigen::Vector3d(0.6, 0.8, 0.0), 3.25};  // not what the fit would give
+  chosen.initial = chosen.plane;
+  chosen.initial_method = "automatic";
+  chosen.message = "converged";
+  recorded.params["result"] = to_json(chosen);
+  push_ok(t, recorded);
+  ASSERT_TRUE(t.state().plane);
+  EXPECT_EQ(t.state().plane->normal, Eigen::Vector3d(0.6, 0.8, 0.0));
+  EXPECT_EQ(t.state().plane->offset, 3.25);
+
+  Json v1 = to_json(commands::fit_plane());
+  v1["version"] = 1;
+  v1["params"]["params"].erase("coarse_iterations");
+  v1["params"]["params"].erase("coarse_robust_scale_mm");
+  Session u(SessionInfo{"small", "tester", ""});
+  push_ok(u, commands::load_skull(test::small_skull_stl()));
+  push_ok(u, command_from_json(v1, "old plan"));
+  EXPECT_TRUE(u.state().plane);
+  EXPECT_FALSE(u.effective_commands().back().params.contains("result"))
+      << "a version-1 command is kept as recorded";
 }
 
 // A proposal is recorded in its command when it is first done, and a replay applies the

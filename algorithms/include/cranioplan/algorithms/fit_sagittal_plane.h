@@ -10,11 +10,16 @@
 namespace cranioplan {
 
 struct PlaneFitParams {
-  bool refine = true;                 ///< run the Ceres refinement after the initial plane
-  bool use_surface_symmetry = true;   ///< add the surface-symmetry residuals (needs a mesh)
-  int sample_count = 4000;            ///< surface samples for symmetry, 100..100000
-  int outer_iterations = 40;          ///< correspondence updates (k-d tree), 1..50
-  double robust_scale_mm = 1.0;       ///< Cauchy loss scale for symmetry residuals, mm (>0)
+  bool refine = true;                ///< run the Ceres refinement after the initial plane
+  bool use_surface_symmetry = true;  ///< add the surface-symmetry residuals (needs a mesh)
+  int sample_count = 4000;           ///< surface samples for symmetry, 100..100000
+  int outer_iterations = 40;         ///< correspondence updates (k-d tree), 1..50
+  double robust_scale_mm = 1.0;      ///< Cauchy loss scale for symmetry residuals, mm (>0)
+  /// The first `coarse_iterations` updates use this wider scale (graduated: the cost is smoother
+  /// there, so starts a fraction of a degree apart reach the same optimum instead of stopping
+  /// in different shallow minima of the nearest-point correspondences), mm (>0).
+  double coarse_robust_scale_mm = 4.0;
+  int coarse_iterations = 8;  ///< updates at the coarse scale (not checked for convergence), ≥ 0
   double max_correspondence_mm = 10;  ///< reflected samples farther than this are ignored, mm
   double inlier_threshold_mm = 1.5;   ///< |residual| below this counts as an inlier, mm
   double landmark_weight = 1.0;       ///< weight of each landmark residual (≥ 0)

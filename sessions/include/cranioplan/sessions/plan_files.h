@@ -34,6 +34,8 @@ Eigen::Vector3d vector_from_json(const Json& j, const std::string& source, const
 Plane plane_from_json(const Json& j, const std::string& source);
 RigidTransform transform_from_json(const Json& j, const std::string& source);
 Landmarks landmarks_from_json(const Json& j, const std::string& source);
+/// The form to_json(PlaneFit) writes, read back; errors name `source`.
+PlaneFit plane_fit_from_json(const Json& j, const std::string& source);
 
 /// Parses a JSON file; throws InputError for a missing file or invalid JSON (with the line).
 Json read_json_file(const std::string& path);
