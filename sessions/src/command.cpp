@@ -200,9 +200,14 @@ int current_version(CommandType type) {
   // done, and a replay applies that instead of proposing again; versions 1 and 2 recompute.
   // fit_plane 2: the refinement starts at a coarse robust scale ("coarse_robust_scale_mm",
   // "coarse_iterations"; version 1 is read without: 0 coarse updates), and the command records
-  // the fit it gave ("result"), which a replay applies instead of fitting again.
+  // the fit it gave ("result") and, when the mirror was registered again after it, that
+  // registration ("registration"), which a replay applies instead of computing them again.
   if (type == CommandType::ProposeMarkers) return 3;
-  if (type == CommandType::BuildImplant || type == CommandType::FitPlane) return 2;
+  // register 2 and adjust_plane 2 record the registration they gave ("result"; adjust_plane:
+  // "registration", when the mirror was registered again), which a replay applies.
+  if (type == CommandType::BuildImplant || type == CommandType::FitPlane ||
+      type == CommandType::Register || type == CommandType::AdjustPlane)
+    return 2;
   return 1;
 }
 

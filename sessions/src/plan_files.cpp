@@ -51,15 +51,19 @@ Json to_json(const MeshReport& r) {
               {"watertight", r.watertight}};
 }
 
+namespace {
+// The names of PlaneFit::Status and RegisterResult::Status (the same three, in this order).
+const char* const kStatusNames[] = {"converged", "max_iterations", "failed"};
+}  // namespace
+
 Json to_json(const PlaneFit& fit) {
-  static const char* names[] = {"converged", "max_iterations", "failed"};
   return Json{{"normal", to_json(fit.plane.normal)},
               {"offset_mm", fit.plane.offset},
               {"symmetry_rms_mm", fit.symmetry_rms_mm},
               {"inlier_fraction", fit.inlier_fraction},
               {"iterations", fit.iterations},
               {"solver_iterations", fit.solver_iterations},
-              {"status", names[static_cast<int>(fit.status)]},
+              {"status", kStatusNames[static_cast<int>(fit.status)]},
               {"message", fit.message},
               {"termination", fit.termination},
               {"initial_method", fit.initial_method},
@@ -68,13 +72,12 @@ Json to_json(const PlaneFit& fit) {
 }
 
 Json to_json(const RegisterResult& r) {
-  static const char* names[] = {"converged", "max_iterations", "failed"};
   Json j = to_json(r.transform);
   j["rms_mm"] = r.rms_mm;
   j["inlier_fraction"] = r.inlier_fraction;
   j["iterations"] = r.iterations;
   j["rotation_deg"] = r.transform.rotation_angle_deg();
-  j["status"] = names[static_cast<int>(r.status)];
+  j["status"] = kStatusNames[static_cast<int>(r.status)];
   j["message"] = r.message;
   j["seconds"] = r.seconds;
   return j;
@@ -175,46 +178,61 @@ Landmarks landmarks_from_json(const Json& j, const std::string& source) {
   return lm;
 }
 
+namespace {
+// A number or text field of a recorded result, named in errors.
+double result_number(const Json& j, const char* key, const std::string& source) {
+  if (!j.contains(key) || !j[key].is_number())
+    throw InputError(source, std::string("'") + key + "' must be a number");
+  return j[key].get<double>();
+}
+std::string result_text(const Json& j, const char* key, const std::string& source) {
+  if (!j.contains(key) || !j[key].is_string())
+    throw InputError(source, std::string("'") + key + "' must be text");
+  return j[key].get<std::string>();
+}
+// PlaneFit::Status and RegisterResult::Status alike (kStatusNames).
+template <class Status>
+Status status_from_json(const Json& j, const std::string& source) {
+  const std::string status = result_text(j, "status", source);
+  for (int k = 0; k < 3; ++k)
+    if (status == kStatusNames[k]) return static_cast<Status>(k);
+  throw InputError(source, "unknown status \"" + status + "\"");
+}
+}  // namespace
+
+RegisterResult register_result_from_json(const Json& j, const std::string& source) {
+  if (!j.is_object()) throw InputError(source, "a registration must be a JSON object");
+  RegisterResult r;
+  r.transform = transform_from_json(j, source);
+  r.rms_mm = result_number(j, "rms_mm", source);
+  r.inlier_fraction = result_number(j, "inlier_fraction", source);
+  r.iterations = static_cast<int>(result_number(j, "iterations", source));
+  r.status = status_from_json<RegisterResult::Status>(j, source);
+  r.message = result_text(j, "message", source);
+  r.seconds = result_number(j, "seconds", source);
+  return r;
+}
+
 PlaneFit plane_fit_from_json(const Json& j, const std::string& source) {
   if (!j.is_object()) throw InputError(source, "a plane fit must be a JSON object");
-  auto need = [&](const char* key) -> const Json& {
+  for (const char* key : {"normal", "initial"})
     if (!j.contains(key)) throw InputError(source, std::string("plane fit has no '") + key + "'");
-    return j[key];
-  };
-  auto number = [&](const char* key) {
-    const Json& v = need(key);
-    if (!v.is_number()) throw InputError(source, std::string("'") + key + "' must be a number");
-    return v.get<double>();
-  };
-  auto text = [&](const char* key) {
-    const Json& v = need(key);
-    if (!v.is_string()) throw InputError(source, std::string("'") + key + "' must be text");
-    return v.get<std::string>();
-  };
   PlaneFit fit;
   // As recorded, not normalised again: a replay gives the same plane to the bit.
-  fit.plane.normal = vector_from_json(need("normal"), source, "normal");
+  fit.plane.normal = vector_from_json(j["normal"], source, "normal");
   if (fit.plane.normal.norm() < 0.5)
     throw InputError(source, "plane 'normal' is not a unit vector");
-  fit.plane.offset = number("offset_mm");
-  fit.initial = plane_from_json(need("initial"), source);
-  fit.symmetry_rms_mm = number("symmetry_rms_mm");
-  fit.inlier_fraction = number("inlier_fraction");
-  fit.iterations = static_cast<int>(number("iterations"));
-  fit.solver_iterations = static_cast<int>(number("solver_iterations"));
-  const std::string status = text("status");
-  if (status == "converged")
-    fit.status = PlaneFit::Status::Converged;
-  else if (status == "max_iterations")
-    fit.status = PlaneFit::Status::MaxIterations;
-  else if (status == "failed")
-    fit.status = PlaneFit::Status::Failed;
-  else
-    throw InputError(source, "unknown plane fit status \"" + status + "\"");
-  fit.message = text("message");
-  fit.termination = text("termination");
-  fit.initial_method = text("initial_method");
-  fit.seconds = number("seconds");
+  fit.plane.offset = result_number(j, "offset_mm", source);
+  fit.initial = plane_from_json(j["initial"], source);
+  fit.symmetry_rms_mm = result_number(j, "symmetry_rms_mm", source);
+  fit.inlier_fraction = result_number(j, "inlier_fraction", source);
+  fit.iterations = static_cast<int>(result_number(j, "iterations", source));
+  fit.solver_iterations = static_cast<int>(result_number(j, "solver_iterations", source));
+  fit.status = status_from_json<PlaneFit::Status>(j, source);
+  fit.message = result_text(j, "message", source);
+  fit.termination = result_text(j, "termination", source);
+  fit.initial_method = result_text(j, "initial_method", source);
+  fit.seconds = result_number(j, "seconds", source);
   return fit;
 }
 

@@ -236,8 +236,15 @@ void update_mirrored(PlanState& s, const std::string& why) {
 
 // Registers the mirror with `s.register_params`; false when the attempt failed and the previous
 // (working) registration was kept.
-bool run_registration(PlanState& s) {
-  RegisterResult result = register_icp(*s.mirror_base, s.skull->surface->mesh, *s.register_params);
+// Registers the mirror with s.register_params, or applies `recorded` (what the command that
+// caused it recorded when it was first done) so that a replay gives the same registration
+// whatever later versions do to ICP. What was computed is put in `*record` when given.
+bool run_registration(PlanState& s, const Json* recorded = nullptr, Json* record = nullptr,
+                      const std::string& where = "") {
+  RegisterResult result =
+      recorded ? register_result_from_json(*recorded, where)
+               : register_icp(*s.mirror_base, s.skull->surface->mesh, *s.register_params);
+  if (!recorded && record) *record = to_json(result);
   if (!result.usable() && s.registration && s.registration->usable()) {
     // A failed attempt does not throw away a working registration.
     s.message = "registration failed: " + result.message + "; the previous registration is kept";
@@ -281,14 +288,21 @@ void markers_changed(PlanState& s) {
   rebuild_implant(s);
 }
 
-void plane_changed(PlanState& s) {
+// After the plane changed, the mirror is recomputed and, when it had been registered,
+// registered again; that registration is recorded in the command as "registration" (and
+// applied from there on replay) when `record` is given.
+void plane_changed(PlanState& s, const ParamReader* r = nullptr, Json* record = nullptr) {
   unacknowledge(s, 4, "the plane changed");
   if (!s.mirror_requested) return;
   s.mirror_base = std::make_shared<const SkullMesh>(mirror_mesh(s.skull->surface->mesh, *s.plane));
   std::string why = "the plane changed: mirror recomputed";
   if (s.register_params) {
     const std::string plane_message = s.message;
-    run_registration(s);
+    const bool recorded = r && r->has("registration");
+    Json computed;
+    run_registration(s, recorded ? &r->value("registration") : nullptr,
+                     record ? &computed : nullptr, r ? r->where() + " registration" : "");
+    if (record && !recorded) (*record)["registration"] = computed;
     why += " and registered again";
     s.message = plane_message + "; " + s.message;
   }
@@ -414,10 +428,10 @@ void apply_fit_plane(PlanState& s, const ParamReader& r, int version, Json& reco
   std::snprintf(buf, sizeof(buf), "plane fitted (%s start): symmetry RMS %.2f mm, %.0f%% inliers",
                 fit.initial_method.c_str(), fit.symmetry_rms_mm, 100.0 * fit.inlier_fraction);
   s.message = buf;
-  plane_changed(s);
+  plane_changed(s, version >= 2 ? &r : nullptr, version >= 2 ? &record : nullptr);
 }
 
-void apply_adjust_plane(PlanState& s, const ParamReader& r) {
+void apply_adjust_plane(PlanState& s, const ParamReader& r, int version, Json& record) {
   if (!s.plane) throw Refusal{"there is no plane to adjust yet: fit it first"};
   const Eigen::Vector3d axis = r.vector3("axis");
   const double angle = r.number("angle_deg");
@@ -430,7 +444,7 @@ void apply_adjust_plane(PlanState& s, const ParamReader& r) {
   if (angle != 0.0) normal = Eigen::AngleAxisd(angle * M_PI / 180.0, axis.normalized()) * normal;
   s.plane = Plane::through(pivot + shift * normal.normalized(), normal);
   s.message = "plane adjusted by hand";
-  plane_changed(s);
+  plane_changed(s, version >= 2 ? &r : nullptr, version >= 2 ? &record : nullptr);
 }
 
 void apply_mirror(PlanState& s) {
@@ -443,13 +457,20 @@ void apply_mirror(PlanState& s) {
   update_mirrored(s, "the mirror was made again");
 }
 
-void apply_register(PlanState& s, const ParamReader& r) {
+// Registers the mirror, or (version 2) applies the registration the command recorded.
+void apply_register(PlanState& s, const ParamReader& r, int version, Json& record) {
   if (!s.mirror_base) throw Refusal{"mirror the skull before registering it"};
   RegisterParams params;
   params_from_json(ParamReader(r.value("params"), r.where() + " params"), params);
   const std::optional<RegisterParams> previous = s.register_params;
   s.register_params = params;
-  if (!run_registration(s)) {
+  const bool recorded = r.has("result");
+  Json computed;
+  const bool registered =
+      run_registration(s, recorded ? &r.value("result") : nullptr,
+                       version >= 2 ? &computed : nullptr, r.where() + " result");
+  if (version >= 2 && !recorded) record["result"] = computed;
+  if (!registered) {
     s.register_params = previous;
     return;
   }
@@ -717,13 +738,13 @@ ApplyOutcome apply_command(const PlanState& before, const Command& command,
         apply_fit_plane(s, r, command.version, out.record);
         break;
       case CommandType::AdjustPlane:
-        apply_adjust_plane(s, r);
+        apply_adjust_plane(s, r, command.version, out.record);
         break;
       case CommandType::Mirror:
         apply_mirror(s);
         break;
       case CommandType::Register:
-        apply_register(s, r);
+        apply_register(s, r, command.version, out.record);
         break;
       case CommandType::MoveMirrored:
         apply_move_mirrored(s, r);

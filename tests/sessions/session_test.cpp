@@ -278,6 +278,44 @@ TEST(Session, APlaneFitIsRecordedAndReplayedAsRecorded) {
       << "a version-1 command is kept as recorded";
 }
 
+// The registration is recorded in the register command (version 2), and in the command that
+// changed the plane when the mirror was registered again; a replay applies what is recorded.
+TEST(Session, RegistrationsAreRecordedAndReplayedAsRecorded) {
+  Session s = session_at_markers();
+  std::vector<Command> done = s.effective_commands();
+  const auto reg = std::find_if(done.begin(), done.end(),
+                                [](const Command& c) { return c.type == CommandType::Register; });
+  ASSERT_NE(reg, done.end());
+  EXPECT_EQ(reg->version, 2);
+  ASSERT_TRUE(reg->params.contains("result"));
+  EXPECT_EQ(reg->params["result"], to_json(*s.state().registration));
+
+  // Turning the plane registers the mirror again: recorded in the adjust_plane command.
+  push_ok(s, commands::adjust_plane({0, 0, 1}, 1.0, 0.5));
+  const Command adjust = s.effective_commands().back();
+  EXPECT_EQ(adjust.version, 2);
+  ASSERT_TRUE(adjust.params.contains("registration"));
+  EXPECT_EQ(adjust.params["registration"], to_json(*s.state().registration));
+  const std::string path = test::scratch_path("registered.json");
+  s.save(path);
+  EXPECT_EQ(fingerprint(Session::open(path).state()), fingerprint(s.state()));
+  EXPECT_EQ(test::validate_session_schema(path), "");
+
+  // What is recorded is what is applied: a registration ICP would not give, as it is.
+  Session t = session_at_markers();
+  Command recorded = commands::register_mirror();
+  RegisterResult chosen;
+  chosen.status = RegisterResult::Status::Converged;
+  chosen.transform = RigidTransform::from_axis_angle({0, 1, 0}, 2.5, {1.0, -0.5, 0.25});
+  chosen.rms_mm = 0.3;
+  chosen.message = "converged";
+  recorded.params["result"] = to_json(chosen);
+  push_ok(t, recorded);
+  ASSERT_TRUE(t.state().registration);
+  EXPECT_EQ(t.state().registration->transform.rotation, chosen.transform.rotation);
+  EXPECT_EQ(t.state().registration->transform.translation, chosen.transform.translation);
+}
+
 // A proposal is recorded in its command when it is first done, and a replay applies the
 // recorded markers: a plan reopened with a later planner stays the plan the surgeon edited.
 TEST(Session, AProposalIsRecordedAndReplayedAsRecorded) {

@@ -34,6 +34,8 @@ Eigen::Vector3d vector_from_json(const Json& j, const std::string& source, const
 Plane plane_from_json(const Json& j, const std::string& source);
 RigidTransform transform_from_json(const Json& j, const std::string& source);
 Landmarks landmarks_from_json(const Json& j, const std::string& source);
+/// The form to_json(RegisterResult) writes, read back; errors name `source`.
+RegisterResult register_result_from_json(const Json& j, const std::string& source);
 /// The form to_json(PlaneFit) writes, read back; errors name `source`.
 PlaneFit plane_fit_from_json(const Json& j, const std::string& source);
 
