@@ -1,6 +1,7 @@
 #include "cranioplan/sessions/autoplan_session.h"
 
 #include <filesystem>
+#include <optional>
 
 #include "cranioplan/algorithms/propose_markers.h"
 
@@ -35,12 +36,14 @@ AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks&
   run(commands::register_mirror(params.registration));
   // Registered again around the opening, as autoplan() does: the region is found here and
   // recorded as the command's parameter, so replay needs no detection.
+  std::optional<DefectRegion> found;
   if (params.local_registration_mm > 0.0 && s.state().registration &&
       s.state().registration->usable()) {
     const PlanState& st = s.state();
     const DefectRegion defect = detect_defect_near_plane(
         st.skull->surface->mesh, st.skull->surface->locator, *st.plane, params.propose.detect);
     if (defect.found()) {
+      found = defect;
       RegisterParams local = params.registration;
       local.initial = st.registration->transform;
       local.roi = local_registration_region(defect, params.local_registration_mm);
@@ -50,7 +53,16 @@ AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks&
   // An unusable registration leaves the mirror where mirroring put it, as autoplan() does.
   if (!step_complete(s.state(), 3)) run(commands::complete_step(3));
   run(commands::complete_step(4));
-  run(commands::propose_markers(params.propose));
+  // The markers are proposed for the opening found above (what the command would find again:
+  // the same skull, plane and detection), and the proposal goes into the command as its result.
+  Command propose = commands::propose_markers(params.propose);
+  if (found && s.state().mirrored) {
+    const PlanState& st = s.state();
+    propose.params["result"] = proposal_result(
+        propose_markers_for_defect(*found, st.skull->surface->locator, st.mirrored->locator,
+                                   params.propose, st.next_marker_id));
+  }
+  run(std::move(propose));
   if (s.state().markers.empty()) {
     out.status = AutoplanSession::Status::NoDefect;
     return stop(s.state().message);

@@ -580,58 +580,35 @@ void apply_marker_edit(PlanState& s, CommandType type, const ParamReader& r) {
   markers_changed(s);
 }
 
-// A proposal's result: whether markers were proposed, the markers (with their ids), the
-// opening's centre and the message. Recorded in the command when it is first done, so a replay
-// applies what the surgeon saw and edited rather than what a later planner would propose.
-Json proposal_to_json(const PlanState& s, bool proposed) {
-  Json j{{"proposed", proposed}};
-  j["markers"] = markers_to_json(proposed ? s.markers : std::vector<Marker>{})["markers"];
-  j["defect_center"] = proposed && s.defect_center ? to_json(*s.defect_center) : Json(nullptr);
-  j["message"] = proposed ? s.proposal_message : s.message;
-  return j;
-}
-
-// Applies a recorded result; false when it says nothing was proposed (s.message says why).
-bool proposal_from_json(PlanState& s, const ParamReader& r) {
-  const ParamReader result(r.value("result"), r.where() + " result");
+// Applies a propose_markers command's result; false when it says nothing was proposed
+// (s.message says why).
+bool apply_proposal_result(PlanState& s, const Json& j, const std::string& where) {
+  const ParamReader result(j, where);
   if (!result.boolean("proposed")) {
     s.message = result.string("message");
     return false;
   }
-  s.markers = markers_from_json(Json{{"markers", result.value("markers")}}, result.where());
+  s.markers = markers_from_json(Json{{"markers", result.value("markers")}}, where);
   s.defect_center.reset();
   if (!result.value("defect_center").is_null()) s.defect_center = result.vector3("defect_center");
   s.proposal_message = result.string("message");
   return true;
 }
 
-// Proposes markers, or applies the proposal the command recorded when it was first done.
-// A proposal replaces the markers; a failed one leaves them as they were.
+// Proposes markers, or applies the proposal the command recorded when it was first done; both
+// go through the recorded form, so a replay is the live command. A proposal replaces the
+// markers; a failed one leaves them as they were.
 void apply_propose(PlanState& s, const ParamReader& r, Json& record) {
   ProposeParams params;
   params_from_json(ParamReader(r.value("params"), r.where() + " params"), params);
-  if (r.has("result")) {
-    if (!proposal_from_json(s, r)) return;
-  } else {
+  if (!r.has("result")) {
     const SurfaceLocator& mirror = s.mirrored ? s.mirrored->locator : s.skull->surface->locator;
-    MarkerProposal p = propose_markers(s.skull->surface->mesh, s.skull->surface->locator, *s.plane,
-                                       mirror, params, s.next_marker_id);
-    if (!p.proposed()) {
-      s.message = "no markers proposed: " + p.message;
-      record["result"] = proposal_to_json(s, false);
-      return;
-    }
-    s.markers = std::move(p.markers);
-    s.defect_center = p.defect.center;
-    char buf[300];
-    std::snprintf(buf, sizeof(buf),
-                  "%zu markers proposed, %s (mirror covers %.0f%% of the opening); %s",
-                  s.markers.size(),
-                  p.method_used == PlanMethod::Mirror ? "mirror-guided" : "rim-only fitting",
-                  100.0 * p.mirror_coverage, p.message.c_str());
-    s.proposal_message = std::string(buf) + "; " + p.surfaces_message;
-    record["result"] = proposal_to_json(s, true);
+    record["result"] =
+        proposal_result(propose_markers(s.skull->surface->mesh, s.skull->surface->locator, *s.plane,
+                                        mirror, params, s.next_marker_id));
   }
+  const Json& result = r.has("result") ? r.value("result") : record["result"];
+  if (!apply_proposal_result(s, result, r.where() + " result")) return;
   for (const auto& m : s.markers) s.next_marker_id = std::max(s.next_marker_id, m.id + 1);
   s.message = s.proposal_message;
   markers_changed(s);
@@ -708,6 +685,23 @@ void apply_step(PlanState& s, CommandType type, const ParamReader& r) {
 }
 
 }  // namespace
+
+Json proposal_result(const MarkerProposal& p) {
+  if (!p.proposed())
+    return Json{{"proposed", false},
+                {"markers", Json::array()},
+                {"defect_center", nullptr},
+                {"message", "no markers proposed: " + p.message}};
+  char buf[300];
+  std::snprintf(
+      buf, sizeof(buf), "%zu markers proposed, %s (mirror covers %.0f%% of the opening); %s",
+      p.markers.size(), p.method_used == PlanMethod::Mirror ? "mirror-guided" : "rim-only fitting",
+      100.0 * p.mirror_coverage, p.message.c_str());
+  return Json{{"proposed", true},
+              {"markers", markers_to_json(p.markers)["markers"]},
+              {"defect_center", to_json(p.defect.center)},
+              {"message", std::string(buf) + "; " + p.surfaces_message}};
+}
 
 ApplyOutcome apply_command(const PlanState& before, const Command& command,
                            const ApplyContext& context) {

@@ -72,6 +72,15 @@ TEST(AutoplanSession, TheProposalIsRecordedInItsCommand) {
   EXPECT_EQ(result["message"], s.state().proposal_message);
   ASSERT_TRUE(s.state().defect_center);
   EXPECT_EQ(result["defect_center"], to_json(*s.state().defect_center));
+  // autoplan_session proposed for the opening it had found; the command alone, on the state
+  // before it, finds and proposes the same.
+  Session again = Session::open(planned().session_path);
+  const size_t at = static_cast<size_t>(propose - commands.begin());
+  Command fresh = *propose;
+  fresh.params.erase("result");
+  const ApplyOutcome out = apply_command(again.state_at(at), fresh);
+  ASSERT_TRUE(out.accepted) << out.message;
+  EXPECT_EQ(out.record["result"], result);
 }
 
 TEST(AutoplanSession, UndoOfTheLastCommandUsesTheCache) {

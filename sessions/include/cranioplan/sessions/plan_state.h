@@ -137,6 +137,13 @@ struct ApplyOutcome {
   Json record = Json::object();
 };
 
+struct MarkerProposal;
+/// What a propose_markers command records as its "result" for `proposal` (whether markers were
+/// proposed, the markers with their ids, the opening's centre, the message), and applies. A
+/// caller that has proposed already (autoplan_session, which found the opening to register
+/// around it) puts it in the command, so the opening is not looked for twice.
+Json proposal_result(const MarkerProposal& proposal);
+
 /// Applies one command. A command of a locked step, or one that refers to something that does
 /// not exist (a marker id, a plane before landmarks), is refused. Bad inputs (a missing skull
 /// file, a changed file) throw InputError/SessionError.
