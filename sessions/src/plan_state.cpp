@@ -234,11 +234,10 @@ void update_mirrored(PlanState& s, const std::string& why) {
     }
 }
 
-// Registers the mirror with `s.register_params`; false when the attempt failed and the previous
-// (working) registration was kept.
 // Registers the mirror with s.register_params, or applies `recorded` (what the command that
 // caused it recorded when it was first done) so that a replay gives the same registration
-// whatever later versions do to ICP. What was computed is put in `*record` when given.
+// whatever later versions do to ICP. What was computed is put in `*record` when given. False
+// when the attempt failed and the previous (working) registration was kept.
 bool run_registration(PlanState& s, const Json* recorded = nullptr, Json* record = nullptr,
                       const std::string& where = "") {
   RegisterResult result =
