@@ -88,6 +88,26 @@ struct Correspondence {
   Eigen::Vector3d p, c, m;
 };
 
+// Sample p (normal m) reflected across the plane to q, and the surface sample c nearest q;
+// `facing` when p's mirrored normal agrees with c's normal (not the outer table mirrored onto
+// the inner one).
+struct MirrorMatch {
+  Eigen::Vector3d q;
+  int c;
+  double d2;  ///< |q − c|², mm²
+  bool facing;
+};
+
+MirrorMatch mirror_match(const Eigen::Vector3d& p, const Eigen::Vector3d& m, const Plane& plane,
+                         const PointIndex& index, const std::vector<Eigen::Vector3d>& normals) {
+  MirrorMatch out;
+  out.q = plane.reflect(p);
+  out.c = index.nearest(out.q, &out.d2);
+  const Eigen::Vector3d mirrored_normal = m - 2.0 * plane.normal.dot(m) * plane.normal;
+  out.facing = mirrored_normal.dot(normals[out.c]) >= 0.3;
+  return out;
+}
+
 // Correspondences of reflected samples on the original surface, rejecting far ones and ones
 // whose mirrored normal disagrees with the surface normal (outer vs inner table of the skull).
 std::vector<Correspondence> find_correspondences(const SurfaceSamples& samples,
@@ -97,14 +117,10 @@ std::vector<Correspondence> find_correspondences(const SurfaceSamples& samples,
   std::vector<Correspondence> out;
   out.reserve(samples.points.size());
   for (size_t i = 0; i < samples.points.size(); ++i) {
-    const Eigen::Vector3d q = plane.reflect(samples.points[i]);
-    double d2;
-    const int c = index.nearest(q, &d2);
-    if (d2 > max_dist * max_dist) continue;
-    const Eigen::Vector3d& np = samples.normals[i];
-    const Eigen::Vector3d mirrored_normal = np - 2.0 * plane.normal.dot(np) * plane.normal;
-    if (mirrored_normal.dot(normals[c]) < 0.3) continue;
-    out.push_back({samples.points[i], index.points()[c], normals[c]});
+    const MirrorMatch mm =
+        mirror_match(samples.points[i], samples.normals[i], plane, index, normals);
+    if (mm.d2 > max_dist * max_dist || !mm.facing) continue;
+    out.push_back({samples.points[i], index.points()[mm.c], normals[mm.c]});
   }
   return out;
 }
@@ -186,14 +202,11 @@ class SymmetryScore {
     std::vector<double> d;
     d.reserve(probe_.points.size());
     for (size_t i = 0; i < probe_.points.size(); ++i) {
-      const Eigen::Vector3d q = plane.reflect(probe_.points[i]);
-      double d2;
-      const int c = index_.nearest(q, &d2);
-      double dist = std::sqrt(d2);
-      const Eigen::Vector3d& m = probe_.normals[i];
-      const Eigen::Vector3d mirrored = m - 2.0 * plane.normal.dot(m) * plane.normal;
-      if (dist < kTangentReach && mirrored.dot(sparse_.normals[c]) > 0.3)
-        dist = std::abs(sparse_.normals[c].dot(q - sparse_.points[c]));
+      const MirrorMatch mm =
+          mirror_match(probe_.points[i], probe_.normals[i], plane, index_, sparse_.normals);
+      double dist = std::sqrt(mm.d2);
+      if (dist < kTangentReach && mm.facing)
+        dist = std::abs(sparse_.normals[mm.c].dot(mm.q - sparse_.points[mm.c]));
       d.push_back(dist);
     }
     const auto at = d.begin() + static_cast<std::ptrdiff_t>(0.8 * static_cast<double>(d.size()));
