@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "cranioplan/algorithms/detect_defect.h"  // fibonacci_sphere
 #include "cranioplan/algorithms/point_index.h"
 #include "cranioplan/algorithms/surface_samples.h"
 
@@ -285,13 +286,10 @@ Plane automatic_initial_plane(const SkullMesh& mesh) {
   // opposite are the same plane), the principal axes and the file's axes. A skull is nearly as
   // wide as it is high, so its principal axes can lie 20° or more off the midsagittal normal,
   // and in an unseen pose the file's axes mean nothing.
-  std::vector<Eigen::Vector3d> normals;
+  // The first half of a Fibonacci sphere of 400 is its upper half (z > 0).
   constexpr int kSpread = 200;
-  const double golden = M_PI * (3.0 - std::sqrt(5.0));
-  for (int i = 0; i < kSpread; ++i) {
-    const double z = 1.0 - (i + 0.5) / kSpread, r = std::sqrt(1.0 - z * z);
-    normals.emplace_back(r * std::cos(i * golden), r * std::sin(i * golden), z);
-  }
+  std::vector<Eigen::Vector3d> normals = fibonacci_sphere(2 * kSpread);
+  normals.resize(kSpread);
   for (int k = 0; k < 3; ++k) normals.push_back(eig.eigenvectors().col(k));
   for (int k = 0; k < 3; ++k) normals.push_back(Eigen::Vector3d::Unit(k));
 

@@ -59,14 +59,12 @@ TEST(AutoplanSession, ReplayReproducesTheExportByteForByte) {
 // ids, are those of the plan.
 TEST(AutoplanSession, TheProposalIsRecordedInItsCommand) {
   const Session s = Session::open(planned().session_path);
-  const std::vector<Command> commands = s.effective_commands();
-  const auto propose = std::find_if(commands.begin(), commands.end(), [](const Command& c) {
-    return c.type == CommandType::ProposeMarkers;
-  });
-  ASSERT_NE(propose, commands.end());
-  EXPECT_EQ(propose->version, 3);
-  ASSERT_TRUE(propose->params.contains("result"));
-  const Json& result = propose->params["result"];
+  const auto at = test::first_command(s, CommandType::ProposeMarkers);
+  ASSERT_TRUE(at);
+  const Command propose = s.effective_commands()[*at];
+  EXPECT_EQ(propose.version, 3);
+  ASSERT_TRUE(propose.params.contains("result"));
+  const Json& result = propose.params["result"];
   EXPECT_EQ(result["proposed"], true);
   EXPECT_EQ(result["markers"], markers_to_json(s.state().markers)["markers"]);
   EXPECT_EQ(result["message"], s.state().proposal_message);
@@ -75,10 +73,9 @@ TEST(AutoplanSession, TheProposalIsRecordedInItsCommand) {
   // autoplan_session proposed for the opening it had found; the command alone, on the state
   // before it, finds and proposes the same.
   Session again = Session::open(planned().session_path);
-  const size_t at = static_cast<size_t>(propose - commands.begin());
-  Command fresh = *propose;
+  Command fresh = propose;
   fresh.params.erase("result");
-  const ApplyOutcome out = apply_command(again.state_at(at), fresh);
+  const ApplyOutcome out = apply_command(again.state_at(*at), fresh);
   ASSERT_TRUE(out.accepted) << out.message;
   EXPECT_EQ(out.record["result"], result);
 }

@@ -243,13 +243,12 @@ TEST(Session, AVersionOneBuildIsAppliedWithoutFitting) {
 // plane; a version-1 fit_plane (before the coarse start) is still read and fitted.
 TEST(Session, APlaneFitIsRecordedAndReplayedAsRecorded) {
   Session s = session_at_markers();
-  const std::vector<Command> done = s.effective_commands();
-  const auto fit = std::find_if(done.begin(), done.end(),
-                                [](const Command& c) { return c.type == CommandType::FitPlane; });
-  ASSERT_NE(fit, done.end());
-  EXPECT_EQ(fit->version, 2);
-  ASSERT_TRUE(fit->params.contains("result"));
-  EXPECT_EQ(fit->params["result"], to_json(*s.state().plane_fit));
+  const auto at = test::first_command(s, CommandType::FitPlane);
+  ASSERT_TRUE(at);
+  const Command fit = s.effective_commands()[*at];
+  EXPECT_EQ(fit.version, 2);
+  ASSERT_TRUE(fit.params.contains("result"));
+  EXPECT_EQ(fit.params["result"], to_json(*s.state().plane_fit));
 
   Session t(SessionInfo{"small", "tester", ""});
   push_ok(t, commands::load_skull(test::small_skull_stl()));
@@ -282,13 +281,12 @@ TEST(Session, APlaneFitIsRecordedAndReplayedAsRecorded) {
 // changed the plane when the mirror was registered again; a replay applies what is recorded.
 TEST(Session, RegistrationsAreRecordedAndReplayedAsRecorded) {
   Session s = session_at_markers();
-  std::vector<Command> done = s.effective_commands();
-  const auto reg = std::find_if(done.begin(), done.end(),
-                                [](const Command& c) { return c.type == CommandType::Register; });
-  ASSERT_NE(reg, done.end());
-  EXPECT_EQ(reg->version, 2);
-  ASSERT_TRUE(reg->params.contains("result"));
-  EXPECT_EQ(reg->params["result"], to_json(*s.state().registration));
+  const auto at = test::first_command(s, CommandType::Register);
+  ASSERT_TRUE(at);
+  const Command reg = s.effective_commands()[*at];
+  EXPECT_EQ(reg.version, 2);
+  ASSERT_TRUE(reg.params.contains("result"));
+  EXPECT_EQ(reg.params["result"], to_json(*s.state().registration));
 
   // Turning the plane registers the mirror again: recorded in the adjust_plane command.
   push_ok(s, commands::adjust_plane({0, 0, 1}, 1.0, 0.5));

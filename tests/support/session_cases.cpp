@@ -80,6 +80,13 @@ Json fingerprint(const PlanState& s) {
   return j;
 }
 
+std::optional<size_t> first_command(const Session& session, CommandType type) {
+  const std::vector<Command> done = session.effective_commands();
+  for (size_t i = 0; i < done.size(); ++i)
+    if (done[i].type == type) return i;
+  return std::nullopt;
+}
+
 void push_ok(Session& session, Command command) {
   const std::string what = describe(command);
   const PushResult r = session.push(std::move(command));

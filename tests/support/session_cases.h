@@ -1,5 +1,6 @@
 #pragma once
 // Skull files for session tests, written once per test program into a temporary folder.
+#include <optional>
 #include <string>
 
 #include "cranioplan/sessions/plan_state.h"
@@ -18,6 +19,9 @@ std::string scratch_path(const std::string& name);
 
 /// Everything that defines a plan's state, as JSON, to compare states for equality.
 Json fingerprint(const PlanState& state);
+
+/// Where the first command of `type` stands among the session's effective commands.
+std::optional<size_t> first_command(const Session& session, CommandType type);
 
 /// Pushes a command and fails the test (with the refusal) when it is refused.
 void push_ok(Session& session, Command command);

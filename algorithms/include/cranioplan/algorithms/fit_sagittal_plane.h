@@ -51,8 +51,9 @@ Plane initial_plane_from_landmarks(const Landmarks& landmarks);
 /// Plane found without landmarks, in any pose: 200 candidate normals spread over the half
 /// sphere plus the principal axes and the coordinate axes, each through the centroid or up to
 /// 6 mm beside it, scored by how far the mirrored surface lies from the original (80th
-/// percentile of 300 probes' distances to the tangent planes of 30,000 samples); the three best
-/// are polished by a pattern search on tilt (down to 0.5°) and offset, and the best one wins.
+/// percentile of 300 probes' distances to the tangent planes of 30,000 samples); the best of
+/// each of up to six basins (20° apart) is polished by a pattern search on tilt and offset (down
+/// to 0.25° and 0.125 mm), and the best polished one wins.
 Plane automatic_initial_plane(const SkullMesh& mesh);
 
 /// Initial plane (landmarks when they hold the required three, otherwise automatic), then the

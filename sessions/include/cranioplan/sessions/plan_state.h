@@ -132,7 +132,9 @@ struct ApplyOutcome {
   std::string message;  ///< why it was refused, or what it did
   PlanState state;      ///< the new state (the old one when refused)
   /// What the command found that a replay must reuse rather than recompute, merged into the
-  /// command's params when it is recorded (propose_markers: "result", the proposed markers).
+  /// command's params when it is recorded: "result" of fit_plane (the fit), register (the
+  /// registration) and propose_markers (the markers); "registration" of fit_plane and
+  /// adjust_plane when the plane change registered the mirror again.
   /// Empty when there is nothing to record or the command already carried it.
   Json record = Json::object();
 };
