@@ -37,18 +37,11 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
     r.message = "midsagittal plane: " + r.plane.message;
     return r;
   }
-  // The mirror is never built as a mesh here: it is the skull moved by the reflection and then
-  // the registration, so it is registered as the skull with the reflection as the starting
-  // transform, and its locator is the skull's locator moved (on a skull of two million
-  // triangles a mesh and a locator are a few hundred megabytes each).
+  // The mirror is never built as a mesh here (register_mirror), and its locator is the skull's
+  // locator moved (on a skull of two million triangles a mesh and a locator are a few hundred
+  // megabytes each).
   const RigidTransform reflection = reflection_across(r.plane.plane);
-  RegisterParams global = params.registration;
-  global.initial = params.registration.initial * reflection;
-  auto registration_of_mirror = [&](RegisterResult result) {
-    result.transform = result.transform * reflection;  // the reflection is its own inverse
-    return result;
-  };
-  r.registration = registration_of_mirror(register_icp(skull, skull, global));
+  r.registration = register_mirror(skull, r.plane.plane, params.registration);
   timer.stage("register");
 
   const SurfaceLocator bone(skull);
@@ -66,9 +59,9 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
 
   if (params.local_registration_mm > 0.0 && r.registration.usable()) {
     RegisterParams local = params.registration;
-    local.initial = r.registration.transform * reflection;
+    local.initial = r.registration.transform;
     local.roi = local_registration_region(r.defect, params.local_registration_mm);
-    const RegisterResult lr = registration_of_mirror(register_icp(skull, skull, local));
+    const RegisterResult lr = register_mirror(skull, r.plane.plane, local);
     if (lr.usable()) r.registration = lr;
     timer.stage("local register");
   }

@@ -22,12 +22,14 @@ LoadedSkull load_skull(const std::string& path, const ExtractBoneSurfaceParams& 
     const Volume volume = read_volume(path);
     out.surface = extract_bone_surface(volume, import);
     if (!out.surface.usable()) throw InputError(path, out.surface.message);
-    out.mesh = std::move(out.surface.mesh);
+    // OpenMesh meshes cannot be moved (std::move copies), so the import's copy is cleared.
+    out.mesh = out.surface.mesh;
+    out.surface.mesh.clear();
     out.source_kind = "volume";
     out.description = volume.description;
   } else {
     MeshFile file = read_mesh(path);
-    out.mesh = std::move(file.mesh);
+    out.mesh = file.mesh;  // a copy (OpenMesh meshes cannot be moved); `file` goes at once
     out.source_kind = "mesh";
     out.description = file.format;
     out.warnings = std::move(file.warnings);

@@ -5,6 +5,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "cranioplan/algorithms/mirror_mesh.h"
 #include "cranioplan/algorithms/point_index.h"
 #include "cranioplan/algorithms/surface_samples.h"
 
@@ -147,6 +148,16 @@ RegisterResult register_icp(const SkullMesh& moving, const SkullMesh& fixed,
   result.message =
       converged ? "converged" : "stopped at the iteration limit (still moving slightly)";
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return result;
+}
+
+RegisterResult register_mirror(const SkullMesh& skull, const Plane& plane,
+                               const RegisterParams& params) {
+  const RigidTransform reflection = reflection_across(plane);
+  RegisterParams own = params;
+  own.initial = params.initial * reflection;
+  RegisterResult result = register_icp(skull, skull, own);
+  result.transform = result.transform * reflection;  // the reflection is its own inverse
   return result;
 }
 

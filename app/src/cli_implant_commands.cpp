@@ -28,6 +28,9 @@
 namespace cranioplan::cli {
 namespace {
 
+// Skulls are used where load_skull put them (`const LoadedSkull loaded = ...; loaded.mesh`), never
+// copied out: OpenMesh meshes have no move constructor, and a copy of a SkullFix skull is 300 MB.
+
 // Meshes, or label volumes (e.g. SkullFix NRRD masks) turned into surfaces with every piece kept.
 SkullMesh load_any(const std::string& path) {
   ExtractBoneSurfaceParams p;
@@ -192,7 +195,8 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
     cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
     out.push_back({cmd, [o, &json] {
                      const std::vector<Marker> raw = read_markers_file(o->markers);
-                     const SkullMesh skull = load_skull(o->skull).mesh;
+                     const LoadedSkull loaded = load_skull(o->skull);
+                     const SkullMesh& skull = loaded.mesh;
                      const SurfaceLocator skull_surface(skull);
                      SkullMesh mirrored;
                      std::unique_ptr<SurfaceLocator> mirrored_surface;
@@ -296,7 +300,8 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
                      o->params.center = parse_point(o->center, "--center");
                      o->params.shape = o->shape == "cube" ? InjectDefectParams::Shape::Cube
                                                           : InjectDefectParams::Shape::Sphere;
-                     const SkullMesh skull = load_skull(o->skull).mesh;
+                     const LoadedSkull loaded = load_skull(o->skull);
+                     const SkullMesh& skull = loaded.mesh;
                      const InjectDefectResult r = inject_defect(skull, o->params);
                      Json j{{"status", r.usable() ? "injected" : "no_bone_in_defect"},
                             {"message", r.message},
@@ -347,7 +352,8 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
                      if (!o->session.empty())
                        return autoplan_with_session(o->skull, lm, o->params, o->output,
                                                     o->markers_out, o->session, json);
-                     const SkullMesh skull = load_skull(o->skull).mesh;
+                     const LoadedSkull loaded = load_skull(o->skull);
+                     const SkullMesh& skull = loaded.mesh;
                      const AutoplanResult r = autoplan(skull, lm, o->params);
                      Json j = autoplan_json(r);
                      if (!o->markers_out.empty() && !r.markers.empty())
@@ -397,7 +403,8 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
            for (const auto& [id, files] : cases) {
              if (files.first.empty() || files.second.empty()) continue;
              const auto t0 = std::chrono::steady_clock::now();
-             const SkullMesh skull = load_skull(files.first).mesh;
+             const LoadedSkull loaded = load_skull(files.first);
+             const SkullMesh& skull = loaded.mesh;
              const AutoplanResult r = autoplan(skull, Landmarks{}, o->params);
              const double seconds =
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -465,7 +472,8 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
     add_fit_option(cmd, o->params);
     out.push_back(
         {cmd, [o, &json] {
-           const SkullMesh skull = load_skull(o->skull).mesh;
+           const LoadedSkull loaded = load_skull(o->skull);
+           const SkullMesh& skull = loaded.mesh;
            const SurfaceLocator bone(skull);
            // Directions on the upper vault, alternately left and right, spread by the golden angle;
            // each defect's centre is in the middle of the bone along that ray from the centroid.

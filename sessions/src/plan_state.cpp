@@ -18,7 +18,8 @@
 
 namespace cranioplan {
 
-SharedSurface::SharedSurface(SkullMesh m) : mesh(std::move(m)), locator(mesh) {}
+SharedSurface::SharedSurface(const std::string& path, const ExtractBoneSurfaceParams& import)
+    : loaded(load_skull(path, import)), mesh(loaded.mesh), locator(mesh) {}
 
 ImplantData::ImplantData(ImplantResult result, std::shared_ptr<const SkullInput> skull)
     : result_(std::move(result)),
@@ -214,18 +215,15 @@ void unacknowledge(PlanState& s, int step, const std::string& why) {
 }
 
 void update_mirrored(PlanState& s, const std::string& why) {
-  if (!s.mirror_base) {
+  if (!s.mirror_requested || !s.plane) {
     s.mirrored.reset();
     return;
   }
-  // The mirror base is always the skull reflected across the current plane (plane_changed makes
-  // it again), so the mirror's locator is the skull's tree, moved: no second tree, no mesh.
-  const RigidTransform motion = s.mirror_transform();
-  SurfaceLocator locator =
-      s.plane ? s.skull->surface->locator.moved(motion * reflection_across(*s.plane))
-              : SurfaceLocator(*s.mirror_base).moved(motion);
-  s.mirrored =
-      std::make_shared<const MovedSurface>(MovedSurface{s.mirror_base, std::move(locator)});
+  // The mirror is always the skull reflected across the current plane (plane_changed registers
+  // it again), so it is the skull moved: no mesh, no second tree.
+  const RigidTransform placement = s.mirror_transform() * reflection_across(*s.plane);
+  s.mirrored = std::make_shared<const MovedSurface>(
+      MovedSurface{s.skull->surface, placement, s.skull->surface->locator.moved(placement)});
   unacknowledge(s, 4, why);
   for (const auto& m : s.markers)
     if (m.surface == MarkerSurface::Mirrored) {
@@ -242,7 +240,7 @@ bool run_registration(PlanState& s, const Json* recorded = nullptr, Json* record
                       const std::string& where = "") {
   RegisterResult result =
       recorded ? register_result_from_json(*recorded, where)
-               : register_icp(*s.mirror_base, s.skull->surface->mesh, *s.register_params);
+               : register_mirror(s.skull->surface->mesh, *s.plane, *s.register_params);
   if (!recorded && record) *record = to_json(result);
   if (!result.usable() && s.registration && s.registration->usable()) {
     // A failed attempt does not throw away a working registration.
@@ -293,7 +291,6 @@ void markers_changed(PlanState& s) {
 void plane_changed(PlanState& s, const ParamReader* r = nullptr, Json* record = nullptr) {
   unacknowledge(s, 4, "the plane changed");
   if (!s.mirror_requested) return;
-  s.mirror_base = std::make_shared<const SkullMesh>(mirror_mesh(s.skull->surface->mesh, *s.plane));
   std::string why = "the plane changed: mirror recomputed";
   if (s.register_params) {
     const std::string plane_message = s.message;
@@ -347,8 +344,7 @@ struct Refusal {
 void apply_load(PlanState& s, const ParamReader& r, const ApplyContext& ctx) {
   const std::string recorded = r.string("path");
   const std::string path = resolve_input(recorded, ctx);
-  const std::string bytes = read_file_bytes(path);
-  const std::string sha = sha256_hex(bytes);
+  const std::string sha = sha256_hex(read_file_bytes(path));  // the bytes go before the mesh comes
   const std::string expected = r.string("sha256");
   if (sha != expected)
     throw SessionError(
@@ -358,13 +354,13 @@ void apply_load(PlanState& s, const ParamReader& r, const ApplyContext& ctx) {
                   " recorded)");
   ExtractBoneSurfaceParams import;
   params_from_json(ParamReader(r.value("import"), r.where() + " import"), import);
-  LoadedSkull loaded = load_skull(path, import);
   auto input = std::make_shared<SkullInput>();
+  input->surface = std::make_shared<const SharedSurface>(path, import);
+  const LoadedSkull& loaded = input->surface->loaded;
   input->path = recorded;
   input->sha256 = sha;
   input->description = loaded.description;
   input->warnings = loaded.warnings;
-  input->surface = std::make_shared<const SharedSurface>(std::move(loaded.mesh));
   const SkullMesh& mesh = input->surface->mesh;
   for (auto vh : mesh.vertices()) input->centroid += to_eigen(mesh.point(vh));
   input->centroid /= static_cast<double>(std::max<size_t>(1, mesh.n_vertices()));
@@ -447,8 +443,8 @@ void apply_adjust_plane(PlanState& s, const ParamReader& r, int version, Json& r
 }
 
 void apply_mirror(PlanState& s) {
+  if (!s.plane) throw Refusal{"fit the midsagittal plane before mirroring the skull"};
   s.mirror_requested = true;
-  s.mirror_base = std::make_shared<const SkullMesh>(mirror_mesh(s.skull->surface->mesh, *s.plane));
   s.registration.reset();
   s.register_params.reset();
   s.manual = RigidTransform{};
@@ -458,7 +454,7 @@ void apply_mirror(PlanState& s) {
 
 // Registers the mirror, or (version 2) applies the registration the command recorded.
 void apply_register(PlanState& s, const ParamReader& r, int version, Json& record) {
-  if (!s.mirror_base) throw Refusal{"mirror the skull before registering it"};
+  if (!s.mirror_requested) throw Refusal{"mirror the skull before registering it"};
   RegisterParams params;
   params_from_json(ParamReader(r.value("params"), r.where() + " params"), params);
   const std::optional<RegisterParams> previous = s.register_params;
@@ -477,7 +473,7 @@ void apply_register(PlanState& s, const ParamReader& r, int version, Json& recor
 }
 
 void apply_move_mirrored(PlanState& s, const ParamReader& r) {
-  if (!s.mirror_base) throw Refusal{"mirror the skull before moving the mirror"};
+  if (!s.mirror_requested) throw Refusal{"mirror the skull before moving the mirror"};
   const Eigen::Vector3d axis = r.vector3("axis");
   const double angle = r.number("angle_deg");
   const Eigen::Vector3d center = r.vector3("center");

@@ -6,6 +6,7 @@
 #include <filesystem>
 
 #include "cranioplan/algorithms/extract_bone_surface.h"
+#include "cranioplan/algorithms/load_skull.h"
 #include "cranioplan/model/error.h"
 #include "support/dicom_writer.h"
 #include "support/synthetic.h"
@@ -54,6 +55,20 @@ TEST(ReadVolume, ObliqueNrrdRawAndGzipPlaceTheSurfaceInWorldCoordinates) {
     EXPECT_GT(signed_volume(surface.mesh), 0.0);
     EXPECT_NEAR(signed_volume(surface.mesh), 4.0 / 3.0 * M_PI * 1000.0, 0.08 * 4188.8);
   }
+}
+
+// A CT loaded as a skull holds its surface once: OpenMesh meshes cannot be moved, so the
+// import's copy used to stay in `surface` beside `mesh` for the skull's whole life (about 300 MB
+// on a SkullFix mask).
+TEST(ReadVolume, ALoadedVolumeHoldsItsSurfaceOnce) {
+  test::TempDir dir;
+  const std::string p = dir.path("ball.nrrd");
+  test::write_nrrd(oblique_ball(Eigen::Vector3d(-120, 40, 17)), p, false);
+  const LoadedSkull loaded = load_skull(p);
+  EXPECT_EQ(loaded.source_kind, "volume");
+  EXPECT_GT(loaded.mesh.n_faces(), 1000u);
+  EXPECT_EQ(loaded.surface.mesh.n_vertices(), 0u);
+  EXPECT_TRUE(loaded.surface.usable());
 }
 
 TEST(ReadVolume, NiftiSformGivesWorldCoordinates) {

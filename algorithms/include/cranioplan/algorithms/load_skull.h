@@ -18,7 +18,8 @@ struct LoadedSkull {
   std::string source_kind;            ///< "mesh" or "volume"
   std::string description;            ///< format / volume description
   std::vector<std::string> warnings;  ///< reader warnings, each naming the file
-  ExtractBoneSurfaceResult surface;   ///< details of the CT import (volumes only; mesh moved out)
+  ExtractBoneSurfaceResult
+      surface;  ///< details of the CT import (volumes only; its mesh is cleared)
   double seconds = 0.0;
 };
 

@@ -13,6 +13,7 @@
 #include "cranioplan/algorithms/build_implant.h"
 #include "cranioplan/algorithms/check_implant.h"
 #include "cranioplan/algorithms/fit_sagittal_plane.h"
+#include "cranioplan/algorithms/load_skull.h"
 #include "cranioplan/algorithms/register_icp.h"
 #include "cranioplan/algorithms/surface_locator.h"
 #include "cranioplan/model/landmarks.h"
@@ -22,20 +23,29 @@
 
 namespace cranioplan {
 
-/// A mesh with its locator, built once and shared by every state that uses it.
+/// A skull loaded from a file with its locator, built once and shared by every state that uses
+/// it. The loaded skull is built in place: OpenMesh meshes have no move constructor, so
+/// std::move copies them (on a skull of two million triangles each copy is about 300 MB, and
+/// taking a loaded mesh into this structure used to peak at three of them).
 struct SharedSurface {
-  explicit SharedSurface(SkullMesh m);
-  SkullMesh mesh;
+  SharedSurface(const std::string& path, const ExtractBoneSurfaceParams& import);
+  SharedSurface(const SharedSurface&) = delete;
+  SharedSurface& operator=(const SharedSurface&) = delete;
+  const LoadedSkull loaded;  ///< how it was read (description, warnings) and its mesh
+  const SkullMesh& mesh;     ///< loaded.mesh
   SurfaceLocator locator;
 };
 
-/// The mirrored skull where the plan has put it: the mirror base moved, not a mesh of its own
-/// (on a skull of two million triangles each copy is about 280 MB, and every registration
-/// kept in the session's history would hold one). The view draws the base moved by the state's
-/// mirror_transform(); the locator answers in place (the skull's own tree, moved).
+/// The mirrored skull where the plan has put it: not a mesh of its own but the skull itself,
+/// moved by `placement` (the reflection across the plane, then the registration and any hand
+/// moves: an improper motion). On a skull of two million triangles a mirrored copy is about
+/// 300 MB, and every registration kept in the session's history held one until session 4 (and
+/// the state one until session 8). The view draws the skull's mesh moved by `placement`; the
+/// locator answers in place (the skull's own tree, moved).
 struct MovedSurface {
-  std::shared_ptr<const SkullMesh> base;  ///< the skull mirrored across the plane
-  SurfaceLocator locator;                 ///< answers for the base moved by mirror_transform()
+  std::shared_ptr<const SharedSurface> skull;  ///< the skull's mesh and tree
+  RigidTransform placement;                    ///< skull → the mirror where the plan has put it
+  SurfaceLocator locator;                      ///< the skull's tree moved by `placement`
 };
 
 struct SkullInput {
@@ -80,12 +90,11 @@ struct PlanState {
   std::optional<Plane> plane;
   std::optional<PlaneFit> plane_fit;  ///< diagnostics of the last fit
   // Step 3
-  bool mirror_requested = false;
-  std::shared_ptr<const SkullMesh> mirror_base;   ///< the skull mirrored across `plane`
+  bool mirror_requested = false;  ///< mirrored: the mirror is the skull reflected across `plane`
   std::optional<RegisterParams> register_params;  ///< re-run when the plane changes
   std::optional<RegisterResult> registration;
   RigidTransform manual;                         ///< hand moves, applied after the registration
-  std::shared_ptr<const MovedSurface> mirrored;  ///< base carried by manual ∘ registration
+  std::shared_ptr<const MovedSurface> mirrored;  ///< reflected, then registration, then manual
   // Step 4
   std::optional<Plane> clip_plane;
   // Steps 5, 6, 8
