@@ -89,12 +89,11 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
   r.quality = check_implant(r.implant.mesh, &skull, &bone, QualityParams{});
   timer.stage("quality");
   r.status = AutoplanResult::Status::Planned;
-  char buf[200];
-  std::snprintf(buf, sizeof(buf), "%s; %s (mirror covers %.0f%% of the opening); ",
-                r.defect.message.c_str(),
+  char buf[80];  // the fixed part; the messages around it can be long (they name rim stretches)
+  std::snprintf(buf, sizeof(buf), "%s (mirror covers %.0f%% of the opening); ",
                 r.method_used == PlanMethod::Mirror ? "mirror-guided" : "rim-only fitting",
                 100.0 * r.mirror_coverage);
-  r.message = buf + r.surfaces_message;
+  r.message = r.defect.message + "; " + buf + r.surfaces_message;
   return r;
 }
 

@@ -5,8 +5,10 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <functional>
 #include <numeric>
 #include <optional>
+#include <string>
 
 #include "cranioplan/algorithms/point_index.h"
 #include "cranioplan/algorithms/surface_locator.h"
@@ -79,6 +81,22 @@ namespace {
 // skulls, about 0 on a shell closed all round).
 constexpr double kVaultDirected = 0.1;
 }  // namespace
+
+std::vector<double> unseen_rim_stretches(const std::vector<Eigen::Vector3d>& rim, double min_gap_mm,
+                                         double times_median) {
+  if (rim.size() < 2) return {};
+  std::vector<double> all;
+  for (size_t k = 0; k < rim.size(); ++k)
+    all.push_back((rim[(k + 1) % rim.size()] - rim[k]).norm());
+  std::vector<double> sorted = all;
+  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+  const double limit = std::max(min_gap_mm, times_median * sorted[sorted.size() / 2]);
+  std::vector<double> gaps;
+  for (double g : all)
+    if (g > limit) gaps.push_back(g);
+  std::sort(gaps.begin(), gaps.end(), std::greater<>());
+  return gaps;
+}
 
 DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator,
                            const Eigen::Vector3d& center, const DetectDefectParams& params) {
@@ -279,6 +297,18 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
     region.outer_rim = std::move(sorted_outer);
     region.inner_rim = std::move(sorted_inner);
     region.message = "opening of " + std::to_string(static_cast<long long>(area)) + " mm² found";
+    region.unseen_rim_mm = unseen_rim_stretches(region.outer_rim);
+    if (!region.unseen_rim_mm.empty()) {
+      std::string lengths;
+      for (size_t k = 0; k < region.unseen_rim_mm.size(); ++k)
+        lengths += (k == 0                                 ? ""
+                    : k + 1 == region.unseen_rim_mm.size() ? " and "
+                                                           : ", ") +
+                   std::to_string(static_cast<long long>(std::lround(region.unseen_rim_mm[k])));
+      region.message += "; the rim was not seen along " + lengths +
+                        " mm (the rays there graze the bone or meet other bone first): check the "
+                        "edge markers there";
+    }
     if (region.other_openings > 0)
       region.message += " (" + std::to_string(region.other_openings) +
                         (region.other_openings == 1 ? " other opening" : " other openings") +

@@ -62,7 +62,8 @@ Json autoplan_json(const AutoplanResult& r) {
   if (r.defect.found()) {
     j["defect"] = Json{{"area_mm2", r.defect.area_mm2},
                        {"axis", to_json(r.defect.axis)},
-                       {"rim_points", r.defect.outer_rim.size()}};
+                       {"rim_points", r.defect.outer_rim.size()},
+                       {"unseen_rim_mm", r.defect.unseen_rim_mm}};
     j["method"] = to_string(r.method_used);
     j["mirror_coverage"] = r.mirror_coverage;
     j["markers"] = r.markers.size();

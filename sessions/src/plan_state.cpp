@@ -687,15 +687,15 @@ Json proposal_result(const MarkerProposal& p) {
                 {"markers", Json::array()},
                 {"defect_center", nullptr},
                 {"message", "no markers proposed: " + p.message}};
-  char buf[300];
+  char buf[120];  // the fixed part; the detection's message can be long (it names rim stretches)
   std::snprintf(
-      buf, sizeof(buf), "%zu markers proposed, %s (mirror covers %.0f%% of the opening); %s",
+      buf, sizeof(buf), "%zu markers proposed, %s (mirror covers %.0f%% of the opening); ",
       p.markers.size(), p.method_used == PlanMethod::Mirror ? "mirror-guided" : "rim-only fitting",
-      100.0 * p.mirror_coverage, p.message.c_str());
+      100.0 * p.mirror_coverage);
   return Json{{"proposed", true},
               {"markers", markers_to_json(p.markers)["markers"]},
               {"defect_center", to_json(p.defect.center)},
-              {"message", std::string(buf) + "; " + p.surfaces_message}};
+              {"message", buf + p.message + "; " + p.surfaces_message}};
 }
 
 ApplyOutcome apply_command(const PlanState& before, const Command& command,

@@ -194,12 +194,39 @@ TEST(Autoplan, IntactSkullGivesNoDefect) {
 // on the rays through the detected rim (on the fitted outer surface, within a fraction of a
 // millimetre of the bone's edge), surface markers over the opening on the fitted surfaces —
 // here, a skull symmetric by construction, on the registered mirror.
+// Where the rays do not see the rim (they graze the bone or meet other bone first, e.g. along
+// an orbit) the outline is interpolated between rim points far apart, and the surgeon is told
+// how long each such stretch is. Rim points every 6° on a circle of 30 mm (3.1 mm apart), with
+// runs of 4, 3 and 2 points taken out (one across the loop's closing): gaps of 30°, 24° and 18°,
+// i.e. chords of 15.5, 12.5 and 9.4 mm. Over 10 mm: the first two; over four times the median
+// spacing as well (12.5 mm): the first.
+TEST(Autoplan, UnseenStretchesOfTheRimAreMeasured) {
+  std::vector<Eigen::Vector3d> rim;
+  auto missing = [](int k) {
+    return (k >= 10 && k < 14) || k >= 58 || k == 0 || (k >= 30 && k < 32);
+  };
+  for (int k = 0; k < 60; ++k)
+    if (!missing(k))
+      rim.emplace_back(30.0 * std::cos(k * M_PI / 30.0), 30.0 * std::sin(k * M_PI / 30.0), 5.0);
+  const double chord30 = 60.0 * std::sin(15.0 * M_PI / 180.0),
+               chord24 = 60.0 * std::sin(12.0 * M_PI / 180.0);
+  const std::vector<double> over10 = unseen_rim_stretches(rim, 10.0, 0.0);
+  ASSERT_EQ(over10.size(), 2u);
+  EXPECT_NEAR(over10[0], chord30, 1e-9);
+  EXPECT_NEAR(over10[1], chord24, 1e-9);
+  const std::vector<double> reported = unseen_rim_stretches(rim);
+  ASSERT_EQ(reported.size(), 1u);
+  EXPECT_NEAR(reported[0], chord30, 1e-9);
+  EXPECT_TRUE(unseen_rim_stretches({rim.front()}).empty());
+}
+
 TEST(Autoplan, StagesAreConsistent) {
   const InjectDefectResult d = defect_at({-0.7, 0.3, 0.6}, 40);
   const AutoplanResult r = autoplan(d.defective, Landmarks{});
   ASSERT_TRUE(r.planned()) << r.message;
   EXPECT_EQ(r.method_used, PlanMethod::Mirror);
-  // The mirror built as a mesh, as the wizard shows it: autoplan only moved the skull's locator.
+  EXPECT_TRUE(r.defect.unseen_rim_mm.empty()) << r.defect.message;  // a clean cut, seen all round
+  // The mirror built as a mesh (as `pipeline` exports it): autoplan only moved the skull's locator.
   const SurfaceLocator bone(d.defective),
       mirror(transform_mesh(mirror_mesh(d.defective, r.plane.plane), r.registration.transform));
   const SurfaceLocator moved = bone.moved(r.mirror_motion);

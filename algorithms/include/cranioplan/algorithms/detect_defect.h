@@ -53,9 +53,25 @@ struct DefectRegion {
   /// The rim: the last bone met along rays next to the opening, outer and inner table, in
   /// order around the axis (same count, paired).
   std::vector<Eigen::Vector3d> outer_rim, inner_rim;
+  /// Stretches of the rim no ray saw (unseen_rim_stretches, longest first, mm): its rays there
+  /// graze the bone or meet other bone first (along an orbit), so the outline there is interpolated
+  /// between rim points far apart. The message names them.
+  std::vector<double> unseen_rim_mm;
   double seconds = 0.0;
   bool found() const { return status == Status::Found; }
 };
+
+/// A rim stretch without a rim point is reported when it is longer than this (mm) and than
+/// kUnseenRimTimesMedian times the rim's median spacing (large openings have sparser rims).
+constexpr double kUnseenRimMm = 10.0;
+constexpr double kUnseenRimTimesMedian = 4.0;
+
+/// The gaps between consecutive points of a closed rim (in order around the opening, the last
+/// followed by the first) longer than `min_gap_mm` and than `times_median` times the median
+/// gap, longest first, mm.
+std::vector<double> unseen_rim_stretches(const std::vector<Eigen::Vector3d>& rim,
+                                         double min_gap_mm = kUnseenRimMm,
+                                         double times_median = kUnseenRimTimesMedian);
 
 /// The skull's own axes, the same on the skull in any pose: the principal axis of the vertices
 /// within the midsagittal plane, the other axis within it, and the plane's normal (columns,
