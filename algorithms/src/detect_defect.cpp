@@ -297,6 +297,10 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
     region.outer_rim = std::move(sorted_outer);
     region.inner_rim = std::move(sorted_inner);
     region.message = "opening of " + std::to_string(static_cast<long long>(area)) + " mm² found";
+    if (region.other_openings > 0)
+      region.message += " (" + std::to_string(region.other_openings) +
+                        (region.other_openings == 1 ? " other opening" : " other openings") +
+                        " not planned: choose with a point near the defect)";
     region.unseen_rim_mm = unseen_rim_stretches(region.outer_rim);
     if (!region.unseen_rim_mm.empty()) {
       std::string lengths;
@@ -305,14 +309,9 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
                     : k + 1 == region.unseen_rim_mm.size() ? " and "
                                                            : ", ") +
                    std::to_string(static_cast<long long>(std::lround(region.unseen_rim_mm[k])));
-      region.message += "; the rim was not seen along " + lengths +
-                        " mm (the rays there graze the bone or meet other bone first): check the "
-                        "edge markers there";
+      region.message += "; rim not seen along " + lengths +
+                        " mm (rays graze the bone there): check the edge markers";
     }
-    if (region.other_openings > 0)
-      region.message += " (" + std::to_string(region.other_openings) +
-                        (region.other_openings == 1 ? " other opening" : " other openings") +
-                        " not planned: choose with a point near the defect)";
     break;
   }
   if (!region.found())
