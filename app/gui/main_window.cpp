@@ -551,6 +551,14 @@ QWidget* MainWindow::make_page(int step) {
       }
       marker_counts_[edges ? 0 : 1] = new QLabel(page);
       form->addRow(marker_counts_[edges ? 0 : 1]);
+      if (edges) {
+        // What the last proposal found stays in view while the markers are edited: where the
+        // rim was not seen, the outline between edge markers far apart needs a look.
+        proposal_note_ = new QLabel(page);
+        proposal_note_->setObjectName("proposalNote");
+        proposal_note_->setWordWrap(true);
+        form->addRow(proposal_note_);
+      }
       break;
     }
     case 7: {
@@ -878,6 +886,12 @@ void MainWindow::refresh_page() {
   if (marker_counts_[1])
     marker_counts_[1]->setText(
         tr("Outer surface: %1, inner surface: %2").arg(counts[2]).arg(counts[3]));
+  if (proposal_note_) {
+    proposal_note_->setText(s.proposal_message.empty()
+                                ? QString()
+                                : tr("Last proposal: %1").arg(q(s.proposal_message)));
+    proposal_note_->setVisible(!s.proposal_message.empty());
+  }
   // The build controls show the parameters the plan's implant was built with (an automatic
   // plan is fitted to the bone), so pressing Build again keeps them unless changed.
   if (implant_fit_ && s.implant_params) {

@@ -118,6 +118,7 @@ class MainWindow : public QMainWindow {
   QComboBox* clip_axis_ = nullptr;
   QSlider* clip_position_ = nullptr;
   QLabel* marker_counts_[2] = {nullptr, nullptr};
+  QLabel* proposal_note_ = nullptr;  ///< step 5: what the last proposal found
   QComboBox* implant_method_ = nullptr;
   QDoubleSpinBox* implant_resolution_ = nullptr;
   QDoubleSpinBox* implant_thickness_ = nullptr;

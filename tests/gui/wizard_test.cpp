@@ -6,6 +6,7 @@
 #include <QApplication>
 #include <QCheckBox>
 #include <QDir>
+#include <QLabel>
 #include <QListWidget>
 #include <QMouseEvent>
 #include <QPushButton>
@@ -213,6 +214,10 @@ TEST_F(Wizard, AllNineStepsOnTheSampleReplayToTheSameImplant) {
   ASSERT_GT(plan.state().markers.size(), 20u);
   EXPECT_TRUE(plan.session().stack().back().params["params"]["detect"]["near"].is_null())
       << "no markers yet: the largest opening";
+  // What the proposal found stays on the step's panel while the markers are edited.
+  const auto* note = w.findChild<QLabel*>("proposalNote");
+  ASSERT_NE(note, nullptr);
+  EXPECT_TRUE(note->text().contains("markers proposed")) << note->text().toStdString();
   // Proposing again with edge markers placed asks for the opening where they are.
   const auto edge_centre = edge_marker_centre(plan.state().markers);
   ASSERT_TRUE(edge_centre);
