@@ -855,7 +855,7 @@ void MainWindow::refresh_page() {
   const PlanState& s = controller_->state();
   if (skull_info_)
     skull_info_->setText(s.skull ? tr("%1<br>%2 triangles")
-                                       .arg(q(s.skull->description).toHtmlEscaped())
+                                       .arg(q(s.skull->surface->loaded.description).toHtmlEscaped())
                                        .arg(s.skull->surface->mesh.n_faces())
                                  : tr("No skull loaded."));
   if (plane_info_) {

@@ -33,7 +33,9 @@
 #include <QMouseEvent>
 #include <QSurfaceFormat>
 #include <QWheelEvent>
+#include <algorithm>
 #include <array>
+#include <vector>
 
 namespace cranioplan::gui {
 
@@ -84,9 +86,11 @@ vtkSmartPointer<vtkPolyData> reversed_winding(vtkPolyData* source) {
   cells->AllocateExact(polys->GetNumberOfCells(), polys->GetNumberOfConnectivityIds());
   vtkIdType n = 0;
   const vtkIdType* ids = nullptr;
+  std::vector<vtkIdType> reversed;
   for (polys->InitTraversal(); polys->GetNextCell(n, ids);) {
-    const vtkIdType reversed[3] = {ids[0], ids[2], ids[1]};
-    cells->InsertNextCell(n == 3 ? 3 : n, n == 3 ? reversed : ids);
+    reversed.assign(ids, ids + n);
+    std::reverse(reversed.begin() + (n > 0 ? 1 : 0), reversed.end());
+    cells->InsertNextCell(n, reversed.data());
   }
   auto out = vtkSmartPointer<vtkPolyData>::New();
   out->SetPoints(source->GetPoints());

@@ -359,8 +359,6 @@ void apply_load(PlanState& s, const ParamReader& r, const ApplyContext& ctx) {
   const LoadedSkull& loaded = input->surface->loaded;
   input->path = recorded;
   input->sha256 = sha;
-  input->description = loaded.description;
-  input->warnings = loaded.warnings;
   const SkullMesh& mesh = input->surface->mesh;
   for (auto vh : mesh.vertices()) input->centroid += to_eigen(mesh.point(vh));
   input->centroid /= static_cast<double>(std::max<size_t>(1, mesh.n_vertices()));

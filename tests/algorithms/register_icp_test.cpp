@@ -33,12 +33,24 @@ TEST(RegisterIcp, RecoversAKnownTransform) {
   EXPECT_LT(r.rms_mm, 0.05);
 }
 
+// The head with a hole (fixed) and the intact head moved away from it by `truth` (moving).
+struct HolePair {
+  SkullMesh fixed, moving;
+  RigidTransform truth = RigidTransform::from_axis_angle({1, 0.3, 0.1}, 4.0, {-2.0, 1.5, 2.5});
+};
+const HolePair& hole_pair() {
+  static const HolePair pair = [] {
+    HolePair p;
+    const SkullMesh full = test::make_symmetric_head(5);
+    p.fixed = test::cut_hole(full, {55, 30, 35}, 30.0);
+    p.moving = test::transformed(full, p.truth.inverse());
+    return p;
+  }();
+  return pair;
+}
+
 TEST(RegisterIcp, TrimmedIcpIgnoresADefectInTheFixedMesh) {
-  const SkullMesh full = test::make_symmetric_head(5);
-  const SkullMesh fixed = test::cut_hole(full, {55, 30, 35}, 30.0);
-  const RigidTransform truth =
-      RigidTransform::from_axis_angle({1, 0.3, 0.1}, 4.0, {-2.0, 1.5, 2.5});
-  const SkullMesh moving = test::transformed(full, truth.inverse());
+  const auto& [fixed, moving, truth] = hole_pair();
   const RegisterResult r = register_icp(moving, fixed);
   ASSERT_TRUE(r.usable()) << r.message;
   expect_transform_near(r.transform, truth, 0.1, 0.1, moving);
@@ -49,11 +61,7 @@ TEST(RegisterIcp, TrimmedIcpIgnoresADefectInTheFixedMesh) {
 // turn and a shift nearly cancel), so it stops at the same place. Checked after every one of
 // the first iterations, where the path shows.
 TEST(RegisterIcp, TheSamePairFarFromTheOriginGivesTheSameMotion) {
-  const SkullMesh full = test::make_symmetric_head(5);
-  const SkullMesh fixed = test::cut_hole(full, {55, 30, 35}, 30.0);
-  const RigidTransform truth =
-      RigidTransform::from_axis_angle({1, 0.3, 0.1}, 4.0, {-2.0, 1.5, 2.5});
-  const SkullMesh moving = test::transformed(full, truth.inverse());
+  const auto& [fixed, moving, truth] = hole_pair();
   const RigidTransform shift = RigidTransform::from_axis_angle({0, 0, 1}, 0.0, {150, -300, 220});
   const SkullMesh moving_far = test::transformed(moving, shift);
   const SkullMesh fixed_far = test::transformed(fixed, shift);
@@ -76,7 +84,7 @@ TEST(RegisterIcp, TheSamePairFarFromTheOriginGivesTheSameMotion) {
 // and a plane 3° and 2 mm off, so the registration has somewhere to go, globally and in a
 // region.
 TEST(RegisterIcp, MirrorRegisteredWithoutItsMeshIsTheMirrorMeshRegistered) {
-  const SkullMesh skull = test::cut_hole(test::make_symmetric_head(5), {55, 30, 35}, 30.0);
+  const SkullMesh& skull = hole_pair().fixed;
   const Plane plane = Plane::through(
       {2.0, 0.0, 0.0},
       Eigen::AngleAxisd(3.0 * M_PI / 180.0, Eigen::Vector3d(0.2, 0.3, 1.0).normalized()) *

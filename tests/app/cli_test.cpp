@@ -165,6 +165,15 @@ TEST(Cli, EvaluateScoresAFolderOfCasesAndWritesTheImplants) {
   EXPECT_GT(j["cases"][0]["dice"].get<double>(), 0.85);
   EXPECT_GT(j["median"]["median_dice"].get<double>(), 0.85);
   EXPECT_TRUE(std::filesystem::exists(dir.path("out/007_planned_implant.stl")));
+  // autoplan --json names the stretches of the rim no ray saw: none around a clean cut.
+  ASSERT_EQ(
+      test::run_command(kCli + " autoplan --json " + dir.path("cases/007_defective_skull.stl") +
+                            " -o " + dir.path("a.stl"),
+                        &out),
+      0);
+  const Json plan = Json::parse(out);
+  ASSERT_TRUE(plan["defect"]["unseen_rim_mm"].is_array()) << out;
+  EXPECT_TRUE(plan["defect"]["unseen_rim_mm"].empty()) << out;
   // --implants-out that is not a folder: bad input (exit 3), naming it.
   ASSERT_EQ(test::run_command(kCli + " evaluate --json " + dir.path("cases") + " --implants-out " +
                                   dir.path("missing"),

@@ -239,16 +239,22 @@ TEST(Session, AVersionOneBuildIsAppliedWithoutFitting) {
   EXPECT_EQ(s.state().implant_params->fit_to_bone_mm, 0.0);
 }
 
+// The first command of `type` in the session has `version` and records `expected` as its
+// "result".
+void expect_recorded_result(const Session& s, CommandType type, int version, const Json& expected) {
+  const auto at = test::first_command(s, type);
+  ASSERT_TRUE(at) << type_tag(type);
+  const Command c = s.effective_commands()[*at];
+  EXPECT_EQ(c.version, version);
+  ASSERT_TRUE(c.params.contains("result")) << type_tag(type);
+  EXPECT_EQ(c.params["result"], expected);
+}
+
 // The plane fit is recorded in its command (fit_plane 2) and a replay applies the recorded
 // plane; a version-1 fit_plane (before the coarse start) is still read and fitted.
 TEST(Session, APlaneFitIsRecordedAndReplayedAsRecorded) {
   Session s = session_at_markers();
-  const auto at = test::first_command(s, CommandType::FitPlane);
-  ASSERT_TRUE(at);
-  const Command fit = s.effective_commands()[*at];
-  EXPECT_EQ(fit.version, 2);
-  ASSERT_TRUE(fit.params.contains("result"));
-  EXPECT_EQ(fit.params["result"], to_json(*s.state().plane_fit));
+  expect_recorded_result(s, CommandType::FitPlane, 2, to_json(*s.state().plane_fit));
 
   Session t(SessionInfo{"small", "tester", ""});
   push_ok(t, commands::load_skull(test::small_skull_stl()));
@@ -281,12 +287,7 @@ TEST(Session, APlaneFitIsRecordedAndReplayedAsRecorded) {
 // changed the plane when the mirror was registered again; a replay applies what is recorded.
 TEST(Session, RegistrationsAreRecordedAndReplayedAsRecorded) {
   Session s = session_at_markers();
-  const auto at = test::first_command(s, CommandType::Register);
-  ASSERT_TRUE(at);
-  const Command reg = s.effective_commands()[*at];
-  EXPECT_EQ(reg.version, 2);
-  ASSERT_TRUE(reg.params.contains("result"));
-  EXPECT_EQ(reg.params["result"], to_json(*s.state().registration));
+  expect_recorded_result(s, CommandType::Register, 2, to_json(*s.state().registration));
 
   // Turning the plane registers the mirror again: recorded in the adjust_plane command.
   push_ok(s, commands::adjust_plane({0, 0, 1}, 1.0, 0.5));

@@ -49,11 +49,9 @@ struct MovedSurface {
 };
 
 struct SkullInput {
-  std::string path;    ///< as recorded in the command
-  std::string sha256;  ///< of the file's bytes
-  std::string description;
-  std::vector<std::string> warnings;
-  std::shared_ptr<const SharedSurface> surface;
+  std::string path;                                    ///< as recorded in the command
+  std::string sha256;                                  ///< of the file's bytes
+  std::shared_ptr<const SharedSurface> surface;        ///< how it was read: surface->loaded
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< of the vertices, mm
 };
 
