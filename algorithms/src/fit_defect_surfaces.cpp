@@ -206,6 +206,7 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
     s.ring_outer.push_back(*o.outer);
     s.ring_inner.push_back(*o.inner);
     s.ring_distance_mm.push_back(dist);
+    s.ring_inner_facing.push_back(-o.inner_normal.dot(d));
   }
   s.ring_rays = static_cast<int>(ring.size());
   if (ring.size() < 12) {

@@ -79,6 +79,10 @@ class DefectSurfaces {
   /// each ray's distance from the opening, mm.
   std::vector<Eigen::Vector3d> ring_outer, ring_inner;
   std::vector<double> ring_distance_mm;
+  /// For each ring ray, how squarely its first bone faces it: the cosine between the ray and
+  /// the inward normal there (1: the inner table met square on; near 0: a cut face met
+  /// side-on, above where the inner table would go on).
+  std::vector<double> ring_inner_facing;
 
   bool fitted() const { return status == Status::Fitted; }
   /// The fitted outer and inner surface points along the ray from the centre in direction

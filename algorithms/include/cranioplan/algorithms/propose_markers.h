@@ -31,8 +31,13 @@ struct ProposeParams {
   double min_mirror_coverage = 0.8;      ///< Auto uses the mirror above this coverage, 0..1
   double edge_spacing_mm = 4.0;          ///< proposed edge markers along the rim, mm (>0)
   double surface_spacing_mm = 6.0;       ///< proposed surface and support markers, mm (>0)
-  SmoothParams smooth{10.0, 2.0, 1};     ///< applied to surface markers (put back after)
-  DefectSurfaceParams surfaces;          ///< fitting the surfaces to the intact ring
+  /// Inner support markers only where the ring ray's first bone faces it within this angle
+  /// (the inner table), deg (0..90; 90: every ray). Beside an oblique cut face a ray from the
+  /// centre first meets the face, above where the inner table would go on, and a marker there
+  /// lifts the implant's inner surface off the missing wedge of bone.
+  double max_support_inner_tilt_deg = 45.0;
+  SmoothParams smooth{10.0, 2.0, 1};  ///< applied to surface markers (put back after)
+  DefectSurfaceParams surfaces;       ///< fitting the surfaces to the intact ring
 };
 
 struct MarkerProposal {
