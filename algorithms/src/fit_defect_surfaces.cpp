@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <cstdlib>
 #include <functional>
 #include <limits>
 #include <string>
@@ -102,6 +103,52 @@ std::optional<VaultSphere> choose_vault(
   };
   if (band_error(from_far) >= band_error(std::nullopt)) return std::nullopt;
   return fit_sphere(outer, all, center);
+}
+
+// Keeps the elements whose flag is set, in order.
+template <class T>
+void keep_where(std::vector<T>& v, const std::vector<char>& keep) {
+  size_t kept = 0;
+  for (size_t i = 0; i < v.size(); ++i)
+    if (keep[i]) v[kept++] = v[i];
+  v.resize(kept);
+}
+
+// The ring's outer table points that continue from the rim without a step: reached from a rim
+// point (within `rim_reach` radians, as seen from `center`) through neighbouring points
+// (within `step` radians) lying at nearly the same distance from the centre (a rise of at most
+// twice the distance across, plus a millimetre). Bone much further in or out is other bone
+// seen past the vault's edge.
+std::vector<char> continuing_from_rim(const std::vector<Eigen::Vector3d>& ring,
+                                      const std::vector<Eigen::Vector3d>& rim,
+                                      const Eigen::Vector3d& center, double step,
+                                      double rim_reach) {
+  std::vector<char> reached(ring.size(), 0);
+  if (ring.empty()) return reached;
+  std::vector<Eigen::Vector3d> dirs;
+  for (const auto& p : ring) dirs.push_back((p - center).normalized());
+  const PointIndex index(dirs);
+  auto continues = [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    const double ra = (a - center).norm(), rb = (b - center).norm();
+    const double cos = (a - center).dot(b - center) / (ra * rb);
+    const double across = std::acos(std::clamp(cos, -1.0, 1.0)) * std::min(ra, rb);
+    return std::abs(ra - rb) <= 1.0 + 2.0 * across;
+  };
+  std::vector<int> queue;
+  auto reach = [&](const Eigen::Vector3d& from, double within) {
+    for (int k : index.within_radius((from - center).normalized(), within))
+      if (!reached[k] && continues(from, ring[k])) {
+        reached[k] = 1;
+        queue.push_back(k);
+      }
+  };
+  for (const auto& p : rim) reach(p, rim_reach);
+  while (!queue.empty()) {
+    const int i = queue.back();
+    queue.pop_back();
+    reach(ring[i], step);
+  }
+  return reached;
 }
 
 }  // namespace
@@ -207,6 +254,21 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
     s.ring_inner.push_back(*o.inner);
     s.ring_distance_mm.push_back(dist);
     s.ring_inner_facing.push_back(-o.inner_normal.dot(d));
+  }
+  // Rim-only, only bone that continues from the rim: past an orbit the rays meet the orbital
+  // roof 30-40 mm nearer the centre than the frontal bone, and a ring holding it bent the fitted
+  // surfaces and the support markers down to it (the sample from its STL: a bay 6.8 mm deep in
+  // the implant's edge above the orbit). Mirror-guided, the fit takes the mismatch with the
+  // mirror, which meets the same roof on the other side: that bone fits as well as any.
+  if (!mirror) {
+    const std::vector<char> continuing = continuing_from_rim(
+        s.ring_outer, defect.outer_rim, s.center_, 1.6 * spacing,
+        (clearance + 2.0 * std::clamp(params.ray_spacing_mm, 0.5, 10.0)) / rim_radius);
+    keep_where(ring, continuing);
+    keep_where(s.ring_outer, continuing);
+    keep_where(s.ring_inner, continuing);
+    keep_where(s.ring_distance_mm, continuing);
+    keep_where(s.ring_inner_facing, continuing);
   }
   s.ring_rays = static_cast<int>(ring.size());
   if (ring.size() < 12) {

@@ -146,9 +146,14 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
   };
   for (size_t i : along(defect.outer_rim, params.edge_spacing_mm)) {
     const Eigen::Vector3d& rim = defect.outer_rim[i];
+    const auto fitted = surfaces.at(rim - c);
     if (!bone_beyond(rim)) {
+      // Not where the rim's last bone lies below the fitted bone altogether: its ray met other
+      // bone past the vault's edge (an orbital roof), and a marker there pulls the implant's
+      // outer surface down into a funnel (the sample: a rim point 18 mm below the surface).
+      if (fitted && (rim - c).norm() < (fitted->second - c).norm() - 1.0) continue;
       r.markers.push_back({id++, MarkerType::OuterEdge, rim, MarkerSurface::Original});
-    } else if (const auto p = surfaces.at(rim - c)) {
+    } else if (const auto& p = fitted) {
       r.markers.push_back({id++, MarkerType::OuterEdge, p->first, MarkerSurface::Original});
     }
   }
