@@ -408,8 +408,9 @@ TriangleSoup read_mesh_soup(const std::string& path, std::string* format_out) {
 
 MeshFile read_mesh(const std::string& path, const ReadMeshParams& params) {
   MeshFile out;
-  const TriangleSoup soup = read_mesh_soup(path, &out.format);
+  TriangleSoup soup = read_mesh_soup(path, &out.format);
   out.triangles_in_file = static_cast<long long>(soup.triangles.size());
+  make_canonical(soup);
 
   BuildMeshStats stats;
   out.mesh = build_mesh(soup, &stats);

@@ -142,7 +142,9 @@ TEST(SurfaceLocator, MovedByAReflectionAnswersForTheMirror) {
     }
     const auto ha = own.first_hit(q, to), hb = moved.first_hit(q, to);
     ASSERT_EQ(ha.has_value(), hb.has_value());
-    if (ha) EXPECT_NEAR(ha->distance, hb->distance, 1e-9);
+    if (ha) {
+      EXPECT_NEAR(ha->distance, hb->distance, 1e-9);
+    }
   }
   EXPECT_GT(same_face, 100);
   // Outward: the closed head's normals point away from its inside.

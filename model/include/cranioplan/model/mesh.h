@@ -34,6 +34,14 @@ struct BuildMeshStats {
   long long nonmanifold_split = 0;   ///< faces added with duplicated vertices (complex edges)
 };
 
+/// Puts the soup in a form that depends only on its triangles: coordinates rounded to single
+/// precision (as STL files hold them), identical positions made one vertex, vertices in
+/// lexicographic order of position, each triangle starting at its smallest vertex (its
+/// orientation kept) and the triangles in lexicographic order. The same surface read from a CT,
+/// from an STL of it or from a PLY in another vertex order then gives the same soup, and so the
+/// same plan: sampling by vertex index no longer depends on how the file listed them.
+void make_canonical(TriangleSoup& soup);
+
 /// Builds a mesh from an indexed soup. Triangles with a repeated index or zero area are dropped;
 /// faces that would make a complex edge are added on duplicated vertices (as OpenMesh's readers
 /// do), so that no triangle of the input is lost. Unused vertices are not added.
