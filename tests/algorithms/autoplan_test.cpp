@@ -86,6 +86,12 @@ const ObliqueCut& oblique_cut() {
   return cut;
 }
 
+// The intact skull's tables along the ray from the plan's detection centre through a marker.
+RayThroughBone tables_along(const SurfaceLocator& truth, const AutoplanResult& r, const Marker& m) {
+  const Eigen::Vector3d ray = (m.position - r.defect.center).normalized();
+  return cast_through_bone(truth, r.defect.center, ray, 400.0, 0.5, 15.0);
+}
+
 TEST(Autoplan, OuterEdgeMarkersAtAnObliqueCutStayOnTheOuterTable) {
   const SkullMesh& intact = oblique_cut().intact;
   const InjectDefectResult& d = oblique_cut().defect;
@@ -98,8 +104,7 @@ TEST(Autoplan, OuterEdgeMarkersAtAnObliqueCutStayOnTheOuterTable) {
   for (const auto& m : r.markers) {
     if (m.type != MarkerType::OuterEdge) continue;
     ++edges;
-    const Eigen::Vector3d ray = (m.position - r.defect.center).normalized();
-    const RayThroughBone t = cast_through_bone(truth, r.defect.center, ray, 400.0, 0.5, 15.0);
+    const RayThroughBone t = tables_along(truth, r, m);
     ASSERT_TRUE(t.paired) << "edge marker " << m.id;
     EXPECT_NEAR((m.position - r.defect.center).norm(), (*t.outer - r.defect.center).norm(), 1.0)
         << "edge marker " << m.id << " is not on the outer table";
@@ -127,8 +132,7 @@ TEST(Autoplan, InnerMarkersAtAnObliqueCutStayOnTheInnerTable) {
   for (const auto& m : r.markers) {
     if (m.type != MarkerType::InnerSurface) continue;
     ++inner;
-    const Eigen::Vector3d ray = (m.position - r.defect.center).normalized();
-    const RayThroughBone t = cast_through_bone(truth, r.defect.center, ray, 400.0, 0.5, 15.0);
+    const RayThroughBone t = tables_along(truth, r, m);
     ASSERT_TRUE(t.paired) << "inner marker " << m.id;
     const double off = (m.position - r.defect.center).norm() - (*t.inner - r.defect.center).norm();
     worst = std::max(worst, std::abs(off));
