@@ -16,9 +16,10 @@ struct TrimToBoneParams {
   double max_voxels = 6e6;
   /// Parts thinner than this (slivers on the bone, filaments between bone fragments) go, mm
   /// (≥ 0). Half a millimetre above the quality report's 1 mm minimum: the surface is then
-  /// kept a voxel off the bone and blurred, which thins what is left, and with 1.25 mm the
-  /// sample's plans kept edges under 1 mm for up to 3.8 mm between the crushed bone fragments
-  /// above the orbit (5 of 26 plans in other poses and readings not printable; 0 with 1.5 mm).
+  /// kept a voxel off the bone and blurred, which thins what is left. With 1.25 mm the
+  /// sample's plans kept edges under 1 mm up to 3.8 mm wide between the crushed bone fragments
+  /// above the orbit (docs/AUTOPLAN.md: 28 plans in other readings and poses, 2 of them not
+  /// printable and 2 more with a rim gap over 0.5 mm with 1.25 mm and 1 mm bridges; none now).
   double min_feature_mm = 1.5;
   double smoothing_mm = 0.3;  ///< Gaussian blur of the mask before meshing (σ), mm (≥ 0)
   /// Cracks narrower than twice this between the implant and the bone (the implant on one side,
