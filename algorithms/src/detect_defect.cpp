@@ -82,19 +82,23 @@ namespace {
 constexpr double kVaultDirected = 0.1;
 }  // namespace
 
-std::vector<double> unseen_rim_stretches(const std::vector<Eigen::Vector3d>& rim, double min_gap_mm,
-                                         double times_median) {
+std::vector<RimStretch> unseen_rim_stretches(const std::vector<Eigen::Vector3d>& rim,
+                                             double min_gap_mm, double times_median) {
   if (rim.size() < 2) return {};
-  std::vector<double> all;
-  for (size_t k = 0; k < rim.size(); ++k)
-    all.push_back((rim[(k + 1) % rim.size()] - rim[k]).norm());
-  std::vector<double> sorted = all;
-  std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-  const double limit = std::max(min_gap_mm, times_median * sorted[sorted.size() / 2]);
-  std::vector<double> gaps;
-  for (double g : all)
-    if (g > limit) gaps.push_back(g);
-  std::sort(gaps.begin(), gaps.end(), std::greater<>());
+  std::vector<RimStretch> all;
+  std::vector<double> lengths;
+  for (size_t k = 0; k < rim.size(); ++k) {
+    all.push_back({rim[k], rim[(k + 1) % rim.size()]});
+    lengths.push_back(all.back().length_mm());
+  }
+  std::nth_element(lengths.begin(), lengths.begin() + lengths.size() / 2, lengths.end());
+  const double limit = std::max(min_gap_mm, times_median * lengths[lengths.size() / 2]);
+  std::vector<RimStretch> gaps;
+  for (const RimStretch& g : all)
+    if (g.length_mm() > limit) gaps.push_back(g);
+  std::stable_sort(gaps.begin(), gaps.end(), [](const RimStretch& a, const RimStretch& b) {
+    return a.length_mm() > b.length_mm();
+  });
   return gaps;
 }
 
@@ -301,14 +305,15 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
       region.message += " (" + std::to_string(region.other_openings) +
                         (region.other_openings == 1 ? " other opening" : " other openings") +
                         " not planned: choose with a point near the defect)";
-    region.unseen_rim_mm = unseen_rim_stretches(region.outer_rim);
-    if (!region.unseen_rim_mm.empty()) {
+    region.unseen_rim = unseen_rim_stretches(region.outer_rim);
+    if (!region.unseen_rim.empty()) {
       std::string lengths;
-      for (size_t k = 0; k < region.unseen_rim_mm.size(); ++k)
-        lengths += (k == 0                                 ? ""
-                    : k + 1 == region.unseen_rim_mm.size() ? " and "
-                                                           : ", ") +
-                   std::to_string(static_cast<long long>(std::lround(region.unseen_rim_mm[k])));
+      for (size_t k = 0; k < region.unseen_rim.size(); ++k)
+        lengths +=
+            (k == 0                              ? ""
+             : k + 1 == region.unseen_rim.size() ? " and "
+                                                 : ", ") +
+            std::to_string(static_cast<long long>(std::lround(region.unseen_rim[k].length_mm())));
       region.message += "; rim not seen along " + lengths +
                         " mm (rays graze the bone there): check the edge markers";
     }

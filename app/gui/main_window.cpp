@@ -887,9 +887,13 @@ void MainWindow::refresh_page() {
     marker_counts_[1]->setText(
         tr("Outer surface: %1, inner surface: %2").arg(counts[2]).arg(counts[3]));
   if (proposal_note_) {
-    proposal_note_->setText(s.proposal_message.empty()
-                                ? QString()
-                                : tr("Last proposal: %1").arg(q(s.proposal_message)));
+    QString note =
+        s.proposal_message.empty() ? QString() : tr("Last proposal: %1").arg(q(s.proposal_message));
+    if (!s.unseen_rim.empty())
+      note +=
+          tr(" The orange lines in the view run along the stretches of the rim no ray saw: "
+             "the outline there goes straight from one edge marker to the next.");
+    proposal_note_->setText(note);
     proposal_note_->setVisible(!s.proposal_message.empty());
   }
   // The build controls show the parameters the plan's implant was built with (an automatic

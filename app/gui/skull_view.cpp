@@ -221,6 +221,14 @@ struct SkullView::Impl {
   vtkNew<vtkPlaneSource> plane_source;
   vtkNew<vtkPolyDataMapper> plane_mapper;
   vtkNew<vtkActor> plane_actor;
+  // The last proposal's unseen stretches of the rim, as lines from rim point to rim point, on
+  // a layer above the scene: a chord between rim points runs through the bone's edge and under
+  // the translucent mirror, where it would be hidden.
+  vtkNew<vtkRenderer> overlay;
+  vtkNew<vtkPolyData> unseen_data;
+  vtkNew<vtkPolyDataMapper> unseen_mapper;
+  vtkNew<vtkActor> unseen_actor;
+  int unseen_shown = 0;
 
   std::vector<Marker> markers;
   bool mirror_wanted = true, plane_wanted = true, markers_editable = false, camera_set = false;
@@ -284,6 +292,18 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
   d.plane_mapper->SetInputConnection(d.plane_source->GetOutputPort());
   d.plane_actor->GetProperty()->SetColor(0.30, 0.55, 1.0);
   d.plane_actor->GetProperty()->SetOpacity(0.25);
+  d.window->SetNumberOfLayers(2);
+  d.overlay->SetLayer(1);
+  d.overlay->InteractiveOff();
+  d.overlay->SetActiveCamera(d.renderer->GetActiveCamera());
+  d.window->AddRenderer(d.overlay);
+  d.unseen_mapper->SetInputData(d.unseen_data);
+  d.unseen_actor->SetMapper(d.unseen_mapper);
+  d.unseen_actor->GetProperty()->SetColor(1.0, 0.45, 0.05);
+  d.unseen_actor->GetProperty()->SetLineWidth(7.0);
+  d.unseen_actor->GetProperty()->SetAmbient(1.0);  // flat: the same orange from any side
+  d.unseen_actor->GetProperty()->SetDiffuse(0.0);
+  d.unseen_actor->GetProperty()->RenderLinesAsTubesOn();
   for (vtkActor* a :
        {d.skull.actor.Get(), d.mirror.actor.Get(), d.implant.actor.Get(), d.outer_edge.actor.Get(),
         d.inner_edge.actor.Get(), d.outer_surface.actor.Get(), d.inner_surface.actor.Get(),
@@ -291,6 +311,8 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
     a->SetVisibility(false);
     d.renderer->AddActor(a);
   }
+  d.unseen_actor->SetVisibility(false);
+  d.overlay->AddActor(d.unseen_actor);
 }
 
 SkullView::~SkullView() {
@@ -363,6 +385,20 @@ void SkullView::show_state(const PlanState& s) {
   lm.insert(lm.end(), s.landmarks.midline.begin(), s.landmarks.midline.end());
   d.landmarks.set(lm);
   set_selected_marker(s.find_marker(d.selected_id) ? d.selected_id : 0);
+  {
+    vtkNew<vtkPoints> points;
+    vtkNew<vtkCellArray> lines;
+    for (const RimStretch& g : s.unseen_rim) {
+      const vtkIdType ids[2] = {points->InsertNextPoint(g.from.data()),
+                                points->InsertNextPoint(g.to.data())};
+      lines->InsertNextCell(2, ids);
+    }
+    d.unseen_data->SetPoints(points);
+    d.unseen_data->SetLines(lines);
+    d.unseen_data->Modified();
+    d.unseen_shown = static_cast<int>(s.unseen_rim.size());
+    d.unseen_actor->SetVisibility(d.unseen_shown > 0);
+  }
 
   if (s.skull) {
     double b[6];
@@ -483,6 +519,8 @@ void SkullView::set_selected_marker(int id) {
   d.selected.set(p);
   update();
 }
+
+int SkullView::unseen_rim_shown() const { return d_->unseen_shown; }
 
 int SkullView::selected_marker() const { return d_->selected_id; }
 

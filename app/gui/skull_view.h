@@ -42,6 +42,8 @@ class SkullView : public QOpenGLWidget {
   void set_markers_editable(bool editable);
   void set_selected_marker(int id);
   int selected_marker() const;
+  /// How many stretches of the rim no ray saw are drawn (the last proposal's).
+  int unseen_rim_shown() const;
 
   /// Where a world point shows in the widget (logical pixels), if in front of the camera.
   std::optional<QPoint> project(const Eigen::Vector3d& world);

@@ -51,6 +51,12 @@ Json implant_json(const ImplantResult& r) {
               {"seconds", r.seconds}};
 }
 
+std::vector<double> unseen_rim_lengths(const std::vector<RimStretch>& stretches) {
+  std::vector<double> mm;
+  for (const RimStretch& s : stretches) mm.push_back(s.length_mm());
+  return mm;
+}
+
 Json autoplan_json(const AutoplanResult& r) {
   Json j{{"status", r.planned()                                    ? "planned"
                     : r.status == AutoplanResult::Status::NoDefect ? "no_defect"
@@ -63,7 +69,7 @@ Json autoplan_json(const AutoplanResult& r) {
     j["defect"] = Json{{"area_mm2", r.defect.area_mm2},
                        {"axis", to_json(r.defect.axis)},
                        {"rim_points", r.defect.outer_rim.size()},
-                       {"unseen_rim_mm", r.defect.unseen_rim_mm}};
+                       {"unseen_rim_mm", unseen_rim_lengths(r.defect.unseen_rim)}};
     j["method"] = to_string(r.method_used);
     j["mirror_coverage"] = r.mirror_coverage;
     j["markers"] = r.markers.size();

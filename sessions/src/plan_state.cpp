@@ -585,6 +585,17 @@ bool apply_proposal_result(PlanState& s, const Json& j, const std::string& where
   s.defect_center.reset();
   if (!result.value("defect_center").is_null()) s.defect_center = result.vector3("defect_center");
   s.proposal_message = result.string("message");
+  // Recorded since session 9; earlier results have none.
+  s.unseen_rim.clear();
+  if (result.has("unseen_rim")) {
+    const Json& stretches = result.value("unseen_rim");
+    if (!stretches.is_array())
+      throw SessionError(where, "'unseen_rim' must be a list of stretches");
+    for (size_t k = 0; k < stretches.size(); ++k) {
+      const ParamReader one(stretches[k], where + " unseen_rim[" + std::to_string(k) + "]");
+      s.unseen_rim.push_back({one.vector3("from"), one.vector3("to")});
+    }
+  }
   return true;
 }
 
@@ -684,15 +695,20 @@ Json proposal_result(const MarkerProposal& p) {
     return Json{{"proposed", false},
                 {"markers", Json::array()},
                 {"defect_center", nullptr},
+                {"unseen_rim", Json::array()},
                 {"message", "no markers proposed: " + p.message}};
   char buf[120];  // the fixed part; the detection's message can be long (it names rim stretches)
   std::snprintf(
       buf, sizeof(buf), "%zu markers proposed, %s (mirror covers %.0f%% of the opening); ",
       p.markers.size(), p.method_used == PlanMethod::Mirror ? "mirror-guided" : "rim-only fitting",
       100.0 * p.mirror_coverage);
+  Json unseen = Json::array();
+  for (const RimStretch& g : p.defect.unseen_rim)
+    unseen.push_back(Json{{"from", to_json(g.from)}, {"to", to_json(g.to)}});
   return Json{{"proposed", true},
               {"markers", markers_to_json(p.markers)["markers"]},
               {"defect_center", to_json(p.defect.center)},
+              {"unseen_rim", unseen},
               {"message", buf + p.message + "; " + p.surfaces_message}};
 }
 

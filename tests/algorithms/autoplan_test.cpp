@@ -256,13 +256,22 @@ TEST(Autoplan, UnseenStretchesOfTheRimAreMeasured) {
       rim.emplace_back(30.0 * std::cos(k * M_PI / 30.0), 30.0 * std::sin(k * M_PI / 30.0), 5.0);
   const double chord30 = 60.0 * std::sin(15.0 * M_PI / 180.0),
                chord24 = 60.0 * std::sin(12.0 * M_PI / 180.0);
-  const std::vector<double> over10 = unseen_rim_stretches(rim, 10.0, 0.0);
+  const std::vector<RimStretch> over10 = unseen_rim_stretches(rim, 10.0, 0.0);
   ASSERT_EQ(over10.size(), 2u);
-  EXPECT_NEAR(over10[0], chord30, 1e-9);
-  EXPECT_NEAR(over10[1], chord24, 1e-9);
-  const std::vector<double> reported = unseen_rim_stretches(rim);
+  EXPECT_NEAR(over10[0].length_mm(), chord30, 1e-9);
+  EXPECT_NEAR(over10[1].length_mm(), chord24, 1e-9);
+  // Each stretch runs between the two rim points around the gap: the longest from k = 9 to
+  // k = 14 across the missing 10-13, the next from k = 57 to k = 1 across 58, 59 and 0.
+  const auto on_circle = [](int k) {
+    return Eigen::Vector3d(30.0 * std::cos(k * M_PI / 30.0), 30.0 * std::sin(k * M_PI / 30.0), 5.0);
+  };
+  EXPECT_LT((over10[0].from - on_circle(9)).norm(), 1e-9);
+  EXPECT_LT((over10[0].to - on_circle(14)).norm(), 1e-9);
+  EXPECT_LT((over10[1].from - on_circle(57)).norm(), 1e-9);
+  EXPECT_LT((over10[1].to - on_circle(1)).norm(), 1e-9);
+  const std::vector<RimStretch> reported = unseen_rim_stretches(rim);
   ASSERT_EQ(reported.size(), 1u);
-  EXPECT_NEAR(reported[0], chord30, 1e-9);
+  EXPECT_NEAR(reported[0].length_mm(), chord30, 1e-9);
   EXPECT_TRUE(unseen_rim_stretches({rim.front()}).empty());
 }
 
@@ -271,7 +280,7 @@ TEST(Autoplan, StagesAreConsistent) {
   const AutoplanResult r = autoplan(d.defective, Landmarks{});
   ASSERT_TRUE(r.planned()) << r.message;
   EXPECT_EQ(r.method_used, PlanMethod::Mirror);
-  EXPECT_TRUE(r.defect.unseen_rim_mm.empty()) << r.defect.message;  // a clean cut, seen all round
+  EXPECT_TRUE(r.defect.unseen_rim.empty()) << r.defect.message;  // a clean cut, seen all round
   // The mirror built as a mesh (as `pipeline` exports it): autoplan only moved the skull's locator.
   const SurfaceLocator bone(d.defective),
       mirror(transform_mesh(mirror_mesh(d.defective, r.plane.plane), r.registration.transform));

@@ -218,6 +218,11 @@ TEST_F(Wizard, AllNineStepsOnTheSampleReplayToTheSameImplant) {
   const auto* note = w.findChild<QLabel*>("proposalNote");
   ASSERT_NE(note, nullptr);
   EXPECT_TRUE(note->text().contains("markers proposed")) << note->text().toStdString();
+  // The sample's rim has a stretch along the orbit no ray saw: the view draws it, and the
+  // panel says what the orange line means.
+  ASSERT_FALSE(plan.state().unseen_rim.empty()) << note->text().toStdString();
+  EXPECT_EQ(view.unseen_rim_shown(), static_cast<int>(plan.state().unseen_rim.size()));
+  EXPECT_TRUE(note->text().contains("orange lines")) << note->text().toStdString();
   // Proposing again with edge markers placed asks for the opening where they are.
   const auto edge_centre = edge_marker_centre(plan.state().markers);
   ASSERT_TRUE(edge_centre);

@@ -35,6 +35,13 @@ struct DetectDefectParams {
   std::optional<Eigen::Matrix3d> frame;
 };
 
+/// A stretch of the rim that no ray saw: between two consecutive rim points far apart, where
+/// the outline is interpolated (straight from one to the other).
+struct RimStretch {
+  Eigen::Vector3d from = Eigen::Vector3d::Zero(), to = Eigen::Vector3d::Zero();
+  double length_mm() const { return (to - from).norm(); }
+};
+
 struct DefectRegion {
   enum class Status { Found, NoDefect };
   Status status = Status::NoDefect;
@@ -53,10 +60,10 @@ struct DefectRegion {
   /// The rim: the last bone met along rays next to the opening, outer and inner table, in
   /// order around the axis (same count, paired).
   std::vector<Eigen::Vector3d> outer_rim, inner_rim;
-  /// Stretches of the rim no ray saw (unseen_rim_stretches, longest first, mm): its rays there
-  /// graze the bone or meet other bone first (along an orbit), so the outline there is interpolated
-  /// between rim points far apart. The message names them.
-  std::vector<double> unseen_rim_mm;
+  /// Stretches of the rim no ray saw (unseen_rim_stretches, longest first): its rays there
+  /// graze the bone or meet other bone first (along an orbit), so the outline there is
+  /// interpolated between rim points far apart. The message names them; the wizard draws them.
+  std::vector<RimStretch> unseen_rim;
   double seconds = 0.0;
   bool found() const { return status == Status::Found; }
 };
@@ -68,10 +75,10 @@ constexpr double kUnseenRimTimesMedian = 4.0;
 
 /// The gaps between consecutive points of a closed rim (in order around the opening, the last
 /// followed by the first) longer than `min_gap_mm` and than `times_median` times the median
-/// gap, longest first, mm.
-std::vector<double> unseen_rim_stretches(const std::vector<Eigen::Vector3d>& rim,
-                                         double min_gap_mm = kUnseenRimMm,
-                                         double times_median = kUnseenRimTimesMedian);
+/// gap, longest first.
+std::vector<RimStretch> unseen_rim_stretches(const std::vector<Eigen::Vector3d>& rim,
+                                             double min_gap_mm = kUnseenRimMm,
+                                             double times_median = kUnseenRimTimesMedian);
 
 /// The skull's own axes, the same on the skull in any pose: the principal axis of the vertices
 /// within the midsagittal plane, the other axis within it, and the plane's normal (columns,

@@ -12,6 +12,7 @@
 
 #include "cranioplan/algorithms/build_implant.h"
 #include "cranioplan/algorithms/check_implant.h"
+#include "cranioplan/algorithms/detect_defect.h"
 #include "cranioplan/algorithms/fit_sagittal_plane.h"
 #include "cranioplan/algorithms/load_skull.h"
 #include "cranioplan/algorithms/register_icp.h"
@@ -100,6 +101,9 @@ struct PlanState {
   int next_marker_id = 1;                        ///< ids are never reused
   std::optional<Eigen::Vector3d> defect_center;  ///< from the last proposal
   std::string proposal_message;
+  /// From the last proposal: stretches of the rim no ray saw, where the outline between the
+  /// edge markers is interpolated (the view draws them for the surgeon to check).
+  std::vector<RimStretch> unseen_rim;
   // Step 7
   std::optional<ImplantParams> implant_params;  ///< rebuilt after every marker change
   std::shared_ptr<const ImplantData> implant;
