@@ -606,7 +606,7 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
                         : build_delaunay(markers, params);
   if (r.usable() && params.method == ImplantMethod::Shell && params.fit_to_bone_mm > 0.0 && skull &&
       skull->n_faces() > 0) {
-    TrimToBoneResult t = trim_to_bone(r.mesh, *skull);
+    TrimToBoneResult t = trim_to_bone(r.mesh, *skull, params.trim);
     if (t.usable()) {
       r.mesh = std::move(t.mesh);
       r.watertight = report_mesh(r.mesh).watertight;

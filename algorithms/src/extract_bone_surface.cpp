@@ -136,7 +136,7 @@ ExtractBoneSurfaceResult extract_bone_surface(const Volume& volume,
 
   if (signed_volume(soup) < 0)
     for (auto& t : soup.triangles) std::swap(t[1], t[2]);
-  make_canonical(soup);
+  if (params.canonical) make_canonical(soup);
   result.mesh = build_mesh(soup);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;

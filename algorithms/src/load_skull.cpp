@@ -28,7 +28,9 @@ LoadedSkull load_skull(const std::string& path, const ExtractBoneSurfaceParams& 
     out.source_kind = "volume";
     out.description = volume.description;
   } else {
-    MeshFile file = read_mesh(path);
+    ReadMeshParams read;
+    read.canonical = import.canonical;
+    MeshFile file = read_mesh(path, read);
     out.mesh = file.mesh;  // a copy (OpenMesh meshes cannot be moved); `file` goes at once
     out.source_kind = "mesh";
     out.description = file.format;

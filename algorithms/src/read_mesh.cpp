@@ -410,7 +410,7 @@ MeshFile read_mesh(const std::string& path, const ReadMeshParams& params) {
   MeshFile out;
   TriangleSoup soup = read_mesh_soup(path, &out.format);
   out.triangles_in_file = static_cast<long long>(soup.triangles.size());
-  make_canonical(soup);
+  if (params.canonical) make_canonical(soup);
 
   BuildMeshStats stats;
   out.mesh = build_mesh(soup, &stats);

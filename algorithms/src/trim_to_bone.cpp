@@ -214,6 +214,9 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
   ExtractBoneSurfaceParams surface;
   surface.threshold = 0.5;
   surface.largest_piece_only = true;
+  // The implant as the meshing gives it: its order follows from the (canonical) skull and the
+  // markers already, and plans saved before meshes were made canonical replay to their bytes.
+  surface.canonical = false;
   ExtractBoneSurfaceResult s = extract_bone_surface(volume, surface);
   if (!s.usable()) {
     result.message = s.message;

@@ -143,6 +143,16 @@ void surface_fit_fields(V& v, P& p) {
   v("outlier_sigmas", p.outlier_sigmas);
 }
 
+// build_implant 3: how the shell is fitted to the bone ("trim").
+template <class V, class P>
+void trim_fields(V& v, P& p) {
+  v("voxel_mm", p.voxel_mm);
+  v("max_voxels", p.max_voxels);
+  v("min_feature_mm", p.min_feature_mm);
+  v("smoothing_mm", p.smoothing_mm);
+  v("bridge_mm", p.bridge_mm);
+}
+
 template <class V, class P>
 void implant_fields(V& v, P& p) {
   v("resolution_mm", p.resolution_mm);
@@ -202,11 +212,15 @@ int current_version(CommandType type) {
   // "coarse_iterations"; version 1 is read without: 0 coarse updates), and the command records
   // the fit it gave ("result") and, when the mirror was registered again after it, that
   // registration ("registration"), which a replay applies instead of computing them again.
-  if (type == CommandType::ProposeMarkers) return 3;
+  // build_implant 3: the fit to the bone's parameters ("trim"; versions 1 and 2 are read with
+  // those of sessions 4-8). load_skull 2: the skull read in canonical form ("import.canonical";
+  // version 1 is read as the file gives it).
+  if (type == CommandType::ProposeMarkers || type == CommandType::BuildImplant) return 3;
+  if (type == CommandType::LoadSkull) return 2;
   // register 2 and adjust_plane 2 record the registration they gave ("result"; adjust_plane:
   // "registration", when the mirror was registered again), which a replay applies.
-  if (type == CommandType::BuildImplant || type == CommandType::FitPlane ||
-      type == CommandType::Register || type == CommandType::AdjustPlane)
+  if (type == CommandType::FitPlane || type == CommandType::Register ||
+      type == CommandType::AdjustPlane)
     return 2;
   return 1;
 }
@@ -260,7 +274,9 @@ Eigen::Vector3d ParamReader::vector3(const char* name) const {
 // Parameter forms
 
 Json params_to_json(const ExtractBoneSurfaceParams& p) {
-  return write_fields([](auto& v, auto& q) { extract_fields(v, q); }, p);
+  Json j = write_fields([](auto& v, auto& q) { extract_fields(v, q); }, p);
+  j["canonical"] = p.canonical;
+  return j;
 }
 Json params_to_json(const PlaneFitParams& p) {
   return write_fields([](auto& v, auto& q) { plane_fields(v, q); }, p);
@@ -300,12 +316,16 @@ Json params_to_json(const ImplantParams& p) {
   j["method"] = to_string(p.method);
   j["frame"] = p.frame == ImplantFrame::Radial ? "radial" : "planar";
   j["radial_center"] = p.radial_center ? to_json(*p.radial_center) : Json(nullptr);
+  j["trim"] = write_fields([](auto& v, auto& q) { trim_fields(v, q); }, p.trim);
   return j;
 }
 
 void params_from_json(const ParamReader& r, ExtractBoneSurfaceParams& p) {
   Reader v{r};
   extract_fields(v, p);
+  // load_skull 1 (before session 9) has no "canonical": the skull as the file gave it, so that
+  // those plans replay to the implants they exported.
+  p.canonical = r.has("canonical") && r.boolean("canonical");
 }
 void params_from_json(const ParamReader& r, PlaneFitParams& p) {
   Reader v{r};
@@ -374,6 +394,17 @@ void params_from_json(const ParamReader& r, ImplantParams& p) {
   const Json& c = r.value("radial_center");
   p.radial_center.reset();
   if (!c.is_null()) p.radial_center = vector_from_json(c, r.where(), "radial_center");
+  // build_implant 1 and 2 have no "trim": the fit to the bone of sessions 4-8 (slivers under
+  // 1.25 mm removed, cracks under 2 mm bridged), so that those plans replay to their implants.
+  p.trim = TrimToBoneParams{};
+  if (r.has("trim")) {
+    const ParamReader trim(r.value("trim"), r.where() + " trim");
+    Reader tv{trim};
+    trim_fields(tv, p.trim);
+  } else {
+    p.trim.min_feature_mm = 1.25;
+    p.trim.bridge_mm = 1.0;
+  }
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -76,10 +76,10 @@ TEST(SampleCase, AutoplanFillsTheRealDefect) {
   // The target on the sample's real defect, from autoplan alone: a watertight shell
   // with a rim gap of at most 0.5 mm and no penetration into the skull (the shell is fitted to
   // the bone: built 4 mm over it and trimmed by it), and printable by the quality report (its
-  // edge on the bone tapers over 1.3 mm; docs/IMPLANT.md). Measured 0.15 mm (session 9; the
+  // edge on the bone tapers over 1.3 mm; docs/IMPLANT.md). Measured 0.14 mm (session 9; the
   // STL of scripts/run-sample is read as this very mesh; it was 0.50 / 0.19 mm before the
-  // ring's rays through cut faces were left out, and 0.14–0.16 mm over 14 readings and poses:
-  // the figure is a maximum over 72 sectors).
+  // ring's rays through cut faces were left out, and at most 0.19 mm over 14 readings and
+  // poses: the figure is a maximum over 72 sectors).
   EXPECT_TRUE(r.quality.watertight);
   EXPECT_TRUE(r.quality.manifold);
   EXPECT_EQ(r.quality.self_intersections, 0);

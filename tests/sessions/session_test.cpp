@@ -127,12 +127,46 @@ TEST(Commands, EveryTypeRoundTripsThroughJson) {
 // read as recorded, built without the fit.
 TEST(Commands, BuildImplantVersionOneIsReadByItsOwnRules) {
   Json v1 = to_json(commands::build_implant());
-  EXPECT_EQ(v1["version"], 2);
+  EXPECT_EQ(v1["version"], 3);
   v1["version"] = 1;
+  v1["params"]["params"].erase("trim");
   v1["params"]["params"].erase("fit_to_bone_mm");
   const Command c = command_from_json(v1, "old plan");
   EXPECT_EQ(c.version, 1);
   EXPECT_EQ(to_json(c), v1) << "kept as recorded: the journal's hashes cover it";
+}
+
+// Plans saved before session 9 replay to the implants they exported: their load_skull (1)
+// reads the skull as the file gave it, not in canonical form, and their build_implant (1, 2)
+// fits to the bone as sessions 4-8 did (slivers under 1.25 mm removed, cracks under 2 mm
+// bridged). Today's commands record both, and read them back as recorded.
+TEST(Commands, PlansSavedBeforeSession9ReadTheSkullAndFitTheBoneAsThen) {
+  const Json load = to_json(commands::load_skull("skull.stl"));
+  EXPECT_EQ(load["version"], 2);
+  ExtractBoneSurfaceParams import;
+  params_from_json(ParamReader(load["params"]["import"], "test"), import);
+  EXPECT_TRUE(import.canonical);
+  Json old_load = load["params"]["import"];
+  old_load.erase("canonical");
+  params_from_json(ParamReader(old_load, "test"), import);
+  EXPECT_FALSE(import.canonical);
+
+  ImplantParams p;
+  p.trim.min_feature_mm = 1.7;
+  p.trim.bridge_mm = 0.8;
+  const Json build = to_json(commands::build_implant(p));
+  EXPECT_EQ(build["version"], 3);
+  ImplantParams back;
+  params_from_json(ParamReader(build["params"]["params"], "test"), back);
+  EXPECT_EQ(back.trim.min_feature_mm, 1.7);
+  EXPECT_EQ(back.trim.bridge_mm, 0.8);
+  EXPECT_EQ(back.trim.voxel_mm, p.trim.voxel_mm);
+  Json old_build = build["params"]["params"];
+  old_build.erase("trim");
+  params_from_json(ParamReader(old_build, "test"), back);
+  EXPECT_EQ(back.trim.min_feature_mm, 1.25);
+  EXPECT_EQ(back.trim.bridge_mm, 1.0);
+  EXPECT_EQ(ImplantParams{}.trim.min_feature_mm, 1.5) << "today's default";
 }
 
 // propose_markers 2 records how the surfaces are fitted and which opening was asked for; a

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "cranioplan/algorithms/trim_to_bone.h"
 #include "cranioplan/model/marker.h"
 #include "cranioplan/model/mesh.h"
 
@@ -36,6 +37,7 @@ struct ImplantParams {
   /// is none even then (an orbit), the rim stays at the edge markers. 0: off (the rims pass
   /// through the edge markers).
   double fit_to_bone_mm = 0.0;
+  TrimToBoneParams trim;  ///< how the shell is fitted to the bone (when fit_to_bone_mm > 0)
   /// Radial needs a skull (its centroid is the centre) or `radial_center`; otherwise planar.
   ImplantFrame frame = ImplantFrame::Radial;
   std::optional<Eigen::Vector3d> radial_center;  ///< centre of the rays (inside the skull)

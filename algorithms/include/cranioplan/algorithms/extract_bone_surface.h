@@ -18,6 +18,10 @@ struct ExtractBoneSurfaceParams {
   long long min_piece_triangles = 1000;  ///< used when largest_piece_only is false; ≥ 1
   /// Decimate to about this many triangles (quadric decimation); 0 keeps full resolution.
   long long target_triangles = 0;
+  /// The surface in canonical form (make_canonical), as every mesh read is, so that the same
+  /// triangles from any file give the same plan; false: as the import (or, through load_skull,
+  /// the file) gives it, as plans saved before session 9 were made.
+  bool canonical = true;
 };
 
 struct ExtractBoneSurfaceResult {

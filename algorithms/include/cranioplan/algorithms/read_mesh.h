@@ -11,6 +11,9 @@ struct ReadMeshParams {
   /// When true, any zero-area or repeated-vertex triangle makes the file an error instead of
   /// being dropped with a warning.
   bool strict = false;
+  /// The mesh in canonical form (make_canonical): vertices and triangles in an order that
+  /// depends only on the triangles. false: in the file's order.
+  bool canonical = true;
 };
 
 struct MeshFile {
