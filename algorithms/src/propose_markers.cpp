@@ -144,14 +144,31 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
     }
     return false;
   };
+  // How far from the centre the rim's neighbours lie (median of four on each side), for rim
+  // points where no fitted surface says where this bone is (mirror-guided, where the mirror
+  // has no bone either).
+  const size_t n_rim = defect.outer_rim.size();
+  auto neighbours_radius = [&](size_t i) {
+    std::vector<double> r;
+    for (size_t k = 1; k <= 4 && k < n_rim; ++k)
+      for (size_t j : {(i + k) % n_rim, (i + n_rim - k) % n_rim})
+        r.push_back((defect.outer_rim[j] - c).norm());
+    std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
+    return r.empty() ? 0.0 : r[r.size() / 2];
+  };
   for (size_t i : along(defect.outer_rim, params.edge_spacing_mm)) {
     const Eigen::Vector3d& rim = defect.outer_rim[i];
     const auto fitted = surfaces.at(rim - c);
     if (!bone_beyond(rim)) {
-      // Not where the rim's last bone lies below the fitted bone altogether: its ray met other
-      // bone past the vault's edge (an orbital roof), and a marker there pulls the implant's
-      // outer surface down into a funnel (the sample: a rim point 18 mm below the surface).
-      if (fitted && (rim - c).norm() < (fitted->second - c).norm() - 1.0) continue;
+      // Not where the rim's last bone lies below the fitted bone altogether, or, without a
+      // fitted surface there, more than one layer of bone below its neighbours on the rim: its
+      // ray met other bone past the vault's edge (an orbital roof, a sinus wall), and a marker
+      // there pulls the implant's outer surface down into a funnel (the sample: a rim point
+      // 18 mm below the surface; decimated, two 20-30 mm below their neighbours, rim gap 7 mm).
+      const double radius = (rim - c).norm();
+      if (fitted ? radius < (fitted->second - c).norm() - 1.0
+                 : radius < neighbours_radius(i) - params.detect.max_thickness_mm)
+        continue;
       r.markers.push_back({id++, MarkerType::OuterEdge, rim, MarkerSurface::Original});
     } else if (const auto& p = fitted) {
       r.markers.push_back({id++, MarkerType::OuterEdge, p->first, MarkerSurface::Original});
