@@ -228,7 +228,6 @@ struct SkullView::Impl {
   vtkNew<vtkPolyData> unseen_data;
   vtkNew<vtkPolyDataMapper> unseen_mapper;
   vtkNew<vtkActor> unseen_actor;
-  int unseen_shown = 0;
 
   std::vector<Marker> markers;
   bool mirror_wanted = true, plane_wanted = true, markers_editable = false, camera_set = false;
@@ -396,8 +395,7 @@ void SkullView::show_state(const PlanState& s) {
     d.unseen_data->SetPoints(points);
     d.unseen_data->SetLines(lines);
     d.unseen_data->Modified();
-    d.unseen_shown = static_cast<int>(s.unseen_rim.size());
-    d.unseen_actor->SetVisibility(d.unseen_shown > 0);
+    d.unseen_actor->SetVisibility(!s.unseen_rim.empty());
   }
 
   if (s.skull) {
@@ -520,7 +518,10 @@ void SkullView::set_selected_marker(int id) {
   update();
 }
 
-int SkullView::unseen_rim_shown() const { return d_->unseen_shown; }
+int SkullView::unseen_rim_shown() const {
+  return d_->unseen_actor->GetVisibility() ? static_cast<int>(d_->unseen_data->GetNumberOfLines())
+                                           : 0;
+}
 
 int SkullView::selected_marker() const { return d_->selected_id; }
 

@@ -389,6 +389,26 @@ TEST(Session, AProposalIsRecordedAndReplayedAsRecorded) {
   EXPECT_EQ(t.state().proposal_message, "3 markers recorded");
   EXPECT_EQ(t.effective_commands().back().params["result"], recorded.params["result"])
       << "a recorded result is kept, not recorded again";
+  EXPECT_TRUE(t.state().unseen_rim.empty()) << "a result recorded before session 9 has none";
+
+  // The rim's unseen stretches (since session 9) are applied as recorded, for the view to draw;
+  // a malformed list is named.
+  Command with_stretch = recorded;
+  with_stretch.params["result"]["unseen_rim"] = {
+      {{"from", to_json(Eigen::Vector3d(1, 2, 3))}, {"to", to_json(Eigen::Vector3d(4, 5, 6))}}};
+  Session u = session_at_markers();
+  push_ok(u, with_stretch);
+  ASSERT_EQ(u.state().unseen_rim.size(), 1u);
+  EXPECT_EQ(u.state().unseen_rim[0].from, Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(u.state().unseen_rim[0].to, Eigen::Vector3d(4, 5, 6));
+  Command bad_stretch = recorded;
+  bad_stretch.params["result"]["unseen_rim"] = 7;
+  try {
+    u.push(bad_stretch);
+    ADD_FAILURE() << "a malformed unseen_rim was applied";
+  } catch (const Error& e) {
+    EXPECT_NE(std::string(e.what()).find("unseen_rim"), std::string::npos) << e.what();
+  }
 
   // A recorded failure leaves the markers as they were and says why.
   Command failed = commands::propose_markers();
