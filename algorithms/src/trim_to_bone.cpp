@@ -7,6 +7,7 @@
 
 #include "cranioplan/algorithms/distance_transform.h"
 #include "cranioplan/algorithms/extract_bone_surface.h"
+#include "cranioplan/algorithms/surface_locator.h"
 #include "cranioplan/algorithms/voxelize_mesh.h"
 
 namespace cranioplan {
@@ -155,6 +156,71 @@ std::vector<float> blur(const Mask& in, const VoxelGrid& g, double sigma_voxels)
   return a;
 }
 
+// The faces of `mesh` whose bounding boxes meet [lo, hi].
+SkullMesh faces_in_box(const SkullMesh& mesh, const Eigen::Vector3d& lo,
+                       const Eigen::Vector3d& hi) {
+  TriangleSoup soup;
+  std::vector<int> index(mesh.n_vertices(), -1);
+  for (auto fh : mesh.faces()) {
+    Eigen::Vector3d a = Eigen::Vector3d::Constant(1e300), b = -a;
+    for (auto vh : mesh.fv_range(fh)) {
+      a = a.cwiseMin(to_eigen(mesh.point(vh)));
+      b = b.cwiseMax(to_eigen(mesh.point(vh)));
+    }
+    if ((b.array() < lo.array()).any() || (a.array() > hi.array()).any()) continue;
+    Eigen::Vector3i t;
+    int n = 0;
+    for (auto vh : mesh.fv_range(fh)) {
+      int& id = index[vh.idx()];
+      if (id < 0) {
+        id = static_cast<int>(soup.vertices.size());
+        soup.vertices.push_back(to_eigen(mesh.point(vh)));
+      }
+      t[n++] = id;
+    }
+    soup.triangles.push_back(t);
+  }
+  return build_mesh(soup);
+}
+
+// The implant's smooth field, held `clearance` mm off the skull's surface to a fraction of the
+// grid: the mask is blurred together with the bone it touches (so the blur does not pull the
+// surface back from the bone), then capped by a field that crosses ½ exactly `clearance` mm
+// outside the skull's surface, from the distance to its triangles. The surface then follows the
+// bone's own surface rather than its voxels.
+std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const VoxelGrid& g,
+                                    const SkullMesh& skull, double sigma_voxels, double clearance) {
+  const double h = g.spacing;
+  // Bone within two voxels of the implant joins the blur.
+  const Mask near_implant = dilate(dilate(mask, g), g);
+  Mask joined = mask;
+  for (size_t c = 0; c < joined.size(); ++c) joined[c] = mask[c] || (bone[c] && near_implant[c]);
+  std::vector<float> field = blur(joined, g, sigma_voxels);
+  Mask().swap(joined);
+  // The skull's triangles near the grid suffice for distances up to a few voxels.
+  const double reach = 3.0 * h + std::max(0.0, clearance);
+  const Eigen::Vector3d lo = g.origin - Eigen::Vector3d::Constant(reach);
+  const Eigen::Vector3d hi =
+      g.center(g.dims[0] - 1, g.dims[1] - 1, g.dims[2] - 1) + Eigen::Vector3d::Constant(reach);
+  const SkullMesh local = faces_in_box(skull, lo, hi);
+  if (local.n_faces() == 0) return field;
+  const SurfaceLocator locator(local);
+  const Mask near_bone = dilate(dilate(bone, g), g);
+  for (int k = 0; k < g.dims[2]; ++k)
+    for (int j = 0; j < g.dims[1]; ++j)
+      for (int i = 0; i < g.dims[0]; ++i) {
+        const size_t c = g.index(i, j, k);
+        if (field[c] <= 0.0f || !near_bone[c]) continue;
+        const double d = locator.closest(g.center(i, j, k)).distance * (bone[c] ? -1.0 : 1.0);
+        const double cap = std::clamp(0.5 + (d - clearance) / h, 0.0, 1.0);
+        field[c] = std::min(field[c], static_cast<float>(cap));
+      }
+  // Deeper in the bone than the band: nothing.
+  for (size_t c = 0; c < field.size(); ++c)
+    if (bone[c] && !near_implant[c]) field[c] = 0.0f;
+  return field;
+}
+
 }  // namespace
 
 TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
@@ -184,7 +250,24 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
   // on one side and the bone on the other, each within the width with nothing between; so a
   // concave corner where the implant's wall meets the top of the bone gets no fillet.
   const int bridge = static_cast<int>(std::lround(params.bridge_mm / h));
-  if (bridge > 0) mask = bridge_cracks(mask, bone, grid, bridge);
+  if (bridge > 0) {
+    Mask bridged = bridge_cracks(mask, bone, grid, bridge);
+    // What the fills leave thinner than the feature size away from the bone goes (a rod
+    // between the implant's edge and a fragment; a wall between the implant and a cut face is
+    // thick along the cut): what lies within a millimetre of the bone is the fill's contact.
+    if (params.thin_fills_removed && params.min_feature_mm > 0) {
+      const std::vector<float> to_bone = distance_to_mask(bone, grid);
+      auto far_fill = [&](size_t c) { return bridged[c] && !mask[c] && to_bone[c] > 1.0f; };
+      bool any = false;
+      for (size_t c = 0; c < bridged.size() && !any; ++c) any = far_fill(c);
+      if (any) {  // the opening costs two distance transforms: only when there is a far fill
+        const Mask thick = open_by_ball(bridged, grid, 0.5 * params.min_feature_mm);
+        for (size_t c = 0; c < bridged.size(); ++c)
+          if (far_fill(c) && !thick[c]) bridged[c] = 0;
+      }
+    }
+    mask = std::move(bridged);
+  }
   mask = largest_piece(mask, grid);
   size_t after = 0;
   for (uint8_t m : mask) after += m;
@@ -199,11 +282,17 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
     result.seconds = elapsed();
     return result;
   }
-  std::vector<float> smooth = blur(mask, grid, params.smoothing_mm / h);
-  Mask().swap(mask);
-  // Neither the grid nor the smoothing may carry the surface into the bone: the bone grown by
-  // one voxel stays outside (the surface then lies a fraction of a voxel off the bone).
-  {
+  std::vector<float> smooth;
+  if (params.clearance_mm) {
+    smooth =
+        fit_against_bone(mask, bone, grid, skull, params.smoothing_mm / h, *params.clearance_mm);
+    Mask().swap(mask);
+  } else {
+    // Sessions up to 9: neither the grid nor the smoothing may carry the surface into the
+    // bone: the bone grown by one voxel stays outside (the surface then lies a fraction of a
+    // voxel off the bone, up to a voxel and a half).
+    smooth = blur(mask, grid, params.smoothing_mm / h);
+    Mask().swap(mask);
     const Mask keep_out = dilate(bone, grid);
     for (size_t c = 0; c < smooth.size(); ++c)
       if (keep_out[c]) smooth[c] = 0.0f;

@@ -215,7 +215,10 @@ int current_version(CommandType type) {
   // build_implant 3: the fit to the bone's parameters ("trim"; versions 1 and 2 are read with
   // those of sessions 4-8). load_skull 2: the skull read in canonical form ("import.canonical";
   // version 1 is read as the file gives it).
-  if (type == CommandType::ProposeMarkers || type == CommandType::BuildImplant) return 3;
+  // build_implant 4: the fit to the bone holds the implant "clearance_mm" off the bone's
+  // surface and removes thin fills ("thin_fills_removed"); version 3 is read without either.
+  if (type == CommandType::BuildImplant) return 4;
+  if (type == CommandType::ProposeMarkers) return 3;
   if (type == CommandType::LoadSkull) return 2;
   // register 2 and adjust_plane 2 record the registration they gave ("result"; adjust_plane:
   // "registration", when the mirror was registered again), which a replay applies.
@@ -317,6 +320,8 @@ Json params_to_json(const ImplantParams& p) {
   j["frame"] = p.frame == ImplantFrame::Radial ? "radial" : "planar";
   j["radial_center"] = p.radial_center ? to_json(*p.radial_center) : Json(nullptr);
   j["trim"] = write_fields([](auto& v, auto& q) { trim_fields(v, q); }, p.trim);
+  j["trim"]["thin_fills_removed"] = p.trim.thin_fills_removed;
+  j["trim"]["clearance_mm"] = p.trim.clearance_mm ? Json(*p.trim.clearance_mm) : Json(nullptr);
   return j;
 }
 
@@ -401,7 +406,20 @@ void params_from_json(const ParamReader& r, ImplantParams& p) {
     const ParamReader trim(r.value("trim"), r.where() + " trim");
     Reader tv{trim};
     trim_fields(tv, p.trim);
+    // build_implant 3 (session 9) has no "clearance_mm": the bone grown by a voxel kept out,
+    // and fills kept as made.
+    p.trim.thin_fills_removed =
+        trim.has("thin_fills_removed") && trim.boolean("thin_fills_removed");
+    p.trim.clearance_mm.reset();
+    if (trim.has("clearance_mm") && !trim.value("clearance_mm").is_null()) {
+      const double c = trim.number("clearance_mm");
+      if (!std::isfinite(c) || c < 0)
+        throw SessionError(trim.where(), "clearance_mm must be a distance of 0 mm or more");
+      p.trim.clearance_mm = c;
+    }
   } else {
+    p.trim.thin_fills_removed = false;
+    p.trim.clearance_mm.reset();
     p.trim.min_feature_mm = 1.25;
     p.trim.bridge_mm = 1.0;
   }

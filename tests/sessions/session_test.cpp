@@ -127,7 +127,7 @@ TEST(Commands, EveryTypeRoundTripsThroughJson) {
 // read as recorded, built without the fit.
 TEST(Commands, BuildImplantVersionOneIsReadByItsOwnRules) {
   Json v1 = to_json(commands::build_implant());
-  EXPECT_EQ(v1["version"], 3);
+  EXPECT_EQ(v1["version"], 4);
   v1["version"] = 1;
   v1["params"]["params"].erase("trim");
   v1["params"]["params"].erase("fit_to_bone_mm");
@@ -155,7 +155,7 @@ TEST(Commands, PlansSavedBeforeSession9ReadTheSkullAndFitTheBoneAsThen) {
   p.trim.min_feature_mm = 1.7;
   p.trim.bridge_mm = 0.8;
   const Json build = to_json(commands::build_implant(p));
-  EXPECT_EQ(build["version"], 3);
+  EXPECT_EQ(build["version"], 4);
   ImplantParams back;
   params_from_json(ParamReader(build["params"]["params"], "test"), back);
   EXPECT_EQ(back.trim.min_feature_mm, 1.7);
@@ -167,6 +167,49 @@ TEST(Commands, PlansSavedBeforeSession9ReadTheSkullAndFitTheBoneAsThen) {
   EXPECT_EQ(back.trim.min_feature_mm, 1.25);
   EXPECT_EQ(back.trim.bridge_mm, 1.0);
   EXPECT_EQ(ImplantParams{}.trim.min_feature_mm, 1.5) << "today's default";
+  EXPECT_FALSE(back.trim.clearance_mm.has_value()) << "sessions 4-8: the bone grown by a voxel";
+  EXPECT_FALSE(back.trim.thin_fills_removed);
+}
+
+// build_implant 4 holds the implant a set clearance off the bone's surface and removes thin
+// fills; a version-3 command (session 9: "trim" without either) is read as session 9 fitted
+// it, and a bad clearance is named.
+TEST(Commands, PlansSavedInSession9FitTheBoneAsThen) {
+  ImplantParams p;
+  p.trim.clearance_mm = 0.25;
+  const Json build = to_json(commands::build_implant(p));
+  ImplantParams back;
+  params_from_json(ParamReader(build["params"]["params"], "test"), back);
+  ASSERT_TRUE(back.trim.clearance_mm.has_value());
+  EXPECT_EQ(*back.trim.clearance_mm, 0.25);
+  EXPECT_TRUE(back.trim.thin_fills_removed);
+  EXPECT_EQ(ImplantParams{}.trim.clearance_mm, 0.1) << "today's default";
+
+  Json unset = build["params"]["params"];
+  unset["trim"]["clearance_mm"] = nullptr;
+  unset["trim"]["thin_fills_removed"] = false;
+  params_from_json(ParamReader(unset, "test"), back);
+  EXPECT_FALSE(back.trim.clearance_mm.has_value()) << "recorded as unset, read as unset";
+  EXPECT_FALSE(back.trim.thin_fills_removed);
+
+  Json session9 = build["params"]["params"];
+  session9["trim"].erase("clearance_mm");
+  session9["trim"].erase("thin_fills_removed");
+  back = ImplantParams{};
+  params_from_json(ParamReader(session9, "test"), back);
+  EXPECT_FALSE(back.trim.clearance_mm.has_value());
+  EXPECT_FALSE(back.trim.thin_fills_removed);
+  EXPECT_EQ(back.trim.min_feature_mm, 1.5) << "the rest as recorded";
+
+  Json bad = build["params"]["params"];
+  bad["trim"]["clearance_mm"] = -0.5;
+  try {
+    params_from_json(ParamReader(bad, "plan.json command 7"), back);
+    ADD_FAILURE() << "a negative clearance is accepted";
+  } catch (const SessionError& e) {
+    EXPECT_NE(std::string(e.what()).find("clearance_mm"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("plan.json command 7"), std::string::npos) << e.what();
+  }
 }
 
 // propose_markers 2 records how the surfaces are fitted and which opening was asked for; a

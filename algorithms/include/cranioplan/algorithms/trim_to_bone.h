@@ -3,6 +3,7 @@
 // voxel grid, slivers left on top of intact bone are removed, and the rest is meshed again with
 // a smooth surface. An implant built a little larger than the opening thereby meets the cut face
 // of the defect everywhere (no gap) and never enters the bone (no overlap).
+#include <optional>
 #include <string>
 
 #include "cranioplan/model/mesh.h"
@@ -26,6 +27,16 @@ struct TrimToBoneParams {
   /// the bone on the other, along one of 13 directions) are filled, mm (0: off). Ragged bone
   /// (crushed fragments by an orbit) leaves cracks up to 3 mm wide along the implant's edge.
   double bridge_mm = 1.5;
+  /// Where a fill leaves material thinner than min_feature_mm more than 1 mm from the bone (a
+  /// rod between the implant's edge and a fragment, rather than a wall against a cut face), it
+  /// goes. False: fills are kept as made (sessions up to 9).
+  bool thin_fills_removed = true;
+  /// The implant's surface keeps this far off the skull's surface where it meets it, mm (≥ 0),
+  /// to a fraction of the grid (from the distance to the skull's triangles). Unset: the bone's
+  /// voxels grown by one voxel are kept out, as in sessions up to 9; the surface then lies
+  /// 0.5-1.5 voxels off the bone (up to 0.7 mm on a large implant's 0.45 mm grid), which left
+  /// a layer of the defect unfilled along its cut face.
+  std::optional<double> clearance_mm = 0.1;
 };
 
 struct TrimToBoneResult {
