@@ -26,6 +26,13 @@ SkullMesh merge(const TriangleSoup& a, const TriangleSoup& b) {
   return build_mesh(s);
 }
 
+// The largest coordinate `axis` of the mesh's vertices.
+double highest(const SkullMesh& m, int axis) {
+  double x = -1e9;
+  for (auto vh : m.vertices()) x = std::max(x, static_cast<double>(m.point(vh)[axis]));
+  return x;
+}
+
 // Bone: two plates 5 mm thick with a 10 mm wide gap (the defect) between them. The implant is
 // built 3 mm wider on both sides and 0.3 mm proud of the bone: trimmed, it fills the gap —
 // against both cut faces, no overlap, and no sliver left on top of the bone.
@@ -72,11 +79,7 @@ TEST(TrimToBone, BridgesANarrowGapToTheBone) {
   off.bridge_mm = 0.0;
   const TrimToBoneResult cracked = trim_to_bone(implant, bone, off);
   ASSERT_TRUE(bridged.usable() && cracked.usable());
-  auto right_end = [](const SkullMesh& m) {
-    double x = -1e9;
-    for (auto vh : m.vertices()) x = std::max(x, static_cast<double>(m.point(vh)[0]));
-    return x;
-  };
+  auto right_end = [](const SkullMesh& m) { return highest(m, 0); };
   EXPECT_GE(right_end(bridged.mesh), 29.5) << "rests on the right cut face";
   EXPECT_LE(right_end(bridged.mesh), 30.0) << "never into it";
   EXPECT_LE(right_end(cracked.mesh), 29.0) << "without the bridge, the crack stays";
@@ -153,11 +156,7 @@ TEST(TrimToBone, ARodOfFillToAFragmentGoes) {
   const TrimToBoneResult now = trim_to_bone(implant, bone, wide),
                          before = trim_to_bone(implant, bone, kept);
   ASSERT_TRUE(now.usable() && before.usable());
-  auto top = [](const SkullMesh& m) {
-    double z = -1e9;
-    for (auto vh : m.vertices()) z = std::max(z, static_cast<double>(m.point(vh)[2]));
-    return z;
-  };
+  auto top = [](const SkullMesh& m) { return highest(m, 2); };
   EXPECT_LE(top(now.mesh), 5.6) << "no rod up to the fragment";
   EXPECT_GE(top(before.mesh), 7.5) << "the case has the rod to remove";
   const QualityReport q = check_implant(now.mesh, &bone);
