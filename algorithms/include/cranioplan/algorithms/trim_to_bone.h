@@ -17,8 +17,8 @@ struct TrimToBoneParams {
   double max_voxels = 6e6;
   /// Parts thinner than this (slivers on the bone, filaments between bone fragments) go, mm
   /// (≥ 0). Half a millimetre above the quality report's 1 mm minimum: the surface is then
-  /// kept a voxel off the bone and blurred, which thins what is left. With 1.25 mm the
-  /// sample's plans kept edges under 1 mm up to 3.8 mm wide between the crushed bone fragments
+  /// blurred and (in session 9) kept a voxel off the bone, which thins what is left. With 1.25 mm
+  /// the sample's plans kept edges under 1 mm up to 3.8 mm wide between the crushed bone fragments
   /// above the orbit (docs/AUTOPLAN.md: 28 plans in other readings and poses, 2 of them not
   /// printable and 2 more with a rim gap over 0.5 mm with 1.25 mm and 1 mm bridges; none now).
   double min_feature_mm = 1.5;
@@ -51,7 +51,7 @@ struct TrimToBoneResult {
 };
 
 /// `implant` and `skull` must be closed surfaces (the skull's bone as a solid). The result
-/// keeps clear of the bone by a fraction of a voxel.
+/// keeps `clearance_mm` off the skull's surface (unset: a fraction of a voxel off its voxels).
 TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
                               const TrimToBoneParams& params = {});
 
