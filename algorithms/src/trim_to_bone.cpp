@@ -198,12 +198,16 @@ std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const Vo
   std::vector<float> field = blur(joined, g, sigma_voxels);
   Mask().swap(joined);
   // The skull's triangles near the grid suffice for distances up to a few voxels.
-  const double reach = 3.0 * h + std::max(0.0, clearance);
+  const double reach = 3.0 * h + clearance;
   const Eigen::Vector3d lo = g.origin - Eigen::Vector3d::Constant(reach);
   const Eigen::Vector3d hi =
       g.center(g.dims[0] - 1, g.dims[1] - 1, g.dims[2] - 1) + Eigen::Vector3d::Constant(reach);
   const SkullMesh local = faces_in_box(skull, lo, hi);
-  if (local.n_faces() == 0) return field;
+  if (local.n_faces() == 0) {  // no surface near the grid: its bone voxels stay empty
+    for (size_t c = 0; c < field.size(); ++c)
+      if (bone[c]) field[c] = 0.0f;
+    return field;
+  }
   const SurfaceLocator locator(local);
   const Mask near_bone = dilate(dilate(bone, g), g);
   for (int k = 0; k < g.dims[2]; ++k)
@@ -215,9 +219,8 @@ std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const Vo
         const double cap = std::clamp(0.5 + (d - clearance) / h, 0.0, 1.0);
         field[c] = std::min(field[c], static_cast<float>(cap));
       }
-  // Deeper in the bone than the band: nothing.
-  for (size_t c = 0; c < field.size(); ++c)
-    if (bone[c] && !near_implant[c]) field[c] = 0.0f;
+  // Every bone voxel is in the band, and half a voxel or more inside the surface its cap is 0
+  // (a distance to fewer triangles is never shorter), so the blur leaves nothing in the bone.
   return field;
 }
 
@@ -284,8 +287,8 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
   }
   std::vector<float> smooth;
   if (params.clearance_mm) {
-    smooth =
-        fit_against_bone(mask, bone, grid, skull, params.smoothing_mm / h, *params.clearance_mm);
+    smooth = fit_against_bone(mask, bone, grid, skull, params.smoothing_mm / h,
+                              std::max(0.0, *params.clearance_mm));
     Mask().swap(mask);
   } else {
     // Sessions up to 9: neither the grid nor the smoothing may carry the surface into the
