@@ -68,10 +68,18 @@ class DefectSurfaces {
   Status status = Status::Failed;
   std::string message;
   bool mirror_guided = false;
-  int ring_rays = 0;              ///< intact rays on the ring (both tables met)
-  int sites = 0;                  ///< fitting sites used (after thinning and outliers)
-  double outer_rms_mm = 0.0;      ///< residual of the fit over all ring rays, outer table
-  double thickness_rms_mm = 0.0;  ///< the same, bone thickness (inner table)
+  int ring_rays = 0;  ///< intact rays on the ring (both tables met)
+  int sites = 0;      ///< fitting sites used (after thinning and outliers)
+  /// RMS residual of the fit over the ring's rays within the outlier limit, outer table (until
+  /// session 10 over all the rays: a few rays past an orbit, 30-50 mm off, dominated it).
+  double outer_rms_mm = 0.0;
+  double thickness_rms_mm = 0.0;  ///< the same, bone thickness (rays through both tables)
+  /// Rays off the fit by more than the outlier limit (`outlier_sigmas` robust σ, at least 1 mm):
+  /// bone the fitted surface does not describe (an orbital roof, a fragment of a cut face).
+  int outer_off_rays = 0;
+  int thickness_off_rays = 0;
+  double outer_off_limit_mm = 0.0;      ///< that limit, outer table
+  double thickness_off_limit_mm = 0.0;  ///< that limit, thickness
   /// Rim-only: the sphere the outer surface was fitted beyond, when the ring preferred it to
   /// the spline's quadratic trend alone.
   const std::optional<VaultSphere>& vault() const { return vault_; }
