@@ -48,9 +48,8 @@ struct MarkerProposal {
   PlanMethod method_used = PlanMethod::RimOnly;
   double mirror_coverage = 0.0;  ///< fraction of the opening's rays that meet mirrored bone
   std::string surfaces_message;  ///< how the surfaces were fitted (ring rays, residual)
-  double ring_rms_mm =
-      0.0;  ///< residual of the outer surface's fit on the ring (DefectSurfaces::outer_rms_mm)
-  std::vector<Marker> markers;  ///< ids from `first_id` on
+  double ring_rms_mm = 0.0;      ///< DefectSurfaces::outer_rms_mm: the outer fit's residual
+  std::vector<Marker> markers;   ///< ids from `first_id` on
   bool proposed() const { return status == Status::Proposed; }
 };
 
