@@ -383,7 +383,9 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
     };
     auto o = std::make_shared<Opts>();
     auto* cmd = app.add_subcommand(
-        "evaluate", "Autoplan every NNN_defective_skull.* against its NNN_implant.*");
+        "evaluate",
+        "Autoplan every NNN_defective_skull.* against its NNN_implant.* (exit 1 if a case could "
+        "not be planned, 3 if a case's file could not be read; every case is in the table)");
     cmd->add_option("CASES_DIR", o->dir, "folder of cases (meshes or NRRD/NIfTI masks)")
         ->required();
     cmd->add_option("--implants-out", o->implants_out,
@@ -407,55 +409,85 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
            }
            Json rows = Json::array();
            std::vector<double> dsc, bdsc, hd95, secs;
+           int failed = 0, unreadable = 0;
            for (const auto& [id, files] : cases) {
              if (files.first.empty() || files.second.empty()) continue;
              const auto t0 = std::chrono::steady_clock::now();
-             const LoadedSkull loaded = load_skull(files.first);
-             const SkullMesh& skull = loaded.mesh;
-             const AutoplanResult r = autoplan(skull, Landmarks{}, o->params);
+             Json row{{"case", id}};
+             // One case's unreadable file is that case's row, not the end of the run: the
+             // others are still planned and scored.
+             try {
+               const SkullMesh truth = load_any(files.second);  // read first: fail before planning
+               const LoadedSkull loaded = load_skull(files.first);
+               const SkullMesh& skull = loaded.mesh;
+               const AutoplanResult r = autoplan(skull, Landmarks{}, o->params);
+               row["status"] = r.planned() ? "planned" : "failed";
+               row["message"] = r.message;
+               if (r.planned()) {
+                 const CompareResult c = compare_implants(r.implant.mesh, truth, &skull);
+                 if (!o->implants_out.empty()) {
+                   const std::string path =
+                       (fs::path(o->implants_out) / (id + "_planned_implant.stl")).string();
+                   write_mesh(r.implant.mesh, path);
+                   row["implant"] = path;
+                 }
+                 row["method"] = to_string(r.method_used);
+                 row["dice"] = c.dice;
+                 row["boundary_dice"] = c.boundary_dice;
+                 row["hd95_mm"] = c.hd95_mm;
+                 dsc.push_back(c.dice);
+                 bdsc.push_back(c.boundary_dice);
+                 hd95.push_back(c.hd95_mm);
+               } else {
+                 // No implant overlaps nothing: a failed plan counts as Dice 0 in the medians
+                 // (as a missing prediction does in the challenge); it has no distance.
+                 ++failed;
+                 dsc.push_back(0.0);
+                 bdsc.push_back(0.0);
+               }
+             } catch (const Error& e) {
+               ++unreadable;
+               row["status"] = "bad_input";
+               row["message"] = e.what();
+             }
              const double seconds =
                  std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-             Json row{{"case", id},
-                      {"status", r.planned() ? "planned" : "failed"},
-                      {"message", r.message},
-                      {"seconds", seconds}};
-             if (r.planned()) {
-               const SkullMesh truth = load_any(files.second);
-               const CompareResult c = compare_implants(r.implant.mesh, truth, &skull);
-               if (!o->implants_out.empty()) {
-                 const std::string path =
-                     (fs::path(o->implants_out) / (id + "_planned_implant.stl")).string();
-                 write_mesh(r.implant.mesh, path);
-                 row["implant"] = path;
-               }
-               row["method"] = to_string(r.method_used);
-               row["dice"] = c.dice;
-               row["boundary_dice"] = c.boundary_dice;
-               row["hd95_mm"] = c.hd95_mm;
-               dsc.push_back(c.dice);
-               bdsc.push_back(c.boundary_dice);
-               hd95.push_back(c.hd95_mm);
+             row["seconds"] = seconds;
+             if (row["status"] != "bad_input") secs.push_back(seconds);
+             if (!json) {
+               if (row["status"] == "planned")
+                 std::cout << id << "  " << row["method"].get<std::string>() << "  DSC "
+                           << row["dice"].get<double>() << "  bDSC "
+                           << row["boundary_dice"].get<double>() << "  HD95 "
+                           << row["hd95_mm"].get<double>() << " mm  " << seconds << " s  "
+                           << row["message"].get<std::string>() << std::endl;
+               else
+                 std::cout << id << "  " << row["status"].get<std::string>() << "  "
+                           << row["message"].get<std::string>() << std::endl;
              }
-             secs.push_back(seconds);
-             if (!json)
-               std::cout << id << "  " << row.value("method", "-") << "  DSC "
-                         << row.value("dice", 0.0) << "  bDSC " << row.value("boundary_dice", 0.0)
-                         << "  HD95 " << row.value("hd95_mm", 0.0) << " mm  " << seconds << " s  "
-                         << r.message << std::endl;
              rows.push_back(row);
            }
            if (rows.empty())
              throw InputError(o->dir,
                               "holds no NNN_defective_skull.* with an NNN_implant.* beside it");
+           // No figure where no case gave one (null, not 0).
+           auto median_of = [](const std::vector<double>& v) {
+             return v.empty() ? Json(nullptr) : Json(median(v));
+           };
            const Json summary{{"cases", rows.size()},
-                              {"median_dice", median(dsc)},
-                              {"median_boundary_dice", median(bdsc)},
-                              {"median_hd95_mm", median(hd95)},
-                              {"median_seconds", median(secs)}};
+                              {"failed", failed},
+                              {"bad_input", unreadable},
+                              {"median_dice", median_of(dsc)},
+                              {"median_boundary_dice", median_of(bdsc)},
+                              {"median_hd95_mm", median_of(hd95)},
+                              {"median_seconds", median_of(secs)}};
            if (json)
              print_result(Json{{"cases", rows}, {"median", summary}}, true);
            else
              print_result(Json{{"median", summary}}, false);
+           // Every case is in the table; the exit code says whether all of them were planned.
+           if (unreadable > 0) return kBadInput;
+           if (failed > 0) return kUnusable;
            return kOk;
          }});
   }

@@ -174,6 +174,33 @@ TEST(Cli, EvaluateScoresAFolderOfCasesAndWritesTheImplants) {
   const Json plan = Json::parse(out);
   ASSERT_TRUE(plan["defect"]["unseen_rim_mm"].is_array()) << out;
   EXPECT_TRUE(plan["defect"]["unseen_rim_mm"].empty()) << out;
+  // A case whose file cannot be read is its row in the table, and the others are still
+  // planned and scored; the exit code (3) says that not every case could be read.
+  std::filesystem::copy_file(dir.path("cases/007_implant.stl"), dir.path("cases/008_implant.stl"));
+  test::write_bytes(dir.path("cases/008_defective_skull.stl"), "solid truncated\nfacet normal");
+  ASSERT_EQ(test::run_command(kCli + " evaluate --json " + dir.path("cases"), &out), 3);
+  const Json both = Json::parse(out);
+  ASSERT_EQ(both["cases"].size(), 2u) << out;
+  EXPECT_EQ(both["cases"][0]["status"].get<std::string>(), "planned");
+  EXPECT_EQ(both["cases"][1]["status"].get<std::string>(), "bad_input");
+  EXPECT_NE(both["cases"][1]["message"].get<std::string>().find("008_defective_skull.stl"),
+            std::string::npos)
+      << out;
+  EXPECT_EQ(both["median"]["bad_input"].get<int>(), 1);
+  EXPECT_NEAR(both["median"]["median_dice"].get<double>(), j["cases"][0]["dice"].get<double>(),
+              1e-9);
+  // A skull without a defect cannot be planned: its row says so, it counts as Dice 0 (as a
+  // missing prediction does in the challenge), and the exit code is 1.
+  std::filesystem::create_directories(dir.path("intact"));
+  std::filesystem::copy_file(dir.path("thick.stl"), dir.path("intact/009_defective_skull.stl"));
+  std::filesystem::copy_file(dir.path("cases/007_implant.stl"), dir.path("intact/009_implant.stl"));
+  ASSERT_EQ(test::run_command(kCli + " evaluate --json " + dir.path("intact"), &out), 1);
+  const Json none = Json::parse(out);
+  EXPECT_EQ(none["cases"][0]["status"].get<std::string>(), "failed");
+  EXPECT_NE(none["cases"][0]["message"].get<std::string>().find("no defect"), std::string::npos);
+  EXPECT_EQ(none["median"]["failed"].get<int>(), 1);
+  EXPECT_EQ(none["median"]["median_dice"].get<double>(), 0.0);
+  EXPECT_TRUE(none["median"]["median_hd95_mm"].is_null());
   // --implants-out that is not a folder: bad input (exit 3), naming it.
   ASSERT_EQ(test::run_command(kCli + " evaluate --json " + dir.path("cases") + " --implants-out " +
                                   dir.path("missing"),
