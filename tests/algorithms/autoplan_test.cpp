@@ -198,6 +198,49 @@ TEST(Autoplan, WithTwoOpeningsAPointChoosesWhichIsPlanned) {
   EXPECT_GE(c.dice, 0.85);
 }
 
+// Bilateral defects, mirror images of each other (as after bilateral decompressions): each
+// opening's mirror falls into the other, so the mirror cannot fill either (the issue's
+// "bilateral" case). The larger is planned, the message names the other, and a point near it
+// plans that one; both from the rim alone, each close to its own ground truth.
+TEST(Autoplan, BilateralDefectsArePlannedOneByOneFromTheRim) {
+  InjectDefectParams right;
+  right.center = test::head_surface_point(Eigen::Vector3d(0.75, 0.2, 0.6).normalized()) * 0.965;
+  right.size_mm = 45;
+  right.voxel_mm = 0.5;
+  const InjectDefectResult first = inject_defect(thick_head(), right);
+  ASSERT_TRUE(first.usable());
+  InjectDefectParams left = right;
+  left.center.x() = -left.center.x();
+  left.size_mm = 40;  // a little smaller: the right one is "the largest"
+  const InjectDefectResult both = inject_defect(first.defective, left);
+  ASSERT_TRUE(both.usable());
+
+  const AutoplanResult a = autoplan(both.defective, Landmarks{});
+  ASSERT_TRUE(a.planned()) << a.message;
+  EXPECT_GT(a.defect.axis.x(), 0.5) << "the larger opening, on the right";
+  EXPECT_EQ(a.defect.other_openings, 1);
+  EXPECT_NE(a.message.find("1 other opening not planned"), std::string::npos) << a.message;
+  EXPECT_EQ(a.method_used, PlanMethod::RimOnly) << a.message;
+  EXPECT_LT(a.mirror_coverage, 0.5);
+  const CompareResult ca = compare_implants(a.implant.mesh, first.implant, &both.defective);
+  EXPECT_GE(ca.dice, 0.85) << "HD95 " << ca.hd95_mm;
+
+  AutoplanParams near_left;
+  near_left.propose.detect.near = left.center;
+  const AutoplanResult b = autoplan(both.defective, Landmarks{}, near_left);
+  ASSERT_TRUE(b.planned()) << b.message;
+  EXPECT_LT(b.defect.axis.x(), -0.5) << "the one near the point, on the left";
+  EXPECT_EQ(b.method_used, PlanMethod::RimOnly) << b.message;
+  // The left defect's truth: what the second cut removed.
+  const CompareResult cb = compare_implants(b.implant.mesh, both.implant, &both.defective);
+  EXPECT_GE(cb.dice, 0.85) << "HD95 " << cb.hd95_mm;
+  EXPECT_TRUE(a.quality.watertight);
+  EXPECT_TRUE(b.quality.watertight);
+  RecordProperty("dice_right", std::to_string(ca.dice));
+  RecordProperty("dice_left", std::to_string(cb.dice));
+  RecordProperty("coverage_right", std::to_string(a.mirror_coverage));
+}
+
 // A skull file may come in any pose (an STL from another tool, a scan of a patient lying
 // prone). Here the skull is turned so that its one-sided defect faces straight down, where a
 // rule "the skull base is the opening below" (sessions 1–5) took the defect for the base and
