@@ -235,6 +235,12 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
         candidates.begin(), candidates.end(),
         [&](const Candidate& a, const Candidate& b) { return closeness(a) > closeness(b); });
   }
+  // The openings not planned: their mean directions, so that a caller can plan each in turn.
+  for (size_t k = 1; k < candidates.size(); ++k) {
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int i : comps[order[candidates[k].r]]) mean += dirs[i];
+    region.other_axes.push_back(mean.normalized());
+  }
   for (const Candidate& cand : candidates) {
     const size_t r = cand.r;
     const std::vector<int>& comp = comps[order[r]];
@@ -310,7 +316,7 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
     if (region.other_openings > 0)
       region.message += " (" + std::to_string(region.other_openings) +
                         (region.other_openings == 1 ? " other opening" : " other openings") +
-                        " not planned: choose with a point near the defect)";
+                        kUnplannedOpeningsNote;
     region.unseen_rim = unseen_rim_stretches(region.outer_rim);
     if (!region.unseen_rim.empty()) {
       std::string lengths;

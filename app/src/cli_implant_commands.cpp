@@ -15,6 +15,7 @@
 #include "cranioplan/algorithms/build_implant.h"
 #include "cranioplan/algorithms/check_implant.h"
 #include "cranioplan/algorithms/compare_implants.h"
+#include "cranioplan/algorithms/detect_defect.h"
 #include "cranioplan/algorithms/inject_defect.h"
 #include "cranioplan/algorithms/load_skull.h"
 #include "cranioplan/algorithms/smooth_markers.h"
@@ -69,7 +70,11 @@ Json autoplan_json(const AutoplanResult& r) {
     j["defect"] = Json{{"area_mm2", r.defect.area_mm2},
                        {"axis", to_json(r.defect.axis)},
                        {"rim_points", r.defect.outer_rim.size()},
-                       {"unseen_rim_mm", unseen_rim_lengths(r.defect.unseen_rim)}};
+                       {"unseen_rim_mm", unseen_rim_lengths(r.defect.unseen_rim)},
+                       {"other_openings", r.defect.other_openings}};
+    Json others = Json::array();
+    for (const auto& a : r.defect.other_axes) others.push_back(to_json(a));
+    j["defect"]["other_axes"] = others;
     j["method"] = to_string(r.method_used);
     j["mirror_coverage"] = r.mirror_coverage;
     j["markers"] = r.markers.size();
@@ -123,6 +128,29 @@ int autoplan_with_session(const std::string& skull, const Landmarks& lm,
   if (a.planned()) j["output"] = output;
   print_result(j, json);
   return a.planned() ? kOk : kUnusable;
+}
+
+// The k-th of several outputs: the path itself for the first, else "name_k.ext" beside it.
+std::string numbered_path(const std::string& path, size_t k) {
+  if (k <= 1) return path;
+  const std::filesystem::path p(path);
+  return (p.parent_path() / (p.stem().string() + "_" + std::to_string(k) + p.extension().string()))
+      .string();
+}
+
+// Writes one automatic plan's implant and markers and prints its report.
+int write_autoplan(const AutoplanResult& r, const std::string& output,
+                   const std::string& markers_out, bool json) {
+  Json j = autoplan_json(r);
+  if (!markers_out.empty() && !r.markers.empty()) write_markers_file(r.markers, markers_out);
+  if (!r.planned()) {
+    print_result(j, json);
+    return kUnusable;
+  }
+  write_mesh(r.implant.mesh, output);
+  j["output"] = output;
+  print_result(j, json);
+  return kOk;
 }
 
 double median(std::vector<double> v) {
@@ -330,6 +358,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
     struct Opts {
       std::string skull, landmarks, output, markers_out, session, method = "auto";
       std::vector<double> near;
+      bool all_openings = false;
       AutoplanParams params;
     };
     auto o = std::make_shared<Opts>();
@@ -346,9 +375,14 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
                     "(default: the largest)")
         ->expected(3);
     add_fit_option(cmd, o->params);
-    cmd->add_option("--session", o->session,
-                    "plan through session commands and save the session (.json): reopen, edit, "
-                    "replay and audit it");
+    auto* session_opt =
+        cmd->add_option("--session", o->session,
+                        "plan through session commands and save the session (.json): reopen, "
+                        "edit, replay and audit it");
+    cmd->add_flag("--all-openings", o->all_openings,
+                  "plan every opening large enough to be a defect (bilateral defects), each to "
+                  "its own implant: IMPLANT, then IMPLANT_2, IMPLANT_3... (markers likewise)")
+        ->excludes(session_opt);
     out.push_back({cmd, [o, &json]() -> int {
                      if (o->near.size() == 3)
                        o->params.propose.detect.near =
@@ -362,17 +396,48 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
                      const LoadedSkull loaded = load_skull(o->skull);
                      const SkullMesh& skull = loaded.mesh;
                      const AutoplanResult r = autoplan(skull, lm, o->params);
-                     Json j = autoplan_json(r);
-                     if (!o->markers_out.empty() && !r.markers.empty())
-                       write_markers_file(r.markers, o->markers_out);
-                     if (!r.planned()) {
-                       print_result(j, json);
-                       return kUnusable;
+                     if (!o->all_openings || !r.defect.found())
+                       return write_autoplan(r, o->output, o->markers_out, json);
+                     // Every opening in turn, each chosen by a point in its direction; the
+                     // first is the one planned without --all-openings.
+                     Json plans = Json::array();
+                     bool all_planned = true;
+                     auto plan_one = [&](const AutoplanResult& one, size_t k) {
+                       Json j = autoplan_json(one);
+                       // The detection's note on the other openings: here they are planned too.
+                       std::string message = j["message"].get<std::string>();
+                       const std::string note = kUnplannedOpeningsNote;
+                       const size_t at = message.find(note);
+                       if (at != std::string::npos)
+                         message.replace(at, note.size(), ", planned as well)");
+                       j["message"] = message;
+                       const std::string out = numbered_path(o->output, k);
+                       const std::string markers =
+                           o->markers_out.empty() ? "" : numbered_path(o->markers_out, k);
+                       if (!markers.empty() && !one.markers.empty())
+                         write_markers_file(one.markers, markers);
+                       if (one.planned()) {
+                         write_mesh(one.implant.mesh, out);
+                         j["output"] = out;
+                       }
+                       all_planned = all_planned && one.planned();
+                       plans.push_back(j);
+                     };
+                     plan_one(r, 1);
+                     for (size_t k = 0; k < r.defect.other_axes.size(); ++k) {
+                       AutoplanParams each = o->params;
+                       each.propose.detect.near = r.defect.center + 100.0 * r.defect.other_axes[k];
+                       plan_one(autoplan(skull, lm, each), k + 2);
                      }
-                     write_mesh(r.implant.mesh, o->output);
-                     j["output"] = o->output;
-                     print_result(j, json);
-                     return kOk;
+                     if (json) {
+                       print_result(Json{{"openings", plans.size()}, {"plans", plans}}, true);
+                     } else {
+                       for (size_t k = 0; k < plans.size(); ++k) {
+                         std::cout << "opening " << k + 1 << " of " << plans.size() << ":\n";
+                         print_result(plans[k], false);
+                       }
+                     }
+                     return all_planned ? kOk : kUnusable;
                    }});
   }
 

@@ -138,6 +138,53 @@ TEST(Cli, StudyInjectsPlansAndScoresDefects) {
   }
 }
 
+// autoplan --all-openings: bilateral defects (mirror images of each other) get an implant each,
+// the larger to IMPLANT and the other to IMPLANT_2, each planned from the rim (the mirror falls
+// into the other opening). --session plans one implant and excludes it (exit 2).
+TEST(Cli, AutoplanAllOpeningsPlansEachDefectToItsOwnImplant) {
+  test::TempDir dir;
+  write_mesh(test::make_thick_head(), dir.path("thick.stl"));
+  const Eigen::Vector3d c =
+      test::head_surface_point(Eigen::Vector3d(0.75, 0.2, 0.6).normalized()) * 0.965;
+  auto point = [](const Eigen::Vector3d& p) {
+    char buf[96];
+    std::snprintf(buf, sizeof(buf), "%.3f,%.3f,%.3f", p.x(), p.y(), p.z());
+    return std::string(buf);
+  };
+  ASSERT_EQ(test::run_command(kCli + " inject-defect " + dir.path("thick.stl") + " --center " +
+                              point(c) + " --size 45 -o " + dir.path("one.stl") + " --implant " +
+                              dir.path("t1.stl")),
+            0);
+  ASSERT_EQ(test::run_command(kCli + " inject-defect " + dir.path("one.stl") + " --center " +
+                              point({-c.x(), c.y(), c.z()}) + " --size 40 -o " +
+                              dir.path("two.stl") + " --implant " + dir.path("t2.stl")),
+            0);
+  std::string out;
+  ASSERT_EQ(
+      test::run_command(kCli + " autoplan --json --all-openings " + dir.path("two.stl") + " -o " +
+                            dir.path("implant.stl") + " --markers-out " + dir.path("m.json"),
+                        &out),
+      0)
+      << out;
+  const Json j = Json::parse(out);
+  ASSERT_EQ(j["plans"].size(), 2u) << out;
+  for (const auto& plan : j["plans"]) {
+    EXPECT_EQ(plan["status"].get<std::string>(), "planned");
+    EXPECT_EQ(plan["method"].get<std::string>(), "rim-only");
+    EXPECT_NE(plan["message"].get<std::string>().find("1 other opening, planned as well"),
+              std::string::npos)
+        << plan["message"];
+  }
+  EXPECT_GT(j["plans"][0]["defect"]["axis"][0].get<double>(), 0.5);  // the larger, on the right
+  EXPECT_LT(j["plans"][1]["defect"]["axis"][0].get<double>(), -0.5);
+  EXPECT_EQ(j["plans"][1]["output"].get<std::string>(), dir.path("implant_2.stl"));
+  for (const char* f : {"implant.stl", "implant_2.stl", "m.json", "m_2.json"})
+    EXPECT_TRUE(std::filesystem::exists(dir.path(f))) << f;
+  EXPECT_EQ(test::run_command(kCli + " autoplan --all-openings " + dir.path("two.stl") + " -o " +
+                              dir.path("x.stl") + " --session " + dir.path("s.json")),
+            2);
+}
+
 // evaluate: a folder in the SkullFix layout (here one case injected into the synthetic head)
 // is planned and scored, and --implants-out writes each planned implant beside the table.
 TEST(Cli, EvaluateScoresAFolderOfCasesAndWritesTheImplants) {

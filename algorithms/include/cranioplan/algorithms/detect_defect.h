@@ -56,6 +56,9 @@ struct DefectRegion {
   /// The axes the rays were laid out in (DetectDefectParams::frame; identity without one).
   Eigen::Matrix3d frame = Eigen::Matrix3d::Identity();
   int other_openings = 0;  ///< further openings large enough to be defects (not planned)
+  /// Their mean directions from `center` (unit; largest first, or after the one `near` chose):
+  /// a point `center + r·axis` on one of them, as `DetectDefectParams::near`, plans it.
+  std::vector<Eigen::Vector3d> other_axes;
   std::vector<Eigen::Vector3d> hole_directions;  ///< unit rays through the opening
   /// The rim: the last bone met along rays next to the opening, outer and inner table, in
   /// order around the axis (same count, paired).
@@ -67,6 +70,10 @@ struct DefectRegion {
   double seconds = 0.0;
   bool found() const { return status == Status::Found; }
 };
+
+/// What the message says after the count of further openings it left unplanned.
+inline constexpr char kUnplannedOpeningsNote[] =
+    " not planned: choose with a point near the defect)";
 
 /// A rim stretch without a rim point is reported when it is longer than this (mm) and than
 /// kUnseenRimTimesMedian times the rim's median spacing (large openings have sparser rims).
