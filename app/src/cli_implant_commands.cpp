@@ -153,6 +153,14 @@ int write_autoplan(const AutoplanResult& r, const std::string& output,
   return kOk;
 }
 
+// A scored plan's row (evaluate, study): the method it used and its agreement with the truth.
+void add_scores(Json& row, const AutoplanResult& r, const CompareResult& c) {
+  row["method"] = to_string(r.method_used);
+  row["dice"] = c.dice;
+  row["boundary_dice"] = c.boundary_dice;
+  row["hd95_mm"] = c.hd95_mm;
+}
+
 double median(std::vector<double> v) {
   if (v.empty()) return 0.0;
   std::sort(v.begin(), v.end());
@@ -496,10 +504,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
                    write_mesh(r.implant.mesh, path);
                    row["implant"] = path;
                  }
-                 row["method"] = to_string(r.method_used);
-                 row["dice"] = c.dice;
-                 row["boundary_dice"] = c.boundary_dice;
-                 row["hd95_mm"] = c.hd95_mm;
+                 add_scores(row, r, c);
                  dsc.push_back(c.dice);
                  bdsc.push_back(c.boundary_dice);
                  hd95.push_back(c.hd95_mm);
@@ -612,10 +617,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
                  {"center", to_json(ip.center)}, {"size_mm", ip.size_mm}, {"message", r.message}};
              if (r.planned()) {
                const CompareResult c = compare_implants(r.implant.mesh, d.implant, &d.defective);
-               row["method"] = to_string(r.method_used);
-               row["dice"] = c.dice;
-               row["boundary_dice"] = c.boundary_dice;
-               row["hd95_mm"] = c.hd95_mm;
+               add_scores(row, r, c);
                dsc.push_back(c.dice);
                hd95.push_back(c.hd95_mm);
              } else {

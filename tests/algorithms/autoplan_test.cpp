@@ -21,12 +21,17 @@ const SkullMesh& thick_head() {
   return head;
 }
 
-InjectDefectResult defect_at(const Eigen::Vector3d& direction, double size) {
+// A spherical defect of `size` mm centred in the bone in `direction` from the head's centre.
+InjectDefectParams defect_params(const Eigen::Vector3d& direction, double size) {
   InjectDefectParams p;
   p.center = test::head_surface_point(direction.normalized()) * 0.965;
   p.size_mm = size;
   p.voxel_mm = 0.5;
-  return inject_defect(thick_head(), p);
+  return p;
+}
+
+InjectDefectResult defect_at(const Eigen::Vector3d& direction, double size) {
+  return inject_defect(thick_head(), defect_params(direction, size));
 }
 
 // The target: DSC >= 0.9 (and HD95 <= 1.5 mm, the target on real skulls).
@@ -170,15 +175,9 @@ TEST(Autoplan, SkullFixCaseAcrossTheMidlineMatchesTheGroundTruth) {
 
 // Two openings: the larger is planned unless a point near the other one says which is meant.
 TEST(Autoplan, WithTwoOpeningsAPointChoosesWhichIsPlanned) {
-  InjectDefectParams big;
-  big.center = test::head_surface_point(Eigen::Vector3d(0.75, 0.2, 0.6).normalized()) * 0.965;
-  big.size_mm = 45;
-  big.voxel_mm = 0.5;
-  const InjectDefectResult first = inject_defect(thick_head(), big);
+  const InjectDefectResult first = defect_at({0.75, 0.2, 0.6}, 45);
   ASSERT_TRUE(first.usable());
-  InjectDefectParams small = big;
-  small.center = test::head_surface_point(Eigen::Vector3d(-0.6, -0.5, 0.6).normalized()) * 0.965;
-  small.size_mm = 35;
+  const InjectDefectParams small = defect_params({-0.6, -0.5, 0.6}, 35);
   const InjectDefectResult both = inject_defect(first.defective, small);
   ASSERT_TRUE(both.usable());
 
@@ -203,15 +202,10 @@ TEST(Autoplan, WithTwoOpeningsAPointChoosesWhichIsPlanned) {
 // "bilateral" case). The larger is planned, the message names the other, and a point near it
 // plans that one; both from the rim alone, each close to its own ground truth.
 TEST(Autoplan, BilateralDefectsArePlannedOneByOneFromTheRim) {
-  InjectDefectParams right;
-  right.center = test::head_surface_point(Eigen::Vector3d(0.75, 0.2, 0.6).normalized()) * 0.965;
-  right.size_mm = 45;
-  right.voxel_mm = 0.5;
-  const InjectDefectResult first = inject_defect(thick_head(), right);
+  const InjectDefectResult first = defect_at({0.75, 0.2, 0.6}, 45);
   ASSERT_TRUE(first.usable());
-  InjectDefectParams left = right;
-  left.center.x() = -left.center.x();
-  left.size_mm = 40;  // a little smaller: the right one is "the largest"
+  // Its mirror image, a little smaller: the right one is "the largest".
+  const InjectDefectParams left = defect_params({-0.75, 0.2, 0.6}, 40);
   const InjectDefectResult both = inject_defect(first.defective, left);
   ASSERT_TRUE(both.usable());
 

@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <memory>
 
 #include "cranioplan/algorithms/inject_defect.h"
 #include "cranioplan/algorithms/surface_locator.h"
@@ -114,6 +115,23 @@ SkullMesh with_plate_in_the_opening() {
   return build_mesh(soup);
 }
 
+// That skull, its locator and the opening found in it, made once for the tests that use it.
+struct PlateCase {
+  SkullMesh skull;
+  std::unique_ptr<SurfaceLocator> bone;
+  DefectRegion defect;
+};
+const PlateCase& plate_case() {
+  static const PlateCase p = [] {
+    PlateCase k;
+    k.skull = with_plate_in_the_opening();
+    k.bone = std::make_unique<SurfaceLocator>(k.skull);
+    k.defect = detect_defect(k.skull, *k.bone, the_case().defect.center);
+    return k;
+  }();
+  return p;
+}
+
 // Bone seen through the opening: next to an orbit the rays from the centre pass the vault's edge
 // and meet the orbital roof, where it is thick enough to count as bone, 30-50 mm from the
 // centre against the frontal bone's 80-90 mm on the sample. Here a plate 0.6 of the way out
@@ -123,13 +141,12 @@ SkullMesh with_plate_in_the_opening() {
 // leaves it out, and the rim-only fit does not bend down to it (on the sample from its STL the
 // implant's edge had a bay 6.8 mm deep above the orbit).
 TEST(FitDefectSurfaces, BoneSeenThroughTheOpeningIsNotTheVault) {
-  const Case& c = the_case();
-  ASSERT_TRUE(c.defect.found());
-  const SkullMesh skull = with_plate_in_the_opening();
-  const SurfaceLocator bone(skull), truth(c.intact);
-  const DefectRegion defect = detect_defect(skull, bone, c.defect.center);
+  ASSERT_TRUE(the_case().defect.found());
+  const PlateCase& plate = plate_case();
+  const DefectRegion& defect = plate.defect;
   ASSERT_TRUE(defect.found()) << defect.message;
-  const DefectSurfaces s = fit_defect_surfaces(defect, bone, nullptr);
+  const SurfaceLocator truth(the_case().intact);
+  const DefectSurfaces s = fit_defect_surfaces(defect, *plate.bone, nullptr);
   ASSERT_TRUE(s.fitted()) << s.message;
   int on_plate = 0;
   for (const auto& p : s.ring_outer) {
@@ -186,11 +203,10 @@ TEST(FitDefectSurfaces, MirrorGuidedCorrectsTheMirrorsMismatch) {
 TEST(FitDefectSurfaces, RingRaysTheFitLeavesOutAreCountedApartFromItsResidual) {
   const Case& c = the_case();
   ASSERT_TRUE(c.defect.found());
-  const SkullMesh skull = with_plate_in_the_opening();
-  const SurfaceLocator bone(skull), mirror(c.intact);
-  const DefectRegion defect = detect_defect(skull, bone, c.defect.center);
-  ASSERT_TRUE(defect.found()) << defect.message;
-  const DefectSurfaces s = fit_defect_surfaces(defect, bone, &mirror);
+  const PlateCase& plate = plate_case();
+  ASSERT_TRUE(plate.defect.found()) << plate.defect.message;
+  const SurfaceLocator mirror(c.intact);
+  const DefectSurfaces s = fit_defect_surfaces(plate.defect, *plate.bone, &mirror);
   ASSERT_TRUE(s.fitted()) << s.message;
   EXPECT_GT(s.outer_off_rays, 10) << s.message;
   EXPECT_GE(s.outer_off_limit_mm, 1.0);
