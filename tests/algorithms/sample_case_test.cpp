@@ -7,11 +7,13 @@
 #include "cranioplan/algorithms/autoplan.h"
 #include "cranioplan/algorithms/compare_implants.h"
 #include "cranioplan/algorithms/fit_sagittal_plane.h"
+#include "cranioplan/algorithms/inject_defect.h"
 #include "cranioplan/algorithms/load_skull.h"
 #include "cranioplan/algorithms/mesh_report.h"
 #include "cranioplan/algorithms/mirror_mesh.h"
 #include "cranioplan/algorithms/read_volume.h"
 #include "cranioplan/algorithms/register_icp.h"
+#include "cranioplan/algorithms/surface_locator.h"
 #include "cranioplan/algorithms/write_mesh.h"
 #include "support/synthetic.h"
 #include "support/test_files.h"
@@ -220,6 +222,44 @@ TEST(SampleCase, ACoarseCopyStillHasItsDefectFoundNotItsBase) {
   RecordProperty("rim_gap_mm", std::to_string(r.quality.rim_gap_mm));
   RecordProperty("penetration_mm3", std::to_string(r.quality.penetration_mm3));
   RecordProperty("area_mm2", std::to_string(r.defect.area_mm2));
+}
+
+// A large one-sided defect low on the side of the head (100 mm, as a decompressive
+// craniectomy reaching down to the temporal fossa) points 109° from the vault: further from it
+// than the 105° beyond which an opening may be the skull base, and larger than the foramen
+// magnum, so the rule on the angle alone took it for the base and planned another opening.
+// The base must also lie within 30° of the midsagittal plane; this defect lies 45° from it.
+TEST(SampleCase, ALargeDefectLowOnTheSideIsNotTakenForTheBase) {
+  const std::string path = sample_case_path();
+  if (!std::filesystem::exists(path))
+    GTEST_SKIP() << path << " not installed (scripts/install-deps)";
+  const LoadedSkull skull = load_skull(path);
+  const SurfaceLocator bone(skull.mesh);
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (auto vh : skull.mesh.vertices()) centroid += to_eigen(skull.mesh.point(vh));
+  centroid /= static_cast<double>(skull.mesh.n_vertices());
+  // On the patient's left (+x), in front (−y) and low (−z), in the middle of the bone.
+  const Eigen::Vector3d dir = Eigen::Vector3d(1.0, -0.6, -0.6).normalized();
+  const auto outside = bone.first_hit(centroid + 400.0 * dir, centroid);
+  const auto inside = bone.first_hit(centroid, centroid + 400.0 * dir);
+  ASSERT_TRUE(outside && inside);
+  InjectDefectParams cut;
+  cut.center = 0.5 * (outside->point + inside->point);
+  cut.size_mm = 100.0;
+  cut.voxel_mm = 0.5;
+  const InjectDefectResult d = inject_defect(skull.mesh, cut);
+  ASSERT_TRUE(d.usable());
+  AutoplanParams params;
+  params.propose.detect.near = cut.center;  // the skull's own defect is there too
+  const AutoplanResult r = autoplan(d.defective, Landmarks{}, params);
+  ASSERT_TRUE(r.planned()) << r.message;
+  const Eigen::Vector3d towards = (cut.center - r.defect.center).normalized();
+  EXPECT_GT(r.defect.axis.dot(towards), std::cos(15.0 * M_PI / 180.0)) << r.message;
+  EXPECT_GT(r.defect.area_mm2, 8000.0) << r.message;
+  EXPECT_LT(r.defect.axis.dot(r.defect.up), std::cos(105.0 * M_PI / 180.0))
+      << "the case reaches past the base's angle";
+  RecordProperty("angle_from_vault_deg",
+                 std::to_string(std::acos(r.defect.axis.dot(r.defect.up)) * 180.0 / M_PI));
 }
 
 // The same defect planned from the rim alone, as for a defect the mirror cannot fill: the
