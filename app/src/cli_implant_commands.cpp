@@ -485,15 +485,20 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
            int failed = 0, unreadable = 0;
            for (const auto& [id, files] : cases) {
              if (files.first.empty() || files.second.empty()) continue;
-             const auto t0 = std::chrono::steady_clock::now();
+             double seconds = 0.0;
              Json row{{"case", id}};
              // One case's unreadable file is that case's row, not the end of the run: the
              // others are still planned and scored.
              try {
-               const SkullMesh truth = load_any(files.second);  // read first: fail before planning
+               // The truth is read first (to fail before planning) and not timed: the time is
+               // the plan's, from reading the skull to the implant (as until session 10).
+               const SkullMesh truth = load_any(files.second);
+               const auto t0 = std::chrono::steady_clock::now();
                const LoadedSkull loaded = load_skull(files.first);
                const SkullMesh& skull = loaded.mesh;
                const AutoplanResult r = autoplan(skull, Landmarks{}, o->params);
+               seconds =
+                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
                row["status"] = r.planned() ? "planned" : "failed";
                row["message"] = r.message;
                if (r.planned()) {
@@ -520,10 +525,9 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
                row["status"] = "bad_input";
                row["message"] = e.what();
              }
-             const double seconds =
-                 std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-             row["seconds"] = seconds;
-             if (row["status"] != "bad_input") secs.push_back(seconds);
+             const bool read = row["status"] != "bad_input";
+             row["seconds"] = read ? Json(seconds) : Json(nullptr);  // no plan, no time
+             if (read) secs.push_back(seconds);
              if (!json) {
                if (row["status"] == "planned")
                  std::cout << id << "  " << row["method"].get<std::string>() << "  DSC "
