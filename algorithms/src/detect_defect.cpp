@@ -243,11 +243,17 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
         candidates.begin(), candidates.end(),
         [&](const Candidate& a, const Candidate& b) { return closeness(a) > closeness(b); });
   }
-  // The openings not planned: their mean directions, so that a caller can plan each in turn.
+  // The openings not planned: a ray through each, the one nearest its mean direction (the mean
+  // itself may fall outside an opening that is not convex, even into another), so that a
+  // caller can plan each in turn with a point along it.
   for (size_t k = 1; k < candidates.size(); ++k) {
+    const std::vector<int>& comp = comps[order[candidates[k].r]];
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (int i : comps[order[candidates[k].r]]) mean += dirs[i];
-    region.other_axes.push_back(mean.normalized());
+    for (int i : comp) mean += dirs[i];
+    int through = comp.front();
+    for (int i : comp)
+      if (dirs[i].dot(mean) > dirs[through].dot(mean)) through = i;
+    region.other_axes.push_back(dirs[through]);
   }
   for (const Candidate& cand : candidates) {
     const size_t r = cand.r;

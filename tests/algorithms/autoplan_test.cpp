@@ -187,6 +187,9 @@ TEST(Autoplan, WithTwoOpeningsAPointChoosesWhichIsPlanned) {
   EXPECT_NE(largest.message.find("1 other opening not planned"), std::string::npos)
       << largest.message;
   EXPECT_GT(largest.defect.axis.x(), 0.5) << "the larger opening is on the right (+x)";
+  // A ray through the other one, for planning it next (autoplan --all-openings).
+  ASSERT_EQ(largest.defect.other_axes.size(), 1u);
+  EXPECT_LT(largest.defect.other_axes[0].x(), -0.3) << "the smaller opening, on the left";
 
   AutoplanParams params;
   params.propose.detect.near = small.center;

@@ -56,8 +56,9 @@ struct DefectRegion {
   /// The axes the rays were laid out in (DetectDefectParams::frame; identity without one).
   Eigen::Matrix3d frame = Eigen::Matrix3d::Identity();
   int other_openings = 0;  ///< further openings large enough to be defects (not planned)
-  /// Their mean directions from `center` (unit; largest first, or after the one `near` chose):
-  /// a point `center + r·axis` on one of them, as `DetectDefectParams::near`, plans it.
+  /// A ray from `center` through each of them (unit; the opening's ray nearest its mean
+  /// direction; largest first, or after the one `near` chose): a point `center + r·axis` on
+  /// one, as `DetectDefectParams::near`, plans that opening.
   std::vector<Eigen::Vector3d> other_axes;
   std::vector<Eigen::Vector3d> hole_directions;  ///< unit rays through the opening
   /// The rim: the last bone met along rays next to the opening, outer and inner table, in
