@@ -176,6 +176,12 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(),
             [&](size_t a, size_t b) { return comps[a].size() > comps[b].size(); });
+  // Each opening's mean direction (unit).
+  std::vector<Eigen::Vector3d> mean_dir(comps.size(), Eigen::Vector3d::Zero());
+  for (size_t c = 0; c < comps.size(); ++c) {
+    for (int i : comps[c]) mean_dir[c] += dirs[i];
+    mean_dir[c].normalize();
+  }
 
   // The skull base (or the scan's cut) is the largest opening whose mean direction points away
   // from the vault, more than 105° from its direction. The sample's foramen magnum lies at 124°
@@ -196,9 +202,7 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
   constexpr double kBaseNearMidline = 0.5;        // sin 30°
   size_t base = order.size();
   for (size_t r = 0; r < order.size() && region.up.norm() > 0; ++r) {
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (int i : comps[order[r]]) mean += dirs[i];
-    mean.normalize();
+    const Eigen::Vector3d& mean = mean_dir[order[r]];
     const bool near_midline =
         !params.frame || std::abs(mean.dot(region.frame.col(2))) < kBaseNearMidline;
     if (mean.dot(region.up) < kBaseAwayFromVault && near_midline) {
@@ -248,8 +252,7 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
   // caller can plan each in turn with a point along it.
   for (size_t k = 1; k < candidates.size(); ++k) {
     const std::vector<int>& comp = comps[order[candidates[k].r]];
-    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
-    for (int i : comp) mean += dirs[i];
+    const Eigen::Vector3d& mean = mean_dir[order[candidates[k].r]];
     int through = comp.front();
     for (int i : comp)
       if (dirs[i].dot(mean) > dirs[through].dot(mean)) through = i;
@@ -263,12 +266,8 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
     region.status = DefectRegion::Status::Found;
     region.other_openings = static_cast<int>(candidates.size()) - 1;
     region.area_mm2 = area;
-    Eigen::Vector3d axis = Eigen::Vector3d::Zero();
-    for (int i : comp) {
-      axis += dirs[i];
-      region.hole_directions.push_back(dirs[i]);
-    }
-    region.axis = axis.normalized();
+    for (int i : comp) region.hole_directions.push_back(dirs[i]);
+    region.axis = mean_dir[order[r]];
     // The rim, in order around the axis: in each angular sector the rim ray nearest the axis
     // (the innermost bone), so the rim is a simple loop even where the ray grid is ragged.
     const Eigen::Vector3d e1 = across_axis(region.axis, region.frame), e2 = region.axis.cross(e1);

@@ -138,19 +138,16 @@ std::string numbered_path(const std::string& path, size_t k) {
       .string();
 }
 
-// Writes one automatic plan's implant and markers and prints its report.
-int write_autoplan(const AutoplanResult& r, const std::string& output,
-                   const std::string& markers_out, bool json) {
+// Writes one automatic plan's markers (if asked for) and implant (if planned); its report.
+Json write_autoplan(const AutoplanResult& r, const std::string& output,
+                    const std::string& markers_out) {
   Json j = autoplan_json(r);
   if (!markers_out.empty() && !r.markers.empty()) write_markers_file(r.markers, markers_out);
-  if (!r.planned()) {
-    print_result(j, json);
-    return kUnusable;
+  if (r.planned()) {
+    write_mesh(r.implant.mesh, output);
+    j["output"] = output;
   }
-  write_mesh(r.implant.mesh, output);
-  j["output"] = output;
-  print_result(j, json);
-  return kOk;
+  return j;
 }
 
 // A scored plan's row (evaluate, study): the method it used and its agreement with the truth.
@@ -404,14 +401,18 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
                      const LoadedSkull loaded = load_skull(o->skull);
                      const SkullMesh& skull = loaded.mesh;
                      const AutoplanResult r = autoplan(skull, lm, o->params);
-                     if (!o->all_openings || !r.defect.found())
-                       return write_autoplan(r, o->output, o->markers_out, json);
-                     // Every opening in turn, each chosen by a point in its direction; the
+                     if (!o->all_openings || !r.defect.found()) {
+                       print_result(write_autoplan(r, o->output, o->markers_out), json);
+                       return r.planned() ? kOk : kUnusable;
+                     }
+                     // Every opening in turn, each chosen by a point along a ray through it; the
                      // first is the one planned without --all-openings.
                      Json plans = Json::array();
                      bool all_planned = true;
                      auto plan_one = [&](const AutoplanResult& one, size_t k) {
-                       Json j = autoplan_json(one);
+                       Json j = write_autoplan(
+                           one, numbered_path(o->output, k),
+                           o->markers_out.empty() ? "" : numbered_path(o->markers_out, k));
                        // The detection's note on the other openings: here they are planned too.
                        std::string message = j["message"].get<std::string>();
                        const std::string note = kUnplannedOpeningsNote;
@@ -419,15 +420,6 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
                        if (at != std::string::npos)
                          message.replace(at, note.size(), ", planned as well)");
                        j["message"] = message;
-                       const std::string out = numbered_path(o->output, k);
-                       const std::string markers =
-                           o->markers_out.empty() ? "" : numbered_path(o->markers_out, k);
-                       if (!markers.empty() && !one.markers.empty())
-                         write_markers_file(one.markers, markers);
-                       if (one.planned()) {
-                         write_mesh(one.implant.mesh, out);
-                         j["output"] = out;
-                       }
                        all_planned = all_planned && one.planned();
                        plans.push_back(j);
                      };
@@ -486,6 +478,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
            for (const auto& [id, files] : cases) {
              if (files.first.empty() || files.second.empty()) continue;
              double seconds = 0.0;
+             bool read = true;
              Json row{{"case", id}};
              // One case's unreadable file is that case's row, not the end of the run: the
              // others are still planned and scored.
@@ -522,10 +515,10 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
                }
              } catch (const Error& e) {
                ++unreadable;
+               read = false;
                row["status"] = "bad_input";
                row["message"] = e.what();
              }
-             const bool read = row["status"] != "bad_input";
              row["seconds"] = read ? Json(seconds) : Json(nullptr);  // no plan, no time
              if (read) secs.push_back(seconds);
              if (!json) {

@@ -209,7 +209,6 @@ TEST(FitDefectSurfaces, RingRaysTheFitLeavesOutAreCountedApartFromItsResidual) {
   const DefectSurfaces s = fit_defect_surfaces(plate.defect, *plate.bone, &mirror);
   ASSERT_TRUE(s.fitted()) << s.message;
   EXPECT_GT(s.outer_off_rays, 10) << s.message;
-  EXPECT_GE(s.outer_off_limit_mm, 1.0);
   EXPECT_LT(s.outer_rms_mm, 0.3) << s.message;
   EXPECT_NE(s.message.find("rays left out"), std::string::npos) << s.message;
   RecordProperty("outer_off_rays", s.outer_off_rays);
