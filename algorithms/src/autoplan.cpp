@@ -25,26 +25,10 @@ class StageTimer {
   std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
 
-}  // namespace
-
-AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
-                        const AutoplanParams& params) {
-  AutoplanResult r;
-  StageTimer timer(r.stage_seconds);
-  r.plane = fit_sagittal_plane(skull, landmarks, params.plane);
-  timer.stage("plane");
-  if (!r.plane.usable()) {
-    r.message = "midsagittal plane: " + r.plane.message;
-    return r;
-  }
-  // The mirror is never built as a mesh here (register_mirror), and its locator is the skull's
-  // locator moved (on a skull of two million triangles a mesh and a locator are a few hundred
-  // megabytes each).
+// From the detection on: `r` holds the plane and the global registration.
+void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const AutoplanParams& params,
+                  StageTimer& timer, AutoplanResult& r) {
   const RigidTransform reflection = reflection_across(r.plane.plane);
-  r.registration = register_mirror(skull, r.plane.plane, params.registration);
-  timer.stage("register");
-
-  const SurfaceLocator bone(skull);
   r.defect = detect_defect_near_plane(skull, bone, r.plane.plane, params.propose.detect);
   timer.stage("detect");
   auto mirror_motion = [&] {
@@ -54,7 +38,7 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
     r.mirror_motion = mirror_motion();
     r.status = AutoplanResult::Status::NoDefect;
     r.message = r.defect.message;
-    return r;
+    return;
   }
 
   if (params.local_registration_mm > 0.0 && r.registration.usable()) {
@@ -75,7 +59,7 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
   timer.stage("markers");
   if (!proposal.proposed()) {
     r.message = "markers: " + proposal.message;
-    return r;
+    return;
   }
 
   ImplantParams implant = params.implant;
@@ -84,7 +68,7 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
   timer.stage("implant");
   if (!r.implant.usable()) {
     r.message = "implant: " + r.implant.message;
-    return r;
+    return;
   }
   r.quality = check_implant(r.implant.mesh, &skull, &bone, QualityParams{});
   timer.stage("quality");
@@ -94,7 +78,70 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
                 r.method_used == PlanMethod::Mirror ? "mirror-guided" : "rim-only fitting",
                 100.0 * r.mirror_coverage);
   r.message = r.defect.message + "; " + buf + r.surfaces_message;
+}
+
+// The plane and the global registration; false (and `r` says why) when the plane fails.
+bool plane_and_registration(const SkullMesh& skull, const Landmarks& landmarks,
+                            const AutoplanParams& params, StageTimer& timer, AutoplanResult& r) {
+  r.plane = fit_sagittal_plane(skull, landmarks, params.plane);
+  timer.stage("plane");
+  if (!r.plane.usable()) {
+    r.message = "midsagittal plane: " + r.plane.message;
+    return false;
+  }
+  // The mirror is never built as a mesh here (register_mirror), and its locator is the skull's
+  // locator moved (on a skull of two million triangles a mesh and a locator are a few hundred
+  // megabytes each).
+  r.registration = register_mirror(skull, r.plane.plane, params.registration);
+  timer.stage("register");
+  return true;
+}
+
+// The detection's note on the openings it left unplanned, for a plan made with the others.
+void note_planned_as_well(AutoplanResult& r) {
+  const std::string note = kUnplannedOpeningsNote;
+  const size_t at = r.message.find(note);
+  if (at != std::string::npos) r.message.replace(at, note.size(), ", planned as well)");
+}
+
+}  // namespace
+
+AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
+                        const AutoplanParams& params) {
+  AutoplanResult r;
+  StageTimer timer(r.stage_seconds);
+  if (!plane_and_registration(skull, landmarks, params, timer, r)) return r;
+  const SurfaceLocator bone(skull);
+  plan_opening(skull, bone, params, timer, r);
   return r;
+}
+
+std::vector<AutoplanResult> autoplan_all_openings(const SkullMesh& skull,
+                                                  const Landmarks& landmarks,
+                                                  const AutoplanParams& params) {
+  AutoplanResult first;
+  StageTimer timer(first.stage_seconds);
+  if (!plane_and_registration(skull, landmarks, params, timer, first)) return {first};
+  AutoplanResult shared;  // the plane and the global registration, before the local one
+  shared.plane = first.plane;
+  shared.registration = first.registration;
+  const SurfaceLocator bone(skull);
+  plan_opening(skull, bone, params, timer, first);
+  std::vector<AutoplanResult> plans;
+  plans.push_back(std::move(first));
+  if (!plans.front().defect.found()) return plans;
+  const Eigen::Vector3d centre = plans.front().defect.center;
+  const std::vector<Eigen::Vector3d> axes = plans.front().defect.other_axes;
+  for (const Eigen::Vector3d& axis : axes) {
+    AutoplanParams each = params;
+    each.propose.detect.near = centre + 100.0 * axis;
+    AutoplanResult r = shared;
+    StageTimer each_timer(r.stage_seconds);
+    plan_opening(skull, bone, each, each_timer, r);
+    plans.push_back(std::move(r));
+  }
+  for (AutoplanResult& r : plans) note_planned_as_well(r);
+  return plans;
 }
 
 }  // namespace cranioplan

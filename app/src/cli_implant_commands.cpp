@@ -400,34 +400,26 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
                                                     o->markers_out, o->session, json);
                      const LoadedSkull loaded = load_skull(o->skull);
                      const SkullMesh& skull = loaded.mesh;
-                     const AutoplanResult r = autoplan(skull, lm, o->params);
-                     if (!o->all_openings || !r.defect.found()) {
+                     if (!o->all_openings) {
+                       const AutoplanResult r = autoplan(skull, lm, o->params);
                        print_result(write_autoplan(r, o->output, o->markers_out), json);
                        return r.planned() ? kOk : kUnusable;
                      }
-                     // Every opening in turn, each chosen by a point along a ray through it; the
-                     // first is the one planned without --all-openings.
+                     // Every opening in turn; the first is the one planned without
+                     // --all-openings.
+                     const std::vector<AutoplanResult> all =
+                         autoplan_all_openings(skull, lm, o->params);
+                     if (!all.front().defect.found()) {  // no defect, or no plane
+                       print_result(write_autoplan(all.front(), o->output, o->markers_out), json);
+                       return all.front().planned() ? kOk : kUnusable;
+                     }
                      Json plans = Json::array();
                      bool all_planned = true;
-                     auto plan_one = [&](const AutoplanResult& one, size_t k) {
-                       Json j = write_autoplan(
-                           one, numbered_path(o->output, k),
-                           o->markers_out.empty() ? "" : numbered_path(o->markers_out, k));
-                       // The detection's note on the other openings: here they are planned too.
-                       std::string message = j["message"].get<std::string>();
-                       const std::string note = kUnplannedOpeningsNote;
-                       const size_t at = message.find(note);
-                       if (at != std::string::npos)
-                         message.replace(at, note.size(), ", planned as well)");
-                       j["message"] = message;
-                       all_planned = all_planned && one.planned();
-                       plans.push_back(j);
-                     };
-                     plan_one(r, 1);
-                     for (size_t k = 0; k < r.defect.other_axes.size(); ++k) {
-                       AutoplanParams each = o->params;
-                       each.propose.detect.near = r.defect.center + 100.0 * r.defect.other_axes[k];
-                       plan_one(autoplan(skull, lm, each), k + 2);
+                     for (size_t k = 0; k < all.size(); ++k) {
+                       plans.push_back(write_autoplan(
+                           all[k], numbered_path(o->output, k + 1),
+                           o->markers_out.empty() ? "" : numbered_path(o->markers_out, k + 1)));
+                       all_planned = all_planned && all[k].planned();
                      }
                      if (json) {
                        print_result(Json{{"openings", plans.size()}, {"plans", plans}}, true);

@@ -236,6 +236,29 @@ TEST(Autoplan, BilateralDefectsArePlannedOneByOneFromTheRim) {
   RecordProperty("dice_right", std::to_string(ca.dice));
   RecordProperty("dice_left", std::to_string(cb.dice));
   RecordProperty("coverage_right", std::to_string(a.mirror_coverage));
+
+  // Both at once: the same two plans, the plane and the global registration found once.
+  const std::vector<AutoplanResult> all = autoplan_all_openings(both.defective, Landmarks{});
+  ASSERT_EQ(all.size(), 2u);
+  for (size_t k = 0; k < all.size(); ++k) {
+    const AutoplanResult& alone = k == 0 ? a : b;
+    ASSERT_TRUE(all[k].planned()) << all[k].message;
+    EXPECT_NE(all[k].message.find("1 other opening, planned as well"), std::string::npos)
+        << all[k].message;
+    EXPECT_EQ(all[k].plane.plane.normal, a.plane.plane.normal);
+    EXPECT_EQ(all[k].markers.size(), alone.markers.size());
+    EXPECT_NEAR(all[k].quality.volume_mm3, alone.quality.volume_mm3,
+                1e-6 * alone.quality.volume_mm3);
+    EXPECT_GT(all[k].defect.axis.dot(alone.defect.axis), std::cos(M_PI / 180));
+  }
+  auto has_stage = [](const AutoplanResult& r, const std::string& name) {
+    for (const auto& [stage, seconds] : r.stage_seconds)
+      if (stage == name) return true;
+    return false;
+  };
+  EXPECT_TRUE(has_stage(all[0], "plane"));
+  EXPECT_FALSE(has_stage(all[1], "plane")) << "the second plan reuses the first's plane";
+  EXPECT_TRUE(has_stage(all[1], "local register"));
 }
 
 // A skull file may come in any pose (an STL from another tool, a scan of a patient lying

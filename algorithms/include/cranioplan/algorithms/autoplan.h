@@ -59,4 +59,15 @@ struct AutoplanResult {
 AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
                         const AutoplanParams& params = {});
 
+/// Every opening large enough to be a defect (bilateral defects), each planned to its own
+/// implant. The first plan is autoplan's (the largest opening, or the one `near` chooses); each
+/// further one is chosen by a ray through it (`DefectRegion::other_axes`). The plane and the
+/// global registration are found once and shared (each plan still registers the mirror again
+/// around its own opening); their times are in the first plan's `stage_seconds` only. Each
+/// message says the other openings are planned as well. One plan (NoDefect or Failed) when the
+/// first finds no defect or the plane fails.
+std::vector<AutoplanResult> autoplan_all_openings(const SkullMesh& skull,
+                                                  const Landmarks& landmarks,
+                                                  const AutoplanParams& params = {});
+
 }  // namespace cranioplan
