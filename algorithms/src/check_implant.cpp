@@ -5,7 +5,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <limits>
+#include <deque>
 #include <memory>
 
 #include "cranioplan/algorithms/distance_transform.h"
@@ -56,6 +56,46 @@ void measure_thin_material(const std::vector<uint8_t>& solid, const std::vector<
   q.thin_volume_mm3 = static_cast<double>(thin) * grid.voxel_volume();
   q.thin_off_bone_mm3 = static_cast<double>(off_bone) * grid.voxel_volume();
 }
+
+}  // namespace
+
+double worst_arc_gap(const std::vector<double>& angle, const std::vector<double>& distance,
+                     double arc_rad) {
+  const size_t n = std::min(angle.size(), distance.size());
+  if (n == 0) return 0.0;
+  std::vector<std::pair<double, double>> at(n);  // (angle in [0, 2π), distance)
+  for (size_t i = 0; i < n; ++i) {
+    const double a = std::fmod(angle[i], 2 * M_PI);
+    at[i] = {a < 0 ? a + 2 * M_PI : a, distance[i]};
+  }
+  std::sort(at.begin(), at.end());
+  const double w = std::clamp(arc_rad, 0.0, 2 * M_PI);
+  auto angle_of = [&](size_t k) { return at[k % n].first + (k >= n ? 2 * M_PI : 0.0); };
+  // An arc's points are a run of the sorted points; the arcs whose minimum can be the largest
+  // hold the smallest runs: an arc that begins just past point j, (a_j, a_j + w], and, where
+  // the next point lies more than w further on, that point alone. Their minima by a sliding
+  // window (a deque of increasing distances) over the points taken twice around.
+  double worst = 0.0;
+  std::deque<size_t> window;
+  size_t next = 1;  // the first point not yet in the window
+  for (size_t j = 0; j < n; ++j) {
+    while (!window.empty() && window.front() <= j) window.pop_front();
+    if (next <= j) next = j + 1;
+    while (next < j + n && angle_of(next) <= angle_of(j) + w) {
+      while (!window.empty() && at[window.back() % n].second >= at[next % n].second)
+        window.pop_back();
+      window.push_back(next++);
+    }
+    if (!window.empty()) {
+      worst = std::max(worst, at[window.front() % n].second);
+    } else {
+      worst = std::max(worst, at[(j + 1) % n].second);  // the next point, alone
+    }
+  }
+  return worst;
+}
+
+namespace {
 
 // The deepest voxel along the segment from `a` to `b` (sampled every half voxel), in mm.
 double deepest_along(const std::vector<float>& depth, const VoxelGrid& grid,
@@ -161,29 +201,21 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
     std::unique_ptr<SurfaceLocator> own;
     if (!skull_locator) own = std::make_unique<SurfaceLocator>(*skull);
     const SurfaceLocator& bone = skull_locator ? *skull_locator : *own;
-    // The gap along the rim: in each 5° sector around the implant's axis, the side-wall vertex
-    // nearest the bone; the rim gap is the worst sector.
+    // The gap along the rim: over every 5° arc around the implant's axis, the side-wall vertex
+    // nearest the bone; the rim gap is the worst arc.
     std::sort(wall_vertices.begin(), wall_vertices.end());
     wall_vertices.erase(std::unique(wall_vertices.begin(), wall_vertices.end()),
                         wall_vertices.end());
-    // Sectors start towards the first wall vertex: the same on the implant in any pose.
-    const Eigen::Vector3d e1 =
-        wall_vertices.empty()
-            ? axis.unitOrthogonal()
-            : unit_across(
-                  to_eigen(implant.point(SkullMesh::VertexHandle(wall_vertices.front()))) - c,
-                  axis);
-    const Eigen::Vector3d e2 = axis.cross(e1);
-    std::vector<double> sector(72, std::numeric_limits<double>::infinity());
+    const Eigen::Vector3d e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
+    std::vector<double> angle, distance;
+    angle.reserve(wall_vertices.size());
+    distance.reserve(wall_vertices.size());
     for (int v : wall_vertices) {
       const Eigen::Vector3d p = to_eigen(implant.point(SkullMesh::VertexHandle(v)));
-      const double a = std::atan2((p - c).dot(e2), (p - c).dot(e1));
-      const int s = std::clamp(static_cast<int>((a + M_PI) / (2 * M_PI) * 72), 0, 71);
-      sector[s] = std::min(sector[s], bone.closest(p).distance);
+      angle.push_back(std::atan2((p - c).dot(e2), (p - c).dot(e1)));
+      distance.push_back(bone.closest(p).distance);
     }
-    q.rim_gap_mm = 0.0;
-    for (double g : sector)
-      if (std::isfinite(g)) q.rim_gap_mm = std::max(q.rim_gap_mm, g);
+    q.rim_gap_mm = worst_arc_gap(angle, distance, M_PI / 36);
     const std::vector<uint8_t> b = voxelize_mesh(*skull, grid);
     long long both = 0;
     for (size_t i = 0; i < solid.size(); ++i) both += solid[i] && b[i];

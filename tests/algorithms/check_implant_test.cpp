@@ -136,5 +136,51 @@ TEST(CheckImplant, ATaperedEdgeOnTheBoneIsPrintableUpToItsWidth) {
   EXPECT_FALSE(judged_thin(plate));
 }
 
+// The rim gap's arcs slide: a gap 5° wide or more is found wherever it lies, and the same
+// points turned by any angle, or listed in another order, give the same gap. (Until session 12
+// the gap was taken over 72 fixed 5° sectors that began at the mesh's first wall vertex: the
+// gap below, 6.5° wide, hid from sectors beginning at 0°, each of which also held a vertex on
+// the bone, and reordering the vertices moved the sectors.)
+TEST(CheckImplant, TheRimGapIsTheWorstArcWhereverItLies) {
+  const double deg = M_PI / 180;
+  std::vector<double> angle, distance;
+  for (int k = 0; k < 720; ++k) {  // a vertex every 0.5°, 0.1 mm from the bone
+    angle.push_back(k * 0.5 * deg);
+    distance.push_back(0.1);
+  }
+  // Over 7° from 101.25° (14 vertices) the wall stands 1.2 mm off, and 1.5 mm in the middle.
+  for (int k = 203; k < 217; ++k) distance[k] = k == 210 ? 1.5 : 1.2;
+  EXPECT_DOUBLE_EQ(worst_arc_gap(angle, distance, 5 * deg), 1.2);
+  double fixed_sectors = 0.0;  // the old measure, sectors beginning at 0°
+  for (int s = 0; s < 72; ++s) {
+    double nearest = 1e9;
+    for (size_t k = 0; k < angle.size(); ++k)
+      if (static_cast<int>(angle[k] / (5 * deg) + 1e-9) == s)
+        nearest = std::min(nearest, distance[k]);
+    fixed_sectors = std::max(fixed_sectors, nearest);
+  }
+  EXPECT_DOUBLE_EQ(fixed_sectors, 0.1) << "the sectors 100°–105° and 105°–110° reach the bone";
+  for (double turn : {0.0, 0.3, 17.0, 103.0, -250.0}) {
+    std::vector<double> turned = angle;
+    for (double& a : turned) a += turn * deg;
+    EXPECT_NEAR(worst_arc_gap(turned, distance, 5 * deg), 1.2, 1e-12) << turn;
+  }
+  // Listed in another order.
+  std::vector<size_t> order(angle.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = (i * 389) % order.size();
+  std::vector<double> a2, d2;
+  for (size_t i : order) {
+    a2.push_back(angle[i]);
+    d2.push_back(distance[i]);
+  }
+  EXPECT_DOUBLE_EQ(worst_arc_gap(a2, d2, 5 * deg), 1.2);
+  // Narrower than the gap's core, the arc finds the 1.5 mm vertex alone only where no other
+  // vertex shares its arc: with vertices 0.5° apart an arc of 0.4° can hold it alone.
+  EXPECT_DOUBLE_EQ(worst_arc_gap(angle, distance, 0.4 * deg), 1.5);
+  // Without points, no gap; one point is its own gap.
+  EXPECT_EQ(worst_arc_gap({}, {}, 5 * deg), 0.0);
+  EXPECT_DOUBLE_EQ(worst_arc_gap({2.0}, {0.7}, 5 * deg), 0.7);
+}
+
 }  // namespace
 }  // namespace cranioplan

@@ -43,6 +43,15 @@ struct QualityReport {
   std::vector<std::string> reasons;  ///< why not printable, one sentence each
 };
 
+/// The rim gap over arcs of the rim: for every arc `arc_rad` wide around the circle (sliding,
+/// not fixed sectors), the smallest of `distance[i]` over the points `angle[i]` (radians, any
+/// range) inside it; the largest over the arcs that hold a point. 0 without points. It is the
+/// same for the points turned by any angle: the fixed sectors it replaces (session 12) started
+/// at the mesh's first wall vertex, so the same implant gave other gaps when its vertices were
+/// listed in another order, and a gap straddling two sectors could hide in both.
+double worst_arc_gap(const std::vector<double>& angle, const std::vector<double>& distance,
+                     double arc_rad);
+
 /// Checks an implant, optionally against the (defective) skull it is made for.
 ///
 /// Thickness: from the centre of each face of the implant's two large surfaces (faces whose
@@ -51,14 +60,14 @@ struct QualityReport {
 /// the opposite surface, but at most the diameter of the deepest ball the ray passes (twice the
 /// deepest voxel's depth on the grid below, plus a voxel): a facet of a voxel-trimmed curved
 /// implant may have a normal that runs along the plate. Rim: the side wall (the other faces). Rim
-/// gap: around the implant's axis in 5° sectors, the distance from the sector's side-wall vertex
-/// nearest the bone to the bone; the largest over the sectors (a gap anywhere along the rim shows
-/// in its sector). Penetration: the volume inside both the implant and the skull, on a voxel grid.
-/// Thin material: on the same grid, the implant minus its opening by a ball of diameter
-/// min_thickness_mm (exact distance transforms; one voxel of slack). It is printable when the
-/// implant has a thick part, its tapered edge on the bone is at most max_taper_mm wide and
-/// thin material elsewhere (sharp corners) reaches at most max_corner_mm. (thickness_min_mm,
-/// measured along face normals, goes to zero at any tapered edge and is reported but not judged.)
+/// gap: around the implant's axis, over every 5° arc (`worst_arc_gap`), the distance from the
+/// arc's side-wall vertex nearest the bone to the bone; the largest over the arcs (a gap anywhere
+/// along the rim 5° wide shows). Penetration: the volume inside both the implant and the skull, on
+/// a voxel grid. Thin material: on the same grid, the implant minus its opening by a ball of
+/// diameter min_thickness_mm (exact distance transforms; one voxel of slack). It is printable when
+/// the implant has a thick part, its tapered edge on the bone is at most max_taper_mm wide and thin
+/// material elsewhere (sharp corners) reaches at most max_corner_mm. (thickness_min_mm, measured
+/// along face normals, goes to zero at any tapered edge and is reported but not judged.)
 QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
                             const QualityParams& params = {});
 
