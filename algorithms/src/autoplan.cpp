@@ -97,13 +97,6 @@ bool plane_and_registration(const SkullMesh& skull, const Landmarks& landmarks,
   return true;
 }
 
-// The detection's note on the openings it left unplanned, for a plan made with the others.
-void note_planned_as_well(AutoplanResult& r) {
-  const std::string note = kUnplannedOpeningsNote;
-  const size_t at = r.message.find(note);
-  if (at != std::string::npos) r.message.replace(at, note.size(), ", planned as well)");
-}
-
 }  // namespace
 
 AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
@@ -140,7 +133,7 @@ std::vector<AutoplanResult> autoplan_all_openings(const SkullMesh& skull,
     plan_opening(skull, bone, each, each_timer, r);
     plans.push_back(std::move(r));
   }
-  for (AutoplanResult& r : plans) note_planned_as_well(r);
+  for (AutoplanResult& r : plans) r.message = with_other_openings_planned(r.message);
   return plans;
 }
 

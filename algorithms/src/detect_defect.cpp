@@ -350,4 +350,11 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
   return region;
 }
 
+std::string with_other_openings_planned(std::string message) {
+  const std::string note = kUnplannedOpeningsNote;
+  const size_t at = message.find(note);
+  if (at != std::string::npos) message.replace(at, note.size(), ", planned as well)");
+  return message;
+}
+
 }  // namespace cranioplan

@@ -107,11 +107,34 @@ void add_fit_option(CLI::App* cmd, AutoplanParams& params) {
 }
 
 // autoplan --session: the plan made by session commands, saved for reopening and audit.
-int autoplan_with_session(const std::string& skull, const Landmarks& lm,
-                          const AutoplanParams& params, const std::string& output,
-                          const std::string& markers_out, const std::string& session_path,
-                          bool json) {
-  AutoplanSession a = autoplan_session(skull, lm, params, output);
+// The k-th of several outputs: the path itself for the first, else "name_k.ext" beside it.
+std::string numbered_path(const std::string& path, size_t k) {
+  if (k <= 1) return path;
+  const std::filesystem::path p(path);
+  return (p.parent_path() / (p.stem().string() + "_" + std::to_string(k) + p.extension().string()))
+      .string();
+}
+
+// The reports of several plans, one per opening: {"openings", "plans"} as JSON, else each in
+// turn.
+void print_plans(const Json& plans, bool json) {
+  if (json) {
+    print_result(Json{{"openings", plans.size()}, {"plans", plans}}, true);
+    return;
+  }
+  for (size_t k = 0; k < plans.size(); ++k) {
+    std::cout << "opening " << k + 1 << " of " << plans.size() << ":\n";
+    print_result(plans[k], false);
+  }
+}
+
+// One automatic plan run as session commands and saved; its report. `a` keeps the status and
+// the opening found, not the session.
+Json autoplan_with_session(const std::string& skull, const Landmarks& lm,
+                           const AutoplanParams& params, const std::string& output,
+                           const std::string& markers_out, const std::string& session_path,
+                           AutoplanSession& a) {
+  a = autoplan_session(skull, lm, params, output);
   a.session.save(session_path);
   const PlanState& s = a.session.state();
   Json j{{"status", a.planned()                                     ? "planned"
@@ -126,16 +149,8 @@ int autoplan_with_session(const std::string& skull, const Landmarks& lm,
   j["session"] = session_path;
   if (!markers_out.empty() && !s.markers.empty()) write_markers_file(s.markers, markers_out);
   if (a.planned()) j["output"] = output;
-  print_result(j, json);
-  return a.planned() ? kOk : kUnusable;
-}
-
-// The k-th of several outputs: the path itself for the first, else "name_k.ext" beside it.
-std::string numbered_path(const std::string& path, size_t k) {
-  if (k <= 1) return path;
-  const std::filesystem::path p(path);
-  return (p.parent_path() / (p.stem().string() + "_" + std::to_string(k) + p.extension().string()))
-      .string();
+  a.session = Session();  // saved; its meshes freed before the next opening is planned
+  return j;
 }
 
 // Writes one automatic plan's markers (if asked for) and implant (if planned); its report.
@@ -380,57 +395,74 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
                     "(default: the largest)")
         ->expected(3);
     add_fit_option(cmd, o->params);
-    auto* session_opt =
-        cmd->add_option("--session", o->session,
-                        "plan through session commands and save the session (.json): reopen, "
-                        "edit, replay and audit it");
+    cmd->add_option("--session", o->session,
+                    "plan through session commands and save the session (.json): reopen, edit, "
+                    "replay and audit it (with --all-openings, SESSION_2... for the others)");
     cmd->add_flag("--all-openings", o->all_openings,
                   "plan every opening large enough to be a defect (bilateral defects), each to "
-                  "its own implant: IMPLANT, then IMPLANT_2, IMPLANT_3... (markers likewise)")
-        ->excludes(session_opt);
-    out.push_back({cmd, [o, &json]() -> int {
-                     if (o->near.size() == 3)
-                       o->params.propose.detect.near =
-                           Eigen::Vector3d(o->near[0], o->near[1], o->near[2]);
-                     const Landmarks lm =
-                         o->landmarks.empty() ? Landmarks{} : read_landmarks_file(o->landmarks);
-                     plan_method_from_string(o->method, o->params.propose.method);
-                     if (!o->session.empty())
-                       return autoplan_with_session(o->skull, lm, o->params, o->output,
-                                                    o->markers_out, o->session, json);
-                     const LoadedSkull loaded = load_skull(o->skull);
-                     const SkullMesh& skull = loaded.mesh;
-                     if (!o->all_openings) {
-                       const AutoplanResult r = autoplan(skull, lm, o->params);
-                       print_result(write_autoplan(r, o->output, o->markers_out), json);
-                       return r.planned() ? kOk : kUnusable;
-                     }
-                     // Every opening in turn; the first is the one planned without
-                     // --all-openings.
-                     const std::vector<AutoplanResult> all =
-                         autoplan_all_openings(skull, lm, o->params);
-                     if (!all.front().defect.found()) {  // no defect, or no plane
-                       print_result(write_autoplan(all.front(), o->output, o->markers_out), json);
-                       return all.front().planned() ? kOk : kUnusable;
-                     }
-                     Json plans = Json::array();
-                     bool all_planned = true;
-                     for (size_t k = 0; k < all.size(); ++k) {
-                       plans.push_back(write_autoplan(
-                           all[k], numbered_path(o->output, k + 1),
-                           o->markers_out.empty() ? "" : numbered_path(o->markers_out, k + 1)));
-                       all_planned = all_planned && all[k].planned();
-                     }
-                     if (json) {
-                       print_result(Json{{"openings", plans.size()}, {"plans", plans}}, true);
-                     } else {
-                       for (size_t k = 0; k < plans.size(); ++k) {
-                         std::cout << "opening " << k + 1 << " of " << plans.size() << ":\n";
-                         print_result(plans[k], false);
-                       }
-                     }
-                     return all_planned ? kOk : kUnusable;
-                   }});
+                  "its own implant: IMPLANT, then IMPLANT_2, IMPLANT_3... (markers and sessions "
+                  "likewise)");
+    out.push_back(
+        {cmd, [o, &json]() -> int {
+           if (o->near.size() == 3)
+             o->params.propose.detect.near = Eigen::Vector3d(o->near[0], o->near[1], o->near[2]);
+           const Landmarks lm =
+               o->landmarks.empty() ? Landmarks{} : read_landmarks_file(o->landmarks);
+           plan_method_from_string(o->method, o->params.propose.method);
+           auto markers_path = [&](size_t k) {
+             return o->markers_out.empty() ? std::string() : numbered_path(o->markers_out, k);
+           };
+           if (!o->session.empty()) {
+             // A session per opening: each holds its own commands (the plane and the
+             // registration included), so each can be reopened and replayed alone.
+             AutoplanSession first;
+             Json j = autoplan_with_session(o->skull, lm, o->params, o->output, o->markers_out,
+                                            o->session, first);
+             if (!o->all_openings || !first.defect.found()) {
+               print_result(j, json);
+               return first.planned() ? kOk : kUnusable;
+             }
+             j["message"] = with_other_openings_planned(j["message"].get<std::string>());
+             Json plans = Json::array({j});
+             bool all_planned = first.planned();
+             for (size_t k = 0; k < first.defect.other_axes.size(); ++k) {
+               AutoplanParams each = o->params;
+               each.propose.detect.near = first.defect.center + 100.0 * first.defect.other_axes[k];
+               AutoplanSession a;
+               Json one =
+                   autoplan_with_session(o->skull, lm, each, numbered_path(o->output, k + 2),
+                                         markers_path(k + 2), numbered_path(o->session, k + 2), a);
+               one["message"] = with_other_openings_planned(one["message"].get<std::string>());
+               plans.push_back(one);
+               all_planned = all_planned && a.planned();
+             }
+             print_plans(plans, json);
+             return all_planned ? kOk : kUnusable;
+           }
+           const LoadedSkull loaded = load_skull(o->skull);
+           const SkullMesh& skull = loaded.mesh;
+           if (!o->all_openings) {
+             const AutoplanResult r = autoplan(skull, lm, o->params);
+             print_result(write_autoplan(r, o->output, o->markers_out), json);
+             return r.planned() ? kOk : kUnusable;
+           }
+           // Every opening in turn; the first is the one planned without
+           // --all-openings.
+           const std::vector<AutoplanResult> all = autoplan_all_openings(skull, lm, o->params);
+           if (!all.front().defect.found()) {  // no defect, or no plane
+             print_result(write_autoplan(all.front(), o->output, o->markers_out), json);
+             return all.front().planned() ? kOk : kUnusable;
+           }
+           Json plans = Json::array();
+           bool all_planned = true;
+           for (size_t k = 0; k < all.size(); ++k) {
+             plans.push_back(
+                 write_autoplan(all[k], numbered_path(o->output, k + 1), markers_path(k + 1)));
+             all_planned = all_planned && all[k].planned();
+           }
+           print_plans(plans, json);
+           return all_planned ? kOk : kUnusable;
+         }});
   }
 
   {  // evaluate

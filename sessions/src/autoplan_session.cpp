@@ -1,7 +1,6 @@
 #include "cranioplan/sessions/autoplan_session.h"
 
 #include <filesystem>
-#include <optional>
 
 #include "cranioplan/algorithms/propose_markers.h"
 
@@ -34,32 +33,31 @@ AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks&
   if (!s.state().plane) return stop("midsagittal plane: " + s.state().message);
   run(commands::mirror());
   run(commands::register_mirror(params.registration));
-  // Registered again around the opening, as autoplan() does: the region is found here and
-  // recorded as the command's parameter, so replay needs no detection.
-  std::optional<DefectRegion> found;
-  if (params.local_registration_mm > 0.0 && s.state().registration &&
-      s.state().registration->usable()) {
+  // The opening, found here as the markers' command would find it (the same skull, plane and
+  // detection): the mirror is registered again around it, as autoplan() does, with the region
+  // recorded as the command's parameter so that replay needs no detection.
+  {
     const PlanState& st = s.state();
-    const DefectRegion defect = detect_defect_near_plane(
-        st.skull->surface->mesh, st.skull->surface->locator, *st.plane, params.propose.detect);
-    if (defect.found()) {
-      found = defect;
-      RegisterParams local = params.registration;
-      local.initial = st.registration->transform;
-      local.roi = local_registration_region(defect, params.local_registration_mm);
-      run(commands::register_mirror(local));
-    }
+    out.defect = detect_defect_near_plane(st.skull->surface->mesh, st.skull->surface->locator,
+                                          *st.plane, params.propose.detect);
+  }
+  if (params.local_registration_mm > 0.0 && out.defect.found() && s.state().registration &&
+      s.state().registration->usable()) {
+    RegisterParams local = params.registration;
+    local.initial = s.state().registration->transform;
+    local.roi = local_registration_region(out.defect, params.local_registration_mm);
+    run(commands::register_mirror(local));
   }
   // An unusable registration leaves the mirror where mirroring put it, as autoplan() does.
   if (!step_complete(s.state(), 3)) run(commands::complete_step(3));
   run(commands::complete_step(4));
-  // The markers are proposed for the opening found above (what the command would find again:
-  // the same skull, plane and detection), and the proposal goes into the command as its result.
+  // The markers are proposed for the opening found above, and the proposal goes into the
+  // command as its result.
   Command propose = commands::propose_markers(params.propose);
-  if (found && s.state().mirrored) {
+  if (out.defect.found() && s.state().mirrored) {
     const PlanState& st = s.state();
     propose.params["result"] = proposal_result(
-        propose_markers_for_defect(*found, st.skull->surface->locator, st.mirrored->locator,
+        propose_markers_for_defect(out.defect, st.skull->surface->locator, st.mirrored->locator,
                                    params.propose, st.next_marker_id));
   }
   run(std::move(propose));

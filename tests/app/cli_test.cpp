@@ -180,9 +180,21 @@ TEST(Cli, AutoplanAllOpeningsPlansEachDefectToItsOwnImplant) {
   EXPECT_EQ(j["plans"][1]["output"].get<std::string>(), dir.path("implant_2.stl"));
   for (const char* f : {"implant.stl", "implant_2.stl", "m.json", "m_2.json"})
     EXPECT_TRUE(std::filesystem::exists(dir.path(f))) << f;
-  EXPECT_EQ(test::run_command(kCli + " autoplan --all-openings " + dir.path("two.stl") + " -o " +
-                              dir.path("x.stl") + " --session " + dir.path("s.json")),
-            2);
+  // Through sessions: one per opening, each reopened and replayed on its own to the implant it
+  // exported, the same as the plan without sessions.
+  ASSERT_EQ(test::run_command(kCli + " autoplan --json --all-openings " + dir.path("two.stl") +
+                                  " -o " + dir.path("s.stl") + " --session " + dir.path("s.json"),
+                              &out),
+            0)
+      << out;
+  const Json js = Json::parse(out);
+  ASSERT_EQ(js["plans"].size(), 2u) << out;
+  EXPECT_EQ(js["plans"][1]["session"].get<std::string>(), dir.path("s_2.json"));
+  EXPECT_NE(js["plans"][1]["message"].get<std::string>().find("planned as well"),
+            std::string::npos);
+  for (const char* f : {"s.json", "s_2.json"})
+    EXPECT_EQ(test::run_command(kCli + " verify " + dir.path(f)), 0) << f;
+  EXPECT_EQ(test::read_bytes(dir.path("s_2.stl")), test::read_bytes(dir.path("implant_2.stl")));
 }
 
 // evaluate: a folder in the SkullFix layout (here one case injected into the synthetic head)

@@ -76,6 +76,10 @@ struct DefectRegion {
 inline constexpr char kUnplannedOpeningsNote[] =
     " not planned: choose with a point near the defect)";
 
+/// `message` with the note on unplanned openings saying instead that they are planned as well
+/// (for plans made of every opening, e.g. `autoplan --all-openings`).
+std::string with_other_openings_planned(std::string message);
+
 /// A rim stretch without a rim point is reported when it is longer than this (mm) and than
 /// kUnseenRimTimesMedian times the rim's median spacing (large openings have sparser rims).
 constexpr double kUnseenRimMm = 10.0;

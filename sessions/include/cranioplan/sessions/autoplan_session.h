@@ -14,6 +14,9 @@ struct AutoplanSession {
   Status status = Status::Failed;
   std::string message;  ///< what happened, or the stage that stopped and why
   Session session;      ///< every command run, whether or not it planned
+  /// The opening planned (found by the same detection as the markers' command), with the
+  /// other openings' rays (`other_axes`) for planning them in sessions of their own.
+  DefectRegion defect;
   bool planned() const { return status == Status::Planned; }
 };
 
