@@ -106,7 +106,6 @@ void add_fit_option(CLI::App* cmd, AutoplanParams& params) {
       ->check(CLI::Range(0.0, 200.0));
 }
 
-// autoplan --session: the plan made by session commands, saved for reopening and audit.
 // The k-th of several outputs: the path itself for the first, else "name_k.ext" beside it.
 std::string numbered_path(const std::string& path, size_t k) {
   if (k <= 1) return path;
@@ -128,8 +127,8 @@ void print_plans(const Json& plans, bool json) {
   }
 }
 
-// One automatic plan run as session commands and saved; its report. `a` keeps the status and
-// the opening found, not the session.
+// autoplan --session: one automatic plan made by session commands and saved for reopening and
+// audit; its report. `a` keeps the status and the opening found, not the session.
 Json autoplan_with_session(const std::string& skull, const Landmarks& lm,
                            const AutoplanParams& params, const std::string& output,
                            const std::string& markers_out, const std::string& session_path,
@@ -151,6 +150,35 @@ Json autoplan_with_session(const std::string& skull, const Landmarks& lm,
   if (a.planned()) j["output"] = output;
   a.session = Session();  // saved; its meshes freed before the next opening is planned
   return j;
+}
+
+// autoplan --session [--all-openings]: a session per opening, each holding its own commands
+// (the plane and the registration included), so that each can be reopened and replayed alone.
+int autoplan_sessions(const std::string& skull, const Landmarks& lm, const AutoplanParams& params,
+                      const std::string& output, const std::string& markers_out,
+                      const std::string& session, bool all_openings, bool json) {
+  AutoplanSession first;
+  Json j = autoplan_with_session(skull, lm, params, output, markers_out, session, first);
+  if (!all_openings || !first.defect.found()) {
+    print_result(j, json);
+    return first.planned() ? kOk : kUnusable;
+  }
+  j["message"] = with_other_openings_planned(j["message"].get<std::string>());
+  Json plans = Json::array({j});
+  bool all_planned = first.planned();
+  for (size_t k = 0; k < first.defect.other_axes.size(); ++k) {
+    AutoplanParams each = params;
+    each.propose.detect.near = first.defect.center + 100.0 * first.defect.other_axes[k];
+    AutoplanSession a;
+    Json one = autoplan_with_session(skull, lm, each, numbered_path(output, k + 2),
+                                     markers_out.empty() ? "" : numbered_path(markers_out, k + 2),
+                                     numbered_path(session, k + 2), a);
+    one["message"] = with_other_openings_planned(one["message"].get<std::string>());
+    plans.push_back(one);
+    all_planned = all_planned && a.planned();
+  }
+  print_plans(plans, json);
+  return all_planned ? kOk : kUnusable;
 }
 
 // Writes one automatic plan's markers (if asked for) and implant (if planned); its report.
@@ -412,33 +440,9 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
            auto markers_path = [&](size_t k) {
              return o->markers_out.empty() ? std::string() : numbered_path(o->markers_out, k);
            };
-           if (!o->session.empty()) {
-             // A session per opening: each holds its own commands (the plane and the
-             // registration included), so each can be reopened and replayed alone.
-             AutoplanSession first;
-             Json j = autoplan_with_session(o->skull, lm, o->params, o->output, o->markers_out,
-                                            o->session, first);
-             if (!o->all_openings || !first.defect.found()) {
-               print_result(j, json);
-               return first.planned() ? kOk : kUnusable;
-             }
-             j["message"] = with_other_openings_planned(j["message"].get<std::string>());
-             Json plans = Json::array({j});
-             bool all_planned = first.planned();
-             for (size_t k = 0; k < first.defect.other_axes.size(); ++k) {
-               AutoplanParams each = o->params;
-               each.propose.detect.near = first.defect.center + 100.0 * first.defect.other_axes[k];
-               AutoplanSession a;
-               Json one =
-                   autoplan_with_session(o->skull, lm, each, numbered_path(o->output, k + 2),
-                                         markers_path(k + 2), numbered_path(o->session, k + 2), a);
-               one["message"] = with_other_openings_planned(one["message"].get<std::string>());
-               plans.push_back(one);
-               all_planned = all_planned && a.planned();
-             }
-             print_plans(plans, json);
-             return all_planned ? kOk : kUnusable;
-           }
+           if (!o->session.empty())
+             return autoplan_sessions(o->skull, lm, o->params, o->output, o->markers_out,
+                                      o->session, o->all_openings, json);
            const LoadedSkull loaded = load_skull(o->skull);
            const SkullMesh& skull = loaded.mesh;
            if (!o->all_openings) {
