@@ -199,6 +199,18 @@ void add_scores(Json& row, const AutoplanResult& r, const CompareResult& c) {
   row["dice"] = c.dice;
   row["boundary_dice"] = c.boundary_dice;
   row["hd95_mm"] = c.hd95_mm;
+  // Whether the plan could go to the printer as it stands (the quality report's verdict).
+  row["printable"] = r.quality.printable;
+  row["rim_gap_mm"] = r.quality.rim_gap_mm;
+  if (!r.quality.printable) row["not_printable_because"] = r.quality.reasons;
+}
+
+// The printable verdict of a scored row, for the text table.
+std::string printable_text(const Json& row) {
+  if (!row.contains("printable")) return "";
+  if (row["printable"].get<bool>()) return "printable  ";
+  const Json& why = row["not_printable_because"];
+  return "NOT printable (" + (why.empty() ? std::string("?") : why[0].get<std::string>()) + ")  ";
 }
 
 double median(std::vector<double> v) {
@@ -502,7 +514,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
            }
            Json rows = Json::array();
            std::vector<double> dsc, bdsc, hd95, secs;
-           int failed = 0, unreadable = 0;
+           int failed = 0, unreadable = 0, printable = 0;
            for (const auto& [id, files] : cases) {
              if (files.first.empty() || files.second.empty()) continue;
              double seconds = 0.0;
@@ -531,6 +543,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
                    row["implant"] = path;
                  }
                  add_scores(row, r, c);
+                 printable += r.quality.printable;
                  dsc.push_back(c.dice);
                  bdsc.push_back(c.boundary_dice);
                  hd95.push_back(c.hd95_mm);
@@ -555,7 +568,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
                            << row["dice"].get<double>() << "  bDSC "
                            << row["boundary_dice"].get<double>() << "  HD95 "
                            << row["hd95_mm"].get<double>() << " mm  " << seconds << " s  "
-                           << row["message"].get<std::string>() << std::endl;
+                           << printable_text(row) << row["message"].get<std::string>() << std::endl;
                else
                  std::cout << id << "  " << row["status"].get<std::string>() << "  "
                            << row["message"].get<std::string>() << std::endl;
@@ -570,6 +583,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
              return v.empty() ? Json(nullptr) : Json(median(v));
            };
            const Json summary{{"cases", rows.size()},
+                              {"printable", printable},
                               {"failed", failed},
                               {"bad_input", unreadable},
                               {"median_dice", median_of(dsc)},
@@ -616,6 +630,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
            centroid /= static_cast<double>(skull.n_vertices());
            Json rows = Json::array();
            std::vector<double> dsc, hd95;
+           int printable = 0;
            for (int k = 0; k < o->count; ++k) {
              const double side = k % 2 == 0 ? 1.0 : -1.0;
              const double phi = 2.39996 * k, up = 0.25 + 0.5 * std::fmod(0.618034 * k, 1.0);
@@ -643,6 +658,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
              if (r.planned()) {
                const CompareResult c = compare_implants(r.implant.mesh, d.implant, &d.defective);
                add_scores(row, r, c);
+               printable += r.quality.printable;
                dsc.push_back(c.dice);
                hd95.push_back(c.hd95_mm);
              } else {
@@ -651,10 +667,12 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
              if (!json)
                std::cout << k << "  size " << ip.size_mm << " mm  " << row.value("method", "-")
                          << "  DSC " << row.value("dice", 0.0) << "  HD95 "
-                         << row.value("hd95_mm", 0.0) << " mm  " << r.message << std::endl;
+                         << row.value("hd95_mm", 0.0) << " mm  " << printable_text(row) << r.message
+                         << std::endl;
              rows.push_back(row);
            }
            const Json summary{{"defects", rows.size()},
+                              {"printable", printable},
                               {"median_dice", median(dsc)},
                               {"median_hd95_mm", median(hd95)}};
            if (json)

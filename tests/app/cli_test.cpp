@@ -132,10 +132,17 @@ TEST(Cli, StudyInjectsPlansAndScoresDefects) {
   ASSERT_EQ(test::run_command(kCli + " study --json --count 2 " + dir.path("thick.stl"), &out), 0);
   const Json j = Json::parse(out);
   ASSERT_EQ(j["defects"].size(), 2u);
+  int printable = 0;
   for (const auto& row : j["defects"]) {
     EXPECT_EQ(row["method"].get<std::string>(), "mirror");
     EXPECT_GT(row["dice"].get<double>(), 0.6);
+    // The quality report's verdict is in each row, and a plan that fails it says why.
+    ASSERT_TRUE(row.contains("printable")) << row;
+    EXPECT_GE(row["rim_gap_mm"].get<double>(), 0.0);
+    EXPECT_EQ(row.contains("not_printable_because"), !row["printable"].get<bool>()) << row;
+    printable += row["printable"].get<bool>();
   }
+  EXPECT_EQ(j["median"]["printable"].get<int>(), printable);
 }
 
 // autoplan --all-openings: bilateral defects (mirror images of each other) get an implant each,
@@ -223,6 +230,7 @@ TEST(Cli, EvaluateScoresAFolderOfCasesAndWritesTheImplants) {
   EXPECT_EQ(j["cases"][0]["case"].get<std::string>(), "007");
   EXPECT_GT(j["cases"][0]["dice"].get<double>(), 0.85);
   EXPECT_GT(j["median"]["median_dice"].get<double>(), 0.85);
+  EXPECT_EQ(j["median"]["printable"].get<int>(), j["cases"][0]["printable"].get<bool>() ? 1 : 0);
   EXPECT_TRUE(std::filesystem::exists(dir.path("out/007_planned_implant.stl")));
   // autoplan --json names the stretches of the rim no ray saw: none around a clean cut.
   ASSERT_EQ(
