@@ -219,7 +219,13 @@ TEST(SampleCase, ACoarseCopyStillHasItsDefectFoundNotItsBase) {
   EXPECT_EQ(r.method_used, PlanMethod::Mirror);
   EXPECT_GT(r.mirror_coverage, 0.9);
   EXPECT_TRUE(r.quality.watertight);
-  EXPECT_EQ(r.quality.printable, r.quality.reasons.empty()) << "unprintable, and it says why";
+  // Where the rim gap is over the limit (on this copy it is: the crushed orbit, 1.7 mm), the
+  // report says so in a reason of its own.
+  bool names_the_gap = false;
+  for (const std::string& why : r.quality.reasons)
+    names_the_gap = names_the_gap || why.find("between the rim and the bone") != std::string::npos;
+  EXPECT_EQ(names_the_gap, r.quality.rim_gap_mm > QualityParams{}.max_rim_gap_mm)
+      << r.quality.rim_gap_mm;
   // The overlap with the bone is not asserted: this copy of the skull is not closed (its STL
   // has 95 boundary edges and 174 non-manifold ones), so its inside is not well defined
   // (measured 0.7 mm³).
