@@ -1,10 +1,8 @@
 #include "cranioplan/algorithms/read_mesh.h"
 
-#include <vtkCallbackCommand.h>
 #include <vtkCellArray.h>
 #include <vtkIdList.h>
 #include <vtkNew.h>
-#include <vtkPLYReader.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
@@ -19,6 +17,8 @@
 #include "cranioplan/algorithms/file_io.h"
 #include "cranioplan/model/error.h"
 #include "file_bytes.h"
+#include "mesh_formats.h"
+#include "vtk_errors.h"
 
 namespace cranioplan {
 namespace {
@@ -221,15 +221,6 @@ TriangleSoup read_stl(const std::string& path, const std::string& bytes, std::st
 
 // ---------------------------------------------------------------------------------------------
 // OFF and OBJ (text, polygons are fan-triangulated)
-void add_polygon(const std::string& path, const std::vector<int>& poly, int nv,
-                 std::vector<Eigen::Vector3i>& tris, long long line) {
-  for (int idx : poly)
-    if (idx < 0 || idx >= nv)
-      fail(path, "face on line " + format_count(line) + " uses vertex " + std::to_string(idx) +
-                     " but the file has " + format_count(nv) + " vertices");
-  for (size_t k = 1; k + 1 < poly.size(); ++k) tris.emplace_back(poly[0], poly[k], poly[k + 1]);
-}
-
 TriangleSoup read_off(const std::string& path, const std::string& bytes) {
   // Comments start with '#': blank them out of a copy for simple tokenizing.
   std::string text = bytes;
@@ -268,7 +259,8 @@ TriangleSoup read_off(const std::string& path, const std::string& bytes) {
     }
     // Colour values may follow on the same line.
     while (cur.p < cur.end && *cur.p != '\n') ++cur.p;
-    add_polygon(path, poly, static_cast<int>(nv), soup.triangles, cur.line);
+    detail::add_polygon(path, poly, static_cast<int>(nv), soup.triangles,
+                        "face on line " + format_count(cur.line));
   }
   return soup;
 }
@@ -301,27 +293,25 @@ TriangleSoup read_obj(const std::string& path, const std::string& bytes) {
         const long v = std::strtol(tok.c_str(), &e, 10);
         if (e == tok.c_str() || v == 0)
           fail(path, "malformed face on line " + format_count(line_no));
+        // OBJ counts from 1, or back from the last vertex so far with negative numbers.
+        if (std::labs(v) > static_cast<long>(soup.vertices.size()))
+          fail(path, "face on line " + format_count(line_no) + " uses vertex " + std::to_string(v) +
+                         " but only " + format_count(soup.vertices.size()) +
+                         " vertices come before it");
         poly.push_back(v > 0 ? static_cast<int>(v - 1)
                              : static_cast<int>(soup.vertices.size()) + static_cast<int>(v));
       }
       if (poly.size() < 3)
         fail(path, "face with fewer than 3 vertices on line " + format_count(line_no));
-      add_polygon(path, poly, static_cast<int>(soup.vertices.size()), soup.triangles, line_no);
+      detail::add_polygon(path, poly, static_cast<int>(soup.vertices.size()), soup.triangles,
+                          "face on line " + format_count(line_no));
     }
   }
   return soup;
 }
 
 // ---------------------------------------------------------------------------------------------
-// PLY and VTP through VTK readers, with their error events turned into messages.
-struct VtkErrorCatcher {
-  std::string message;
-  static void callback(vtkObject*, unsigned long, void* client, void* call) {
-    auto* self = static_cast<VtkErrorCatcher*>(client);
-    if (self->message.empty() && call) self->message = static_cast<const char*>(call);
-  }
-};
-
+// VTP through VTK's reader, its errors turned into messages.
 TriangleSoup soup_from_polydata(const std::string& path, vtkPolyData* pd) {
   TriangleSoup soup;
   if (!pd || !pd->GetPoints()) return soup;
@@ -338,7 +328,9 @@ TriangleSoup soup_from_polydata(const std::string& path, vtkPolyData* pd) {
   long long cell = 0;
   for (cells->InitTraversal(); cells->GetNextCell(ids);) {
     poly.assign(ids->begin(), ids->end());
-    if (poly.size() >= 3) add_polygon(path, poly, static_cast<int>(np), soup.triangles, ++cell);
+    if (poly.size() >= 3)
+      detail::add_polygon(path, poly, static_cast<int>(np), soup.triangles,
+                          "polygon " + format_count(++cell));
   }
   vtkCellArray* strips = pd->GetStrips();
   for (strips->InitTraversal(); strips->GetNextCell(ids);)
@@ -350,26 +342,25 @@ TriangleSoup soup_from_polydata(const std::string& path, vtkPolyData* pd) {
   return soup;
 }
 
-template <class Reader>
-TriangleSoup read_with_vtk(const std::string& path, const char* what) {
-  vtkNew<Reader> reader;
-  VtkErrorCatcher catcher;
-  vtkNew<vtkCallbackCommand> cb;
-  cb->SetCallback(&VtkErrorCatcher::callback);
-  cb->SetClientData(&catcher);
-  reader->AddObserver(vtkCommand::ErrorEvent, cb);
-  reader->AddObserver(vtkCommand::WarningEvent, cb);
+TriangleSoup read_vtp(const std::string& path) {
+  vtkNew<vtkXMLPolyDataReader> reader;
+  const detail::VtkErrorCatcher errors(reader);
   reader->SetFileName(path.c_str());
   reader->Update();
-  if (!catcher.message.empty()) {
-    std::string m = catcher.message;
-    while (!m.empty() && (m.back() == '\n' || m.back() == ' ')) m.pop_back();
-    fail(path, std::string("not a readable ") + what + " file (" + m.substr(0, 200) + ")");
-  }
+  if (!errors.message().empty()) fail(path, "not a readable VTP file (" + errors.message() + ")");
   return soup_from_polydata(path, reader->GetOutput());
 }
 
 }  // namespace
+
+void detail::add_polygon(const std::string& path, const std::vector<int>& poly, int nv,
+                         std::vector<Eigen::Vector3i>& tris, const std::string& where) {
+  for (int idx : poly)
+    if (idx < 0 || idx >= nv)
+      fail(path, where + " uses vertex " + std::to_string(idx) + " but the file has " +
+                     format_count(nv) + " vertices (numbered from 0)");
+  for (size_t k = 1; k + 1 < poly.size(); ++k) tris.emplace_back(poly[0], poly[k], poly[k + 1]);
+}
 
 TriangleSoup read_mesh_soup(const std::string& path, std::string* format_out) {
   const std::string bytes = read_file_bytes(path);
@@ -386,14 +377,12 @@ TriangleSoup read_mesh_soup(const std::string& path, std::string* format_out) {
     soup = read_obj(path, bytes);
   } else if (ext == ".ply") {
     format = "PLY";
-    if (bytes.compare(0, 3, "ply") != 0)
-      fail(path, "not a PLY file (it does not start with 'ply')");
-    soup = read_with_vtk<vtkPLYReader>(path, "PLY");
+    soup = detail::read_ply(path, bytes);
   } else if (ext == ".vtp") {
     format = "VTP";
     if (bytes.find("<VTKFile") == std::string::npos)
       fail(path, "not a VTP file (no <VTKFile> element)");
-    soup = read_with_vtk<vtkXMLPolyDataReader>(path, "VTP");
+    soup = read_vtp(path);
   } else {
     fail(path, "unknown mesh format '" + ext + "' (expected .stl, .ply, .obj, .off or .vtp)");
   }

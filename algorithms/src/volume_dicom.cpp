@@ -1,7 +1,6 @@
 // DICOM series: every slice file of one folder, read by VTK's DICOM reader. World coordinates
 // follow ImagePositionPatient and ImageOrientationPatient (LPS, mm); values in Hounsfield units
 // (VTK's reader applies the rescale slope and intercept).
-#include <vtkCallbackCommand.h>
 #include <vtkDICOMImageReader.h>
 #include <vtkDataArray.h>
 #include <vtkImageData.h>
@@ -13,6 +12,7 @@
 
 #include "cranioplan/model/error.h"
 #include "volume_formats.h"
+#include "vtk_errors.h"
 
 namespace cranioplan::detail {
 
@@ -25,22 +25,16 @@ Volume read_dicom_folder(const std::string& path) {
   if (!any_file) throw InputError(path, "folder holds no files (expected a DICOM series)");
 
   vtkNew<vtkDICOMImageReader> reader;
-  std::string error;
-  vtkNew<vtkCallbackCommand> cb;
-  cb->SetClientData(&error);
-  cb->SetCallback([](vtkObject*, unsigned long, void* client, void* call) {
-    auto* e = static_cast<std::string*>(client);
-    if (e->empty() && call) *e = static_cast<const char*>(call);
-  });
-  reader->AddObserver(vtkCommand::ErrorEvent, cb);
+  const VtkErrorCatcher errors(reader);
   reader->SetDirectoryName(path.c_str());
   reader->Update();
+  const std::string error = errors.message(160);
   vtkImageData* img = reader->GetOutput();
   int dims[3] = {0, 0, 0};
   if (img) img->GetDimensions(dims);
   if (!error.empty() || !img || !img->GetPointData()->GetScalars() || dims[2] < 2)
     throw InputError(path, "not a readable DICOM series of two or more slices" +
-                               (error.empty() ? std::string() : " (" + error.substr(0, 160) + ")"));
+                               (error.empty() ? std::string() : " (" + error + ")"));
   Volume v;
   v.dims = {dims[0], dims[1], dims[2]};
   double spacing[3];

@@ -112,6 +112,19 @@ TEST(ReadVolume, HeaderThatDisagreesWithDataIsAnError) {
   EXPECT_THROW(read_volume(dir.path("missing.nrrd")), InputError);
   std::filesystem::create_directories(dir.path("emptydir"));
   EXPECT_THROW(read_volume(dir.path("emptydir")), InputError);
+  // A folder of other files: the reader's reason, and nothing of VTK's own on the terminal.
+  std::filesystem::create_directories(dir.path("notes"));
+  test::write_bytes(dir.path("notes/readme.txt"), "not a slice");
+  testing::internal::CaptureStderr();
+  try {
+    read_volume(dir.path("notes"));
+    ADD_FAILURE() << "a folder without slices was read";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not a readable DICOM series"), std::string::npos)
+        << e.what();
+    EXPECT_NE(std::string(e.what()).find("readme.txt"), std::string::npos) << e.what();
+  }
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
 }
 
 TEST(ReadVolume, SkullFixMaskHonoursObliqueDirections) {
