@@ -1,7 +1,10 @@
 #include "cranioplan/algorithms/load_skull.h"
 
 #include <chrono>
+#include <cmath>
+#include <cstdio>
 #include <cstdlib>
+#include <limits>
 
 #include "cranioplan/algorithms/read_mesh.h"
 #include "cranioplan/algorithms/read_volume.h"
@@ -15,7 +18,7 @@ std::string sample_case_path() {
   return "/usr/share/doc/invesalius-examples/examples/Cranium.inv3";
 }
 
-LoadedSkull load_skull(const std::string& path, const ExtractBoneSurfaceParams& import) {
+LoadedSkull load_surface(const std::string& path, const ExtractBoneSurfaceParams& import) {
   const auto t0 = std::chrono::steady_clock::now();
   LoadedSkull out;
   if (is_volume_path(path)) {
@@ -30,14 +33,78 @@ LoadedSkull load_skull(const std::string& path, const ExtractBoneSurfaceParams& 
   } else {
     ReadMeshParams read;
     read.canonical = import.canonical;
+    read.unit_mm = import.mesh_unit_mm;
     MeshFile file = read_mesh(path, read);
     out.mesh = file.mesh;  // a copy (OpenMesh meshes cannot be moved); `file` goes at once
     out.source_kind = "mesh";
     out.description = file.format;
+    if (import.mesh_unit_mm != 1.0) {
+      std::string unit = std::to_string(import.mesh_unit_mm) + " mm units";
+      for (const LengthUnit& u : length_units())
+        if (u.mm == import.mesh_unit_mm) unit = u.label;
+      out.description += " in " + unit;
+    }
     out.warnings = std::move(file.warnings);
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
+}
+
+LoadedSkull load_skull(const std::string& path, const ExtractBoneSurfaceParams& import) {
+  LoadedSkull out = load_surface(path, import);
+  check_skull_size(out.mesh, path, out.source_kind == "mesh" ? import.mesh_unit_mm : 0.0);
+  return out;
+}
+
+const std::vector<LengthUnit>& length_units() {
+  static const std::vector<LengthUnit> kUnits = {{"mm", "millimetres", 1.0},
+                                                 {"cm", "centimetres", 10.0},
+                                                 {"m", "metres", 1000.0},
+                                                 {"in", "inches", 25.4},
+                                                 {"um", "micrometres", 0.001}};
+  return kUnits;
+}
+
+std::optional<LengthUnit> length_unit_named(const std::string& name) {
+  for (const LengthUnit& u : length_units())
+    if (name == u.name) return u;
+  return std::nullopt;
+}
+
+void check_skull_size(const SkullMesh& mesh, const std::string& path, double read_unit_mm) {
+  if (mesh.n_vertices() == 0) return;
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  Eigen::Vector3d hi = -lo;
+  for (auto vh : mesh.vertices()) {
+    lo = lo.cwiseMin(to_eigen(mesh.point(vh)));
+    hi = hi.cwiseMax(to_eigen(mesh.point(vh)));
+  }
+  const double extent = (hi - lo).maxCoeff();
+  if (extent >= kSkullMinExtentMm && extent <= kSkullMaxExtentMm) return;
+  auto mm = [](double v) {
+    char buf[48];
+    std::snprintf(buf, sizeof(buf), v < 10.0 ? "%.3g mm" : "%.0f mm", v);
+    return std::string(buf);
+  };
+  std::string problem = "the surface is " + mm(extent) + " across at its largest, but a skull is " +
+                        mm(kSkullMinExtentMm) + " to " + mm(kSkullMaxExtentMm) + " across";
+  if (read_unit_mm <= 0.0)
+    throw InputError(path, problem + ": check the voxel spacing in the volume's header");
+  // The unit that makes it the size of a head (about 190 mm), if any.
+  const double in_file_units = extent / read_unit_mm;
+  std::optional<LengthUnit> likely;
+  for (const LengthUnit& u : length_units()) {
+    const double size = in_file_units * u.mm;
+    if (u.mm == read_unit_mm || size < kSkullMinExtentMm || size > kSkullMaxExtentMm) continue;
+    if (!likely ||
+        std::abs(std::log(size / 190.0)) < std::abs(std::log(in_file_units * likely->mm / 190.0)))
+      likely = u;
+  }
+  if (!likely)
+    throw InputError(path, problem + ": it is no skull, or not in a length unit Cranioplan reads");
+  throw InputError(path, problem + ": the file looks to be in " + likely->label + " (then " +
+                             mm(in_file_units * likely->mm) + " across); read it in " +
+                             likely->label + " (length unit '" + likely->name + "')");
 }
 
 }  // namespace cranioplan

@@ -8,6 +8,7 @@
 #include <vtkSmartPointer.h>
 #include <vtkXMLPolyDataReader.h>
 
+#include <cassert>
 #include <cmath>
 #include <cstdint>
 #include <cstdlib>
@@ -399,6 +400,9 @@ MeshFile read_mesh(const std::string& path, const ReadMeshParams& params) {
   MeshFile out;
   TriangleSoup soup = read_mesh_soup(path, &out.format);
   out.triangles_in_file = static_cast<long long>(soup.triangles.size());
+  assert(params.unit_mm > 0.0 && std::isfinite(params.unit_mm) && "validated by the caller");
+  if (params.unit_mm != 1.0)
+    for (auto& v : soup.vertices) v *= params.unit_mm;
   if (params.canonical) make_canonical(soup);
 
   BuildMeshStats stats;

@@ -1,4 +1,5 @@
-// cranioplan [MESH|VOLUME|SESSION] [--sample] [--step N] [--screenshot OUT.png] [--quit]
+// cranioplan [MESH|VOLUME|SESSION] [--sample] [--units U] [--step N] [--screenshot OUT.png]
+// [--quit]
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QFileInfo>
@@ -26,10 +27,16 @@ int main(int argc, char** argv) {
   const QCommandLineOption screenshot("screenshot", "save a picture of the window", "OUT.png");
   const QCommandLineOption quit("quit", "quit when done (no dialogs)");
   const QCommandLineOption view("view", "front, back, left, right, top or markers", "VIEW");
-  parser.addOptions({sample, step, screenshot, quit, view});
+  const QCommandLineOption units("units", "a mesh file's length unit: mm, cm, m, in or um", "U");
+  parser.addOptions({sample, units, step, screenshot, quit, view});
   parser.process(app);
 
   cranioplan::gui::MainWindow window;
+  if (parser.isSet(units) && !window.set_mesh_unit(parser.value(units).toStdString())) {
+    std::fprintf(stderr, "cranioplan: --units: unknown length unit '%s'\n",
+                 parser.value(units).toLocal8Bit().constData());
+    return 2;
+  }
   const bool automated = parser.isSet(quit);
   window.set_interactive(!automated);
   // Bad input is reported on stderr too (the window shows it in the status bar), and an

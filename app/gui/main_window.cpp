@@ -368,8 +368,17 @@ QWidget* MainWindow::make_page(int step) {
       threshold_->setValue(300);
       threshold_->setSuffix(" HU");
       threshold_->setToolTip(tr("Bone threshold for CTs (masks use 0.5)"));
+      units_ = new QComboBox(page);
+      units_->setObjectName("meshUnits");
+      for (const LengthUnit& u : length_units())
+        units_->addItem(QStringLiteral("%1 (%2)").arg(tr(u.label), QString::fromLatin1(u.name)),
+                        u.mm);
+      units_->setToolTip(
+          tr("The length unit a mesh file was written in (STL, PLY, OBJ and OFF carry none). A "
+             "skull of the wrong size is refused, naming the unit it looks to be in."));
       form->addRow(open);
       form->addRow(sample);
+      form->addRow(tr("Mesh units"), units_);
       form->addRow(tr("CT bone threshold"), threshold_);
       skull_info_ = new QLabel(page);
       skull_info_->setWordWrap(true);
@@ -996,6 +1005,7 @@ void MainWindow::open_input(const QString& path, double threshold) {
   if (!confirm_discard()) return;
   ExtractBoneSurfaceParams import;
   const bool volume = is_volume_path(path.toStdString());
+  if (!volume) import.mesh_unit_mm = units_->currentData().toDouble();
   if (volume) {
     import.threshold = std::isfinite(threshold) ? threshold : threshold_->value();
     if (interactive_ && !std::isfinite(threshold)) {
@@ -1019,6 +1029,13 @@ void MainWindow::open_input(const QString& path, double threshold) {
   total_timer_.restart();
   add_recent(path);
   push(commands::load_skull(path.toStdString(), import), tr("Loading %1").arg(case_id));
+}
+
+bool MainWindow::set_mesh_unit(const std::string& name) {
+  const std::optional<LengthUnit> unit = length_unit_named(name);
+  if (!unit) return false;
+  units_->setCurrentIndex(units_->findData(unit->mm));
+  return true;
 }
 
 void MainWindow::open_sample() {

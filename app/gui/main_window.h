@@ -46,6 +46,9 @@ class MainWindow : public QMainWindow {
 
   // What the menus and buttons do, callable from tests and the command line.
   void open_input(const QString& path, double threshold = std::numeric_limits<double>::quiet_NaN());
+  /// The length unit meshes are read in (step 1's "Mesh units"): mm, cm, m, in or um; false
+  /// for another name.
+  bool set_mesh_unit(const std::string& name);
   void open_sample();
   bool open_session(const QString& path);
   /// Shows the plan as it was when step `step` was current (commands of later steps undone).
@@ -104,6 +107,7 @@ class MainWindow : public QMainWindow {
 
   // Step controls.
   QDoubleSpinBox* threshold_ = nullptr;
+  QComboBox* units_ = nullptr;  // a mesh file's length unit
   QLabel* skull_info_ = nullptr;
   QComboBox* landmark_ = nullptr;
   QLabel* plane_info_ = nullptr;

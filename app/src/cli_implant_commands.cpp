@@ -37,7 +37,7 @@ SkullMesh load_any(const std::string& path) {
   ExtractBoneSurfaceParams p;
   p.largest_piece_only = false;
   p.min_piece_triangles = 1;
-  return load_skull(path, p).mesh;
+  return load_surface(path, p).mesh;
 }
 
 Json implant_json(const ImplantResult& r) {
@@ -129,11 +129,11 @@ void print_plans(const Json& plans, bool json) {
 
 // autoplan --session: one automatic plan made by session commands and saved for reopening and
 // audit; its report. `a` keeps the status and the opening found, not the session.
-Json autoplan_with_session(const std::string& skull, const Landmarks& lm,
-                           const AutoplanParams& params, const std::string& output,
-                           const std::string& markers_out, const std::string& session_path,
-                           AutoplanSession& a) {
-  a = autoplan_session(skull, lm, params, output);
+Json autoplan_with_session(const std::string& skull, const ExtractBoneSurfaceParams& import,
+                           const Landmarks& lm, const AutoplanParams& params,
+                           const std::string& output, const std::string& markers_out,
+                           const std::string& session_path, AutoplanSession& a) {
+  a = autoplan_session(skull, lm, params, output, {}, import);
   a.session.save(session_path);
   const PlanState& s = a.session.state();
   Json j{{"status", a.planned()                                     ? "planned"
@@ -154,11 +154,12 @@ Json autoplan_with_session(const std::string& skull, const Landmarks& lm,
 
 // autoplan --session [--all-openings]: a session per opening, each holding its own commands
 // (the plane and the registration included), so that each can be reopened and replayed alone.
-int autoplan_sessions(const std::string& skull, const Landmarks& lm, const AutoplanParams& params,
-                      const std::string& output, const std::string& markers_out,
-                      const std::string& session, bool all_openings, bool json) {
+int autoplan_sessions(const std::string& skull, const ExtractBoneSurfaceParams& import,
+                      const Landmarks& lm, const AutoplanParams& params, const std::string& output,
+                      const std::string& markers_out, const std::string& session, bool all_openings,
+                      bool json) {
   AutoplanSession first;
-  Json j = autoplan_with_session(skull, lm, params, output, markers_out, session, first);
+  Json j = autoplan_with_session(skull, import, lm, params, output, markers_out, session, first);
   if (!all_openings || !first.defect.found()) {
     print_result(j, json);
     return first.planned() ? kOk : kUnusable;
@@ -170,7 +171,7 @@ int autoplan_sessions(const std::string& skull, const Landmarks& lm, const Autop
     AutoplanParams each = params;
     each.propose.detect.near = first.defect.center + 100.0 * first.defect.other_axes[k];
     AutoplanSession a;
-    Json one = autoplan_with_session(skull, lm, each, numbered_path(output, k + 2),
+    Json one = autoplan_with_session(skull, import, lm, each, numbered_path(output, k + 2),
                                      markers_out.empty() ? "" : numbered_path(markers_out, k + 2),
                                      numbered_path(session, k + 2), a);
     one["message"] = with_other_openings_planned(one["message"].get<std::string>());
@@ -338,7 +339,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
     cmd->add_option("--max-penetration", o->params.max_penetration_mm3,
                     "largest acceptable overlap (mm³)");
     out.push_back({cmd, [o, &json] {
-                     const SkullMesh implant = load_skull(o->implant).mesh;
+                     const SkullMesh implant = load_surface(o->implant).mesh;
                      SkullMesh skull;
                      if (!o->skull.empty()) skull = load_skull(o->skull).mesh;
                      const QualityReport q =
@@ -420,6 +421,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
       std::vector<double> near;
       bool all_openings = false;
       AutoplanParams params;
+      ExtractBoneSurfaceParams import;
     };
     auto o = std::make_shared<Opts>();
     auto* cmd =
@@ -430,6 +432,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
         ->check(CLI::IsMember({"auto", "mirror", "rim-only"}));
     cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
     cmd->add_option("--markers-out", o->markers_out, "proposed markers to write (.json or .csv)");
+    add_units_option(cmd, o->import.mesh_unit_mm);
     cmd->add_option("--near", o->near,
                     "X Y Z (mm): with several openings, plan the one in this point's direction "
                     "(default: the largest)")
@@ -453,9 +456,9 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
              return o->markers_out.empty() ? std::string() : numbered_path(o->markers_out, k);
            };
            if (!o->session.empty())
-             return autoplan_sessions(o->skull, lm, o->params, o->output, o->markers_out,
+             return autoplan_sessions(o->skull, o->import, lm, o->params, o->output, o->markers_out,
                                       o->session, o->all_openings, json);
-           const LoadedSkull loaded = load_skull(o->skull);
+           const LoadedSkull loaded = load_skull(o->skull, o->import);
            const SkullMesh& skull = loaded.mesh;
            if (!o->all_openings) {
              const AutoplanResult r = autoplan(skull, lm, o->params);

@@ -25,9 +25,11 @@ struct ImportOptions {
   double threshold = std::numeric_limits<double>::quiet_NaN();
   long long target_triangles = 0;
   long long all_pieces_above = 0;
+  double mesh_unit_mm = 1.0;
   ExtractBoneSurfaceParams params() const {
     ExtractBoneSurfaceParams p;
     p.threshold = threshold;
+    p.mesh_unit_mm = mesh_unit_mm;
     p.target_triangles = target_triangles;
     if (all_pieces_above > 0) {
       p.largest_piece_only = false;
@@ -46,6 +48,7 @@ void add_import_options(CLI::App* cmd, ImportOptions& o) {
   cmd->add_option("--all-pieces-above", o.all_pieces_above,
                   "keep every piece of at least N triangles instead of only the largest")
       ->check(CLI::NonNegativeNumber);
+  add_units_option(cmd, o.mesh_unit_mm);
 }
 
 Json skull_json(const LoadedSkull& s) {
@@ -179,7 +182,7 @@ int run(int argc, char** argv) {
 
   try {
     if (info->parsed()) {
-      const LoadedSkull s = load_skull(info_path, import.params());
+      const LoadedSkull s = load_surface(info_path, import.params());
       Json r = to_json(report_mesh(s.mesh));
       r["file"] = skull_json(s);
       print_warnings(s.warnings, json);
@@ -191,7 +194,7 @@ int run(int argc, char** argv) {
         throw InputError(ct_path,
                          "is not a volume (expected .inv3, .nrrd, .nhdr, .nii, .nii.gz "
                          "or a DICOM folder)");
-      const LoadedSkull s = load_skull(ct_path, import.params());
+      const LoadedSkull s = load_surface(ct_path, import.params());
       write_mesh(s.mesh, output);
       Json r = skull_json(s);
       r["output"] = output;
@@ -239,8 +242,8 @@ int run(int argc, char** argv) {
         }
         params.roi = roi;
       }
-      const LoadedSkull moving = load_skull(moving_path, import.params());
-      const LoadedSkull fixed = load_skull(fixed_path, import.params());
+      const LoadedSkull moving = load_surface(moving_path, import.params());
+      const LoadedSkull fixed = load_surface(fixed_path, import.params());
       const RegisterResult r = register_icp(moving.mesh, fixed.mesh, params);
       Json j = to_json(r);
       if (!r.usable()) {
@@ -302,6 +305,12 @@ int run(int argc, char** argv) {
   } catch (const std::filesystem::filesystem_error& e) {
     print_error(e.what(), kBadInput, json);
     return kBadInput;
+  } catch (const std::bad_alloc&) {
+    print_error("out of memory", kUnusable, json);
+    return kUnusable;
+  } catch (const std::exception& e) {  // a defect of ours: said, not an abort
+    print_error(std::string("unexpected error (please report it): ") + e.what(), kUnusable, json);
+    return kUnusable;
   }
   return kUsage;
 }

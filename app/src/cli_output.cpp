@@ -2,7 +2,10 @@
 
 #include <CLI/CLI.hpp>
 #include <iostream>
+#include <map>
 #include <sstream>
+
+#include "cranioplan/algorithms/load_skull.h"
 
 namespace cranioplan::cli {
 namespace {
@@ -36,6 +39,20 @@ void print_error(const std::string& message, int code, bool json) {
 void print_warnings(const std::vector<std::string>& warnings, bool json) {
   if (json) return;  // included in the JSON result instead
   for (const auto& w : warnings) std::cerr << "warning: " << w << "\n";
+}
+
+void add_units_option(CLI::App* cmd, double& mesh_unit_mm) {
+  std::map<std::string, double> units;
+  std::string names;
+  for (const LengthUnit& u : length_units()) {
+    units[u.name] = u.mm;
+    names += std::string(names.empty() ? "" : ", ") + u.name;
+  }
+  cmd->add_option("--units", mesh_unit_mm,
+                  "length unit of a mesh file: " + names +
+                      " (default mm; a skull of the wrong size "
+                      "is refused, naming the unit it looks to be in)")
+      ->transform(CLI::CheckedTransformer(units));
 }
 
 Eigen::Vector3d parse_point(const std::string& text, const std::string& option) {

@@ -2,6 +2,10 @@
 // How cranioplan-cli prints: one JSON object with --json, otherwise "key: value" lines.
 #include <string>
 
+namespace CLI {
+class App;
+}
+
 #include "cranioplan/sessions/plan_files.h"
 
 namespace cranioplan::cli {
@@ -12,6 +16,9 @@ enum Exit : int { kOk = 0, kUnusable = 1, kUsage = 2, kBadInput = 3 };
 void print_result(const Json& result, bool json);
 void print_error(const std::string& message, int code, bool json);
 void print_warnings(const std::vector<std::string>& warnings, bool json);
+
+/// --units NAME: a mesh file's length unit (mm, cm, m, in, um), stored as mm per unit.
+void add_units_option(CLI::App* cmd, double& mesh_unit_mm);
 
 /// "x,y,z" in mm; throws CLI::ValidationError naming the option otherwise.
 Eigen::Vector3d parse_point(const std::string& text, const std::string& option);

@@ -8,7 +8,7 @@ namespace cranioplan {
 
 AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks& landmarks,
                                  const AutoplanParams& params, const std::string& export_path,
-                                 const SessionInfo& info) {
+                                 const SessionInfo& info, const ExtractBoneSurfaceParams& import) {
   AutoplanSession out;
   SessionInfo with_case = info;
   if (with_case.case_id.empty())
@@ -24,7 +24,7 @@ AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks&
     out.message = why;
     return std::move(out);
   };
-  if (!run(commands::load_skull(skull_path))) return out;
+  if (!run(commands::load_skull(skull_path, import))) return out;
   if (landmarks.nasion) run(commands::set_landmark("nasion", *landmarks.nasion));
   if (landmarks.orbit_left) run(commands::set_landmark("orbit_left", *landmarks.orbit_left));
   if (landmarks.orbit_right) run(commands::set_landmark("orbit_right", *landmarks.orbit_right));

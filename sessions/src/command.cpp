@@ -279,6 +279,7 @@ Eigen::Vector3d ParamReader::vector3(const char* name) const {
 Json params_to_json(const ExtractBoneSurfaceParams& p) {
   Json j = write_fields([](auto& v, auto& q) { extract_fields(v, q); }, p);
   j["canonical"] = p.canonical;
+  j["mesh_unit_mm"] = p.mesh_unit_mm;
   return j;
 }
 Json params_to_json(const PlaneFitParams& p) {
@@ -331,6 +332,10 @@ void params_from_json(const ParamReader& r, ExtractBoneSurfaceParams& p) {
   // load_skull 1 (before session 9) has no "canonical": the skull as the file gave it, so that
   // those plans replay to the implants they exported.
   p.canonical = r.has("canonical") && r.boolean("canonical");
+  // Before session 13 every mesh was read in millimetres.
+  p.mesh_unit_mm = r.has("mesh_unit_mm") ? r.number("mesh_unit_mm") : 1.0;
+  if (!(p.mesh_unit_mm > 0.0) || !std::isfinite(p.mesh_unit_mm))
+    throw SessionError(r.where(), "parameter 'mesh_unit_mm' must be a positive length in mm");
 }
 void params_from_json(const ParamReader& r, PlaneFitParams& p) {
   Reader v{r};

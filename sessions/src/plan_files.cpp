@@ -249,7 +249,7 @@ Json read_json_file(const std::string& path) {
     throw InputError(path, "file is empty");
   try {
     return Json::parse(text);
-  } catch (const nlohmann::json::parse_error& e) {
+  } catch (const nlohmann::json::exception& e) {  // a syntax error, or a number out of range
     std::string what = e.what();
     const size_t colon = what.find("] ");
     throw InputError(path, "not valid JSON (" +

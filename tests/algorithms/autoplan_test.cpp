@@ -162,7 +162,7 @@ TEST(Autoplan, SkullFixCaseAcrossTheMidlineMatchesTheGroundTruth) {
   const AutoplanResult r = autoplan(skull, Landmarks{});
   ASSERT_TRUE(r.planned()) << r.message;
   EXPECT_EQ(r.method_used, PlanMethod::RimOnly);
-  const SkullMesh truth = load_skull(dir + "/000_implant.nrrd").mesh;
+  const SkullMesh truth = load_surface(dir + "/000_implant.nrrd").mesh;
   const CompareResult c = compare_implants(r.implant.mesh, truth, &skull);
   RecordProperty("dice", std::to_string(c.dice));
   RecordProperty("boundary_dice", std::to_string(c.boundary_dice));

@@ -10,8 +10,10 @@
 #include <algorithm>
 #include <cmath>
 #include <cstring>
+#include <functional>
 #include <limits>
 
+#include "cranioplan/algorithms/load_skull.h"
 #include "cranioplan/algorithms/mesh_report.h"
 #include "cranioplan/algorithms/write_mesh.h"
 #include "cranioplan/model/error.h"
@@ -262,6 +264,65 @@ TEST(ReadMesh, SomeZeroAreaTrianglesAreDroppedWithAWarningOrRefusedWhenStrict) {
   ReadMeshParams strict;
   strict.strict = true;
   EXPECT_THROW(read_mesh(p, strict), InputError);
+}
+
+// A head about 180 mm across, written in another unit: refused as a skull, naming the unit
+// that makes it head-sized, and read at its size in that unit.
+TEST(LoadSkull, ASkullInAnotherUnitIsRefusedNamingTheUnitAndReadInIt) {
+  TempDir dir;
+  const SkullMesh head = test::make_symmetric_head(2);
+  const MeshReport size = report_mesh(head);
+  const double extent = (size.bbox_max - size.bbox_min).maxCoeff();
+  ASSERT_GT(extent, kSkullMinExtentMm);
+  ASSERT_LT(extent, kSkullMaxExtentMm);
+  struct Case {
+    const char* unit;
+    const char* label;
+  };
+  for (const Case c : {Case{"m", "metres"}, Case{"in", "inches"}, Case{"cm", "centimetres"}}) {
+    const double unit_mm = length_unit_named(c.unit)->mm;
+    SkullMesh scaled = head;
+    for (auto vh : scaled.vertices()) scaled.set_point(vh, scaled.point(vh) / unit_mm);
+    const std::string p = dir.path(std::string("head-") + c.unit + ".stl");
+    write_mesh(scaled, p);
+    try {
+      load_skull(p);
+      ADD_FAILURE() << "a head in " << c.label << " was planned as millimetres";
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind(p, 0), 0u) << msg;
+      EXPECT_NE(msg.find(std::string("looks to be in ") + c.label), std::string::npos) << msg;
+      EXPECT_NE(msg.find(std::string("(length unit '") + c.unit + "')"), std::string::npos) << msg;
+    }
+    // Any surface may be read as it is (an implant, a test shape): no size to check.
+    EXPECT_EQ(load_surface(p).mesh.n_faces(), head.n_faces());
+    ExtractBoneSurfaceParams in_unit;
+    in_unit.mesh_unit_mm = unit_mm;
+    const LoadedSkull read = load_skull(p, in_unit);
+    const MeshReport got = report_mesh(read.mesh);
+    EXPECT_NEAR((got.bbox_max - got.bbox_min).maxCoeff(), extent, 1e-3 * extent) << c.unit;
+  }
+  // No unit makes a 2 mm part a skull; a volume of the wrong size points at its spacing.
+  SkullMesh tiny = head;
+  for (auto vh : tiny.vertices()) tiny.set_point(vh, tiny.point(vh) / 100.0);
+  write_mesh(tiny, dir.path("tiny.stl"));
+  auto refusal = [](const std::function<void()>& load) {
+    try {
+      load();
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(taken for a skull)");
+  };
+  EXPECT_NE(refusal([&] {
+              load_skull(dir.path("tiny.stl"));
+            }).find("it is no skull, or not in a length unit Cranioplan reads"),
+            std::string::npos);
+  EXPECT_NE(refusal([&] {
+              check_skull_size(tiny, "ct.nrrd", 0.0);
+            }).find("check the voxel spacing in the volume's header"),
+            std::string::npos);
+  EXPECT_FALSE(length_unit_named("furlong"));
 }
 
 TEST(WriteMesh, RefusesUnknownExtensionAndMissingFolder) {

@@ -64,7 +64,7 @@ TEST(ReadVolume, ALoadedVolumeHoldsItsSurfaceOnce) {
   test::TempDir dir;
   const std::string p = dir.path("ball.nrrd");
   test::write_nrrd(oblique_ball(Eigen::Vector3d(-120, 40, 17)), p, false);
-  const LoadedSkull loaded = load_skull(p);
+  const LoadedSkull loaded = load_surface(p);
   EXPECT_EQ(loaded.source_kind, "volume");
   EXPECT_GT(loaded.mesh.n_faces(), 1000u);
   EXPECT_EQ(loaded.surface.mesh.n_vertices(), 0u);

@@ -72,6 +72,33 @@ TEST(Cli, ExitCodesForUsageAndBadInput) {
       test::run_command(kCli + " import-ct " + dir.path("h.stl") + " -o " + dir.path("x.stl")), 3);
 }
 
+// STL carries no unit: a head exported in metres is refused as a skull (exit 3, naming the unit
+// it looks to be in) by the subcommands that plan on it, and read in it with --units.
+TEST(Cli, AHeadInMetresIsRefusedUntilItsUnitIsGiven) {
+  test::TempDir dir;
+  SkullMesh head = test::make_symmetric_head(4);
+  for (auto vh : head.vertices()) head.set_point(vh, head.point(vh) / 1000.0);
+  const std::string p = dir.path("head-m.stl");
+  write_mesh(head, p);
+  std::string out;
+  for (const std::string& sub :
+       {std::string(" plane "), " pipeline -o " + dir.path("pipe") + " "}) {
+    EXPECT_EQ(test::run_command(kCli + sub + p + " --json", &out), 3) << sub;
+    EXPECT_NE(Json::parse(out)["error"].get<std::string>().find(
+                  "looks to be in metres (then 1"),  // about 180 mm across
+              std::string::npos)
+        << out;
+  }
+  for (const std::string& session : {std::string(), " --session " + dir.path("s.json")}) {
+    EXPECT_EQ(test::run_command(kCli + " autoplan " + p + " -o " + dir.path("i.stl") + session), 3)
+        << session;
+  }
+  EXPECT_EQ(test::run_command(kCli + " info " + p), 0) << "any surface may be described";
+  ASSERT_EQ(test::run_command(kCli + " plane " + p + " --units m --json", &out), 0);
+  EXPECT_NEAR(std::abs(Json::parse(out)["normal"][0].get<double>()), 1.0, 1e-4);
+  EXPECT_EQ(test::run_command(kCli + " plane " + p + " --units furlong"), 2);
+}
+
 TEST(Cli, ImplantSubcommandsAndTheirErrors) {
   test::TempDir dir;
   const SkullMesh head = test::make_symmetric_head(4);

@@ -5,6 +5,7 @@
 #include <QAction>
 #include <QApplication>
 #include <QCheckBox>
+#include <QComboBox>
 #include <QDir>
 #include <QLabel>
 #include <QListWidget>
@@ -15,9 +16,11 @@
 #include <filesystem>
 
 #include "cranioplan/algorithms/load_skull.h"
+#include "cranioplan/algorithms/write_mesh.h"
 #include "cranioplan/sessions/session.h"
 #include "cranioplan/sessions/sha256.h"
 #include "main_window.h"
+#include "support/synthetic.h"
 #include "support/test_files.h"
 
 namespace cranioplan::gui {
@@ -335,6 +338,40 @@ TEST_F(Wizard, AllNineStepsOnTheSampleReplayToTheSameImplant) {
   EXPECT_EQ(slider->maximum(), static_cast<int>(replayed.stack().size()));
   slider->setValue(3);
   EXPECT_EQ(audit.controller().session().index(), replayed.index()) << "audit does not undo";
+}
+
+// A mesh in metres (STL carries no unit): refused with the unit named, then loaded once the
+// step's "Mesh units" says metres, and the unit recorded in the plan. Needs no sample case.
+TEST(WizardUnits, AMeshInMetresLoadsOnceItsUnitIsChosen) {
+  test::TempDir tmp;
+  SkullMesh head = test::make_symmetric_head(3);
+  for (auto vh : head.vertices()) head.set_point(vh, head.point(vh) / 1000.0);
+  const std::string path = tmp.path("head-m.stl");
+  write_mesh(head, path);
+  MainWindow w;
+  w.set_interactive(false);
+  w.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&w));
+  PlanController& plan = w.controller();
+  QString failure;
+  QObject::connect(&plan, &PlanController::failed, [&](const QString& m) { failure = m; });
+  w.open_input(QString::fromStdString(path));
+  plan.wait();
+  EXPECT_FALSE(plan.state().skull);
+  EXPECT_TRUE(failure.contains("looks to be in metres")) << failure.toStdString();
+
+  EXPECT_FALSE(w.set_mesh_unit("furlong"));
+  auto* units = child<QComboBox>(w, "meshUnits");
+  ASSERT_TRUE(units);
+  const int metres = units->findData(1000.0);
+  ASSERT_GE(metres, 0);
+  units->setCurrentIndex(metres);
+  w.open_input(QString::fromStdString(path));
+  plan.wait();
+  ASSERT_TRUE(plan.state().skull);
+  EXPECT_EQ(plan.state().current_step, 2);
+  const Json load = to_json(plan.session().effective_commands().front());
+  EXPECT_EQ(load["params"]["import"]["mesh_unit_mm"], 1000.0);
 }
 
 TEST_F(Wizard, CommandLineScreenshotOfASessionAtAStep) {

@@ -40,6 +40,16 @@ TEST(PlanFiles, BadFilesNameTheFileAndTheProblem) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("not valid JSON"), std::string::npos);
   }
+  // A number past a double's range: nlohmann's out_of_range, not a parse_error; it aborted.
+  test::write_bytes(dir.path("huge.json"), "{\"nasion\": [1e400, 0, 0]}");
+  try {
+    read_landmarks_file(dir.path("huge.json"));
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("not valid JSON (number overflow parsing '1e400')"),
+              std::string::npos)
+        << e.what();
+  }
   test::write_bytes(dir.path("few.json"), "{\"nasion\": [1, 2, 3]}");
   EXPECT_THROW(read_landmarks_file(dir.path("few.json")), InputError);
   test::write_bytes(

@@ -6,6 +6,8 @@
 #include <filesystem>
 #include <random>
 
+#include "cranioplan/algorithms/mesh_report.h"
+#include "cranioplan/algorithms/write_mesh.h"
 #include "cranioplan/model/error.h"
 #include "cranioplan/sessions/audit.h"
 #include "cranioplan/sessions/marker_files.h"
@@ -169,6 +171,52 @@ TEST(Commands, PlansSavedBeforeSession9ReadTheSkullAndFitTheBoneAsThen) {
   EXPECT_EQ(ImplantParams{}.trim.min_feature_mm, 1.5) << "today's default";
   EXPECT_FALSE(back.trim.clearance_mm.has_value()) << "sessions 4-8: the bone grown by a voxel";
   EXPECT_FALSE(back.trim.thin_fills_removed);
+}
+
+// A mesh's length unit is part of the load: recorded, replayed, and read as millimetres from
+// plans saved before session 13, which had none. A unit that is no length is refused.
+TEST(Commands, TheLoadRecordsTheMeshesLengthUnit) {
+  test::TempDir dir;
+  const SkullMesh head = test::make_symmetric_head(3);
+  SkullMesh in_metres = head;
+  for (auto vh : in_metres.vertices()) in_metres.set_point(vh, in_metres.point(vh) / 1000.0);
+  const std::string p = dir.path("head-m.stl");
+  write_mesh(in_metres, p);
+
+  Session refused;
+  try {
+    refused.push(commands::load_skull(p));
+    ADD_FAILURE() << "a head in metres was loaded as millimetres";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("looks to be in metres"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(refused.state().skull);
+
+  ExtractBoneSurfaceParams metres;
+  metres.mesh_unit_mm = 1000.0;
+  Session s;
+  push_ok(s, commands::load_skull(p, metres));
+  ASSERT_TRUE(s.state().skull);
+  const MeshReport size = report_mesh(s.state().skull->surface->loaded.mesh);
+  EXPECT_GT((size.bbox_max - size.bbox_min).maxCoeff(), 100.0) << "read in mm, not metres";
+  const Json load = to_json(s.effective_commands().front());
+  EXPECT_EQ(load["params"]["import"]["mesh_unit_mm"], 1000.0);
+  const std::string saved = dir.path("plan.json");
+  s.save(saved);
+  const Session back = Session::open(saved);
+  ASSERT_TRUE(back.state().skull);
+  EXPECT_LT((back.state().skull->centroid - s.state().skull->centroid).norm(), 1e-9);
+
+  ExtractBoneSurfaceParams import;
+  Json old_load = load["params"]["import"];
+  old_load.erase("mesh_unit_mm");
+  params_from_json(ParamReader(old_load, "test"), import);
+  EXPECT_EQ(import.mesh_unit_mm, 1.0);
+  for (const Json& bad : {Json(0.0), Json(-25.4), Json("m")}) {
+    Json j = load["params"]["import"];
+    j["mesh_unit_mm"] = bad;
+    EXPECT_THROW(params_from_json(ParamReader(j, "test"), import), SessionError) << bad;
+  }
 }
 
 // build_implant 4 holds the implant a set clearance off the bone's surface and removes thin

@@ -22,6 +22,9 @@ struct ExtractBoneSurfaceParams {
   /// triangles from any file give the same plan; false: as the import (or, through load_skull,
   /// the file) gives it, as plans saved before session 9 were made.
   bool canonical = true;
+  /// Through load_skull, a mesh file's length unit in millimetres (STL, PLY, OBJ and OFF carry
+  /// none): 1 for mm, 10 for cm, 1000 for metres, 25.4 for inches. Volumes carry their spacing.
+  double mesh_unit_mm = 1.0;
 };
 
 struct ExtractBoneSurfaceResult {

@@ -1,6 +1,7 @@
 #pragma once
 // One entry point for a skull from any supported file: a surface mesh, or a CT / label volume
 // turned into a bone surface.
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -23,8 +24,33 @@ struct LoadedSkull {
   double seconds = 0.0;
 };
 
-/// Reads a mesh, or imports a volume with `import` parameters. Throws InputError for bad files,
-/// including a volume in which the threshold finds no surface.
+/// Reads a mesh (in `import.mesh_unit_mm`), or imports a volume with `import` parameters: any
+/// surface, e.g. an implant. Throws InputError for bad files, including a volume in which the
+/// threshold finds no surface.
+LoadedSkull load_surface(const std::string& path, const ExtractBoneSurfaceParams& import = {});
+
+/// load_surface, for a skull to plan on: throws InputError as well when the surface cannot be
+/// a skull in millimetres by its size (check_skull_size).
 LoadedSkull load_skull(const std::string& path, const ExtractBoneSurfaceParams& import = {});
+
+/// A length unit a mesh file may be written in.
+struct LengthUnit {
+  const char* name;   ///< as the command line takes it: "mm", "cm", "m", "in", "um"
+  const char* label;  ///< for people: "millimetres", ...
+  double mm;          ///< millimetres per unit
+};
+const std::vector<LengthUnit>& length_units();
+/// The unit called `name` (LengthUnit::name), or none.
+std::optional<LengthUnit> length_unit_named(const std::string& name);
+
+/// The largest side of a skull's bounding box, mm: from a child's vault cropped close to an
+/// adult's head with its neck and jaw. Planning's distances (bone thickness, ring widths, marker
+/// spacing) are millimetres; a surface outside these sizes is in another unit, or no skull.
+constexpr double kSkullMinExtentMm = 60.0, kSkullMaxExtentMm = 500.0;
+
+/// Throws InputError naming `path` when `mesh`'s largest extent lies outside the skull's range,
+/// saying which unit the file looks to be in (the one that would make it the size of a head) and
+/// how to read it so. `read_unit_mm`: the unit the file was read in (a volume's own: 0).
+void check_skull_size(const SkullMesh& mesh, const std::string& path, double read_unit_mm);
 
 }  // namespace cranioplan

@@ -14,6 +14,9 @@ struct ReadMeshParams {
   /// The mesh in canonical form (make_canonical): vertices and triangles in an order that
   /// depends only on the triangles. false: in the file's order.
   bool canonical = true;
+  /// The file's length unit in millimetres: coordinates are multiplied by it (before the
+  /// canonical form's rounding). 1: the file is in mm.
+  double unit_mm = 1.0;
 };
 
 struct MeshFile {

@@ -22,9 +22,11 @@ struct AutoplanSession {
 
 /// Load → landmarks → fit plane → mirror → register → inspect → propose markers → build
 /// implant → review, and, when `export_path` is not empty, export. The same algorithms and
-/// parameters as `autoplan()`, so the implant is the same. Throws InputError for a bad skull.
+/// parameters as `autoplan()`, so the implant is the same. `import`: how the skull file is read
+/// (a CT's threshold, a mesh's length unit). Throws InputError for a bad skull.
 AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks& landmarks,
                                  const AutoplanParams& params, const std::string& export_path,
-                                 const SessionInfo& info = {});
+                                 const SessionInfo& info = {},
+                                 const ExtractBoneSurfaceParams& import = {});
 
 }  // namespace cranioplan
