@@ -1,5 +1,6 @@
 #pragma once
-// Private helpers of the readers: gzip inflation and extensions.
+// Private helpers of the readers: gzip inflation, extensions and binary sample types.
+#include <cstddef>
 #include <string>
 
 namespace cranioplan::detail {
@@ -8,6 +9,11 @@ namespace cranioplan::detail {
 /// that is an error, which stops a corrupt stream from filling memory.
 std::string gunzip(const std::string& path, const char* data, size_t size,
                    size_t expected_size = 0);
+
+/// The binary number types of volume and mesh files (NRRD, NIfTI, PLY...).
+enum class SampleType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
+/// Bytes of one sample.
+size_t sample_size(SampleType t);
 
 /// Lower-case extension including the dot (".stl"); ".nii.gz" for a gzipped NIfTI.
 std::string lower_extension(const std::string& path);

@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "cranioplan/model/error.h"
+#include "file_bytes.h"
 #include "mesh_formats.h"
 
 namespace cranioplan::detail {
@@ -17,47 +18,28 @@ namespace {
   throw InputError(path, "PLY: " + problem);
 }
 
-enum class Scalar { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
-
-std::optional<Scalar> scalar_named(const std::string& name) {
+std::optional<SampleType> scalar_named(const std::string& name) {
   struct Named {
     const char* name;
-    Scalar type;
+    SampleType type;
   };
-  static const Named kNames[] = {
-      {"char", Scalar::Int8},      {"int8", Scalar::Int8},       {"uchar", Scalar::UInt8},
-      {"uint8", Scalar::UInt8},    {"short", Scalar::Int16},     {"int16", Scalar::Int16},
-      {"ushort", Scalar::UInt16},  {"uint16", Scalar::UInt16},   {"int", Scalar::Int32},
-      {"int32", Scalar::Int32},    {"uint", Scalar::UInt32},     {"uint32", Scalar::UInt32},
-      {"float", Scalar::Float32},  {"float32", Scalar::Float32}, {"double", Scalar::Float64},
-      {"float64", Scalar::Float64}};
+  static const Named kNames[] = {{"char", SampleType::Int8},      {"int8", SampleType::Int8},
+                                 {"uchar", SampleType::UInt8},    {"uint8", SampleType::UInt8},
+                                 {"short", SampleType::Int16},    {"int16", SampleType::Int16},
+                                 {"ushort", SampleType::UInt16},  {"uint16", SampleType::UInt16},
+                                 {"int", SampleType::Int32},      {"int32", SampleType::Int32},
+                                 {"uint", SampleType::UInt32},    {"uint32", SampleType::UInt32},
+                                 {"float", SampleType::Float32},  {"float32", SampleType::Float32},
+                                 {"double", SampleType::Float64}, {"float64", SampleType::Float64}};
   for (const Named& n : kNames)
     if (name == n.name) return n.type;
   return std::nullopt;
 }
 
-size_t size_of(Scalar t) {
-  switch (t) {
-    case Scalar::Int8:
-    case Scalar::UInt8:
-      return 1;
-    case Scalar::Int16:
-    case Scalar::UInt16:
-      return 2;
-    case Scalar::Int32:
-    case Scalar::UInt32:
-    case Scalar::Float32:
-      return 4;
-    case Scalar::Float64:
-      return 8;
-  }
-  return 1;
-}
-
 struct Property {
   std::string name;
-  Scalar type = Scalar::Float32;  // of the value, or of a list's items
-  std::optional<Scalar> list_count;
+  SampleType type = SampleType::Float32;  // of the value, or of a list's items
+  std::optional<SampleType> list_count;
 };
 
 struct Element {
@@ -127,14 +109,14 @@ Header parse_header(const std::string& path, const std::string& bytes) {
       Property p;
       if (w.size() == 5 && w[1] == "list") {
         p.list_count = scalar_named(w[2]);
-        const std::optional<Scalar> item = scalar_named(w[3]);
-        if (!p.list_count || !item || *p.list_count == Scalar::Float32 ||
-            *p.list_count == Scalar::Float64)
+        const std::optional<SampleType> item = scalar_named(w[3]);
+        if (!p.list_count || !item || *p.list_count == SampleType::Float32 ||
+            *p.list_count == SampleType::Float64)
           fail(path, "malformed list property" + where);
         p.type = *item;
         p.name = w[4];
       } else if (w.size() == 3 && w[1] != "list") {
-        const std::optional<Scalar> t = scalar_named(w[1]);
+        const std::optional<SampleType> t = scalar_named(w[1]);
         if (!t) fail(path, "unknown property type '" + w[1].substr(0, 40) + "'" + where);
         p.type = *t;
         p.name = w[2];
@@ -169,7 +151,7 @@ class Values {
         p_(bytes.data() + h.data_start),
         end_(bytes.data() + bytes.size()),
         encoding_(h.encoding) {}
-  double next(Scalar t, const Place& at) {
+  double next(SampleType t, const Place& at) {
     if (encoding_ == Encoding::Ascii) {
       while (p_ < end_ && std::isspace(static_cast<unsigned char>(*p_))) ++p_;
       if (p_ >= end_) fail(path_, "the file ends in " + at.text());
@@ -183,7 +165,7 @@ class Values {
         fail(path_, "'" + token.substr(0, 20) + "' is not a number, in " + at.text());
       return v;
     }
-    const size_t n = size_of(t);
+    const size_t n = sample_size(t);
     if (static_cast<size_t>(end_ - p_) < n) fail(path_, "the file ends in " + at.text());
     unsigned char b[8];
     std::memcpy(b, p_, n);
@@ -209,23 +191,23 @@ class Values {
     std::memcpy(&v, b, sizeof(T));
     return static_cast<double>(v);
   }
-  static double decode(Scalar t, const unsigned char* b) {
+  static double decode(SampleType t, const unsigned char* b) {
     switch (t) {
-      case Scalar::Int8:
+      case SampleType::Int8:
         return as<int8_t>(b);
-      case Scalar::UInt8:
+      case SampleType::UInt8:
         return as<uint8_t>(b);
-      case Scalar::Int16:
+      case SampleType::Int16:
         return as<int16_t>(b);
-      case Scalar::UInt16:
+      case SampleType::UInt16:
         return as<uint16_t>(b);
-      case Scalar::Int32:
+      case SampleType::Int32:
         return as<int32_t>(b);
-      case Scalar::UInt32:
+      case SampleType::UInt32:
         return as<uint32_t>(b);
-      case Scalar::Float32:
+      case SampleType::Float32:
         return as<float>(b);
-      case Scalar::Float64:
+      case SampleType::Float64:
         return as<double>(b);
     }
     return 0.0;

@@ -13,24 +13,6 @@
 namespace cranioplan {
 namespace detail {
 
-size_t sample_size(SampleType t) {
-  switch (t) {
-    case SampleType::Int8:
-    case SampleType::UInt8:
-      return 1;
-    case SampleType::Int16:
-    case SampleType::UInt16:
-      return 2;
-    case SampleType::Int32:
-    case SampleType::UInt32:
-    case SampleType::Float32:
-      return 4;
-    case SampleType::Float64:
-      return 8;
-  }
-  return 1;
-}
-
 namespace {
 template <class T>
 void convert_typed(const char* data, size_t count, bool swap, std::vector<float>& out) {

@@ -3,11 +3,9 @@
 #include <string>
 
 #include "cranioplan/model/volume.h"
+#include "file_bytes.h"
 
 namespace cranioplan::detail {
-
-enum class SampleType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };
-size_t sample_size(SampleType t);
 
 /// Converts `count` raw samples into floats. Throws InputError when fewer bytes are available.
 void convert_samples(const std::string& path, const char* data, size_t available, size_t count,

@@ -281,10 +281,8 @@ TEST(LoadSkull, ASkullInAnotherUnitIsRefusedNamingTheUnitAndReadInIt) {
   };
   for (const Case c : {Case{"m", "metres"}, Case{"in", "inches"}, Case{"cm", "centimetres"}}) {
     const double unit_mm = length_unit_named(c.unit)->mm;
-    SkullMesh scaled = head;
-    for (auto vh : scaled.vertices()) scaled.set_point(vh, scaled.point(vh) / unit_mm);
     const std::string p = dir.path(std::string("head-") + c.unit + ".stl");
-    write_mesh(scaled, p);
+    write_mesh(test::scaled(head, 1.0 / unit_mm), p);
     try {
       load_skull(p);
       ADD_FAILURE() << "a head in " << c.label << " was planned as millimetres";
@@ -303,8 +301,7 @@ TEST(LoadSkull, ASkullInAnotherUnitIsRefusedNamingTheUnitAndReadInIt) {
     EXPECT_NEAR((got.bbox_max - got.bbox_min).maxCoeff(), extent, 1e-3 * extent) << c.unit;
   }
   // No unit makes a 2 mm part a skull; a volume of the wrong size points at its spacing.
-  SkullMesh tiny = head;
-  for (auto vh : tiny.vertices()) tiny.set_point(vh, tiny.point(vh) / 100.0);
+  const SkullMesh tiny = test::scaled(head, 0.01);
   write_mesh(tiny, dir.path("tiny.stl"));
   auto refusal = [](const std::function<void()>& load) {
     try {

@@ -76,10 +76,8 @@ TEST(Cli, ExitCodesForUsageAndBadInput) {
 // it looks to be in) by the subcommands that plan on it, and read in it with --units.
 TEST(Cli, AHeadInMetresIsRefusedUntilItsUnitIsGiven) {
   test::TempDir dir;
-  SkullMesh head = test::make_symmetric_head(4);
-  for (auto vh : head.vertices()) head.set_point(vh, head.point(vh) / 1000.0);
   const std::string p = dir.path("head-m.stl");
-  write_mesh(head, p);
+  write_mesh(test::scaled(test::make_symmetric_head(4), 1e-3), p);
   std::string out;
   for (const std::string& sub :
        {std::string(" plane "), " pipeline -o " + dir.path("pipe") + " "}) {

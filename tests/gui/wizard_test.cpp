@@ -344,10 +344,8 @@ TEST_F(Wizard, AllNineStepsOnTheSampleReplayToTheSameImplant) {
 // step's "Mesh units" says metres, and the unit recorded in the plan. Needs no sample case.
 TEST(WizardUnits, AMeshInMetresLoadsOnceItsUnitIsChosen) {
   test::TempDir tmp;
-  SkullMesh head = test::make_symmetric_head(3);
-  for (auto vh : head.vertices()) head.set_point(vh, head.point(vh) / 1000.0);
   const std::string path = tmp.path("head-m.stl");
-  write_mesh(head, path);
+  write_mesh(test::scaled(test::make_symmetric_head(3), 1e-3), path);
   MainWindow w;
   w.set_interactive(false);
   w.show();

@@ -177,11 +177,8 @@ TEST(Commands, PlansSavedBeforeSession9ReadTheSkullAndFitTheBoneAsThen) {
 // plans saved before session 13, which had none. A unit that is no length is refused.
 TEST(Commands, TheLoadRecordsTheMeshesLengthUnit) {
   test::TempDir dir;
-  const SkullMesh head = test::make_symmetric_head(3);
-  SkullMesh in_metres = head;
-  for (auto vh : in_metres.vertices()) in_metres.set_point(vh, in_metres.point(vh) / 1000.0);
   const std::string p = dir.path("head-m.stl");
-  write_mesh(in_metres, p);
+  write_mesh(test::scaled(test::make_symmetric_head(3), 1e-3), p);
 
   Session refused;
   try {

@@ -94,6 +94,12 @@ SkullMesh cut_hole(const SkullMesh& mesh, const Eigen::Vector3d& center, double 
   return build_mesh(s);
 }
 
+SkullMesh scaled(const SkullMesh& mesh, double factor) {
+  SkullMesh out = mesh;
+  for (auto vh : out.vertices()) out.set_point(vh, out.point(vh) * factor);
+  return out;
+}
+
 SkullMesh transformed(const SkullMesh& mesh, const RigidTransform& t) {
   SkullMesh out = mesh;
   for (auto vh : out.vertices()) out.set_point(vh, to_point(t.apply(to_eigen(out.point(vh)))));

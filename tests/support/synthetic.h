@@ -25,6 +25,9 @@ TriangleSoup box_soup(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
 SkullMesh cut_hole(const SkullMesh& mesh, const Eigen::Vector3d& center, double radius);
 
 SkullMesh transformed(const SkullMesh& mesh, const RigidTransform& t);
+/// The mesh with every coordinate multiplied by `factor` (a head written in another unit:
+/// 1/1000 for metres).
+SkullMesh scaled(const SkullMesh& mesh, double factor);
 Landmarks transformed(const Landmarks& lm, const RigidTransform& t);
 Plane transformed(const Plane& p, const RigidTransform& t);
 
