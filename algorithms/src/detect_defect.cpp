@@ -330,6 +330,18 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
       region.message += " (" + std::to_string(region.other_openings) +
                         (region.other_openings == 1 ? " other opening" : " other openings") +
                         kUnplannedOpeningsNote;
+    // Asked for the opening towards a point, and none lies that way: the nearest was planned,
+    // and the message says so (a point on intact bone, or at a cut that did not go through,
+    // would otherwise plan another opening without a word).
+    if (params.near && (*params.near - center).norm() > 1e-9) {
+      const Eigen::Vector3d want = (*params.near - center).normalized();
+      double closest = -1.0;
+      for (int i : comp) closest = std::max(closest, dirs[i].dot(want));
+      region.near_miss_deg = std::acos(std::clamp(closest, -1.0, 1.0)) * 180.0 / M_PI;
+      if (region.near_miss_deg > kNearMissDeg)
+        region.message += "; no opening lies towards the point given: the nearest, planned, is " +
+                          std::to_string(std::lround(region.near_miss_deg)) + "° from it";
+    }
     region.unseen_rim = unseen_rim_stretches(region.outer_rim);
     if (!region.unseen_rim.empty()) {
       std::string lengths;

@@ -68,9 +68,18 @@ struct DefectRegion {
   /// graze the bone or meet other bone first (along an orbit), so the outline there is
   /// interpolated between rim points far apart. The message names them; the wizard draws them.
   std::vector<RimStretch> unseen_rim;
+  /// With DetectDefectParams::near: the angle, seen from `center`, between the point and the
+  /// opening's nearest ray, degrees (0 when the point lies in the opening's direction). Over
+  /// kNearMissDeg the message says that no opening lies towards the point.
+  double near_miss_deg = 0.0;
   double seconds = 0.0;
   bool found() const { return status == Status::Found; }
 };
+
+/// A point given to choose the opening (DetectDefectParams::near) that lies further than this
+/// from every ray through the opening planned, degrees, is said to miss it (a point on the rim
+/// lies within a ray spacing or two, about 3°).
+inline constexpr double kNearMissDeg = 10.0;
 
 /// What the message says after the count of further openings it left unplanned.
 inline constexpr char kUnplannedOpeningsNote[] =
