@@ -260,8 +260,7 @@ TriangleSoup read_off(const std::string& path, const std::string& bytes) {
     }
     // Colour values may follow on the same line.
     while (cur.p < cur.end && *cur.p != '\n') ++cur.p;
-    detail::add_polygon(path, poly, static_cast<int>(nv), soup.triangles,
-                        "face on line " + format_count(cur.line));
+    detail::add_polygon(path, poly, static_cast<int>(nv), soup.triangles, "face on line", cur.line);
   }
   return soup;
 }
@@ -305,7 +304,7 @@ TriangleSoup read_obj(const std::string& path, const std::string& bytes) {
       if (poly.size() < 3)
         fail(path, "face with fewer than 3 vertices on line " + format_count(line_no));
       detail::add_polygon(path, poly, static_cast<int>(soup.vertices.size()), soup.triangles,
-                          "face on line " + format_count(line_no));
+                          "face on line", line_no);
     }
   }
   return soup;
@@ -330,8 +329,7 @@ TriangleSoup soup_from_polydata(const std::string& path, vtkPolyData* pd) {
   for (cells->InitTraversal(); cells->GetNextCell(ids);) {
     poly.assign(ids->begin(), ids->end());
     if (poly.size() >= 3)
-      detail::add_polygon(path, poly, static_cast<int>(np), soup.triangles,
-                          "polygon " + format_count(++cell));
+      detail::add_polygon(path, poly, static_cast<int>(np), soup.triangles, "polygon", ++cell);
   }
   vtkCellArray* strips = pd->GetStrips();
   for (strips->InitTraversal(); strips->GetNextCell(ids);)
@@ -355,11 +353,11 @@ TriangleSoup read_vtp(const std::string& path) {
 }  // namespace
 
 void detail::add_polygon(const std::string& path, const std::vector<int>& poly, int nv,
-                         std::vector<Eigen::Vector3i>& tris, const std::string& where) {
+                         std::vector<Eigen::Vector3i>& tris, const char* what, long long number) {
   for (int idx : poly)
     if (idx < 0 || idx >= nv)
-      fail(path, where + " uses vertex " + std::to_string(idx) + " but the file has " +
-                     format_count(nv) + " vertices (numbered from 0)");
+      fail(path, what + (" " + format_count(number)) + " uses vertex " + std::to_string(idx) +
+                     " but the file has " + format_count(nv) + " vertices (numbered from 0)");
   for (size_t k = 1; k + 1 < poly.size(); ++k) tris.emplace_back(poly[0], poly[k], poly[k + 1]);
 }
 

@@ -150,7 +150,9 @@ class Values {
       : path_(path),
         p_(bytes.data() + h.data_start),
         end_(bytes.data() + bytes.size()),
-        encoding_(h.encoding) {}
+        encoding_(h.encoding),
+        swap_(encoding_ != Encoding::Ascii &&
+              (encoding_ == Encoding::LittleEndian) != host_is_little_endian()) {}
   double next(SampleType t, const Place& at) {
     if (encoding_ == Encoding::Ascii) {
       while (p_ < end_ && std::isspace(static_cast<unsigned char>(*p_))) ++p_;
@@ -170,10 +172,7 @@ class Values {
     unsigned char b[8];
     std::memcpy(b, p_, n);
     p_ += n;
-    const uint16_t probe = 1;
-    unsigned char first;
-    std::memcpy(&first, &probe, 1);
-    if ((encoding_ == Encoding::LittleEndian) != (first == 1))
+    if (swap_)
       for (size_t i = 0; i < n / 2; ++i) std::swap(b[i], b[n - 1 - i]);
     return decode(t, b);
   }
@@ -185,6 +184,12 @@ class Values {
   }
 
  private:
+  static bool host_is_little_endian() {
+    const uint16_t probe = 1;
+    unsigned char first;
+    std::memcpy(&first, &probe, 1);
+    return first == 1;
+  }
   template <class T>
   static double as(const unsigned char* b) {
     T v;
@@ -216,6 +221,7 @@ class Values {
   const char* p_;
   const char* end_;
   Encoding encoding_;
+  bool swap_;  // binary, in the other byte order than this machine's
 };
 
 int index_of(const Element& e, const char* name) {
@@ -231,7 +237,9 @@ TriangleSoup read_ply(const std::string& path, const std::string& bytes) {
   Values values(path, bytes, h);
   TriangleSoup soup;
   const Element* vertex_element = nullptr;
-  std::vector<std::vector<int>> faces;
+  // The faces' vertex indices, one after another; face f is [starts[f], starts[f + 1]).
+  std::vector<int> indices_read;
+  std::vector<size_t> starts{0};
   constexpr long long kMaxPolygon = 1000000;
   for (const Element& e : h.elements) {
     const bool is_vertex = e.name == "vertex", is_face = e.name == "face";
@@ -252,7 +260,7 @@ TriangleSoup read_ply(const std::string& path, const std::string& bytes) {
       if (indices < 0) indices = index_of(e, "vertex_index");
       if (indices < 0 || !e.properties[indices].list_count)
         fail(path, "the face element has no vertex_indices list");
-      faces.reserve(std::min<size_t>(static_cast<size_t>(e.count), values.room(13)));
+      starts.reserve(std::min<size_t>(static_cast<size_t>(e.count), values.room(13)) + 1);
     }
     Place place{&e, 0};
     for (long long item = 0; item < e.count; ++item) {
@@ -267,29 +275,31 @@ TriangleSoup read_ply(const std::string& path, const std::string& bytes) {
           continue;
         }
         const double n = values.next(*prop.list_count, place);
-        if (n < 0 || n > kMaxPolygon || n != std::floor(n))
-          fail(path, "a list of " + format_count(static_cast<long long>(n)) + " values in " +
-                         place.text());
+        if (!(n >= 0 && n <= kMaxPolygon && n == std::floor(n)))
+          fail(path, "a list of " + std::to_string(n) + " values in " + place.text());
         const bool keep = static_cast<int>(k) == indices;
-        std::vector<int> poly;
         for (long long j = 0; j < static_cast<long long>(n); ++j) {
           const double v = values.next(prop.type, place);
-          if (keep) {
-            if (v != std::floor(v) || std::abs(v) > 0x7fffffff)
-              fail(path, "vertex index " + std::to_string(v) + " in " + place.text());
-            poly.push_back(static_cast<int>(v));
-          }
+          if (!keep) continue;
+          if (!(v == std::floor(v) && std::abs(v) <= 0x7fffffff))
+            fail(path, "vertex index " + std::to_string(v) + " in " + place.text());
+          indices_read.push_back(static_cast<int>(v));
         }
-        if (keep) faces.push_back(std::move(poly));
+        if (keep) starts.push_back(indices_read.size());
       }
       if (is_vertex) soup.vertices.push_back(p);
     }
   }
   if (!vertex_element) fail(path, "the file has no vertex element");
   const int nv = static_cast<int>(soup.vertices.size());
-  for (size_t f = 0; f < faces.size(); ++f)
-    if (faces[f].size() >= 3)
-      add_polygon(path, faces[f], nv, soup.triangles, "face " + format_count(f + 1LL));
+  std::vector<int> poly;
+  soup.triangles.reserve(starts.size() - 1);
+  for (size_t f = 0; f + 1 < starts.size(); ++f) {
+    if (starts[f + 1] - starts[f] < 3) continue;
+    poly.assign(indices_read.begin() + static_cast<ptrdiff_t>(starts[f]),
+                indices_read.begin() + static_cast<ptrdiff_t>(starts[f + 1]));
+    add_polygon(path, poly, nv, soup.triangles, "face", static_cast<long long>(f) + 1);
+  }
   return soup;
 }
 
