@@ -18,7 +18,10 @@ std::string sample_case_path() {
   return "/usr/share/doc/invesalius-examples/examples/Cranium.inv3";
 }
 
-LoadedSkull load_surface(const std::string& path, const ExtractBoneSurfaceParams& import) {
+namespace {
+
+// A skull (`as_skull`: turned outward when the file winds it inward) or any surface.
+LoadedSkull load(const std::string& path, const ExtractBoneSurfaceParams& import, bool as_skull) {
   const auto t0 = std::chrono::steady_clock::now();
   LoadedSkull out;
   if (is_volume_path(path)) {
@@ -34,15 +37,18 @@ LoadedSkull load_surface(const std::string& path, const ExtractBoneSurfaceParams
     ReadMeshParams read;
     read.canonical = import.canonical;
     read.unit_mm = import.mesh_unit_mm;
+    read.orient_outward = as_skull && import.orient_outward;
     MeshFile file = read_mesh(path, read);
     out.mesh = file.mesh;  // a copy (OpenMesh meshes cannot be moved); `file` goes at once
     out.source_kind = "mesh";
     out.description = file.format;
     if (import.mesh_unit_mm != 1.0) {
-      std::string unit = std::to_string(import.mesh_unit_mm) + " mm units";
+      char unit[48];
+      std::snprintf(unit, sizeof(unit), "units of %g mm", import.mesh_unit_mm);
+      std::string named = unit;
       for (const LengthUnit& u : length_units())
-        if (u.mm == import.mesh_unit_mm) unit = u.label;
-      out.description += " in " + unit;
+        if (u.mm == import.mesh_unit_mm) named = u.label;
+      out.description += " in " + named;
     }
     out.warnings = std::move(file.warnings);
   }
@@ -50,8 +56,14 @@ LoadedSkull load_surface(const std::string& path, const ExtractBoneSurfaceParams
   return out;
 }
 
+}  // namespace
+
+LoadedSkull load_surface(const std::string& path, const ExtractBoneSurfaceParams& import) {
+  return load(path, import, false);
+}
+
 LoadedSkull load_skull(const std::string& path, const ExtractBoneSurfaceParams& import) {
-  LoadedSkull out = load_surface(path, import);
+  LoadedSkull out = load(path, import, true);
   check_skull_size(out.mesh, path, out.source_kind == "mesh" ? import.mesh_unit_mm : 0.0);
   return out;
 }
@@ -90,14 +102,15 @@ void check_skull_size(const SkullMesh& mesh, const std::string& path, double rea
                         mm(kSkullMinExtentMm) + " to " + mm(kSkullMaxExtentMm) + " across";
   if (read_unit_mm <= 0.0)
     throw InputError(path, problem + ": check the voxel spacing in the volume's header");
-  // The unit that makes it the size of a head (about 190 mm), if any.
+  // The unit that makes it nearest the size of a head, if any.
+  constexpr double kHeadMm = 190.0;  // an adult skull's largest extent, about
   const double in_file_units = extent / read_unit_mm;
   std::optional<LengthUnit> likely;
   for (const LengthUnit& u : length_units()) {
     const double size = in_file_units * u.mm;
     if (u.mm == read_unit_mm || size < kSkullMinExtentMm || size > kSkullMaxExtentMm) continue;
-    if (!likely ||
-        std::abs(std::log(size / 190.0)) < std::abs(std::log(in_file_units * likely->mm / 190.0)))
+    if (!likely || std::abs(std::log(size / kHeadMm)) <
+                       std::abs(std::log(in_file_units * likely->mm / kHeadMm)))
       likely = u;
   }
   if (!likely)

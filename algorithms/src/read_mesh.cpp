@@ -8,6 +8,7 @@
 #include <vtkSmartPointer.h>
 #include <vtkXMLPolyDataReader.h>
 
+#include <Eigen/Geometry>
 #include <cassert>
 #include <cmath>
 #include <cstdint>
@@ -350,6 +351,19 @@ TriangleSoup read_vtp(const std::string& path) {
   return soup_from_polydata(path, reader->GetOutput());
 }
 
+// The volume the triangles enclose, taken about the vertices' centroid (for a surface with
+// holes, as a skull's base and defect are, that origin keeps the open parts' share small).
+double enclosed_volume(const TriangleSoup& soup) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const auto& v : soup.vertices) c += v;
+  c /= static_cast<double>(std::max<size_t>(1, soup.vertices.size()));
+  double six_v = 0.0;
+  for (const auto& t : soup.triangles)
+    six_v +=
+        (soup.vertices[t[0]] - c).dot((soup.vertices[t[1]] - c).cross(soup.vertices[t[2]] - c));
+  return six_v / 6.0;
+}
+
 }  // namespace
 
 void detail::add_polygon(const std::string& path, const std::vector<int>& poly, int nv,
@@ -401,6 +415,13 @@ MeshFile read_mesh(const std::string& path, const ReadMeshParams& params) {
   assert(params.unit_mm > 0.0 && std::isfinite(params.unit_mm) && "validated by the caller");
   if (params.unit_mm != 1.0)
     for (auto& v : soup.vertices) v *= params.unit_mm;
+  if (params.orient_outward && enclosed_volume(soup) < 0.0) {
+    for (auto& t : soup.triangles) std::swap(t[1], t[2]);
+    out.turned_outward = true;
+    out.warnings.push_back(path +
+                           ": the surface was inside out (its triangles wind inward); it was "
+                           "turned outward");
+  }
   if (params.canonical) make_canonical(soup);
 
   BuildMeshStats stats;

@@ -862,11 +862,20 @@ void MainWindow::show_quality() {
 
 void MainWindow::refresh_page() {
   const PlanState& s = controller_->state();
-  if (skull_info_)
-    skull_info_->setText(s.skull ? tr("%1<br>%2 triangles")
-                                       .arg(q(s.skull->surface->loaded.description).toHtmlEscaped())
-                                       .arg(s.skull->surface->mesh.n_faces())
-                                 : tr("No skull loaded."));
+  if (skull_info_) {
+    QString info = tr("No skull loaded.");
+    if (s.skull) {
+      const LoadedSkull& loaded = s.skull->surface->loaded;
+      info = tr("%1<br>%2 triangles")
+                 .arg(q(loaded.description).toHtmlEscaped())
+                 .arg(s.skull->surface->mesh.n_faces());
+      // What the reader changed or found (a skull turned outward, non-manifold edges).
+      for (const std::string& w : loaded.warnings)
+        info +=
+            QStringLiteral("<br><span style='color:#a05a00'>⚠ %1</span>").arg(q(w).toHtmlEscaped());
+    }
+    skull_info_->setText(info);
+  }
   if (plane_info_) {
     QString t;
     if (s.plane_fit)

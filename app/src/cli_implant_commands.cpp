@@ -141,6 +141,8 @@ Json autoplan_with_session(const std::string& skull, const ExtractBoneSurfacePar
                                                                     : "failed"},
          {"message", a.message}};
   j.update(plan_state_json(s));
+  if (s.skull && !s.skull->surface->loaded.warnings.empty())
+    j["warnings"] = s.skull->surface->loaded.warnings;
   Json times = Json::object();
   for (const auto& c : a.session.effective_commands())
     times[type_tag(c.type)] = c.meta.duration_ms / 1000.0;
@@ -460,23 +462,29 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
                                       o->session, o->all_openings, json);
            const LoadedSkull loaded = load_skull(o->skull, o->import);
            const SkullMesh& skull = loaded.mesh;
+           // The reader's warnings (a skull turned outward, non-manifold edges) with the plan.
+           auto with_warnings = [&loaded](Json j) {
+             if (!loaded.warnings.empty()) j["warnings"] = loaded.warnings;
+             return j;
+           };
            if (!o->all_openings) {
              const AutoplanResult r = autoplan(skull, lm, o->params);
-             print_result(write_autoplan(r, o->output, o->markers_out), json);
+             print_result(with_warnings(write_autoplan(r, o->output, o->markers_out)), json);
              return r.planned() ? kOk : kUnusable;
            }
            // Every opening in turn; the first is the one planned without
            // --all-openings.
            const std::vector<AutoplanResult> all = autoplan_all_openings(skull, lm, o->params);
            if (!all.front().defect.found()) {  // no defect, or no plane
-             print_result(write_autoplan(all.front(), o->output, o->markers_out), json);
+             print_result(with_warnings(write_autoplan(all.front(), o->output, o->markers_out)),
+                          json);
              return all.front().planned() ? kOk : kUnusable;
            }
            Json plans = Json::array();
            bool all_planned = true;
            for (size_t k = 0; k < all.size(); ++k) {
-             plans.push_back(
-                 write_autoplan(all[k], numbered_path(o->output, k + 1), markers_path(k + 1)));
+             plans.push_back(with_warnings(
+                 write_autoplan(all[k], numbered_path(o->output, k + 1), markers_path(k + 1))));
              all_planned = all_planned && all[k].planned();
            }
            print_plans(plans, json);

@@ -214,12 +214,14 @@ int current_version(CommandType type) {
   // registration ("registration"), which a replay applies instead of computing them again.
   // build_implant 3: the fit to the bone's parameters ("trim"; versions 1 and 2 are read with
   // those of sessions 4-8). load_skull 2: the skull read in canonical form ("import.canonical";
-  // version 1 is read as the file gives it).
+  // version 1 is read as the file gives it). load_skull 3 (session 13): a mesh's length unit
+  // ("import.mesh_unit_mm", mm when absent) and a skull that winds inward turned outward
+  // ("import.orient_outward", not when absent).
   // build_implant 4: the fit to the bone holds the implant "clearance_mm" off the bone's
   // surface and removes thin fills ("thin_fills_removed"); version 3 is read without either.
   if (type == CommandType::BuildImplant) return 4;
   if (type == CommandType::ProposeMarkers) return 3;
-  if (type == CommandType::LoadSkull) return 2;
+  if (type == CommandType::LoadSkull) return 3;
   // register 2 and adjust_plane 2 record the registration they gave ("result"; adjust_plane:
   // "registration", when the mirror was registered again), which a replay applies.
   if (type == CommandType::FitPlane || type == CommandType::Register ||
@@ -280,6 +282,7 @@ Json params_to_json(const ExtractBoneSurfaceParams& p) {
   Json j = write_fields([](auto& v, auto& q) { extract_fields(v, q); }, p);
   j["canonical"] = p.canonical;
   j["mesh_unit_mm"] = p.mesh_unit_mm;
+  j["orient_outward"] = p.orient_outward;
   return j;
 }
 Json params_to_json(const PlaneFitParams& p) {
@@ -336,6 +339,8 @@ void params_from_json(const ParamReader& r, ExtractBoneSurfaceParams& p) {
   p.mesh_unit_mm = r.has("mesh_unit_mm") ? r.number("mesh_unit_mm") : 1.0;
   if (!(p.mesh_unit_mm > 0.0) || !std::isfinite(p.mesh_unit_mm))
     throw SessionError(r.where(), "parameter 'mesh_unit_mm' must be a positive length in mm");
+  // Nor did they turn a skull that winds inward outward.
+  p.orient_outward = r.has("orient_outward") && r.boolean("orient_outward");
 }
 void params_from_json(const ParamReader& r, PlaneFitParams& p) {
   Reader v{r};

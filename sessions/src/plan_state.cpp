@@ -369,6 +369,7 @@ void apply_load(PlanState& s, const ParamReader& r, const ApplyContext& ctx) {
   fresh.message = "loaded " + loaded.description + ": " +
                   format_count(static_cast<long long>(fresh.skull->surface->mesh.n_faces())) +
                   " triangles";
+  for (const std::string& w : loaded.warnings) fresh.message += "; " + w;
   s = std::move(fresh);
 }
 

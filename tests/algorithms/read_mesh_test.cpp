@@ -322,6 +322,35 @@ TEST(LoadSkull, ASkullInAnotherUnitIsRefusedNamingTheUnitAndReadInIt) {
   EXPECT_FALSE(length_unit_named("furlong"));
 }
 
+// Some exporters wind triangles the other way: the skull then encloses a negative volume and
+// its normals point in, which the detection reads as inner and outer tables swapped (the
+// sample turned inside out: "too little intact bone around the opening (0 rays)"). load_skull
+// turns it outward, with a warning, into the very mesh the outward file gives; load_surface
+// (an implant for the quality check) keeps it as it is.
+TEST(LoadSkull, ASkullThatWindsInwardIsTurnedOutward) {
+  TempDir dir;
+  const SkullMesh head =
+      test::cut_hole(test::make_symmetric_head(3),
+                     test::head_surface_point(Eigen::Vector3d(0.7, 0.1, 0.7).normalized()), 25);
+  TriangleSoup inward = to_soup(head);
+  for (auto& t : inward.triangles) std::swap(t[1], t[2]);
+  write_mesh(head, dir.path("out.stl"));
+  write_mesh(build_mesh(inward), dir.path("in.stl"));
+  ASSERT_LT(signed_volume(load_surface(dir.path("in.stl")).mesh), 0.0) << "kept as it is";
+  const LoadedSkull turned = load_skull(dir.path("in.stl"));
+  EXPECT_GT(signed_volume(turned.mesh), 0.0);
+  ASSERT_EQ(turned.warnings.size(), 1u);
+  EXPECT_NE(turned.warnings[0].find("inside out"), std::string::npos) << turned.warnings[0];
+  const LoadedSkull outward = load_skull(dir.path("out.stl"));
+  EXPECT_TRUE(outward.warnings.empty());
+  const TriangleSoup a = to_soup(turned.mesh), b = to_soup(outward.mesh);
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_EQ(a.vertices, b.vertices);
+  ExtractBoneSurfaceParams as_it_came;
+  as_it_came.orient_outward = false;
+  EXPECT_LT(signed_volume(load_skull(dir.path("in.stl"), as_it_came).mesh), 0.0);
+}
+
 TEST(WriteMesh, RefusesUnknownExtensionAndMissingFolder) {
   const SkullMesh head = test::make_symmetric_head(1);
   EXPECT_THROW(write_mesh(head, "/tmp/x.obj"), InputError);

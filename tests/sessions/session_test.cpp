@@ -144,7 +144,7 @@ TEST(Commands, BuildImplantVersionOneIsReadByItsOwnRules) {
 // bridged). Today's commands record both, and read them back as recorded.
 TEST(Commands, PlansSavedBeforeSession9ReadTheSkullAndFitTheBoneAsThen) {
   const Json load = to_json(commands::load_skull("skull.stl"));
-  EXPECT_EQ(load["version"], 2);
+  EXPECT_EQ(load["version"], 3);
   ExtractBoneSurfaceParams import;
   params_from_json(ParamReader(load["params"]["import"], "test"), import);
   EXPECT_TRUE(import.canonical);
@@ -174,7 +174,8 @@ TEST(Commands, PlansSavedBeforeSession9ReadTheSkullAndFitTheBoneAsThen) {
 }
 
 // A mesh's length unit is part of the load: recorded, replayed, and read as millimetres from
-// plans saved before session 13, which had none. A unit that is no length is refused.
+// plans saved before session 13, which had none (nor turned a skull that winds inward
+// outward). A unit that is no length is refused.
 TEST(Commands, TheLoadRecordsTheMeshesLengthUnit) {
   test::TempDir dir;
   const std::string p = dir.path("head-m.stl");
@@ -207,8 +208,11 @@ TEST(Commands, TheLoadRecordsTheMeshesLengthUnit) {
   ExtractBoneSurfaceParams import;
   Json old_load = load["params"]["import"];
   old_load.erase("mesh_unit_mm");
+  old_load.erase("orient_outward");
   params_from_json(ParamReader(old_load, "test"), import);
   EXPECT_EQ(import.mesh_unit_mm, 1.0);
+  EXPECT_FALSE(import.orient_outward) << "plans before session 13 read the skull as it came";
+  EXPECT_EQ(load["params"]["import"]["orient_outward"], true);
   for (const Json& bad : {Json(0.0), Json(-25.4), Json("m")}) {
     Json j = load["params"]["import"];
     j["mesh_unit_mm"] = bad;

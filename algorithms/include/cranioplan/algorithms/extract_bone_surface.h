@@ -25,6 +25,10 @@ struct ExtractBoneSurfaceParams {
   /// Through load_skull, a mesh file's length unit in millimetres (STL, PLY, OBJ and OFF carry
   /// none): 1 for mm, 10 for cm, 1000 for metres, 25.4 for inches. Volumes carry their spacing.
   double mesh_unit_mm = 1.0;
+  /// Through load_skull, a mesh whose triangles wind inward is turned outward (with a warning);
+  /// false: as the file gives it, as plans saved before session 13 read it. CT surfaces are
+  /// made outward.
+  bool orient_outward = true;
 };
 
 struct ExtractBoneSurfaceResult {

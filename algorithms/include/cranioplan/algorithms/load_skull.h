@@ -29,8 +29,9 @@ struct LoadedSkull {
 /// threshold finds no surface.
 LoadedSkull load_surface(const std::string& path, const ExtractBoneSurfaceParams& import = {});
 
-/// load_surface, for a skull to plan on: throws InputError as well when the surface cannot be
-/// a skull in millimetres by its size (check_skull_size).
+/// load_surface, for a skull to plan on: a mesh that winds inward is turned outward (with a
+/// warning; `import.orient_outward`), and a surface that cannot be a skull in millimetres by
+/// its size is an InputError as well (check_skull_size).
 LoadedSkull load_skull(const std::string& path, const ExtractBoneSurfaceParams& import = {});
 
 /// A length unit a mesh file may be written in.

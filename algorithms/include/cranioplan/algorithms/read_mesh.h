@@ -17,6 +17,11 @@ struct ReadMeshParams {
   /// The file's length unit in millimetres: coordinates are multiplied by it (before the
   /// canonical form's rounding). 1: the file is in mm.
   double unit_mm = 1.0;
+  /// A surface whose triangles wind inward (it encloses a negative volume, taken about its
+  /// vertices' centroid) is turned outward, with a warning (MeshFile::turned_outward): some
+  /// exporters wind the other way, and a skull's inside and outside tables are told apart by
+  /// its normals. false: as the file gives it.
+  bool orient_outward = false;
 };
 
 struct MeshFile {
@@ -25,6 +30,7 @@ struct MeshFile {
   long long triangles_in_file = 0;    ///< triangles (after fan triangulation of polygons)
   long long degenerate_dropped = 0;   ///< zero-area triangles removed
   long long nonmanifold_split = 0;    ///< triangles added on duplicated vertices
+  bool turned_outward = false;        ///< ReadMeshParams::orient_outward turned it
   std::vector<std::string> warnings;  ///< one sentence each, naming the file
 };
 
