@@ -210,6 +210,7 @@ int run(int argc, char** argv) {
       params.refine = !no_refine;
       const PlaneFit fit = fit_sagittal_plane(s.mesh, lm, params);
       Json r = to_json(fit);
+      if (!s.warnings.empty()) r["warnings"] = s.warnings;
       if (!fit.usable()) {
         print_result(r, json);
         return kUnusable;
@@ -224,6 +225,7 @@ int run(int argc, char** argv) {
       const SkullMesh m = mirror_mesh(s.mesh, p);
       write_mesh(m, output);
       Json r{{"output", output}, {"plane", to_json(p)}, {"mesh", to_json(report_mesh(m))}};
+      if (!s.warnings.empty()) r["warnings"] = s.warnings;
       print_result(r, json);
       return kOk;
     }
