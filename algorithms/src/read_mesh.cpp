@@ -8,7 +8,6 @@
 #include <vtkSmartPointer.h>
 #include <vtkXMLPolyDataReader.h>
 
-#include <Eigen/Geometry>
 #include <cassert>
 #include <cmath>
 #include <cstdint>
@@ -347,21 +346,17 @@ TriangleSoup read_vtp(const std::string& path) {
   const detail::VtkErrorCatcher errors(reader);
   reader->SetFileName(path.c_str());
   reader->Update();
-  if (!errors.message().empty()) fail(path, "not a readable VTP file (" + errors.message() + ")");
+  const std::string error = errors.message();
+  if (!error.empty()) fail(path, "not a readable VTP file (" + error + ")");
   return soup_from_polydata(path, reader->GetOutput());
 }
 
 // The volume the triangles enclose, taken about the vertices' centroid (for a surface with
-// holes, as a skull's base and defect are, that origin keeps the open parts' share small).
+// holes, as a skull's base and defect are, a point inside keeps the open parts' share small).
 double enclosed_volume(const TriangleSoup& soup) {
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
   for (const auto& v : soup.vertices) c += v;
-  c /= static_cast<double>(std::max<size_t>(1, soup.vertices.size()));
-  double six_v = 0.0;
-  for (const auto& t : soup.triangles)
-    six_v +=
-        (soup.vertices[t[0]] - c).dot((soup.vertices[t[1]] - c).cross(soup.vertices[t[2]] - c));
-  return six_v / 6.0;
+  return signed_volume(soup, c / static_cast<double>(std::max<size_t>(1, soup.vertices.size())));
 }
 
 }  // namespace

@@ -282,10 +282,11 @@ double signed_volume(const SkullMesh& mesh) {
   return six_v / 6.0;
 }
 
-double signed_volume(const TriangleSoup& soup) {
+double signed_volume(const TriangleSoup& soup, const Eigen::Vector3d& about) {
   double six_v = 0.0;
   for (const auto& t : soup.triangles)
-    six_v += soup.vertices[t[0]].dot(soup.vertices[t[1]].cross(soup.vertices[t[2]]));
+    six_v += (soup.vertices[t[0]] - about)
+                 .dot((soup.vertices[t[1]] - about).cross(soup.vertices[t[2]] - about));
   return six_v / 6.0;
 }
 

@@ -54,8 +54,11 @@ TriangleSoup to_soup(const SkullMesh& mesh);
 Eigen::Matrix3Xd vertex_matrix(const SkullMesh& mesh);
 
 /// Signed volume (mm³) enclosed by the faces: positive for a closed, outward-oriented mesh.
+/// Taken about `about` (the same for any point when the surface is closed; for a surface with
+/// holes, a point inside it keeps the open parts' share small).
 double signed_volume(const SkullMesh& mesh);
-double signed_volume(const TriangleSoup& soup);
+double signed_volume(const TriangleSoup& soup,
+                     const Eigen::Vector3d& about = Eigen::Vector3d::Zero());
 
 /// Reverses the orientation of every face (normals point the other way).
 void flip_orientation(SkullMesh& mesh);
