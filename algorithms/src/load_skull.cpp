@@ -4,10 +4,10 @@
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
-#include <limits>
 
 #include "cranioplan/algorithms/read_mesh.h"
 #include "cranioplan/algorithms/read_volume.h"
+#include "cranioplan/algorithms/voxelize_mesh.h"
 #include "cranioplan/model/error.h"
 
 namespace cranioplan {
@@ -85,12 +85,7 @@ std::optional<LengthUnit> length_unit_named(const std::string& name) {
 
 void check_skull_size(const SkullMesh& mesh, const std::string& path, double read_unit_mm) {
   if (mesh.n_vertices() == 0) return;
-  Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-  Eigen::Vector3d hi = -lo;
-  for (auto vh : mesh.vertices()) {
-    lo = lo.cwiseMin(to_eigen(mesh.point(vh)));
-    hi = hi.cwiseMax(to_eigen(mesh.point(vh)));
-  }
+  const auto [lo, hi] = mesh_bounds(mesh);
   const double extent = (hi - lo).maxCoeff();
   if (extent >= kSkullMinExtentMm && extent <= kSkullMaxExtentMm) return;
   auto mm = [](double v) {

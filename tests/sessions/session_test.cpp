@@ -213,6 +213,16 @@ TEST(Commands, TheLoadRecordsTheMeshesLengthUnit) {
   EXPECT_EQ(import.mesh_unit_mm, 1.0);
   EXPECT_FALSE(import.orient_outward) << "plans before session 13 read the skull as it came";
   EXPECT_EQ(load["params"]["import"]["orient_outward"], true);
+  // The reader's warnings reach the load's message (the wizard's status bar): here a head whose
+  // triangles wind inward, turned outward.
+  TriangleSoup inward = to_soup(test::make_symmetric_head(3));
+  for (auto& t : inward.triangles) std::swap(t[1], t[2]);
+  write_mesh(build_mesh(inward), dir.path("inward.stl"));
+  Session turned;
+  push_ok(turned, commands::load_skull(dir.path("inward.stl")));
+  EXPECT_NE(turned.state().message.find("inward.stl: the surface was inside out"),
+            std::string::npos)
+      << turned.state().message;
   for (const Json& bad : {Json(0.0), Json(-25.4), Json("m")}) {
     Json j = load["params"]["import"];
     j["mesh_unit_mm"] = bad;
