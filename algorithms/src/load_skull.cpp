@@ -25,7 +25,10 @@ LoadedSkull load(const std::string& path, const ExtractBoneSurfaceParams& import
   const auto t0 = std::chrono::steady_clock::now();
   LoadedSkull out;
   if (is_volume_path(path)) {
-    const Volume volume = read_volume(path);
+    ReadVolumeParams read;
+    read.dicom_series = import.dicom_series;
+    read.patient_frame = import.patient_frame;
+    const Volume volume = read_volume(path, read);
     out.surface = extract_bone_surface(volume, import);
     if (!out.surface.usable()) throw InputError(path, out.surface.message);
     // OpenMesh meshes cannot be moved (std::move copies), so the import's copy is cleared.
@@ -33,11 +36,14 @@ LoadedSkull load(const std::string& path, const ExtractBoneSurfaceParams& import
     out.surface.mesh.clear();
     out.source_kind = "volume";
     out.description = volume.description;
+    out.frame = volume.frame;
+    out.warnings = volume.warnings;
   } else {
     ReadMeshParams read;
     read.canonical = import.canonical;
     read.unit_mm = import.mesh_unit_mm;
     read.orient_outward = as_skull && import.orient_outward;
+    read.far_piece_mm = as_skull && import.drop_far_pieces ? kFarPieceMm : 0.0;
     MeshFile file = read_mesh(path, read);
     out.mesh = file.mesh;  // a copy (OpenMesh meshes cannot be moved); `file` goes at once
     out.source_kind = "mesh";
@@ -51,6 +57,8 @@ LoadedSkull load(const std::string& path, const ExtractBoneSurfaceParams& import
       out.description += " in " + named;
     }
     out.warnings = std::move(file.warnings);
+    out.frame = "the file's own coordinates (a mesh file declares no frame), taken as LPS";
+    out.pieces_dropped = file.pieces_dropped;
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;

@@ -50,10 +50,17 @@ SoupComponents soup_components(const TriangleSoup& soup) {
 
 TriangleSoup keep_largest_pieces(const TriangleSoup& soup, const SoupComponents& comps,
                                  int keep_count) {
+  std::vector<bool> keep(comps.sizes.size(), false);
+  for (size_t c = 0; c < keep.size() && static_cast<int>(c) < keep_count; ++c) keep[c] = true;
+  return keep_pieces(soup, comps, keep);
+}
+
+TriangleSoup keep_pieces(const TriangleSoup& soup, const SoupComponents& comps,
+                         const std::vector<bool>& keep) {
   TriangleSoup out;
   std::vector<int> remap(soup.vertices.size(), -1);
   for (size_t i = 0; i < soup.triangles.size(); ++i) {
-    if (comps.label[i] >= keep_count) continue;
+    if (!keep[static_cast<size_t>(comps.label[i])]) continue;
     Eigen::Vector3i t;
     for (int k = 0; k < 3; ++k) {
       int& m = remap[soup.triangles[i][k]];
@@ -66,6 +73,26 @@ TriangleSoup keep_largest_pieces(const TriangleSoup& soup, const SoupComponents&
     out.triangles.push_back(t);
   }
   return out;
+}
+
+
+std::vector<PieceBox> piece_boxes(const TriangleSoup& soup, const SoupComponents& comps) {
+  std::vector<PieceBox> boxes(comps.sizes.size());
+  for (size_t i = 0; i < soup.triangles.size(); ++i) {
+    PieceBox& b = boxes[static_cast<size_t>(comps.label[i])];
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d& p = soup.vertices[soup.triangles[i][k]];
+      b.lo = b.lo.cwiseMin(p);
+      b.hi = b.hi.cwiseMax(p);
+    }
+  }
+  return boxes;
+}
+
+double PieceBox::gap_to(const PieceBox& o) const {
+  const Eigen::Vector3d g =
+      (o.lo - hi).cwiseMax(lo - o.hi).cwiseMax(Eigen::Vector3d::Zero());
+  return g.norm();
 }
 
 }  // namespace cranioplan

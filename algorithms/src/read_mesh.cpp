@@ -9,13 +9,16 @@
 #include <vtkXMLPolyDataReader.h>
 
 #include <cassert>
+#include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <sstream>
 
 #include "cranioplan/algorithms/file_io.h"
+#include "cranioplan/algorithms/mesh_components.h"
 #include "cranioplan/model/error.h"
 #include "file_bytes.h"
 #include "mesh_formats.h"
@@ -41,16 +44,16 @@ class FloatWelder {
       const float v = xyz[i] == 0.0f ? 0.0f : xyz[i];  // -0 and +0 weld together
       std::memcpy(&k[i], &v, 4);
     }
-    uint64_t h = (k[0] * 0x9E3779B97F4A7C15ull) ^ (k[1] * 0xC2B2AE3D27D4EB4Full) ^
-                 (k[2] * 0x165667B19E3779F9ull);
-    h ^= h >> 29;
-    size_t slot = static_cast<size_t>(h) & mask_;
+    size_t slot = hash(k) & mask_;
     while (true) {
       const int idx = slots_[slot];
       if (idx < 0) {
         const int id = static_cast<int>(keys_.size() / 3);
         keys_.insert(keys_.end(), k, k + 3);
         slots_[slot] = id;
+        // At most half the slots in use: the probe above always meets a free slot (a file's
+        // triangles may name up to three new points each, more than the size guessed).
+        if (2 * (keys_.size() / 3) > slots_.size()) grow();
         return id;
       }
       const uint32_t* e = &keys_[static_cast<size_t>(idx) * 3];
@@ -69,6 +72,21 @@ class FloatWelder {
   }
 
  private:
+  static size_t hash(const uint32_t* k) {
+    uint64_t h = (k[0] * 0x9E3779B97F4A7C15ull) ^ (k[1] * 0xC2B2AE3D27D4EB4Full) ^
+                 (k[2] * 0x165667B19E3779F9ull);
+    h ^= h >> 29;
+    return static_cast<size_t>(h);
+  }
+  void grow() {
+    slots_.assign(slots_.size() * 2, -1);
+    mask_ = slots_.size() - 1;
+    for (size_t id = 0; id < keys_.size() / 3; ++id) {
+      size_t slot = hash(&keys_[id * 3]) & mask_;
+      while (slots_[slot] >= 0) slot = (slot + 1) & mask_;
+      slots_[slot] = static_cast<int>(id);
+    }
+  }
   std::vector<int> slots_;
   std::vector<uint32_t> keys_;
   size_t mask_ = 0;
@@ -359,6 +377,34 @@ double enclosed_volume(const TriangleSoup& soup) {
   return signed_volume(soup, c / static_cast<double>(std::max<size_t>(1, soup.vertices.size())));
 }
 
+// Drops the pieces that lie more than `far_mm` from the largest piece's bounding box.
+void drop_far_pieces(const std::string& path, double far_mm, TriangleSoup& soup, MeshFile& out) {
+  const SoupComponents comps = soup_components(soup);
+  if (comps.sizes.size() < 2) return;
+  const std::vector<PieceBox> boxes = piece_boxes(soup, comps);
+  std::vector<bool> keep(comps.sizes.size(), true);
+  double farthest = 0.0;
+  for (size_t c = 1; c < keep.size(); ++c) {
+    const double gap = boxes[c].gap_to(boxes[0]);
+    if (gap <= far_mm) continue;
+    keep[c] = false;
+    ++out.pieces_dropped;
+    out.triangles_dropped += comps.sizes[c];
+    farthest = std::max(farthest, gap);
+  }
+  if (out.pieces_dropped == 0) return;
+  soup = keep_pieces(soup, comps, keep);
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.0f mm", farthest);
+  out.warnings.push_back(
+      path + ": " + format_count(out.pieces_dropped) + " piece" +
+      (out.pieces_dropped == 1 ? "" : "s") + " of " + format_count(out.triangles_dropped) +
+      " triangles lying apart from the skull (up to " + buf + " from it) " +
+      (out.pieces_dropped == 1 ? "was" : "were") + " dropped; the skull is its largest piece (" +
+      format_count(comps.sizes[0]) + " triangles) and what lies within " +
+      std::to_string(static_cast<int>(far_mm)) + " mm of it");
+}
+
 }  // namespace
 
 void detail::add_polygon(const std::string& path, const std::vector<int>& poly, int nv,
@@ -410,6 +456,7 @@ MeshFile read_mesh(const std::string& path, const ReadMeshParams& params) {
   assert(params.unit_mm > 0.0 && std::isfinite(params.unit_mm) && "validated by the caller");
   if (params.unit_mm != 1.0)
     for (auto& v : soup.vertices) v *= params.unit_mm;
+  if (params.far_piece_mm > 0.0) drop_far_pieces(path, params.far_piece_mm, soup, out);
   if (params.orient_outward && enclosed_volume(soup) < 0.0) {
     for (auto& t : soup.triangles) std::swap(t[1], t[2]);
     out.turned_outward = true;

@@ -70,6 +70,12 @@ void convert_samples(const std::string& path, const char* data, size_t available
                                  " is not a number (NaN or Inf)");
 }
 
+void flip_axes(Volume& v, const Eigen::Vector3d& signs) {
+  const Eigen::Matrix3d f = signs.asDiagonal();
+  v.directions = f * v.directions;
+  v.origin = f * v.origin;
+}
+
 void classify_kind(Volume& v) {
   for (float x : v.data)
     if (x != 0.0f && x != 1.0f) {
@@ -81,6 +87,13 @@ void classify_kind(Volume& v) {
 
 }  // namespace detail
 
+namespace {
+// A missing path without an extension was meant as a DICOM folder, most likely.
+std::string ext_of_missing(const std::string& path) {
+  return detail::lower_extension(path).empty() ? "no such file or folder" : "file not found";
+}
+}  // namespace
+
 bool is_volume_path(const std::string& path) {
   std::error_code ec;
   if (std::filesystem::is_directory(path, ec)) return true;
@@ -89,19 +102,21 @@ bool is_volume_path(const std::string& path) {
          ext == ".dcm";
 }
 
-Volume read_volume(const std::string& path) {
+Volume read_volume(const std::string& path, const ReadVolumeParams& params) {
   std::error_code ec;
-  if (!std::filesystem::exists(path, ec)) throw InputError(path, "file not found");
+  const bool folder = std::filesystem::is_directory(path, ec);
+  if (!std::filesystem::exists(path, ec))
+    throw InputError(path, ext_of_missing(path));
   Volume v;
   const std::string ext = detail::lower_extension(path);
-  if (std::filesystem::is_directory(path, ec))
-    v = detail::read_dicom_folder(path);
+  if (folder)
+    v = detail::read_dicom_folder(path, params.dicom_series);
   else if (ext == ".inv3")
     v = detail::read_inv3(path);
   else if (ext == ".nrrd" || ext == ".nhdr")
-    v = detail::read_nrrd(path);
+    v = detail::read_nrrd(path, params.patient_frame);
   else if (ext == ".nii" || ext == ".nii.gz")
-    v = detail::read_nifti(path);
+    v = detail::read_nifti(path, params.patient_frame);
   else
     throw InputError(path, "unknown volume format '" + ext +
                                "' (expected .inv3, .nrrd, .nhdr, .nii, .nii.gz or a DICOM folder)");

@@ -14,9 +14,13 @@ void convert_samples(const std::string& path, const char* data, size_t available
 /// Marks the volume as a mask when all samples are 0 or 1.
 void classify_kind(Volume& v);
 
+/// Turns positions written in a space whose axes are LPS's times `signs` (RAS: -1, -1, 1) into
+/// LPS.
+void flip_axes(Volume& v, const Eigen::Vector3d& signs);
+
 Volume read_inv3(const std::string& path);
-Volume read_nrrd(const std::string& path);
-Volume read_nifti(const std::string& path);
-Volume read_dicom_folder(const std::string& path);
+Volume read_nrrd(const std::string& path, bool patient_frame);
+Volume read_nifti(const std::string& path, bool patient_frame);
+Volume read_dicom_folder(const std::string& path, const std::string& series_uid);
 
 }  // namespace cranioplan::detail

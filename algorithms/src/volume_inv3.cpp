@@ -53,6 +53,16 @@ struct Plist {
     if (a == std::string::npos || b == std::string::npos) return {};
     return xml.substr(a + element.size() + 2, b - a - element.size() - 2);
   }
+  // The text of the element that comes next after `from` (a key's value), whatever its type.
+  std::string next_value(size_t from) const {
+    const size_t a = xml.find('<', from);
+    if (a == std::string::npos) return {};
+    const size_t b = xml.find('>', a);
+    if (b == std::string::npos || xml[b - 1] == '/') return {};
+    const std::string tag = xml.substr(a + 1, b - a - 1);
+    const size_t c = xml.find("</" + tag + ">", b);
+    return c == std::string::npos ? std::string() : xml.substr(b + 1, c - b - 1);
+  }
   std::vector<double> numbers_in_array(size_t from) const {
     std::vector<double> out;
     const size_t end = xml.find("</array>", from);
@@ -97,6 +107,20 @@ Volume read_inv3(const std::string& path) {
   if (dtype.empty() || filename.empty() || shape_at == std::string::npos ||
       spacing_at == std::string::npos)
     throw InputError(path, "main.plist lacks the matrix dtype, filename, shape or spacing");
+  // InVesalius's "orientation" of the series it was made from: 1 axial, 2 coronal, 3 sagittal
+  // (constants.py); the matrix's layout differs for each, and only the axial one is read.
+  const size_t orientation_at = plist.find_key("orientation");
+  if (orientation_at != std::string::npos) {
+    const std::string named = plist.next_value(orientation_at);
+    if (!named.empty() && named != "1" && named != "AXIAL")
+      throw InputError(path, "the project was made from a " +
+                                 std::string(named == "2" || named == "CORONAL" ? "coronal"
+                                             : named == "3" || named == "SAGITTAL"
+                                                 ? "sagittal"
+                                                 : "non-axial (" + named + ")") +
+                                 " series; only projects of axial series are read (import the "
+                                 "DICOM series itself)");
+  }
   const std::vector<double> shape = plist.numbers_in_array(shape_at);
   const std::vector<double> spacing = plist.numbers_in_array(spacing_at);
   if (shape.size() != 3 || spacing.size() != 3)
@@ -132,12 +156,15 @@ Volume read_inv3(const std::string& path) {
   Volume v;
   // shape is (slices, rows, columns) = (k, j, i); spacing is (x, y, z).
   v.dims = {static_cast<int>(shape[2]), static_cast<int>(shape[1]), static_cast<int>(shape[0])};
-  // InVesalius stores the rows of each slice flipped with respect to DICOM (row 0 is the
-  // patient's front): flip j so that the frame is right-handed and patient-true (LPS-like:
-  // x to the patient's left, y to the back, z up). Without the flip every mesh would be the
-  // mirror image of the patient, and so would an implant designed on it.
+  // InVesalius's layout of an axial series (docs/FRAMES.md, from its source): slices in
+  // GDCM's IPPSorter order (k towards the head), each slice's rows reversed from DICOM's
+  // (row 0 of the matrix is DICOM's last row, the back of the head), columns as in DICOM
+  // (towards the patient's left). j is flipped back so that the frame is the patient's LPS;
+  // without the flip every mesh would be the mirror image of the patient. The project keeps
+  // no ImagePositionPatient: the first voxel of the first slice lies at x = 0, z = 0.
   v.directions = Eigen::Vector3d(spacing[0], -spacing[1], spacing[2]).asDiagonal();
   v.origin = Eigen::Vector3d(0.0, spacing[1] * (shape[1] - 1), 0.0);
+  v.frame = "InVesalius project (axial series in InVesalius's layout), LPS; origin not stored";
   convert_samples(path + " (" + filename + ")", data_it->second.data(), data_it->second.size(),
                   v.size(), type, false, v.data);
   if (data_it->second.size() != v.size() * sample_size(type))

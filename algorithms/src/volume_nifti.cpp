@@ -1,5 +1,5 @@
 // NIfTI-1 volumes (.nii, .nii.gz): world coordinates from the sform when set, else the qform,
-// else the voxel sizes. Both byte orders.
+// else the voxel sizes; NIfTI's RAS turned to the patient's LPS. Both byte orders.
 #include <cmath>
 #include <cstdint>
 #include <cstring>
@@ -29,7 +29,7 @@ struct HeaderReader {
 
 }  // namespace
 
-Volume read_nifti(const std::string& path) {
+Volume read_nifti(const std::string& path, bool patient_frame) {
   const std::string raw = read_file_bytes(path);
   const bool gz = raw.size() >= 2 && static_cast<unsigned char>(raw[0]) == 0x1f &&
                   static_cast<unsigned char>(raw[1]) == 0x8b;
@@ -116,6 +116,20 @@ Volume read_nifti(const std::string& path) {
   }
   if (!v.directions.allFinite() || !v.origin.allFinite())
     throw InputError(path, "NIfTI orientation holds values that are not numbers");
+  // NIfTI's sform and qform give RAS+ positions (x to the patient's right... negative: left).
+  if (sform_code > 0 || qform_code > 0) {
+    v.frame = std::string(sform_code > 0 ? "NIfTI sform" : "NIfTI qform") + " (RAS)";
+    if (patient_frame) {
+      flip_axes(v, Eigen::Vector3d(-1, -1, 1));
+      v.frame += ", turned to LPS";
+    }
+  } else {
+    v.frame = "none declared (NIfTI without sform or qform); the voxel axes read as LPS";
+    v.warnings.push_back(path +
+                         ": the file declares no orientation (neither sform nor qform), so "
+                         "the patient's left and right are not known from it; its voxel axes "
+                         "were read as left, posterior, superior");
+  }
   const size_t offset = static_cast<size_t>(vox_offset);
   convert_samples(path, bytes.data() + offset, bytes.size() - offset, v.size(), type, swap, v.data);
   float slope = h.get<float>(112);

@@ -1,6 +1,7 @@
 // NRRD (teem) volumes: attached or detached data, raw or gzip, `space directions` (possibly
 // oblique) and `space origin`; `spacings` when no directions are given.
 #include <algorithm>
+#include <optional>
 #include <cctype>
 #include <cstdlib>
 #include <filesystem>
@@ -69,9 +70,41 @@ std::vector<Eigen::Vector3d> parse_vectors(const std::string& path, const std::s
   return out;
 }
 
+// The NRRD `space` (its name or abbreviation) as signs of LPS's axes; none for spaces that are
+// no patient's (scanner-xyz, 3D-right-handed) or absent.
+std::optional<Eigen::Vector3d> patient_space_signs(std::string space) {
+  std::transform(space.begin(), space.end(), space.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (space == "left-posterior-superior" || space == "lps") return Eigen::Vector3d(1, 1, 1);
+  if (space == "right-anterior-superior" || space == "ras") return Eigen::Vector3d(-1, -1, 1);
+  if (space == "left-anterior-superior" || space == "las") return Eigen::Vector3d(1, -1, 1);
+  return std::nullopt;
+}
+
+void frame_from_space(const std::string& path, const std::string& space, bool patient_frame,
+                      Volume& v) {
+  const std::optional<Eigen::Vector3d> signs = patient_space_signs(space);
+  if (!signs) {
+    v.frame = space.empty() ? std::string("none declared (NRRD without 'space')")
+                            : "NRRD space '" + space + "' (no patient's)";
+    v.frame += "; read as LPS";
+    v.warnings.push_back(path + ": the file declares " +
+                         (space.empty() ? std::string("no patient space")
+                                        : "the space '" + space + "', which is no patient's") +
+                         ", so the patient's left and right are not known from it; its axes "
+                         "were read as left, posterior, superior");
+    return;
+  }
+  v.frame = "NRRD space " + space;
+  if (patient_frame && *signs != Eigen::Vector3d(1, 1, 1)) {
+    flip_axes(v, *signs);
+    v.frame += ", turned to LPS";
+  }
+}
+
 }  // namespace
 
-Volume read_nrrd(const std::string& path) {
+Volume read_nrrd(const std::string& path, bool patient_frame) {
   const std::string bytes = read_file_bytes(path);
   if (bytes.compare(0, 4, "NRRD") != 0) throw InputError(path, "not a NRRD file (no 'NRRD' magic)");
   std::map<std::string, std::string> fields;
@@ -138,6 +171,7 @@ Volume read_nrrd(const std::string& path) {
     if (o.size() != 1) throw InputError(path, "NRRD 'space origin' must be one vector");
     v.origin = o[0];
   }
+  frame_from_space(path, field("space"), patient_frame, v);
   const std::string encoding = field("encoding");
   const bool big_endian = field("endian") == "big";
   std::string detached;

@@ -1015,6 +1015,7 @@ void MainWindow::open_input(const QString& path, double threshold) {
   ExtractBoneSurfaceParams import;
   const bool volume = is_volume_path(path.toStdString());
   if (!volume) import.mesh_unit_mm = units_->currentData().toDouble();
+  if (volume && QFileInfo(path).isDir() && !choose_dicom_series(path, import)) return;
   if (volume) {
     import.threshold = std::isfinite(threshold) ? threshold : threshold_->value();
     if (interactive_ && !std::isfinite(threshold)) {
@@ -1038,6 +1039,45 @@ void MainWindow::open_input(const QString& path, double threshold) {
   total_timer_.restart();
   add_recent(path);
   push(commands::load_skull(path.toStdString(), import), tr("Loading %1").arg(case_id));
+}
+
+bool MainWindow::choose_dicom_series(const QString& folder, ExtractBoneSurfaceParams& import) {
+  std::vector<DicomSeries> series;
+  try {
+    series = list_dicom_series(folder.toStdString());
+  } catch (const Error& e) {
+    show_message(QString::fromStdString(e.what()), true);
+    return false;
+  }
+  if (series.size() < 2 || !interactive_) return true;  // the reader takes the largest CT
+  // The default is the reader's own choice: the largest CT series.
+  QStringList items;
+  int preferred = 0;
+  long long best = -1;
+  for (size_t i = 0; i < series.size(); ++i) {
+    const DicomSeries& d = series[i];
+    items << tr("%1 — %2 %3×%4×%5 — %6")
+                 .arg(d.description.empty() ? tr("(no description)") : q(d.description))
+                 .arg(q(d.modality))
+                 .arg(d.columns)
+                 .arg(d.rows)
+                 .arg(d.slices)
+                 .arg(q(d.uid));
+    const long long size = (d.modality == "CT" ? 1LL << 40 : 0) + d.slices * d.rows * d.columns;
+    if (size > best) {
+      best = size;
+      preferred = static_cast<int>(i);
+    }
+  }
+  bool ok = false;
+  const QString chosen =
+      QInputDialog::getItem(this, tr("DICOM series"),
+                            tr("The folder holds %1 series. Which is the skull's CT?")
+                                .arg(series.size()),
+                            items, preferred, false, &ok);
+  if (!ok) return false;
+  import.dicom_series = series[static_cast<size_t>(items.indexOf(chosen))].uid;
+  return true;
 }
 
 bool MainWindow::set_mesh_unit(const std::string& name) {

@@ -49,6 +49,8 @@ class MainWindow : public QMainWindow {
   /// The length unit meshes are read in (step 1's "Mesh units"): mm, cm, m, in or um; false
   /// for another name.
   bool set_mesh_unit(const std::string& name);
+  // Which series of a DICOM folder to read (asked when it holds several); false: cancelled.
+  bool choose_dicom_series(const QString& folder, ExtractBoneSurfaceParams& import);
   void open_sample();
   bool open_session(const QString& path);
   /// Shows the plan as it was when step `step` was current (commands of later steps undone).

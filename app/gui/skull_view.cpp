@@ -5,6 +5,7 @@
 // clang-format on
 
 #include <vtkActor.h>
+#include <vtkAnnotatedCubeActor.h>
 #include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
@@ -206,6 +207,42 @@ constexpr std::array<double, 3> kEdge{0.10, 0.75, 0.20};
 constexpr std::array<double, 3> kSurface{0.90, 0.20, 0.85};
 constexpr std::array<double, 3> kImplant{0.95, 0.70, 0.25};
 
+void setup_orientation_marker(vtkRenderer* r, vtkAnnotatedCubeActor* cube) {
+  cube->SetXPlusFaceText("L");
+  cube->SetXMinusFaceText("R");
+  cube->SetYPlusFaceText("P");
+  cube->SetYMinusFaceText("A");
+  cube->SetZPlusFaceText("S");
+  cube->SetZMinusFaceText("I");
+  cube->SetFaceTextScale(0.62);
+  cube->GetCubeProperty()->SetColor(0.82, 0.84, 0.88);
+  cube->GetTextEdgesProperty()->SetColor(0.2, 0.2, 0.2);
+  cube->GetTextEdgesProperty()->SetLineWidth(1.0);
+  // Left/right red, anterior/posterior green, superior/inferior blue, as in Slicer and ITK-SNAP.
+  for (auto* p : {cube->GetXPlusFaceProperty(), cube->GetXMinusFaceProperty()})
+    p->SetColor(0.85, 0.15, 0.15);
+  for (auto* p : {cube->GetYPlusFaceProperty(), cube->GetYMinusFaceProperty()})
+    p->SetColor(0.15, 0.65, 0.20);
+  for (auto* p : {cube->GetZPlusFaceProperty(), cube->GetZMinusFaceProperty()})
+    p->SetColor(0.20, 0.35, 0.90);
+  r->SetLayer(1);
+  r->InteractiveOff();
+  r->AddActor(cube);
+}
+
+// The marker's camera looks along the main camera's direction, with its up, from a fixed
+// distance: the cube turns as the skull does.
+void follow_camera(vtkCamera* main, vtkCamera* marker) {
+  double dop[3], up[3];
+  main->GetDirectionOfProjection(dop);
+  main->GetViewUp(up);
+  marker->SetFocalPoint(0, 0, 0);
+  marker->SetPosition(-4.0 * dop[0], -4.0 * dop[1], -4.0 * dop[2]);
+  marker->SetViewUp(up);
+  marker->SetViewAngle(30.0);
+  marker->SetClippingRange(0.1, 20.0);
+}
+
 }  // namespace
 
 struct SkullView::Impl {
@@ -228,6 +265,11 @@ struct SkullView::Impl {
   vtkNew<vtkPolyData> unseen_data;
   vtkNew<vtkPolyDataMapper> unseen_mapper;
   vtkNew<vtkActor> unseen_actor;
+  // The patient's directions in the lower-left corner: a cube labelled L/R, A/P, S/I in the
+  // frame meshes are in (LPS: +x is the patient's left, +y posterior, +z superior), turned with
+  // the camera, so a skull that came in reflected or upside down shows at a glance.
+  vtkNew<vtkRenderer> orientation;
+  vtkNew<vtkAnnotatedCubeActor> orientation_cube;
 
   std::vector<Marker> markers;
   bool mirror_wanted = true, plane_wanted = true, markers_editable = false, camera_set = false;
@@ -312,6 +354,8 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
   }
   d.unseen_actor->SetVisibility(false);
   d.overlay->AddActor(d.unseen_actor);
+  setup_orientation_marker(d.orientation, d.orientation_cube);
+  d.window->AddRenderer(d.orientation);
 }
 
 SkullView::~SkullView() {
@@ -336,6 +380,9 @@ void SkullView::resizeGL(int w, int h) {
   const int pw = static_cast<int>(w * d.dpr), ph = static_cast<int>(h * d.dpr);
   d.window->SetSize(pw, ph);
   d.interactor->UpdateSize(pw, ph);
+  const double side = 96.0 * d.dpr;  // the orientation cube's square, pixels
+  d.orientation->SetViewport(0.0, 0.0, std::min(1.0, side / std::max(1, pw)),
+                             std::min(1.0, side / std::max(1, ph)));
 }
 
 void SkullView::paintGL() {
@@ -343,6 +390,7 @@ void SkullView::paintGL() {
   d.dpr = devicePixelRatioF();
   d.window->SetReadyForRendering(true);
   d.window->SetSize(static_cast<int>(width() * d.dpr), static_cast<int>(height() * d.dpr));
+  follow_camera(d.renderer->GetActiveCamera(), d.orientation->GetActiveCamera());
   d.window->Render();
   d.window->SetReadyForRendering(false);
 }

@@ -435,6 +435,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
     cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
     cmd->add_option("--markers-out", o->markers_out, "proposed markers to write (.json or .csv)");
     add_units_option(cmd, o->import.mesh_unit_mm);
+    add_series_option(cmd, o->import.dicom_series);
     cmd->add_option("--near", o->near,
                     "X Y Z (mm): with several openings, plan the one in this point's direction "
                     "(default: the largest)")

@@ -26,9 +26,11 @@ struct ImportOptions {
   long long target_triangles = 0;
   long long all_pieces_above = 0;
   double mesh_unit_mm = 1.0;
+  std::string dicom_series;
   ExtractBoneSurfaceParams params() const {
     ExtractBoneSurfaceParams p;
     p.threshold = threshold;
+    p.dicom_series = dicom_series;
     p.mesh_unit_mm = mesh_unit_mm;
     p.target_triangles = target_triangles;
     if (all_pieces_above > 0) {
@@ -49,10 +51,15 @@ void add_import_options(CLI::App* cmd, ImportOptions& o) {
                   "keep every piece of at least N triangles instead of only the largest")
       ->check(CLI::NonNegativeNumber);
   add_units_option(cmd, o.mesh_unit_mm);
+  add_series_option(cmd, o.dicom_series);
 }
 
 Json skull_json(const LoadedSkull& s) {
-  Json j{{"source", s.source_kind}, {"format", s.description}, {"load_s", s.seconds}};
+  Json j{{"source", s.source_kind},
+         {"format", s.description},
+         {"frame", s.frame},
+         {"load_s", s.seconds}};
+  if (s.pieces_dropped > 0) j["pieces_dropped"] = s.pieces_dropped;
   if (s.source_kind == "volume") {
     j["threshold"] = s.surface.threshold_used;
     j["pieces_found"] = s.surface.pieces_found;
@@ -154,6 +161,12 @@ int run(int argc, char** argv) {
   pipeline->add_option("-o,--output", output, "output folder")->required();
   add_import_options(pipeline, import);
 
+  // series
+  std::string series_folder;
+  auto* series = app.add_subcommand("series", "List the DICOM series of a folder");
+  series->add_option("FOLDER", series_folder, "folder of DICOM files (searched 8 deep)")
+      ->required();
+
   // bench
   BenchOptions bench_options;
   auto* bench = app.add_subcommand("bench", "Time the pipeline's steps on the sample case");
@@ -189,7 +202,22 @@ int run(int argc, char** argv) {
       print_result(r, json);
       return kOk;
     }
+    if (series->parsed()) {
+      Json list = Json::array();
+      for (const DicomSeries& d : list_dicom_series(series_folder))
+        list.push_back({{"uid", d.uid},
+                        {"modality", d.modality},
+                        {"description", d.description},
+                        {"columns", d.columns},
+                        {"rows", d.rows},
+                        {"slices", d.slices}});
+      print_result(Json{{"folder", series_folder}, {"series", list}}, json);
+      return list.empty() ? kUnusable : kOk;
+    }
     if (import_ct->parsed()) {
+      std::error_code ec;
+      if (!std::filesystem::exists(ct_path, ec))
+        throw InputError(ct_path, "does not exist (no such file or folder)");
       if (!is_volume_path(ct_path))
         throw InputError(ct_path,
                          "is not a volume (expected .inv3, .nrrd, .nhdr, .nii, .nii.gz "

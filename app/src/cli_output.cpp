@@ -55,6 +55,12 @@ void add_units_option(CLI::App* cmd, double& mesh_unit_mm) {
       ->transform(CLI::CheckedTransformer(units));
 }
 
+void add_series_option(CLI::App* cmd, std::string& series_uid) {
+  cmd->add_option("--series", series_uid,
+                  "a DICOM folder's series to read, by its SeriesInstanceUID (default: the "
+                  "largest CT series; `series FOLDER` lists them)");
+}
+
 Eigen::Vector3d parse_point(const std::string& text, const std::string& option) {
   std::stringstream in(text);
   Eigen::Vector3d p;

@@ -221,7 +221,10 @@ int current_version(CommandType type) {
   // surface and removes thin fills ("thin_fills_removed"); version 3 is read without either.
   if (type == CommandType::BuildImplant) return 4;
   if (type == CommandType::ProposeMarkers) return 3;
-  if (type == CommandType::LoadSkull) return 3;
+  // load_skull 4: volumes in the patient's frame ("import.patient_frame"), a DICOM folder's
+  // series ("import.dicom_series"), a mesh's far pieces dropped ("import.drop_far_pieces");
+  // absent, as version 3 read them.
+  if (type == CommandType::LoadSkull) return 4;
   // register 2 and adjust_plane 2 record the registration they gave ("result"; adjust_plane:
   // "registration", when the mirror was registered again), which a replay applies.
   if (type == CommandType::FitPlane || type == CommandType::Register ||
@@ -283,6 +286,9 @@ Json params_to_json(const ExtractBoneSurfaceParams& p) {
   j["canonical"] = p.canonical;
   j["mesh_unit_mm"] = p.mesh_unit_mm;
   j["orient_outward"] = p.orient_outward;
+  j["patient_frame"] = p.patient_frame;
+  j["drop_far_pieces"] = p.drop_far_pieces;
+  j["dicom_series"] = p.dicom_series;
   return j;
 }
 Json params_to_json(const PlaneFitParams& p) {
@@ -341,6 +347,11 @@ void params_from_json(const ParamReader& r, ExtractBoneSurfaceParams& p) {
     throw SessionError(r.where(), "parameter 'mesh_unit_mm' must be a positive length in mm");
   // Nor did they turn a skull that winds inward outward.
   p.orient_outward = r.has("orient_outward") && r.boolean("orient_outward");
+  // Before load_skull 4, a NRRD's or NIfTI's positions were read as the file writes them (NIfTI
+  // in RAS), and a mesh's far pieces were kept.
+  p.patient_frame = r.has("patient_frame") && r.boolean("patient_frame");
+  p.drop_far_pieces = r.has("drop_far_pieces") && r.boolean("drop_far_pieces");
+  p.dicom_series = r.has("dicom_series") ? r.string("dicom_series") : std::string();
 }
 void params_from_json(const ParamReader& r, PlaneFitParams& p) {
   Reader v{r};

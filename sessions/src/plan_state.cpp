@@ -344,7 +344,7 @@ struct Refusal {
 void apply_load(PlanState& s, const ParamReader& r, const ApplyContext& ctx) {
   const std::string recorded = r.string("path");
   const std::string path = resolve_input(recorded, ctx);
-  const std::string sha = sha256_hex(read_file_bytes(path));  // the bytes go before the mesh comes
+  const std::string sha = sha256_file(path);  // the bytes go before the mesh comes
   const std::string expected = r.string("sha256");
   if (sha != expected)
     throw SessionError(
@@ -369,6 +369,7 @@ void apply_load(PlanState& s, const ParamReader& r, const ApplyContext& ctx) {
   fresh.message = "loaded " + loaded.description + ": " +
                   format_count(static_cast<long long>(fresh.skull->surface->mesh.n_faces())) +
                   " triangles";
+  if (!loaded.frame.empty()) fresh.message += "; patient frame: " + loaded.frame;
   for (const std::string& w : loaded.warnings) fresh.message += "; " + w;
   s = std::move(fresh);
 }

@@ -2,9 +2,13 @@
 
 #include <openssl/evp.h>
 
+#include <algorithm>
 #include <cassert>
+#include <filesystem>
+#include <vector>
 
 #include "cranioplan/algorithms/file_io.h"
+#include "cranioplan/model/error.h"
 
 namespace cranioplan {
 
@@ -24,6 +28,26 @@ std::string sha256_hex(std::string_view bytes) {
   return out;
 }
 
-std::string sha256_file(const std::string& path) { return sha256_hex(read_file_bytes(path)); }
+std::string sha256_file(const std::string& path) {
+  namespace fs = std::filesystem;
+  std::error_code ec;
+  if (!fs::is_directory(path, ec)) return sha256_hex(read_file_bytes(path));
+  // A folder (a DICOM series): its files' relative paths and hashes, in name order.
+  std::vector<std::string> lines;
+  for (fs::recursive_directory_iterator it(path, fs::directory_options::skip_permission_denied,
+                                           ec),
+       end;
+       !ec && it != end; it.increment(ec)) {
+    std::error_code fec;
+    if (!it->is_regular_file(fec)) continue;
+    lines.push_back(fs::relative(it->path(), path, fec).generic_string() + '\0' +
+                    sha256_hex(read_file_bytes(it->path().string())) + '\n');
+  }
+  if (ec) throw InputError(path, "the folder cannot be listed: " + ec.message());
+  std::sort(lines.begin(), lines.end());
+  std::string all;
+  for (const std::string& l : lines) all += l;
+  return sha256_hex(all);
+}
 
 }  // namespace cranioplan

@@ -359,3 +359,55 @@ TEST(WriteMesh, RefusesUnknownExtensionAndMissingFolder) {
 
 }  // namespace
 }  // namespace cranioplan
+
+namespace cranioplan {
+namespace {
+
+// Every triangle of a binary STL may name three points no other triangle names (a mutated or
+// unwelded file): the welder's table, sized for a welded mesh, must grow rather than fill and
+// probe for a free slot forever.
+TEST(ReadMesh, ABinaryStlOfUnsharedVerticesIsReadNotSpunOn) {
+  test::TempDir dir;
+  std::vector<std::array<float, 9>> tris;
+  for (int t = 0; t < 5000; ++t) {
+    const float x = static_cast<float>(t) * 0.01f;
+    tris.push_back({x, 0, 0, x, 1, 0, x, 0, 1});
+  }
+  test::write_bytes(dir.path("unshared.stl"), binary_stl(tris, static_cast<uint32_t>(tris.size())));
+  const MeshFile f = read_mesh(dir.path("unshared.stl"));
+  EXPECT_EQ(f.mesh.n_vertices(), 15000u);
+  EXPECT_EQ(f.mesh.n_faces(), 5000u);
+}
+
+// A CT export may carry the table, a clip or noise far from the head: the skull is its largest
+// piece and what lies near it, and the size check sees only that.
+TEST(LoadSkull, APieceFarFromTheSkullIsDroppedBeforeTheSizeCheck) {
+  test::TempDir dir;
+  const SkullMesh head = test::make_symmetric_head(3);
+  TriangleSoup soup = to_soup(head);
+  const TriangleSoup far = test::box_soup(Eigen::Vector3d(2000, 0, 0), Eigen::Vector3d(2005, 5, 5));
+  const TriangleSoup near =
+      test::box_soup(Eigen::Vector3d(0, 0, -5), Eigen::Vector3d(3, 3, -2));  // inside the head
+  for (const TriangleSoup* piece : {&far, &near}) {
+    const int base = static_cast<int>(soup.vertices.size());
+    soup.vertices.insert(soup.vertices.end(), piece->vertices.begin(), piece->vertices.end());
+    for (const auto& t : piece->triangles) soup.triangles.push_back(t + Eigen::Vector3i::Constant(base));
+  }
+  write_mesh(build_mesh(soup), dir.path("with-table.stl"));
+  const LoadedSkull s = load_skull(dir.path("with-table.stl"));
+  EXPECT_EQ(s.pieces_dropped, 1);
+  EXPECT_EQ(s.mesh.n_faces(), head.n_faces() + near.triangles.size());
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("1 piece of 12 triangles lying apart from the skull"),
+            std::string::npos)
+      << s.warnings[0];
+  // Plans saved before keep every piece, and so refuse the file as before.
+  ExtractBoneSurfaceParams as_before;
+  as_before.drop_far_pieces = false;
+  EXPECT_THROW(load_skull(dir.path("with-table.stl"), as_before), InputError);
+  // Any surface (an implant) keeps its pieces.
+  EXPECT_EQ(load_surface(dir.path("with-table.stl")).mesh.n_faces(), soup.triangles.size());
+}
+
+}  // namespace
+}  // namespace cranioplan

@@ -138,13 +138,32 @@ TEST(Commands, BuildImplantVersionOneIsReadByItsOwnRules) {
   EXPECT_EQ(to_json(c), v1) << "kept as recorded: the journal's hashes cover it";
 }
 
+// load_skull 4 reads volumes in the patient's frame, a DICOM folder's named series, and drops a
+// mesh's far pieces; a plan saved before (no such fields) reads its skull as it was then.
+TEST(Commands, PlansSavedBeforeThePatientFrameReadTheirSkullAsThen) {
+  ExtractBoneSurfaceParams now;
+  now.dicom_series = "1.2.3";
+  const Json load = to_json(commands::load_skull("ct", now));
+  ExtractBoneSurfaceParams back;
+  params_from_json(ParamReader(load["params"]["import"], "test"), back);
+  EXPECT_TRUE(back.patient_frame);
+  EXPECT_TRUE(back.drop_far_pieces);
+  EXPECT_EQ(back.dicom_series, "1.2.3");
+  Json old = load["params"]["import"];
+  for (const char* k : {"patient_frame", "drop_far_pieces", "dicom_series"}) old.erase(k);
+  params_from_json(ParamReader(old, "test"), back);
+  EXPECT_FALSE(back.patient_frame);
+  EXPECT_FALSE(back.drop_far_pieces);
+  EXPECT_EQ(back.dicom_series, "");
+}
+
 // Plans saved before session 9 replay to the implants they exported: their load_skull (1)
 // reads the skull as the file gave it, not in canonical form, and their build_implant (1, 2)
 // fits to the bone as sessions 4-8 did (slivers under 1.25 mm removed, cracks under 2 mm
 // bridged). Today's commands record both, and read them back as recorded.
 TEST(Commands, PlansSavedBeforeSession9ReadTheSkullAndFitTheBoneAsThen) {
   const Json load = to_json(commands::load_skull("skull.stl"));
-  EXPECT_EQ(load["version"], 3);
+  EXPECT_EQ(load["version"], 4);
   ExtractBoneSurfaceParams import;
   params_from_json(ParamReader(load["params"]["import"], "test"), import);
   EXPECT_TRUE(import.canonical);

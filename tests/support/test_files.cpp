@@ -1,5 +1,7 @@
 #include "support/test_files.h"
 
+#include <Eigen/Geometry>
+
 #include <sys/wait.h>
 #include <unistd.h>
 #include <zlib.h>
@@ -60,18 +62,26 @@ std::string gzip(const std::string& bytes) {
   return out;
 }
 
-void write_nrrd(const Volume& v, const std::string& path, bool gzip_encoding) {
+void write_nrrd(const Volume& v, const std::string& path, bool gzip_encoding,
+                const std::string& space) {
   std::ostringstream h;
   h.precision(17);
-  h << "NRRD0004\ntype: int16\ndimension: 3\nspace: left-posterior-superior\n";
+  h << "NRRD0004\ntype: int16\ndimension: 3\n";
   h << "sizes: " << v.dims[0] << " " << v.dims[1] << " " << v.dims[2] << "\n";
-  h << "space directions:";
-  for (int c = 0; c < 3; ++c)
-    h << " (" << v.directions(0, c) << "," << v.directions(1, c) << "," << v.directions(2, c)
-      << ")";
-  h << "\nkinds: domain domain domain\nendian: little\n";
-  h << "encoding: " << (gzip_encoding ? "gzip" : "raw") << "\n";
-  h << "space origin: (" << v.origin.x() << "," << v.origin.y() << "," << v.origin.z() << ")\n\n";
+  if (space.empty()) {
+    const Eigen::Vector3d sp = v.spacing();
+    h << "spacings: " << sp.x() << " " << sp.y() << " " << sp.z() << "\n";
+  } else {
+    const Eigen::Vector3d signs =
+        space == "right-anterior-superior" ? Eigen::Vector3d(-1, -1, 1) : Eigen::Vector3d(1, 1, 1);
+    const Eigen::Matrix3d d = signs.asDiagonal() * v.directions;
+    const Eigen::Vector3d o = signs.asDiagonal() * v.origin;
+    h << "space: " << space << "\nspace directions:";
+    for (int c = 0; c < 3; ++c) h << " (" << d(0, c) << "," << d(1, c) << "," << d(2, c) << ")";
+    h << "\nspace origin: (" << o.x() << "," << o.y() << "," << o.z() << ")\n";
+  }
+  h << "kinds: domain domain domain\nendian: little\n";
+  h << "encoding: " << (gzip_encoding ? "gzip" : "raw") << "\n\n";
   std::string data(v.size() * 2, '\0');
   for (size_t i = 0; i < v.size(); ++i) {
     const int16_t s = static_cast<int16_t>(v.data[i]);
@@ -80,7 +90,7 @@ void write_nrrd(const Volume& v, const std::string& path, bool gzip_encoding) {
   write_bytes(path, h.str() + (gzip_encoding ? gzip(data) : data));
 }
 
-void write_nifti(const Volume& v, const std::string& path) {
+void write_nifti(const Volume& v, const std::string& path, NiftiForm form) {
   std::string hdr(352, '\0');
   auto put = [&](size_t off, auto value) { std::memcpy(&hdr[off], &value, sizeof(value)); };
   put(0, int32_t{348});
@@ -89,15 +99,31 @@ void write_nifti(const Volume& v, const std::string& path) {
   for (int a = 3; a < 8; ++a) put(42 + 2 * a, int16_t{1});
   put(70, int16_t{16});  // float32
   put(72, int16_t{32});
-  put(76, 1.0f);
   const Eigen::Vector3d sp = v.spacing();
+  // NIfTI's world is RAS: x and y of LPS negated.
+  const Eigen::Matrix3d ras = Eigen::Vector3d(-1, -1, 1).asDiagonal() * v.directions;
+  const Eigen::Vector3d origin = Eigen::Vector3d(-1, -1, 1).asDiagonal() * v.origin;
+  const double qfac = ras.determinant() < 0 ? -1.0 : 1.0;
+  put(76, static_cast<float>(qfac));
   for (int a = 0; a < 3; ++a) put(80 + 4 * a, static_cast<float>(sp[a]));
   put(108, 352.0f);
   put(112, 1.0f);
-  put(254, int16_t{1});  // sform_code
-  for (int r = 0; r < 3; ++r) {
-    for (int c = 0; c < 3; ++c) put(280 + 16 * r + 4 * c, static_cast<float>(v.directions(r, c)));
-    put(280 + 16 * r + 12, static_cast<float>(v.origin[r]));
+  if (form == NiftiForm::Sform) {
+    put(254, int16_t{1});  // sform_code: scanner anatomical
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) put(280 + 16 * r + 4 * c, static_cast<float>(ras(r, c)));
+      put(280 + 16 * r + 12, static_cast<float>(origin[r]));
+    }
+  } else {
+    put(252, int16_t{1});  // qform_code
+    Eigen::Matrix3d rot = ras * sp.cwiseInverse().asDiagonal();
+    rot.col(2) *= qfac;
+    Eigen::Quaterniond q(rot);
+    if (q.w() < 0) q.coeffs() *= -1.0;
+    put(256, static_cast<float>(q.x()));
+    put(260, static_cast<float>(q.y()));
+    put(264, static_cast<float>(q.z()));
+    for (int a = 0; a < 3; ++a) put(268 + 4 * a, static_cast<float>(origin[a]));
   }
   std::memcpy(&hdr[344], "n+1\0", 4);
   std::string data(v.size() * 4, '\0');

@@ -29,7 +29,23 @@ struct ExtractBoneSurfaceParams {
   /// false: as the file gives it, as plans saved before session 13 read it. CT surfaces are
   /// made outward.
   bool orient_outward = true;
+  /// Through load_skull, a volume's positions in the patient's LPS frame, whatever space the
+  /// file declares (ReadVolumeParams::patient_frame); false: a NRRD's or NIfTI's positions as
+  /// the file writes them, as plans saved before version 0.2 read them.
+  bool patient_frame = true;
+  /// Through load_skull, the series of a DICOM folder to read (SeriesInstanceUID); empty: the
+  /// largest CT series.
+  std::string dicom_series;
+  /// Through load_skull, a skull mesh's pieces that lie apart from its largest piece (their
+  /// bounding boxes more than `far_piece_mm` from its own) are dropped before the skull's size
+  /// is checked, and reported: the CT table, a clip, noise. false: every piece kept, as plans
+  /// saved before version 0.2 read them.
+  bool drop_far_pieces = true;
 };
+
+/// How far a skull mesh's piece may lie from the largest piece's bounding box and be kept, mm
+/// (the mandible, loose fragments in the defect, a separate orbit floor lie within).
+constexpr double kFarPieceMm = 20.0;
 
 struct ExtractBoneSurfaceResult {
   enum class Status { Ok, NoSurface };

@@ -19,6 +19,9 @@ struct LoadedSkull {
   std::string source_kind;            ///< "mesh" or "volume"
   std::string description;            ///< format / volume description
   std::vector<std::string> warnings;  ///< reader warnings, each naming the file
+  /// The frame the file declared and how it was brought to the patient's LPS (Volume::frame).
+  std::string frame;
+  long long pieces_dropped = 0;  ///< a mesh's pieces far from the skull (drop_far_pieces)
   ExtractBoneSurfaceResult
       surface;  ///< details of the CT import (volumes only; its mesh is cleared)
   double seconds = 0.0;

@@ -22,6 +22,10 @@ struct ReadMeshParams {
   /// exporters wind the other way, and a skull's inside and outside tables are told apart by
   /// its normals. false: as the file gives it.
   bool orient_outward = false;
+  /// Pieces whose bounding box lies more than this far from the largest piece's (mm) are
+  /// dropped, with a warning (MeshFile::pieces_dropped): the CT table, a clip, noise far from
+  /// the head. 0: every piece kept.
+  double far_piece_mm = 0.0;
 };
 
 struct MeshFile {
@@ -31,6 +35,8 @@ struct MeshFile {
   long long degenerate_dropped = 0;   ///< zero-area triangles removed
   long long nonmanifold_split = 0;    ///< triangles added on duplicated vertices
   bool turned_outward = false;        ///< ReadMeshParams::orient_outward turned it
+  long long pieces_dropped = 0;       ///< pieces far from the largest (far_piece_mm)
+  long long triangles_dropped = 0;    ///< their triangles
   std::vector<std::string> warnings;  ///< one sentence each, naming the file
 };
 

@@ -1,5 +1,6 @@
 #pragma once
-// A scalar volume (CT in Hounsfield units, or a label mask) on a possibly oblique grid.
+// A scalar volume (CT in Hounsfield units, or a label mask) on a possibly oblique grid, in the
+// patient's frame: LPS (x to the patient's left, y to the back, z to the head), millimetres.
 #include <Eigen/Core>
 #include <array>
 #include <string>
@@ -18,6 +19,12 @@ struct Volume {
   Eigen::Vector3d origin = Eigen::Vector3d::Zero();  ///< world position of sample (0,0,0), mm
   VolumeKind kind = VolumeKind::CT;
   std::string description;  ///< e.g. "InVesalius project 'ProMED CT 0051'"
+  /// The frame the file declared its positions in and how they were brought to the patient's
+  /// LPS frame, e.g. "NIfTI sform (RAS), turned to LPS".
+  std::string frame;
+  /// What the reader did that a person should know (a series chosen among several, a
+  /// resampling, a frame the file did not declare), one sentence each, naming the file.
+  std::vector<std::string> warnings;
 
   size_t size() const { return static_cast<size_t>(dims[0]) * dims[1] * dims[2]; }
   size_t index(int i, int j, int k) const {

@@ -7,7 +7,8 @@
 namespace cranioplan {
 
 std::string sha256_hex(std::string_view bytes);
-/// SHA-256 of a file's bytes; throws InputError for a missing or unreadable file.
+/// SHA-256 of a file's bytes; of a folder (a DICOM series), of its files' relative paths and
+/// SHA-256s in name order. Throws InputError for a missing or unreadable file.
 std::string sha256_file(const std::string& path);
 
 }  // namespace cranioplan
