@@ -156,9 +156,12 @@ struct TextCursor {
     char* e = nullptr;
     out = std::strtod(p, &e);
     if (e == p) return false;
+    last = std::string(p, std::min<size_t>(static_cast<size_t>(e - p), 40));
     p = e;
     return true;
   }
+  const std::string& last_word() const { return last; }
+  std::string last;  // the text of the last number read, for messages
   bool at_end() {
     skip_space();
     return p >= end;
@@ -274,6 +277,10 @@ TriangleSoup read_off(const std::string& path, const std::string& bytes) {
     for (auto& idx : poly) {
       double v;
       if (!cur.number(v)) fail(path, "malformed face " + format_count(f + 1));
+      // Checked before the cast: a double beyond int's range has no int value (UB).
+      if (!(std::abs(v) <= 2e9))
+        fail(path, "face " + format_count(f + 1) + " uses vertex " + cur.last_word() +
+                       " but the file has " + format_count(nv) + " vertices");
       idx = static_cast<int>(v);
     }
     // Colour values may follow on the same line.
