@@ -75,7 +75,6 @@ TriangleSoup keep_pieces(const TriangleSoup& soup, const SoupComponents& comps,
   return out;
 }
 
-
 std::vector<PieceBox> piece_boxes(const TriangleSoup& soup, const SoupComponents& comps) {
   std::vector<PieceBox> boxes(comps.sizes.size());
   for (size_t i = 0; i < soup.triangles.size(); ++i) {
@@ -90,8 +89,7 @@ std::vector<PieceBox> piece_boxes(const TriangleSoup& soup, const SoupComponents
 }
 
 double PieceBox::gap_to(const PieceBox& o) const {
-  const Eigen::Vector3d g =
-      (o.lo - hi).cwiseMax(lo - o.hi).cwiseMax(Eigen::Vector3d::Zero());
+  const Eigen::Vector3d g = (o.lo - hi).cwiseMax(lo - o.hi).cwiseMax(Eigen::Vector3d::Zero());
   return g.norm();
 }
 

@@ -105,8 +105,7 @@ bool is_volume_path(const std::string& path) {
 Volume read_volume(const std::string& path, const ReadVolumeParams& params) {
   std::error_code ec;
   const bool folder = std::filesystem::is_directory(path, ec);
-  if (!std::filesystem::exists(path, ec))
-    throw InputError(path, ext_of_missing(path));
+  if (!std::filesystem::exists(path, ec)) throw InputError(path, ext_of_missing(path));
   Volume v;
   const std::string ext = detail::lower_extension(path);
   if (folder)

@@ -93,8 +93,7 @@ struct Scan {
 std::vector<std::string> folder_files(const std::string& path) {
   std::vector<std::string> files;
   std::error_code ec;
-  for (fs::recursive_directory_iterator it(path, fs::directory_options::skip_permission_denied,
-                                           ec),
+  for (fs::recursive_directory_iterator it(path, fs::directory_options::skip_permission_denied, ec),
        end;
        !ec && it != end; it.increment(ec)) {
     if (it.depth() > 8) {
@@ -202,11 +201,11 @@ std::string describe(const DicomSeries& s) {
 const Stack& choose(const std::string& path, const Scan& scan, const std::string& uid,
                     std::vector<std::string>& warnings) {
   if (scan.stacks.empty())
-    throw InputError(path, "not a readable DICOM series: none of its " +
-                               format_count(static_cast<long long>(scan.files)) +
-                               " files is a DICOM image" +
-                               (scan.first_other.empty() ? std::string()
-                                                         : " (" + scan.first_other + ": not one)"));
+    throw InputError(
+        path,
+        "not a readable DICOM series: none of its " +
+            format_count(static_cast<long long>(scan.files)) + " files is a DICOM image" +
+            (scan.first_other.empty() ? std::string() : " (" + scan.first_other + ": not one)"));
   const Stack* best = nullptr;
   for (const Stack& s : scan.stacks) {
     if (!uid.empty() && s.info.uid != uid) continue;
@@ -251,8 +250,8 @@ SampleType sample_type(const std::string& file, const gdcm::PixelFormat& pf) {
     case gdcm::PixelFormat::FLOAT64:
       return SampleType::Float64;
     default:
-      throw InputError(file, std::string("pixels of type ") + pf.GetScalarTypeAsString() +
-                                 " are not supported");
+      throw InputError(
+          file, std::string("pixels of type ") + pf.GetScalarTypeAsString() + " are not supported");
   }
 }
 
@@ -338,9 +337,9 @@ SliceAxis slice_axis(const std::string& path, const Stack& s, const Eigen::Vecto
         sl.front().position + axis.per_mm_along * (x.along - sl.front().along);
     const double off = (x.position - expected).norm();
     if (off > line_tol)
-      throw InputError(path, "the slices do not lie on one line: " +
-                                 fs::path(x.file).filename().string() + " stands " + mm(off) +
-                                 " off the line from the first slice to the last");
+      throw InputError(
+          path, "the slices do not lie on one line: " + fs::path(x.file).filename().string() +
+                    " stands " + mm(off) + " off the line from the first slice to the last");
   }
   const double largest = sorted.back(), smallest = sorted.front();
   if (largest > 2.0 * median + tol) {
@@ -352,8 +351,7 @@ SliceAxis slice_axis(const std::string& path, const Stack& s, const Eigen::Vecto
                                " where the series' spacing is " + mm(median));
   }
   const double tilt_deg =
-      std::acos(std::clamp(normal.dot(axis.per_mm_along.normalized()), -1.0, 1.0)) * 180.0 /
-      M_PI;
+      std::acos(std::clamp(normal.dot(axis.per_mm_along.normalized()), -1.0, 1.0)) * 180.0 / M_PI;
   if (tilt_deg > 0.01) {
     char buf[200];
     std::snprintf(buf, sizeof(buf),

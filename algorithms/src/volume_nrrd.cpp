@@ -1,11 +1,11 @@
 // NRRD (teem) volumes: attached or detached data, raw or gzip, `space directions` (possibly
 // oblique) and `space origin`; `spacings` when no directions are given.
 #include <algorithm>
-#include <optional>
 #include <cctype>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "cranioplan/algorithms/file_io.h"

@@ -1070,11 +1070,10 @@ bool MainWindow::choose_dicom_series(const QString& folder, ExtractBoneSurfacePa
     }
   }
   bool ok = false;
-  const QString chosen =
-      QInputDialog::getItem(this, tr("DICOM series"),
-                            tr("The folder holds %1 series. Which is the skull's CT?")
-                                .arg(series.size()),
-                            items, preferred, false, &ok);
+  const QString chosen = QInputDialog::getItem(
+      this, tr("DICOM series"),
+      tr("The folder holds %1 series. Which is the skull's CT?").arg(series.size()), items,
+      preferred, false, &ok);
   if (!ok) return false;
   import.dicom_series = series[static_cast<size_t>(items.indexOf(chosen))].uid;
   return true;

@@ -34,8 +34,7 @@ std::string sha256_file(const std::string& path) {
   if (!fs::is_directory(path, ec)) return sha256_hex(read_file_bytes(path));
   // A folder (a DICOM series): its files' relative paths and hashes, in name order.
   std::vector<std::string> lines;
-  for (fs::recursive_directory_iterator it(path, fs::directory_options::skip_permission_denied,
-                                           ec),
+  for (fs::recursive_directory_iterator it(path, fs::directory_options::skip_permission_denied, ec),
        end;
        !ec && it != end; it.increment(ec)) {
     std::error_code fec;

@@ -107,8 +107,7 @@ TEST(PatientFrame, NrrdWithoutASpaceIsReadAsLpsAndSaysSo) {
   test::write_nrrd(v, dir.path("nospace.nrrd"), false, "");
   const Volume r = read_volume(dir.path("nospace.nrrd"));
   ASSERT_EQ(r.warnings.size(), 1u);
-  EXPECT_NE(r.warnings[0].find("left and right are not known"), std::string::npos)
-      << r.warnings[0];
+  EXPECT_NE(r.warnings[0].find("left and right are not known"), std::string::npos) << r.warnings[0];
   EXPECT_NE(r.frame.find("none declared"), std::string::npos) << r.frame;
 }
 
@@ -117,9 +116,8 @@ TEST(PatientFrame, NiftiSformAndQformAreTurnedFromRas) {
   // Oblique, and a grid whose k runs to the feet (NIfTI's qfac of -1 in RAS).
   Eigen::Matrix3d down = kSpacing.asDiagonal();
   down.col(2) *= -1.0;
-  for (const auto& [name, directions] :
-       std::vector<std::pair<std::string, Eigen::Matrix3d>>{{"oblique", oblique(kSpacing)},
-                                                            {"feet-first", down}}) {
+  for (const auto& [name, directions] : std::vector<std::pair<std::string, Eigen::Matrix3d>>{
+           {"oblique", oblique(kSpacing)}, {"feet-first", down}}) {
     const Volume v = phantom(directions);
     for (const test::NiftiForm form : {test::NiftiForm::Sform, test::NiftiForm::Qform}) {
       const std::string path =
@@ -260,8 +258,7 @@ TEST(PatientFrame, AFolderOfSeveralSeriesReadsTheLargestCtOrTheOneNamed) {
   mr.file_prefix = "mr";
   test::write_dicom_series(phantom(Eigen::Matrix3d(kSpacing.asDiagonal()), 40), folder, big);
   test::write_dicom_series(phantom(Eigen::Matrix3d(kSpacing.asDiagonal()), 24), folder, small);
-  test::write_dicom_series(phantom(Eigen::Matrix3d(kSpacing.asDiagonal()), 60), folder + "/mr",
-                           mr);
+  test::write_dicom_series(phantom(Eigen::Matrix3d(kSpacing.asDiagonal()), 60), folder + "/mr", mr);
   const std::vector<DicomSeries> listed = list_dicom_series(folder);
   ASSERT_EQ(listed.size(), 3u);
   const Volume r = read_volume(folder);

@@ -391,7 +391,8 @@ TEST(LoadSkull, APieceFarFromTheSkullIsDroppedBeforeTheSizeCheck) {
   for (const TriangleSoup* piece : {&far, &near}) {
     const int base = static_cast<int>(soup.vertices.size());
     soup.vertices.insert(soup.vertices.end(), piece->vertices.begin(), piece->vertices.end());
-    for (const auto& t : piece->triangles) soup.triangles.push_back(t + Eigen::Vector3i::Constant(base));
+    for (const auto& t : piece->triangles)
+      soup.triangles.push_back(t + Eigen::Vector3i::Constant(base));
   }
   write_mesh(build_mesh(soup), dir.path("with-table.stl"));
   const LoadedSkull s = load_skull(dir.path("with-table.stl"));
