@@ -22,6 +22,7 @@
 #include "cranioplan/algorithms/read_volume.h"
 #include "cranioplan/model/error.h"
 #include "file_bytes.h"
+#include "isolated_read.h"
 #include "volume_formats.h"
 
 namespace cranioplan {
@@ -34,6 +35,9 @@ const gdcm::Tag kSeriesUid(0x0020, 0x000e), kSeriesDescription(0x0008, 0x103e),
     kModality(0x0008, 0x0060), kRows(0x0028, 0x0010), kColumns(0x0028, 0x0011),
     kOrientation(0x0020, 0x0037), kPosition(0x0020, 0x0032), kPixelSpacing(0x0028, 0x0030),
     kFrames(0x0028, 0x0008), kSeriesNumber(0x0020, 0x0011);
+
+// How messages name the reader when it dies on a file.
+const char* const kLibrary = "the DICOM library (GDCM)";
 
 // The most files a folder may hold for a series to be looked for in it.
 constexpr size_t kMaxFiles = 200000;
@@ -114,23 +118,25 @@ std::vector<std::string> folder_files(const std::string& path) {
   return files;
 }
 
-Scan scan_folder(const std::string& path) {
+// Reads every file's header. `report` hears of each file before GDCM is given it.
+Scan scan_folder(const std::string& path, ChildReport& report) {
   // GDCM's own warnings and errors go to the terminal; the messages here say what went wrong.
   gdcm::Trace::WarningOff();
   gdcm::Trace::ErrorOff();
   gdcm::Trace::DebugOff();
   const std::vector<std::string> files = folder_files(path);
   if (files.empty()) throw InputError(path, "folder holds no files (expected a DICOM series)");
-  gdcm::Scanner scanner;
-  for (const gdcm::Tag& t : {kSeriesUid, kSeriesDescription, kModality, kRows, kColumns,
-                             kOrientation, kPosition, kPixelSpacing, kFrames, kSeriesNumber})
-    scanner.AddTag(t);
   Scan scan;
   scan.files = files.size();
-  if (!scanner.Scan(files)) throw InputError(path, "the folder's files could not be read");
   std::map<std::string, size_t> index;  // stack key → stacks[]
   for (const std::string& file : files) {
-    if (!scanner.IsKey(file.c_str())) {
+    // One file a scan, so that a file the library dies on is known.
+    report.reading(file);
+    gdcm::Scanner scanner;
+    for (const gdcm::Tag& t : {kSeriesUid, kSeriesDescription, kModality, kRows, kColumns,
+                               kOrientation, kPosition, kPixelSpacing, kFrames, kSeriesNumber})
+      scanner.AddTag(t);
+    if (!scanner.Scan({file}) || !scanner.IsKey(file.c_str())) {
       if (scan.first_other.empty()) scan.first_other = fs::path(file).filename().string();
       continue;
     }
@@ -257,7 +263,8 @@ SampleType sample_type(const std::string& file, const gdcm::PixelFormat& pf) {
 
 // One slice's pixels in Hounsfield units (its own rescale applied), rows × columns, column
 // fastest.
-std::vector<float> read_pixels(const Stack& stack, const std::string& file) {
+std::vector<float> read_pixels(const Stack& stack, const std::string& file, ChildReport& report) {
+  report.reading(file);
   gdcm::ImageReader reader;
   reader.SetFileName(file.c_str());
   if (!reader.Read()) throw InputError(file, "not a readable DICOM image");
@@ -374,10 +381,9 @@ SliceAxis slice_axis(const std::string& path, const Stack& s, const Eigen::Vecto
   return axis;
 }
 
-}  // namespace
-
-Volume read_dicom_folder(const std::string& path, const std::string& series_uid) {
-  const Scan scan = scan_folder(path);
+Volume read_series(const std::string& path, const std::string& series_uid,
+                   ChildReport& report) {
+  const Scan scan = scan_folder(path, report);
   Volume v;
   const Stack& s = choose(path, scan, series_uid, v.warnings);
   if (s.frames > 1)
@@ -414,20 +420,20 @@ Volume read_dicom_folder(const std::string& path, const std::string& series_uid)
   v.data.resize(v.size());
   if (!axis.resample) {
     for (int k = 0; k < axis.count; ++k) {
-      const std::vector<float> px = read_pixels(s, sorted.slices[k].file);
+      const std::vector<float> px = read_pixels(s, sorted.slices[k].file, report);
       std::copy(px.begin(), px.end(), v.data.begin() + static_cast<std::ptrdiff_t>(k * plane));
     }
   } else {
     // Linear interpolation along the normal between the two slices around each grid slice.
     size_t below = 0;
-    std::vector<float> a = read_pixels(s, sorted.slices[0].file),
-                       b = read_pixels(s, sorted.slices[1].file);
+    std::vector<float> a = read_pixels(s, sorted.slices[0].file, report),
+                       b = read_pixels(s, sorted.slices[1].file, report);
     for (int k = 0; k < axis.count; ++k) {
       const double at = sorted.slices.front().along + k * axis.step;
       while (below + 2 < sorted.slices.size() && sorted.slices[below + 1].along < at) {
         ++below;
         a = std::move(b);
-        b = read_pixels(s, sorted.slices[below + 1].file);
+        b = read_pixels(s, sorted.slices[below + 1].file, report);
       }
       const double t0 = sorted.slices[below].along, t1 = sorted.slices[below + 1].along;
       const float w = static_cast<float>(std::clamp((at - t0) / (t1 - t0), 0.0, 1.0));
@@ -442,15 +448,83 @@ Volume read_dicom_folder(const std::string& path, const std::string& series_uid)
   return v;
 }
 
+std::string serialise(const Volume& v) {
+  ByteWriter w;
+  for (int d : v.dims) w.pod(d);
+  w.raw(v.directions.data(), 9 * sizeof(double));
+  w.raw(v.origin.data(), 3 * sizeof(double));
+  w.pod(static_cast<int>(v.kind));
+  w.str(v.description);
+  w.str(v.frame);
+  w.pod<uint64_t>(v.warnings.size());
+  for (const std::string& s : v.warnings) w.str(s);
+  w.pod<uint64_t>(v.data.size());
+  w.raw(v.data.data(), v.data.size() * sizeof(float));
+  return w.take();
+}
+
+Volume deserialise_volume(const std::string& bytes) {
+  ByteReader r(bytes);
+  Volume v;
+  for (int& d : v.dims) d = r.pod<int>();
+  r.raw(v.directions.data(), 9 * sizeof(double));
+  r.raw(v.origin.data(), 3 * sizeof(double));
+  v.kind = static_cast<VolumeKind>(r.pod<int>());
+  v.description = r.str();
+  v.frame = r.str();
+  v.warnings.resize(r.pod<uint64_t>());
+  for (std::string& s : v.warnings) s = r.str();
+  v.data.resize(r.pod<uint64_t>());
+  r.raw(v.data.data(), v.data.size() * sizeof(float));
+  return v;
+}
+
+}  // namespace
+
+// GDCM ends the process on some malformed files (an assertion in its file meta reader, for one):
+// the series is read in a child process, whose death becomes a message naming the file.
+Volume read_dicom_folder(const std::string& path, const std::string& series_uid) {
+  const std::string bytes = run_isolated(path, kLibrary, [&](ChildReport& report) {
+    report.result(serialise(read_series(path, series_uid, report)));
+  });
+  return deserialise_volume(bytes);
+}
+
+std::vector<DicomSeries> dicom_series_of(const std::string& folder) {
+  const std::string bytes = run_isolated(folder, kLibrary, [&](ChildReport& report) {
+    ByteWriter w;
+    const Scan scan = scan_folder(folder, report);
+    w.pod<uint64_t>(scan.stacks.size());
+    for (const Stack& s : scan.stacks) {
+      w.str(s.info.uid);
+      w.str(s.info.description);
+      w.str(s.info.modality);
+      w.pod(s.info.rows);
+      w.pod(s.info.columns);
+      w.pod(s.info.slices);
+    }
+    report.result(w.take());
+  });
+  ByteReader r(bytes);
+  std::vector<DicomSeries> out(r.pod<uint64_t>());
+  for (DicomSeries& s : out) {
+    s.uid = r.str();
+    s.description = r.str();
+    s.modality = r.str();
+    s.rows = r.pod<int>();
+    s.columns = r.pod<int>();
+    s.slices = r.pod<long long>();
+  }
+  return out;
+}
+
 }  // namespace detail
 
 std::vector<DicomSeries> list_dicom_series(const std::string& folder) {
   std::error_code ec;
   if (!std::filesystem::exists(folder, ec)) throw InputError(folder, "does not exist");
   if (!std::filesystem::is_directory(folder, ec)) throw InputError(folder, "is not a folder");
-  std::vector<DicomSeries> out;
-  for (const auto& s : detail::scan_folder(folder).stacks) out.push_back(s.info);
-  return out;
+  return detail::dicom_series_of(folder);
 }
 
 }  // namespace cranioplan

@@ -2,6 +2,7 @@
 // Private: one reader per volume format, and the sample conversion they share.
 #include <string>
 
+#include "cranioplan/algorithms/read_volume.h"
 #include "cranioplan/model/volume.h"
 #include "file_bytes.h"
 
@@ -21,6 +22,10 @@ void flip_axes(Volume& v, const Eigen::Vector3d& signs);
 Volume read_inv3(const std::string& path);
 Volume read_nrrd(const std::string& path, bool patient_frame);
 Volume read_nifti(const std::string& path, bool patient_frame);
+/// Reads a DICOM series in a child process (isolated_read.h): a file the DICOM library dies on is
+/// an InputError naming it.
 Volume read_dicom_folder(const std::string& path, const std::string& series_uid);
+/// The series of a DICOM folder, scanned in a child process as read_dicom_folder reads.
+std::vector<DicomSeries> dicom_series_of(const std::string& folder);
 
 }  // namespace cranioplan::detail
