@@ -3,6 +3,7 @@
 #include <fcntl.h>
 #include <poll.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
@@ -10,8 +11,13 @@
 #include <cstdint>
 #include <cstdio>
 #include <cstring>
+#include <fstream>
 
 #include "cranioplan/model/error.h"
+
+// Present only in a sanitizer build: the function a sanitizer calls before it ends the process
+// on an error it reports (libFuzzer sets one that saves the input as a crash of its own).
+extern "C" void __sanitizer_set_death_callback(void (*callback)(void)) __attribute__((weak));
 
 namespace cranioplan::detail {
 namespace {
@@ -68,6 +74,11 @@ std::string signal_name(int sig) {
 }
 
 [[noreturn]] void run_child(int fd, FILE* err, const std::function<void(ChildReport&)>& job) {
+  // The child dies of what it meets: a crash handler inherited from the parent (a fuzzer's, a
+  // sanitizer's) would report the parent's state, and a timer would fire in the wrong process.
+  for (int sig : {SIGABRT, SIGSEGV, SIGBUS, SIGFPE, SIGILL, SIGTRAP, SIGALRM, SIGPIPE})
+    ::signal(sig, SIG_DFL);
+  if (__sanitizer_set_death_callback) __sanitizer_set_death_callback(nullptr);
   // What the library prints goes to a file the parent reads, not to the user's terminal.
   if (err) ::dup2(fileno(err), STDERR_FILENO);
   ChildReport report(fd);
@@ -191,13 +202,35 @@ std::string run_isolated(const std::string& path, const std::string& reader,
   const std::string why =
       stalled ? "it made no progress for " + std::to_string(static_cast<int>(stall_seconds)) +
                     " s and was stopped"
-      : WIFSIGNALED(status) ? signal_name(WTERMSIG(status))
-                            : "it ended (exit status " + std::to_string(WEXITSTATUS(status)) +
-                                  ") without a result";
+      : WIFSIGNALED(status)
+          ? signal_name(WTERMSIG(status))
+          : "it ended (exit status " + std::to_string(WEXITSTATUS(status)) + ") without a result";
   throw InputError(current, reader + " could not read this file: " + why +
                                 (said.empty() ? std::string() : " (" + said + ")") +
                                 "; the file is malformed, or of a kind " + reader +
                                 " does not know");
+}
+
+AddressSpaceBudget::AddressSpaceBudget(double extra_bytes) {
+  std::ifstream statm("/proc/self/statm");
+  unsigned long long pages = 0;
+  rlimit lim{};
+  if (!(statm >> pages) || ::getrlimit(RLIMIT_AS, &lim) != 0) return;
+  const double wanted =
+      static_cast<double>(pages) * static_cast<double>(::sysconf(_SC_PAGESIZE)) + extra_bytes;
+  if (lim.rlim_max != RLIM_INFINITY && wanted >= static_cast<double>(lim.rlim_max)) return;
+  if (lim.rlim_cur != RLIM_INFINITY && wanted >= static_cast<double>(lim.rlim_cur)) return;
+  saved_soft_ = lim.rlim_cur;
+  lim.rlim_cur = static_cast<rlim_t>(wanted);
+  set_ = ::setrlimit(RLIMIT_AS, &lim) == 0;
+}
+
+AddressSpaceBudget::~AddressSpaceBudget() {
+  if (!set_) return;
+  rlimit lim{};
+  ::getrlimit(RLIMIT_AS, &lim);
+  lim.rlim_cur = static_cast<rlim_t>(saved_soft_);
+  ::setrlimit(RLIMIT_AS, &lim);
 }
 
 void ByteWriter::str(const std::string& s) {

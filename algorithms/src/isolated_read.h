@@ -36,6 +36,22 @@ std::string run_isolated(const std::string& path, const std::string& reader,
                          const std::function<void(ChildReport&)>& job,
                          double stall_seconds = 120.0);
 
+/// In the child: while it lives, the process may map at most `extra_bytes` more than it has
+/// mapped now, so that a library that believes a malformed length (a 4 GiB element in a file of
+/// 2 kB) fails to allocate (std::bad_alloc) instead of zero-filling gigabytes. Restores the limit
+/// it found when it ends.
+class AddressSpaceBudget {
+ public:
+  explicit AddressSpaceBudget(double extra_bytes);
+  ~AddressSpaceBudget();
+  AddressSpaceBudget(const AddressSpaceBudget&) = delete;
+  AddressSpaceBudget& operator=(const AddressSpaceBudget&) = delete;
+
+ private:
+  unsigned long long saved_soft_ = 0;
+  bool set_ = false;
+};
+
 /// Little helpers to serialise a result into bytes and read it back (native byte order: the
 /// bytes never leave the machine).
 class ByteWriter {

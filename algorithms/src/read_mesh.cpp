@@ -21,6 +21,7 @@
 #include "cranioplan/algorithms/mesh_components.h"
 #include "cranioplan/model/error.h"
 #include "file_bytes.h"
+#include "isolated_read.h"
 #include "mesh_formats.h"
 #include "vtk_errors.h"
 
@@ -169,7 +170,7 @@ struct TextCursor {
 };
 
 TriangleSoup parse_ascii_stl(const std::string& path, const std::string& bytes) {
-  TextCursor cur{bytes.c_str(), bytes.c_str() + bytes.size()};
+  TextCursor cur{bytes.c_str(), bytes.c_str() + bytes.size(), 1, {}};
   auto expect = [&](const char* w) {
     const std::string got = cur.word();
     if (got != w)
@@ -249,7 +250,7 @@ TriangleSoup read_off(const std::string& path, const std::string& bytes) {
   for (size_t i = 0; i < text.size(); ++i)
     if (text[i] == '#')
       while (i < text.size() && text[i] != '\n') text[i++] = ' ';
-  TextCursor cur{text.c_str(), text.c_str() + text.size()};
+  TextCursor cur{text.c_str(), text.c_str() + text.size(), 1, {}};
   const std::string magic = cur.word();
   if (magic != "OFF") fail(path, "not an OFF file (first word is '" + magic.substr(0, 20) + "')");
   double nv_d, nf_d, ne_d;
@@ -366,14 +367,33 @@ TriangleSoup soup_from_polydata(const std::string& path, vtkPolyData* pd) {
   return soup;
 }
 
+// VTK's XML reader leaks on some malformed files and is not proved against crashing on them:
+// it runs in a child process (isolated_read.h), which sends the soup back.
 TriangleSoup read_vtp(const std::string& path) {
-  vtkNew<vtkXMLPolyDataReader> reader;
-  const detail::VtkErrorCatcher errors(reader);
-  reader->SetFileName(path.c_str());
-  reader->Update();
-  const std::string error = errors.message();
-  if (!error.empty()) fail(path, "not a readable VTP file (" + error + ")");
-  return soup_from_polydata(path, reader->GetOutput());
+  const std::string bytes =
+      detail::run_isolated(path, "VTK's VTP reader", [&](detail::ChildReport& report) {
+        report.reading(path);
+        vtkNew<vtkXMLPolyDataReader> reader;
+        const detail::VtkErrorCatcher errors(reader);
+        reader->SetFileName(path.c_str());
+        reader->Update();
+        const std::string error = errors.message();
+        if (!error.empty()) fail(path, "not a readable VTP file (" + error + ")");
+        const TriangleSoup soup = soup_from_polydata(path, reader->GetOutput());
+        detail::ByteWriter w;
+        w.pod<uint64_t>(soup.vertices.size());
+        w.raw(soup.vertices.data(), soup.vertices.size() * sizeof(Eigen::Vector3d));
+        w.pod<uint64_t>(soup.triangles.size());
+        w.raw(soup.triangles.data(), soup.triangles.size() * sizeof(Eigen::Vector3i));
+        report.result(w.take());
+      });
+  detail::ByteReader r(bytes);
+  TriangleSoup soup;
+  soup.vertices.resize(r.pod<uint64_t>());
+  r.raw(soup.vertices.data(), soup.vertices.size() * sizeof(Eigen::Vector3d));
+  soup.triangles.resize(r.pod<uint64_t>());
+  r.raw(soup.triangles.data(), soup.triangles.size() * sizeof(Eigen::Vector3i));
+  return soup;
 }
 
 // The volume the triangles enclose, taken about the vertices' centroid (for a surface with

@@ -39,6 +39,9 @@ const gdcm::Tag kSeriesUid(0x0020, 0x000e), kSeriesDescription(0x0008, 0x103e),
 // How messages name the reader when it dies on a file.
 const char* const kLibrary = "the DICOM library (GDCM)";
 
+// The most voxels a series may have: 2^31 (8 GiB as floats), four times a 1024 × 1024 × 512 CT.
+constexpr double kMaxVoxels = 2147483648.0;
+
 // The most files a folder may hold for a series to be looked for in it.
 constexpr size_t kMaxFiles = 200000;
 
@@ -118,6 +121,20 @@ std::vector<std::string> folder_files(const std::string& path) {
   return files;
 }
 
+// Memory a header may need beyond what the child has: far more than any real header.
+constexpr double kHeaderBudget = 1024.0 * 1024.0 * 1024.0;
+
+// Scans one file's header; false when it is no DICOM file GDCM can read, or declares an
+// element too large to hold (a malformed length).
+bool scan_file(gdcm::Scanner& scanner, const std::string& file) {
+  try {
+    const AddressSpaceBudget budget(kHeaderBudget);
+    return scanner.Scan({file}) && scanner.IsKey(file.c_str());
+  } catch (const std::bad_alloc&) {
+    return false;
+  }
+}
+
 // Reads every file's header. `report` hears of each file before GDCM is given it.
 Scan scan_folder(const std::string& path, ChildReport& report) {
   // GDCM's own warnings and errors go to the terminal; the messages here say what went wrong.
@@ -136,7 +153,7 @@ Scan scan_folder(const std::string& path, ChildReport& report) {
     for (const gdcm::Tag& t : {kSeriesUid, kSeriesDescription, kModality, kRows, kColumns,
                                kOrientation, kPosition, kPixelSpacing, kFrames, kSeriesNumber})
       scanner.AddTag(t);
-    if (!scanner.Scan({file}) || !scanner.IsKey(file.c_str())) {
+    if (!scan_file(scanner, file)) {
       if (scan.first_other.empty()) scan.first_other = fs::path(file).filename().string();
       continue;
     }
@@ -265,9 +282,17 @@ SampleType sample_type(const std::string& file, const gdcm::PixelFormat& pf) {
 // fastest.
 std::vector<float> read_pixels(const Stack& stack, const std::string& file, ChildReport& report) {
   report.reading(file);
+  // The pixels of a slice the size the header says, several times over, and no more.
+  const AddressSpaceBudget budget(kHeaderBudget + 32.0 * stack.info.rows * stack.info.columns);
   gdcm::ImageReader reader;
   reader.SetFileName(file.c_str());
-  if (!reader.Read()) throw InputError(file, "not a readable DICOM image");
+  bool read = false;
+  try {
+    read = reader.Read();
+  } catch (const std::bad_alloc&) {
+    throw InputError(file, "declares more data than its slice can hold (a malformed length)");
+  }
+  if (!read) throw InputError(file, "not a readable DICOM image");
   const gdcm::Image& image = reader.GetImage();
   const gdcm::PixelFormat& pf = image.GetPixelFormat();
   if (pf.GetSamplesPerPixel() != 1)
@@ -286,6 +311,14 @@ std::vector<float> read_pixels(const Stack& stack, const std::string& file, Chil
                                std::to_string(stack.info.rows));
   const SampleType type = sample_type(file, pf);
   const size_t count = static_cast<size_t>(d[0]) * d[1];
+  // Uncompressed pixel data must hold every pixel: checked before the buffer is made, so a
+  // header that claims a vast slice costs no memory.
+  if (const gdcm::ByteValue* stored = image.GetDataElement().GetByteValue())
+    if (stored->GetLength() < count * sample_size(type))
+      throw InputError(file, "its pixel data holds " +
+                                 format_count(static_cast<long long>(stored->GetLength())) +
+                                 " bytes, fewer than its " +
+                                 format_count(static_cast<long long>(count)) + " pixels need");
   const unsigned long length = image.GetBufferLength();
   if (length < count * sample_size(type))
     throw InputError(file, "its pixel data holds " + format_count(static_cast<long long>(length)) +
@@ -381,8 +414,7 @@ SliceAxis slice_axis(const std::string& path, const Stack& s, const Eigen::Vecto
   return axis;
 }
 
-Volume read_series(const std::string& path, const std::string& series_uid,
-                   ChildReport& report) {
+Volume read_series(const std::string& path, const std::string& series_uid, ChildReport& report) {
   const Scan scan = scan_folder(path, report);
   Volume v;
   const Stack& s = choose(path, scan, series_uid, v.warnings);
@@ -417,17 +449,26 @@ Volume read_series(const std::string& path, const std::string& series_uid,
   v.directions.col(2) = axis.per_mm_along * axis.step;
   v.origin = sorted.slices.front().position;
   const size_t plane = static_cast<size_t>(s.info.columns) * s.info.rows;
+  if (static_cast<double>(plane) * axis.count > kMaxVoxels)
+    throw InputError(path, "series " + s.info.uid + " would be " + std::to_string(v.dims[0]) + "×" +
+                               std::to_string(v.dims[1]) + "×" + std::to_string(v.dims[2]) +
+                               " voxels, more than the " +
+                               format_count(static_cast<long long>(kMaxVoxels)) +
+                               " read; crop the series or export it at a coarser resolution");
+  // The first slice is decoded before the volume is made: a header that lies about the slice's
+  // size is refused by its pixel data, not believed.
+  std::vector<float> first = read_pixels(s, sorted.slices[0].file, report);
   v.data.resize(v.size());
   if (!axis.resample) {
-    for (int k = 0; k < axis.count; ++k) {
+    std::copy(first.begin(), first.end(), v.data.begin());
+    for (int k = 1; k < axis.count; ++k) {
       const std::vector<float> px = read_pixels(s, sorted.slices[k].file, report);
       std::copy(px.begin(), px.end(), v.data.begin() + static_cast<std::ptrdiff_t>(k * plane));
     }
   } else {
     // Linear interpolation along the normal between the two slices around each grid slice.
     size_t below = 0;
-    std::vector<float> a = read_pixels(s, sorted.slices[0].file, report),
-                       b = read_pixels(s, sorted.slices[1].file, report);
+    std::vector<float> a = std::move(first), b = read_pixels(s, sorted.slices[1].file, report);
     for (int k = 0; k < axis.count; ++k) {
       const double at = sorted.slices.front().along + k * axis.step;
       while (below + 2 < sorted.slices.size() && sorted.slices[below + 1].along < at) {

@@ -12,6 +12,7 @@
 #include <filesystem>
 #include <fstream>
 #include <iterator>
+#include <vector>
 
 #include "cranioplan/algorithms/read_volume.h"
 #include "cranioplan/model/error.h"
@@ -87,9 +88,8 @@ TEST(IsolatedRead, AnAssertionInTheLibraryNamesTheFileAndTheAssertion) {
 }
 
 TEST(IsolatedRead, ACrashBeforeAnyFileNamesTheFolder) {
-  const std::string m = message_of([] {
-    run_isolated("folder", "the library", [](ChildReport&) { std::raise(SIGSEGV); });
-  });
+  const std::string m = message_of(
+      [] { run_isolated("folder", "the library", [](ChildReport&) { std::raise(SIGSEGV); }); });
   EXPECT_EQ(m.rfind("folder: ", 0), 0u) << m;
   EXPECT_NE(m.find("crashed (SIGSEGV)"), std::string::npos) << m;
 }
@@ -109,10 +109,33 @@ TEST(IsolatedRead, AChildThatStopsMakingProgressIsStopped) {
 }
 
 TEST(IsolatedRead, AChildThatExitsWithoutAResultIsAnError) {
-  const std::string m = message_of([] {
-    run_isolated("folder", "the library", [](ChildReport&) { _exit(7); });
-  });
+  const std::string m =
+      message_of([] { run_isolated("folder", "the library", [](ChildReport&) { _exit(7); }); });
   EXPECT_NE(m.find("exit status 7"), std::string::npos) << m;
+}
+
+// A budget makes an allocation a malformed length asks for fail in the child, quickly, instead
+// of zero-filling gigabytes.
+TEST(IsolatedRead, AnAddressSpaceBudgetRefusesAVastAllocation) {
+#if defined(__SANITIZE_ADDRESS__)
+  GTEST_SKIP() << "AddressSanitizer's allocator reports a refused mapping instead of throwing";
+#endif
+  const std::string back = run_isolated("file", "the library", [](ChildReport& report) {
+    std::string said;
+    {
+      const detail::AddressSpaceBudget budget(256.0 * 1024 * 1024);
+      try {
+        std::vector<char> vast(size_t{4} << 30);
+        said = "allocated";
+      } catch (const std::bad_alloc&) {
+        said = "refused";
+      }
+    }
+    std::vector<char> after(size_t{512} << 20);  // the limit is lifted again
+    said += after.size() == (size_t{512} << 20) ? ", then allocated" : "";
+    report.result(said);
+  });
+  EXPECT_EQ(back, "refused, then allocated");
 }
 
 // The input on which Debian's GDCM 3.0.21 asserts in its file meta reader (a libFuzzer finding,
