@@ -234,8 +234,10 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
   const VoxelGrid grid = VoxelGrid::covering_at_most(lo, hi, std::clamp(params.voxel_mm, 0.1, 1.0),
                                                      std::max(1e5, params.max_voxels), 4);
   const double h = grid.spacing;
-  Mask mask = voxelize_mesh(implant, grid);
-  Mask bone = voxelize_mesh(skull, grid);
+  VoxelizeParams solid;
+  solid.vote_through_holes = params.vote_through_holes;
+  Mask mask = voxelize_mesh(implant, grid, solid);
+  Mask bone = voxelize_mesh(skull, grid, solid);
   size_t before = 0;
   for (size_t c = 0; c < mask.size(); ++c) {
     before += mask[c];

@@ -219,7 +219,9 @@ int current_version(CommandType type) {
   // ("import.orient_outward", not when absent).
   // build_implant 4: the fit to the bone holds the implant "clearance_mm" off the bone's
   // surface and removes thin fills ("thin_fills_removed"); version 3 is read without either.
-  if (type == CommandType::BuildImplant) return 4;
+  // build_implant 5: the skull's inside decided by votes where its surface is open
+  // ("trim.vote_through_holes"); version 4 is read with parity along z.
+  if (type == CommandType::BuildImplant) return 5;
   if (type == CommandType::ProposeMarkers) return 3;
   // load_skull 4: volumes in the patient's frame ("import.patient_frame"), a DICOM folder's
   // series ("import.dicom_series"), a mesh's far pieces dropped ("import.drop_far_pieces");
@@ -332,6 +334,7 @@ Json params_to_json(const ImplantParams& p) {
   j["trim"] = write_fields([](auto& v, auto& q) { trim_fields(v, q); }, p.trim);
   j["trim"]["thin_fills_removed"] = p.trim.thin_fills_removed;
   j["trim"]["clearance_mm"] = p.trim.clearance_mm ? Json(*p.trim.clearance_mm) : Json(nullptr);
+  j["trim"]["vote_through_holes"] = p.trim.vote_through_holes;
   return j;
 }
 
@@ -431,6 +434,8 @@ void params_from_json(const ParamReader& r, ImplantParams& p) {
     // and fills kept as made.
     p.trim.thin_fills_removed =
         trim.has("thin_fills_removed") && trim.boolean("thin_fills_removed");
+    p.trim.vote_through_holes =
+        trim.has("vote_through_holes") && trim.boolean("vote_through_holes");
     p.trim.clearance_mm.reset();
     if (trim.has("clearance_mm") && !trim.value("clearance_mm").is_null()) {
       const double c = trim.number("clearance_mm");
@@ -440,6 +445,7 @@ void params_from_json(const ParamReader& r, ImplantParams& p) {
     }
   } else {
     p.trim.thin_fills_removed = false;
+    p.trim.vote_through_holes = false;
     p.trim.clearance_mm.reset();
     p.trim.min_feature_mm = 1.25;
     p.trim.bridge_mm = 1.0;

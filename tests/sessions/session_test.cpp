@@ -129,7 +129,7 @@ TEST(Commands, EveryTypeRoundTripsThroughJson) {
 // read as recorded, built without the fit.
 TEST(Commands, BuildImplantVersionOneIsReadByItsOwnRules) {
   Json v1 = to_json(commands::build_implant());
-  EXPECT_EQ(v1["version"], 4);
+  EXPECT_EQ(v1["version"], 5);
   v1["version"] = 1;
   v1["params"]["params"].erase("trim");
   v1["params"]["params"].erase("fit_to_bone_mm");
@@ -176,7 +176,7 @@ TEST(Commands, PlansSavedBeforeSession9ReadTheSkullAndFitTheBoneAsThen) {
   p.trim.min_feature_mm = 1.7;
   p.trim.bridge_mm = 0.8;
   const Json build = to_json(commands::build_implant(p));
-  EXPECT_EQ(build["version"], 4);
+  EXPECT_EQ(build["version"], 5);
   ImplantParams back;
   params_from_json(ParamReader(build["params"]["params"], "test"), back);
   EXPECT_EQ(back.trim.min_feature_mm, 1.7);
@@ -190,6 +190,22 @@ TEST(Commands, PlansSavedBeforeSession9ReadTheSkullAndFitTheBoneAsThen) {
   EXPECT_EQ(ImplantParams{}.trim.min_feature_mm, 1.5) << "today's default";
   EXPECT_FALSE(back.trim.clearance_mm.has_value()) << "sessions 4-8: the bone grown by a voxel";
   EXPECT_FALSE(back.trim.thin_fills_removed);
+  EXPECT_FALSE(back.trim.vote_through_holes);
+}
+
+// build_implant 5 decides the skull's inside by votes where its surface is open; version 4 (no
+// "vote_through_holes") by parity along z, as it fitted its implants.
+TEST(Commands, PlansSavedBeforeVotingThroughHolesFitTheBoneAsThen) {
+  const Json build = to_json(commands::build_implant(ImplantParams{}));
+  EXPECT_EQ(build["params"]["params"]["trim"]["vote_through_holes"], true);
+  ImplantParams back;
+  params_from_json(ParamReader(build["params"]["params"], "test"), back);
+  EXPECT_TRUE(back.trim.vote_through_holes);
+  Json v4 = build["params"]["params"];
+  v4["trim"].erase("vote_through_holes");
+  params_from_json(ParamReader(v4, "test"), back);
+  EXPECT_FALSE(back.trim.vote_through_holes);
+  EXPECT_TRUE(back.trim.thin_fills_removed) << "the rest of version 4 as recorded";
 }
 
 // A mesh's length unit is part of the load: recorded, replayed, and read as millimetres from

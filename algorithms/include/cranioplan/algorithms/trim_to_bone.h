@@ -37,6 +37,11 @@ struct TrimToBoneParams {
   /// 0.5-1.5 voxels off the bone (up to 0.7 mm on a large implant's 0.45 mm grid), which left
   /// a layer of the defect unfilled along its cut face.
   std::optional<double> clearance_mm = 0.1;
+  /// The skull's inside where its surface is open (the cut where the scan ends): decided by
+  /// parity-count voting along three axes (VoxelizeParams::vote_through_holes). false: parity
+  /// along z, as plans saved before version 0.2 fitted their implants (a skull open at the
+  /// scan's lower border then counted the air above its cut as bone, and the bone as air).
+  bool vote_through_holes = true;
 };
 
 struct TrimToBoneResult {

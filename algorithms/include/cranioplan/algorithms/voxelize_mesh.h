@@ -38,9 +38,22 @@ struct VoxelGrid {
 /// Bounding box of a mesh's vertices.
 std::pair<Eigen::Vector3d, Eigen::Vector3d> mesh_bounds(const SkullMesh& mesh);
 
-/// 1 for voxels whose centre lies inside the mesh, else 0. The mesh should be closed; inside is
-/// decided by the parity of crossings along z through the voxel centre.
-std::vector<uint8_t> voxelize_mesh(const SkullMesh& mesh, const VoxelGrid& grid);
+struct VoxelizeParams {
+  /// A line along z through a hole in the surface (the cut where a CT scan ends and an exporter
+  /// left the surface open, a small hole) crosses it an odd number of times, and parity along it
+  /// is wrong on one side of the hole. true: such a line's voxels are decided by the lines along
+  /// x and y through them that cross the surface an even number of times (parity-count voting,
+  /// Nooruddin & Turk 2003), by parity along z when neither does. false: parity along z from
+  /// below, pairing crossings up from the lowest, as plans saved before version 0.2 fitted
+  /// implants to the bone. A closed surface gives the same mask either way.
+  bool vote_through_holes = true;
+};
+
+/// 1 for voxels whose centre lies inside the mesh, else 0: the parity of the surface crossings
+/// along z through the voxel centre, with votes along x and y where the line along z passes
+/// through a hole (VoxelizeParams).
+std::vector<uint8_t> voxelize_mesh(const SkullMesh& mesh, const VoxelGrid& grid,
+                                   const VoxelizeParams& params = {});
 
 /// The mask as a Volume (values 0/1), for surface extraction.
 Volume mask_volume(const std::vector<uint8_t>& mask, const VoxelGrid& grid);
