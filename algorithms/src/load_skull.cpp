@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <cstdlib>
 
+#include "cranioplan/algorithms/mesh_report.h"
 #include "cranioplan/algorithms/read_mesh.h"
 #include "cranioplan/algorithms/read_volume.h"
 #include "cranioplan/algorithms/voxelize_mesh.h"
@@ -57,6 +58,10 @@ LoadedSkull load(const std::string& path, const ExtractBoneSurfaceParams& import
       out.description += " in " + named;
     }
     out.warnings = std::move(file.warnings);
+    // Where a skull's surface is open, and what planning does about it.
+    if (as_skull)
+      for (const std::string& s : describe_openings(report_mesh(out.mesh)))
+        out.warnings.push_back(path + ": " + s);
     out.frame = "the file's own coordinates (a mesh file declares no frame), taken as LPS";
     out.pieces_dropped = file.pieces_dropped;
   }

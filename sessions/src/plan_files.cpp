@@ -39,7 +39,20 @@ Json to_json(const Landmarks& lm) {
 }
 
 Json to_json(const MeshReport& r) {
+  // The longest loops (a mesh may have thousands of small holes), and every opening described.
+  Json loops = Json::array();
+  for (size_t i = 0; i < r.loops.size() && i < 20; ++i) {
+    const BoundaryLoop& l = r.loops[i];
+    loops.push_back({{"edges", l.edges},
+                     {"length_mm", l.length_mm},
+                     {"centroid", to_json(l.centroid)},
+                     {"flatness_mm", l.flatness_mm},
+                     {"border", l.at_border ? Json(l.border) : Json(nullptr)}});
+  }
   return Json{{"vertices", r.vertices},
+              {"boundary_loops", r.loops.size()},
+              {"longest_boundary_loops", loops},
+              {"openings", describe_openings(r)},
               {"triangles", r.triangles},
               {"bbox_min", to_json(r.bbox_min)},
               {"bbox_max", to_json(r.bbox_max)},

@@ -42,3 +42,53 @@ TEST(MeshReport, NonManifoldEdgeIsCounted) {
 
 }  // namespace
 }  // namespace cranioplan
+
+namespace cranioplan {
+namespace {
+
+// A head cut flat across its lower part (where a scan ended) and with a small hole in its side:
+// the cut is one loop at the lower border, the hole one loop elsewhere, each measured, and both
+// described for a person.
+TEST(MeshReport, ACutAtTheBorderAndAHoleAreToldApart) {
+  const SkullMesh head = test::make_symmetric_head(5);
+  MeshReport whole = report_mesh(head);
+  const double cut_z = whole.bbox_min.z() + 30.0;
+  TriangleSoup soup;
+  for (auto vh : head.vertices()) soup.vertices.push_back(to_eigen(head.point(vh)));
+  for (auto fh : head.faces()) {
+    Eigen::Vector3i t;
+    int k = 0;
+    bool above = true;
+    for (auto vh : head.fv_range(fh)) {
+      t[k++] = vh.idx();
+      above = above && head.point(vh)[2] > cut_z;
+    }
+    if (above) soup.triangles.push_back(t);
+  }
+  // The cut's vertices put on the cut plane, as marching cubes ends at the scan's last slice.
+  SkullMesh cut = build_mesh(soup);
+  for (auto vh : cut.vertices())
+    if (cut.is_boundary(vh)) cut.point(vh)[2] = static_cast<float>(cut_z + 0.5);
+  const Eigen::Vector3d side((whole.bbox_max.x()), 0.5 * (whole.bbox_min.y() + whole.bbox_max.y()),
+                             0.5 * (whole.bbox_min.z() + whole.bbox_max.z()));
+  const SkullMesh open = test::cut_hole(cut, side, 6.0);
+  const MeshReport r = report_mesh(open);
+  ASSERT_EQ(r.loops.size(), 2u);
+  EXPECT_TRUE(r.loops[0].at_border);
+  EXPECT_EQ(r.loops[0].border, "lower");
+  EXPECT_GT(r.loops[0].length_mm, 300.0);  // around a head 140 × 180 mm near its base
+  EXPECT_LT(r.loops[0].flatness_mm, 0.1);
+  EXPECT_FALSE(r.loops[1].at_border);
+  EXPECT_GT(r.loops[1].length_mm, 20.0);  // around a hole of about 12 mm
+  EXPECT_LT(r.loops[1].length_mm, 60.0);
+  EXPECT_LT((r.loops[1].centroid - side).norm(), 8.0);
+  const std::vector<std::string> said = describe_openings(r);
+  ASSERT_EQ(said.size(), 2u);
+  EXPECT_EQ(said[0].rfind("open along a flat cut at its lower border (z = ", 0), 0u) << said[0];
+  EXPECT_NE(said[0].find("1 loop, "), std::string::npos) << said[0];
+  EXPECT_EQ(said[1].rfind("1 hole in the surface", 0), 0u) << said[1];
+  EXPECT_TRUE(describe_openings(whole).empty());
+}
+
+}  // namespace
+}  // namespace cranioplan

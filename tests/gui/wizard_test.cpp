@@ -421,7 +421,9 @@ TEST(WizardOrientation, TheCubeShowsTheFaceTheCameraLooksAt) {
     const int area = side * side;
     EXPECT_GT(dominant[c.channel], area / 60) << "the expected face's letter is not in view";
     for (int k = 0; k < 3; ++k)
-      if (k != c.channel) EXPECT_LT(dominant[k], dominant[c.channel] / 4) << "channel " << k;
+      if (k != c.channel) {
+        EXPECT_LT(dominant[k], dominant[c.channel] / 4) << "channel " << k;
+      }
     expect_image_like_baseline(cube, std::string("cube-") + c.name, 0.004);
   }
 }

@@ -1,9 +1,27 @@
 #pragma once
 #include <Eigen/Core>
+#include <string>
+#include <vector>
 
 #include "cranioplan/model/mesh.h"
 
 namespace cranioplan {
+
+/// One connected chain of boundary edges (edges with one triangle): a loop around a hole, or
+/// loops that touch at a vertex.
+struct BoundaryLoop {
+  long long edges = 0;
+  double length_mm = 0.0;
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< of its vertices, mm
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();   ///< of the plane that fits it best
+  double flatness_mm = 0.0;  ///< the largest distance of its vertices from that plane
+  /// Flat, at least 30 mm across, and its plane is where the mesh ends along the normal (within
+  /// 2 mm): the cut where a scan ended, or where an exporter cropped the surface.
+  bool at_border = false;
+  /// Which border, in the patient's LPS frame: "lower" (−z), "upper" (+z), "front" (−y),
+  /// "back" (+y), "right" (−x), "left" (+x); empty unless at_border.
+  std::string border;
+};
 
 struct MeshReport {
   long long vertices = 0;
@@ -16,7 +34,13 @@ struct MeshReport {
   long long nonmanifold_edges = 0;  ///< edges with three or more triangles
   long long pieces = 0;             ///< connected pieces
   bool watertight = false;          ///< no boundary and no non-manifold edge
+  std::vector<BoundaryLoop> loops;  ///< the boundary's chains, longest first
 };
+
+/// What a person should know of a skull mesh's openness, one sentence each (empty when it is
+/// closed): the flat cuts at its border ("open along a flat cut at its lower border (z = −1.0 mm):
+/// 3 loops, 412 mm"), and the other holes with the largest's size and place.
+std::vector<std::string> describe_openings(const MeshReport& report);
 
 /// Counts and measures a mesh. Vertices at identical positions are treated as one, so edges a
 /// reader split to keep OpenMesh manifold are still reported as non-manifold.
