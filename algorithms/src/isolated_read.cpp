@@ -248,6 +248,7 @@ std::string ByteReader::str() {
 
 void ByteReader::raw(void* data, size_t size) {
   if (size > in_.size() - at_) throw Error("isolated reader: a truncated report");
+  if (size == 0) return;  // an empty vector's data() may be null
   std::memcpy(data, in_.data() + at_, size);
   at_ += size;
 }

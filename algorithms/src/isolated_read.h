@@ -61,7 +61,9 @@ class ByteWriter {
     out_.append(reinterpret_cast<const char*>(&v), sizeof(T));
   }
   void str(const std::string& s);
-  void raw(const void* data, size_t size) { out_.append(static_cast<const char*>(data), size); }
+  void raw(const void* data, size_t size) {
+    if (size > 0) out_.append(static_cast<const char*>(data), size);
+  }
   std::string take() { return std::move(out_); }
 
  private:

@@ -122,7 +122,7 @@ std::vector<std::string> folder_files(const std::string& path) {
 }
 
 // Memory a header may need beyond what the child has: far more than any real header.
-constexpr double kHeaderBudget = 1024.0 * 1024.0 * 1024.0;
+constexpr double kHeaderBudget = 256.0 * 1024.0 * 1024.0;
 
 // Scans one file's header; false when it is no DICOM file GDCM can read, or declares an
 // element too large to hold (a malformed length).
