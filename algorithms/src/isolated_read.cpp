@@ -35,6 +35,13 @@ void write_all(int fd, const char* data, size_t size) {
   }
 }
 
+void write_record(int fd, char tag, const std::string& bytes) {
+  const uint64_t size = bytes.size();
+  write_all(fd, &tag, 1);
+  write_all(fd, reinterpret_cast<const char*>(&size), sizeof(size));
+  write_all(fd, bytes.data(), bytes.size());
+}
+
 // The last thing the child printed before it ended (an assertion's text), without the program's
 // name and the library's source path, for the message.
 std::string last_words(FILE* err) {
@@ -88,19 +95,9 @@ std::string signal_name(int sig) {
     ByteWriter w;
     w.str(e.path());
     w.str(e.problem());
-    const std::string bytes = w.take();
-    const char tag = kInputError;
-    const uint64_t size = bytes.size();
-    write_all(fd, &tag, 1);
-    write_all(fd, reinterpret_cast<const char*>(&size), sizeof(size));
-    write_all(fd, bytes.data(), bytes.size());
+    write_record(fd, kInputError, w.take());
   } catch (const std::exception& e) {
-    const std::string what = e.what();
-    const char tag = kOtherError;
-    const uint64_t size = what.size();
-    write_all(fd, &tag, 1);
-    write_all(fd, reinterpret_cast<const char*>(&size), sizeof(size));
-    write_all(fd, what.data(), what.size());
+    write_record(fd, kOtherError, e.what());
   }
   // No destructors or exit handlers of the parent's objects run in the child.
   _exit(0);
@@ -108,15 +105,8 @@ std::string signal_name(int sig) {
 
 }  // namespace
 
-void ChildReport::record(char tag, const std::string& bytes) {
-  const uint64_t size = bytes.size();
-  write_all(fd_, &tag, 1);
-  write_all(fd_, reinterpret_cast<const char*>(&size), sizeof(size));
-  write_all(fd_, bytes.data(), bytes.size());
-}
-
-void ChildReport::reading(const std::string& file) { record(kReading, file); }
-void ChildReport::result(const std::string& bytes) { record(kResult, bytes); }
+void ChildReport::reading(const std::string& file) { write_record(fd_, kReading, file); }
+void ChildReport::result(const std::string& bytes) { write_record(fd_, kResult, bytes); }
 
 std::string run_isolated(const std::string& path, const std::string& reader,
                          const std::function<void(ChildReport&)>& job, double stall_seconds) {

@@ -22,9 +22,6 @@ class ChildReport {
   void result(const std::string& bytes);
 
  private:
-  friend std::string run_isolated(const std::string&, const std::string&,
-                                  const std::function<void(ChildReport&)>&, double);
-  void record(char tag, const std::string& bytes);
   int fd_;
 };
 

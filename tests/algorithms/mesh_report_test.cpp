@@ -53,20 +53,8 @@ TEST(MeshReport, ACutAtTheBorderAndAHoleAreToldApart) {
   const SkullMesh head = test::make_symmetric_head(5);
   MeshReport whole = report_mesh(head);
   const double cut_z = whole.bbox_min.z() + 30.0;
-  TriangleSoup soup;
-  for (auto vh : head.vertices()) soup.vertices.push_back(to_eigen(head.point(vh)));
-  for (auto fh : head.faces()) {
-    Eigen::Vector3i t;
-    int k = 0;
-    bool above = true;
-    for (auto vh : head.fv_range(fh)) {
-      t[k++] = vh.idx();
-      above = above && head.point(vh)[2] > cut_z;
-    }
-    if (above) soup.triangles.push_back(t);
-  }
+  SkullMesh cut = test::cut_open(head, Eigen::Vector3d(0, 0, cut_z), Eigen::Vector3d::UnitZ());
   // The cut's vertices put on the cut plane, as marching cubes ends at the scan's last slice.
-  SkullMesh cut = build_mesh(soup);
   for (auto vh : cut.vertices())
     if (cut.is_boundary(vh)) cut.point(vh)[2] = static_cast<float>(cut_z + 0.5);
   const Eigen::Vector3d side((whole.bbox_max.x()), 0.5 * (whole.bbox_min.y() + whole.bbox_max.y()),

@@ -205,19 +205,8 @@ TEST(SampleCase, AnExportOpenWhereTheScanEndsIsPlannedOnTheBone) {
   if (!std::filesystem::exists(path))
     GTEST_SKIP() << path << " not installed (scripts/install-deps)";
   const LoadedSkull skull = load_skull(path);
-  TriangleSoup soup;
-  for (auto vh : skull.mesh.vertices()) soup.vertices.push_back(to_eigen(skull.mesh.point(vh)));
-  for (auto fh : skull.mesh.faces()) {
-    Eigen::Vector3i t;
-    int k = 0;
-    bool in_scan = true;
-    for (auto vh : skull.mesh.fv_range(fh)) {
-      t[k++] = vh.idx();
-      in_scan = in_scan && skull.mesh.point(vh)[2] >= -1e-3;
-    }
-    if (in_scan) soup.triangles.push_back(t);
-  }
-  const SkullMesh open = build_mesh(soup);
+  const SkullMesh open =
+      test::cut_open(skull.mesh, Eigen::Vector3d(0, 0, -1e-3), Eigen::Vector3d::UnitZ());
   const MeshReport rep = report_mesh(open);
   ASSERT_GT(rep.boundary_edges, 500) << "the export is open along the scan's lower border";
 

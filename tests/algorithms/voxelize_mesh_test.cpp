@@ -12,24 +12,6 @@
 namespace cranioplan {
 namespace {
 
-// The faces of `mesh` whose three vertices lie above the plane through `point` with normal `up`:
-// the surface a marching-cubes export gives when the scan ends at that plane (open there).
-SkullMesh cut_open(const SkullMesh& mesh, const Eigen::Vector3d& point, const Eigen::Vector3d& up) {
-  TriangleSoup soup;
-  for (auto vh : mesh.vertices()) soup.vertices.push_back(to_eigen(mesh.point(vh)));
-  for (auto fh : mesh.faces()) {
-    Eigen::Vector3i t;
-    int k = 0;
-    bool above = true;
-    for (auto vh : mesh.fv_range(fh)) {
-      t[k++] = vh.idx();
-      above = above && (to_eigen(mesh.point(vh)) - point).dot(up) > 0;
-    }
-    if (above) soup.triangles.push_back(t);
-  }
-  return build_mesh(soup);
-}
-
 // A skull-like shell bounded by two smooth closed surfaces: the synthetic head outside, the
 // same head scaled by 0.93 about its centre inside, wound inward.
 SkullMesh hollow_head() {
@@ -102,7 +84,7 @@ TEST(VoxelizeMesh, ASkullOpenWhereTheScanEndsIsSolidAboveTheCut) {
                         Case{"side", Eigen::Vector3d::UnitX(),
                              centre - 0.3 * (hi.x() - lo.x()) * Eigen::Vector3d::UnitX()}}) {
     SCOPED_TRACE(c.name);
-    const SkullMesh open = cut_open(closed, c.point, c.up);
+    const SkullMesh open = test::cut_open(closed, c.point, c.up);
     ASSERT_LT(open.n_faces(), closed.n_faces());
     const Agreement voted = compare_above(voxelize_mesh(open, g), truth, g, c.point, c.up, kEdge);
     EXPECT_EQ(voted.differing, 0) << "of " << voted.compared << ", up to " << voted.highest;

@@ -94,6 +94,18 @@ SkullMesh cut_hole(const SkullMesh& mesh, const Eigen::Vector3d& center, double 
   return build_mesh(s);
 }
 
+SkullMesh cut_open(const SkullMesh& mesh, const Eigen::Vector3d& point, const Eigen::Vector3d& up) {
+  TriangleSoup s = to_soup(mesh);
+  std::vector<Eigen::Vector3i> kept;
+  for (const auto& t : s.triangles) {
+    bool above = true;
+    for (int k = 0; k < 3; ++k) above = above && (s.vertices[t[k]] - point).dot(up) >= 0.0;
+    if (above) kept.push_back(t);
+  }
+  s.triangles = kept;
+  return build_mesh(s);
+}
+
 SkullMesh scaled(const SkullMesh& mesh, double factor) {
   SkullMesh out = mesh;
   for (auto vh : out.vertices()) out.set_point(vh, out.point(vh) * factor);

@@ -24,6 +24,11 @@ TriangleSoup box_soup(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
 /// Removes every face whose centroid lies within `radius` of `center`.
 SkullMesh cut_hole(const SkullMesh& mesh, const Eigen::Vector3d& center, double radius);
 
+/// Keeps the faces whose three vertices lie on or above the plane through `point` with normal
+/// `up`: the surface marching cubes gives when the scan ends at that plane (open there, as most
+/// exporters leave it).
+SkullMesh cut_open(const SkullMesh& mesh, const Eigen::Vector3d& point, const Eigen::Vector3d& up);
+
 SkullMesh transformed(const SkullMesh& mesh, const RigidTransform& t);
 /// The mesh with every coordinate multiplied by `factor` (a head written in another unit:
 /// 1/1000 for metres).
