@@ -311,17 +311,14 @@ std::vector<float> read_pixels(const Stack& stack, const std::string& file, Chil
                                std::to_string(stack.info.rows));
   const SampleType type = sample_type(file, pf);
   const size_t count = static_cast<size_t>(d[0]) * d[1];
-  // Uncompressed pixel data must hold every pixel: checked before the buffer is made, so a
-  // header that claims a vast slice costs no memory.
-  if (const gdcm::ByteValue* stored = image.GetDataElement().GetByteValue())
-    if (stored->GetLength() < count * sample_size(type))
-      throw InputError(file, "its pixel data holds " +
-                                 format_count(static_cast<long long>(stored->GetLength())) +
-                                 " bytes, fewer than its " +
-                                 format_count(static_cast<long long>(count)) + " pixels need");
+  // Pixel data must hold every pixel. Uncompressed data is measured as stored, before the buffer
+  // is made, so a header that claims a vast slice costs no memory.
+  const gdcm::ByteValue* stored = image.GetDataElement().GetByteValue();
   const unsigned long length = image.GetBufferLength();
-  if (length < count * sample_size(type))
-    throw InputError(file, "its pixel data holds " + format_count(static_cast<long long>(length)) +
+  const unsigned long holds =
+      stored ? std::min<unsigned long>(stored->GetLength(), length) : length;
+  if (holds < count * sample_size(type))
+    throw InputError(file, "its pixel data holds " + format_count(static_cast<long long>(holds)) +
                                " bytes, fewer than its " +
                                format_count(static_cast<long long>(count)) + " pixels need");
   std::string buffer(length, '\0');

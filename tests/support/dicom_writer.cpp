@@ -86,8 +86,8 @@ void write_dicom_series(const Volume& v, const std::string& folder,
     std::vector<int16_t> pixels(static_cast<size_t>(v.dims[0]) * v.dims[1]);
     for (int j = 0; j < v.dims[1]; ++j)
       for (int i = 0; i < v.dims[0]; ++i)
-        pixels[static_cast<size_t>(j) * v.dims[0] + i] = static_cast<int16_t>(
-            std::lround((v.at(i, j, k) - options.intercept) / options.slope));
+        pixels[static_cast<size_t>(j) * v.dims[0] + i] =
+            static_cast<int16_t>(std::lround((v.at(i, j, k) - options.intercept) / options.slope));
     gdcm::DataElement pixel_data(gdcm::Tag(0x7fe0, 0x0010));
     pixel_data.SetByteValue(reinterpret_cast<const char*>(pixels.data()),
                             static_cast<uint32_t>(pixels.size() * sizeof(int16_t)));

@@ -1,11 +1,10 @@
 #include "support/test_files.h"
 
-#include <Eigen/Geometry>
-
 #include <sys/wait.h>
 #include <unistd.h>
 #include <zlib.h>
 
+#include <Eigen/Geometry>
 #include <array>
 #include <cstdint>
 #include <cstdio>
