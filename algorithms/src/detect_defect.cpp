@@ -50,6 +50,39 @@ RayThroughBone cast_through_bone(const SurfaceLocator& locator, const Eigen::Vec
   return h;
 }
 
+bool ScanBorder::reached_by(const Eigen::Vector3d& from, const Eigen::Vector3d& dir) const {
+  const double along = dir.dot(normal);
+  if (along <= 1e-9) return false;  // parallel to the plane, or away from it
+  const double t = (offset - from.dot(normal)) / along;
+  if (t <= 0.0) return false;
+  const Eigen::Vector3d hit = from + t * dir;
+  // Within the box but along the normal, where the hit lies on the plane.
+  for (int k = 0; k < 3; ++k)
+    if (std::abs(normal[k]) < 0.5 && (hit[k] < box_min[k] || hit[k] > box_max[k])) return false;
+  return true;
+}
+
+std::vector<ScanBorder> scan_borders(const MeshReport& report) {
+  std::vector<ScanBorder> out;
+  std::vector<std::string> sides;
+  for (const BoundaryLoop& loop : report.loops) {
+    if (!loop.at_border || std::find(sides.begin(), sides.end(), loop.border) != sides.end())
+      continue;
+    sides.push_back(loop.border);
+    int axis = 0;
+    loop.normal.cwiseAbs().maxCoeff(&axis);
+    ScanBorder b;
+    const bool low =
+        loop.centroid[axis] - report.bbox_min[axis] <= report.bbox_max[axis] - loop.centroid[axis];
+    b.normal = (low ? -1.0 : 1.0) * Eigen::Vector3d::Unit(axis);
+    b.offset = b.normal.dot(loop.centroid);
+    b.box_min = report.bbox_min;
+    b.box_max = report.bbox_max;
+    out.push_back(b);
+  }
+  return out;
+}
+
 Eigen::Matrix3d skull_frame(const SkullMesh& skull, const Eigen::Vector3d& center,
                             const Eigen::Vector3d& plane_normal) {
   const Eigen::Vector3d n = plane_normal.normalized();
@@ -153,18 +186,25 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
     for (int j : index.within_radius(dirs[i], 1.6 * spacing))
       if (j != i) nbrs[i].push_back(j);
 
-  // Openings: connected directions without bone.
+  // Openings: connected directions without bone, but for those that leave through the scan's
+  // border (closed there by the scan's end, not open in the bone).
+  std::vector<char> blocked(n, 0);
+  for (int i = 0; i < n; ++i) {
+    blocked[i] = inner[i].has_value();
+    for (const ScanBorder& border : params.scan_borders)
+      if (!blocked[i] && border.reached_by(center, dirs[i])) blocked[i] = 1;
+  }
   std::vector<int> label(n, -1);
   std::vector<std::vector<int>> comps;
   for (int i = 0; i < n; ++i) {
-    if (inner[i] || label[i] >= 0) continue;
+    if (blocked[i] || label[i] >= 0) continue;
     std::vector<int> comp{i}, stack{i};
     label[i] = static_cast<int>(comps.size());
     while (!stack.empty()) {
       const int v = stack.back();
       stack.pop_back();
       for (int w : nbrs[v])
-        if (!inner[w] && label[w] < 0) {
+        if (!blocked[w] && label[w] < 0) {
           label[w] = label[i];
           comp.push_back(w);
           stack.push_back(w);

@@ -32,6 +32,15 @@ bool plan_method_from_string(const std::string& text, PlanMethod& out) {
 
 namespace {
 
+// Open somewhere: more than a few boundary edges (a reader splits a non-manifold vertex or two
+// of a closed surface, which leaves a handful).
+bool has_boundary(const SkullMesh& mesh) {
+  int count = 0;
+  for (auto heh : mesh.halfedges())
+    if (mesh.is_boundary(heh) && ++count > 20) return true;
+  return false;
+}
+
 // Along an ordered closed polyline, indices every `spacing` mm of arc length.
 std::vector<size_t> along(const std::vector<Eigen::Vector3d>& loop, double spacing) {
   std::vector<size_t> out;
@@ -56,6 +65,8 @@ DefectRegion detect_defect_near_plane(const SkullMesh& skull, const SurfaceLocat
   const Eigen::Vector3d center = plane.project(centroid);
   DetectDefectParams framed = params;
   if (!framed.frame) framed.frame = skull_frame(skull, center, plane.normal);
+  if (framed.scan_borders.empty() && has_boundary(skull))
+    framed.scan_borders = scan_borders(report_mesh(skull));
   return detect_defect(skull, bone, center, framed);
 }
 

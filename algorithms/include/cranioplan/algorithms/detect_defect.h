@@ -9,11 +9,28 @@
 #include <string>
 #include <vector>
 
+#include "cranioplan/algorithms/mesh_report.h"
 #include "cranioplan/model/mesh.h"
 
 namespace cranioplan {
 
 class SurfaceLocator;
+
+/// A side of the surface where the scan ended: the plane of a flat cut at the surface's border
+/// (`normal` points out of the surface; the plane is normal·x = offset) and the surface's
+/// bounding box.
+struct ScanBorder {
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
+  double offset = 0.0;
+  Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();
+  /// The ray from `from` along `dir` reaches the plane within the box's extent.
+  bool reached_by(const Eigen::Vector3d& from, const Eigen::Vector3d& dir) const;
+};
+
+/// The sides where a surface is open along a flat cut at its border (MeshReport's loops
+/// `at_border`: where a scan ended or an exporter cropped), one per side; none for a closed
+/// surface.
+std::vector<ScanBorder> scan_borders(const MeshReport& report);
 
 struct DetectDefectParams {
   int directions = 20000;       ///< rays cast (Fibonacci sphere), 2,000..200,000
@@ -33,6 +50,11 @@ struct DetectDefectParams {
   /// coordinates). With the skull's own frame (skull_frame) the rays meet the same anatomy
   /// whatever pose the file came in, and so the plan is the same.
   std::optional<Eigen::Matrix3d> frame;
+  /// Where the scan ended (scan_borders). A ray that meets no bone and reaches such a border
+  /// is closed there by the scan's end, not open in the bone: the cut is never planned as a
+  /// defect, and a defect that reaches the cut keeps its own rays. Not a user's parameter:
+  /// detect_defect_near_plane takes them from the mesh.
+  std::vector<ScanBorder> scan_borders;
 };
 
 /// A stretch of the rim that no ray saw: between two consecutive rim points far apart, where
