@@ -341,7 +341,24 @@ struct Refusal {
 
 // ----- the commands ----------------------------------------------------------------------------
 
-void apply_load(PlanState& s, const ParamReader& r, const ApplyContext& ctx) {
+// What the skull's file held and what the reading did about it (the load's warnings: the
+// openings and how the inside is taken through them, pieces dropped, non-manifold edges, an
+// inward winding turned), recorded when the command is first done. A replay reads the file
+// again, repairs it the same way (the import's parameters are in the command), and says so
+// when it finds the input otherwise than recorded. The file's path is left out of the warnings
+// so a session moved with its skull compares equal.
+Json input_report(const LoadedSkull& loaded, const SkullMesh& mesh, const std::string& path) {
+  Json warnings = Json::array();
+  for (std::string w : loaded.warnings) {
+    if (w.rfind(path + ": ", 0) == 0) w = w.substr(path.size() + 2);
+    warnings.push_back(w);
+  }
+  return Json{{"triangles", static_cast<long long>(mesh.n_faces())},
+              {"pieces_dropped", loaded.pieces_dropped},
+              {"warnings", warnings}};
+}
+
+void apply_load(PlanState& s, const ParamReader& r, const ApplyContext& ctx, Json& record) {
   const std::string recorded = r.string("path");
   const std::string path = resolve_input(recorded, ctx);
   const std::string sha = sha256_file(path);  // the bytes go before the mesh comes
@@ -371,6 +388,16 @@ void apply_load(PlanState& s, const ParamReader& r, const ApplyContext& ctx) {
                   " triangles";
   if (!loaded.frame.empty()) fresh.message += "; patient frame: " + loaded.frame;
   for (const std::string& w : loaded.warnings) fresh.message += "; " + w;
+  const Json report = input_report(loaded, fresh.skull->surface->mesh, path);
+  const Json recorded_report = r.has("input_report") ? r.value("input_report") : Json();
+  if (!recorded_report.is_object())
+    record["input_report"] = report;
+  else if (recorded_report != report)
+    fresh.message += "; the file reads otherwise than when this plan was made (recorded: " +
+                     std::to_string(recorded_report.value("triangles", 0LL)) + " triangles, " +
+                     std::to_string(recorded_report.value("warnings", Json::array()).size()) +
+                     " warnings; now " + std::to_string(report["triangles"].get<long long>()) +
+                     " and " + std::to_string(report["warnings"].size()) + ")";
   s = std::move(fresh);
 }
 
@@ -731,7 +758,7 @@ ApplyOutcome apply_command(const PlanState& before, const Command& command,
   try {
     switch (command.type) {
       case CommandType::LoadSkull:
-        apply_load(s, r, context);
+        apply_load(s, r, context, out.record);
         break;
       case CommandType::SetLandmark:
         apply_landmark(s, r, true);

@@ -265,6 +265,53 @@ TEST(Commands, TheLoadRecordsTheMeshesLengthUnit) {
   }
 }
 
+// What the skull's file held and what the reading did about it is recorded in the load when it
+// is first done ("input_report": triangles, pieces dropped, the warnings without the file's
+// path): a skull left open, the opening said and how its inside is taken. A
+// replay repairs the same way (the import's parameters are in the command) and says so when the
+// file reads otherwise than recorded.
+TEST(Commands, TheLoadRecordsWhatTheSkullHeldAndAReplaySaysWhenItDiffers) {
+  test::TempDir dir;
+  const SkullMesh head = test::make_symmetric_head(3);
+  const MeshReport whole = report_mesh(head);
+  const std::string p = dir.path("open.stl");
+  write_mesh(
+      test::cut_open(head, whole.bbox_min + Eigen::Vector3d(0, 0, 20), Eigen::Vector3d::UnitZ()),
+      p);
+  Session s;
+  push_ok(s, commands::load_skull(p));
+  const Json load = to_json(s.effective_commands().front());
+  ASSERT_TRUE(load["params"].contains("input_report")) << load.dump();
+  const Json& report = load["params"]["input_report"];
+  EXPECT_EQ(report["triangles"], static_cast<long long>(s.state().skull->surface->mesh.n_faces()));
+  EXPECT_EQ(report["pieces_dropped"], 0);
+  bool says_open = false;
+  for (const Json& w : report["warnings"]) {
+    says_open = says_open || w.get<std::string>().find("open edge") != std::string::npos;
+    EXPECT_EQ(w.get<std::string>().find(p), std::string::npos) << "no path: " << w;
+  }
+  EXPECT_TRUE(says_open) << report.dump();
+
+  // Replayed from its file: the same report, nothing said.
+  const std::string saved = dir.path("plan.json");
+  s.save(saved);
+  const Session back = Session::open(saved);
+  ASSERT_TRUE(back.state().skull);
+  EXPECT_EQ(back.state().message.find("reads otherwise"), std::string::npos)
+      << back.state().message;
+  EXPECT_EQ(to_json(back.effective_commands().front())["params"]["input_report"], report);
+
+  // A load whose record says otherwise (as a file read by an older program would): said.
+  Command recorded = commands::load_skull(p);
+  recorded.params["input_report"] = report;
+  recorded.params["input_report"]["triangles"] = 12;
+  Session t;
+  push_ok(t, recorded);
+  EXPECT_NE(t.state().message.find("the file reads otherwise than when this plan was made"),
+            std::string::npos)
+      << t.state().message;
+}
+
 // build_implant 4 holds the implant a set clearance off the bone's surface and removes thin
 // fills; a version-3 command (session 9: "trim" without either) is read as session 9 fitted
 // it, and a bad clearance is named.
