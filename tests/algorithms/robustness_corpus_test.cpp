@@ -15,6 +15,7 @@
 #include <vtkWindowedSincPolyDataFilter.h>
 
 #include <cstdio>
+#include <cstdlib>
 #include <filesystem>
 #include <functional>
 #include <string>
@@ -159,7 +160,11 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
     SCOPED_TRACE(c.name);
     Row row;
     row.name = c.name;
-    const SkullMesh skull = exported(c.make(), dir.path("case" + std::to_string(i) + ".stl"));
+    // CRANIOPLAN_KEEP_CORPUS=DIR keeps the exports (case0.stl ...) to plan them by hand.
+    const char* keep = std::getenv("CRANIOPLAN_KEEP_CORPUS");
+    const std::string file = "case" + std::to_string(i) + ".stl";
+    const SkullMesh skull =
+        exported(c.make(), keep ? std::string(keep) + "/" + file : dir.path(file));
     const AutoplanResult r = autoplan(skull, Landmarks{});
     row.planned = r.planned();
     row.message = r.message;
