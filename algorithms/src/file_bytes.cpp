@@ -22,15 +22,18 @@ std::string gunzip(const std::string& path, const char* data, size_t size, size_
   z_stream zs{};
   // 15 + 32: accept both gzip and zlib headers.
   if (inflateInit2(&zs, 15 + 32) != Z_OK) throw InputError(path, "cannot start decompression");
+  // Grown as the data comes, up to the size the header announces: a header may announce
+  // terabytes over a few bytes of data (a fuzzed NRRD asked for 600 GB at once).
+  const size_t guess = std::max<size_t>(size * 4, 1 << 16);
   std::string out;
-  out.resize(expected_size > 0 ? expected_size : std::max<size_t>(size * 4, 1 << 16));
+  out.resize(expected_size > 0 ? std::min(expected_size, guess) : guess);
   zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data));
   zs.avail_in = static_cast<uInt>(std::min<size_t>(size, 0x7fffffff));
   size_t produced = 0;
   int rc = Z_OK;
   while (true) {
     if (produced == out.size()) {
-      if (expected_size > 0) {
+      if (expected_size > 0 && out.size() == expected_size) {
         // The stream must end exactly here; one probe byte tells whether more data follows.
         char probe;
         zs.next_out = reinterpret_cast<Bytef*>(&probe);
@@ -44,7 +47,7 @@ std::string gunzip(const std::string& path, const char* data, size_t size, size_
         }
         break;
       }
-      out.resize(out.size() * 2);
+      out.resize(expected_size > 0 ? std::min(expected_size, out.size() * 2) : out.size() * 2);
     }
     zs.next_out = reinterpret_cast<Bytef*>(out.data() + produced);
     zs.avail_out = static_cast<uInt>(std::min<size_t>(out.size() - produced, 0x7fffffff));
