@@ -229,15 +229,14 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
   // triangles (the thin bone around it and the orbits opens up, which moves both the opening's
   // mean and the vault's direction), and its frontal defect at 96°, 89°, 84°, 82°; SkullFix's
   // bases 125–154°, their defects 26–53°. The orbits lie further still (120–150°) but are
-  // smaller than the foramen. Until session 10 the limit was 114°: on the 60,000-triangle copy
-  // the largest opening beyond it was an orbit, and the foramen magnum was planned as the
-  // defect. With the skull's frame (its third axis the midsagittal plane's normal), the base
-  // must also lie within 30° of the plane, as the foramen magnum and a scan's cut do (on the
-  // sample 0°, and 17–27° for its orbits): a large one-sided defect low on the side of the head
-  // (a decompressive hemicraniectomy, 8,000 mm² and more) is larger than the foramen magnum and
-  // would otherwise be taken for the base if it reached 105°. Without such an opening, or
-  // without a vault direction, the skull is closed below. The defect is the largest of the
-  // others whose area, at the radius of its rim, is large enough.
+  // smaller than the foramen (a limit of 114° took an orbit of the 60,000-triangle copy for
+  // the base, and planned the foramen magnum as the defect). With the skull's frame (its third axis
+  // the midsagittal plane's normal), the base must also lie within 30° of the plane, as the foramen
+  // magnum and a scan's cut do (on the sample 0°, and 17–27° for its orbits): a large one-sided
+  // defect low on the side of the head (a decompressive hemicraniectomy, 8,000 mm² and more) is
+  // larger than the foramen magnum and would otherwise be taken for the base if it reached 105°.
+  // Without such an opening, or without a vault direction, the skull is closed below. The defect is
+  // the largest of the others whose area, at the radius of its rim, is large enough.
   constexpr double kBaseAwayFromVault = -0.2588;  // cos 105°
   constexpr double kBaseNearMidline = 0.5;        // sin 30°
   size_t base = order.size();

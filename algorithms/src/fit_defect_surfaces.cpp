@@ -62,7 +62,7 @@ struct Sample {
 // bending as around the opening): whichever predicts the ring's band next to the opening
 // better from the rest of the ring. A quadratic trend sags over wide openings (a synthetic
 // 100 mm cut: Dice 0.82 against 0.89 over the sphere); a sphere bulges where the vault
-// flattens (SkullFix 003 with an intermediate planner of session 5: 0.917 against 0.875), and
+// flattens (SkullFix 003 planned with a quadratic trend: Dice 0.917, over a sphere 0.875), and
 // the band tells them apart. `uv` projects a ray's direction as the fit does; `distance` is
 // each ray's distance from the opening.
 std::optional<VaultSphere> choose_vault(

@@ -188,12 +188,11 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
   // Support markers: the intact bone next to the rim (the ring's nearest band). Inner ones
   // where the ray's first bone is the inner table (it faces the ray), also where the ray did
   // not meet both tables squarely: next to a real defect's rim the bone thins and bends, and
-  // the implant meets it only if its inner surface follows it (session 5 tried the inner ones
-  // only where both tables were parallel: the sample's defect planned rim-only opened a 4 mm
-  // gap at the rim). Not where the first bone is a cut face met side-on: it lies above where
-  // the inner table goes on, and the implant's inner surface would rise to it and leave the
-  // wedge of bone under the cut empty (SkullFix: median Dice 0.904 -> 0.910, boundary Dice
-  // 0.901 -> 0.924).
+  // the implant meets it only if its inner surface follows it (inner ones only where both
+  // tables are parallel open a 4 mm gap at the rim of the sample's defect planned rim-only). Not
+  // where the first bone is a cut face met side-on: it lies above where the inner table goes on,
+  // and the implant's inner surface would rise to it and leave the wedge of bone under the cut
+  // empty (SkullFix: median Dice 0.904 -> 0.910, boundary Dice 0.901 -> 0.924).
   std::vector<Eigen::Vector3d> support_outer, support_inner;
   const double band = params.surfaces.rim_clearance_mm + params.detect.support_width_mm;
   const double min_facing =

@@ -293,7 +293,8 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
                               std::max(0.0, *params.clearance_mm));
     Mask().swap(mask);
   } else {
-    // Sessions up to 9: neither the grid nor the smoothing may carry the surface into the
+    // Without a clearance (build_implant commands before version 4): neither the grid nor the
+    // smoothing may carry the surface into the
     // bone: the bone grown by one voxel stays outside (the surface then lies a fraction of a
     // voxel off the bone, up to a voxel and a half).
     smooth = blur(mask, grid, params.smoothing_mm / h);

@@ -536,7 +536,7 @@ std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
              // others are still planned and scored.
              try {
                // The truth is read first (to fail before planning) and not timed: the time is
-               // the plan's, from reading the skull to the implant (as until session 10).
+               // the plan's, from reading the skull to the implant.
                const SkullMesh truth = load_any(files.second);
                const auto t0 = std::chrono::steady_clock::now();
                const LoadedSkull loaded = load_skull(files.first);

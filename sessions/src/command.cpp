@@ -213,8 +213,9 @@ int current_version(CommandType type) {
   // the fit it gave ("result") and, when the mirror was registered again after it, that
   // registration ("registration"), which a replay applies instead of computing them again.
   // build_implant 3: the fit to the bone's parameters ("trim"; versions 1 and 2 are read with
-  // those of sessions 4-8). load_skull 2: the skull read in canonical form ("import.canonical";
-  // version 1 is read as the file gives it). load_skull 3 (session 13): a mesh's length unit
+  // the trim they were made with). load_skull 2: the skull read in canonical form
+  // ("import.canonical"; version 1 is read as the file gives it). load_skull 3: a mesh's length
+  // unit
   // ("import.mesh_unit_mm", mm when absent) and a skull that winds inward turned outward
   // ("import.orient_outward", not when absent).
   // build_implant 4: the fit to the bone holds the implant "clearance_mm" off the bone's
@@ -341,10 +342,10 @@ Json params_to_json(const ImplantParams& p) {
 void params_from_json(const ParamReader& r, ExtractBoneSurfaceParams& p) {
   Reader v{r};
   extract_fields(v, p);
-  // load_skull 1 (before session 9) has no "canonical": the skull as the file gave it, so that
+  // load_skull 1 has no "canonical": the skull as the file gave it, so that
   // those plans replay to the implants they exported.
   p.canonical = r.has("canonical") && r.boolean("canonical");
-  // Before session 13 every mesh was read in millimetres.
+  // load_skull 1 and 2 read every mesh in millimetres.
   p.mesh_unit_mm = r.has("mesh_unit_mm") ? r.number("mesh_unit_mm") : 1.0;
   if (!(p.mesh_unit_mm > 0.0) || !std::isfinite(p.mesh_unit_mm))
     throw SessionError(r.where(), "parameter 'mesh_unit_mm' must be a positive length in mm");
@@ -423,14 +424,15 @@ void params_from_json(const ParamReader& r, ImplantParams& p) {
   const Json& c = r.value("radial_center");
   p.radial_center.reset();
   if (!c.is_null()) p.radial_center = vector_from_json(c, r.where(), "radial_center");
-  // build_implant 1 and 2 have no "trim": the fit to the bone of sessions 4-8 (slivers under
-  // 1.25 mm removed, cracks under 2 mm bridged), so that those plans replay to their implants.
+  // build_implant 1 and 2 have no "trim": the fit to the bone they were made with (slivers
+  // under 1.25 mm removed, cracks under 2 mm bridged), so that those plans replay to their
+  // implants.
   p.trim = TrimToBoneParams{};
   if (r.has("trim")) {
     const ParamReader trim(r.value("trim"), r.where() + " trim");
     Reader tv{trim};
     trim_fields(tv, p.trim);
-    // build_implant 3 (session 9) has no "clearance_mm": the bone grown by a voxel kept out,
+    // build_implant 3 has no "clearance_mm": the bone grown by a voxel kept out,
     // and fills kept as made.
     p.trim.thin_fills_removed =
         trim.has("thin_fills_removed") && trim.boolean("thin_fills_removed");

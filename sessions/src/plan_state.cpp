@@ -614,7 +614,7 @@ bool apply_proposal_result(PlanState& s, const Json& j, const std::string& where
   s.defect_center.reset();
   if (!result.value("defect_center").is_null()) s.defect_center = result.vector3("defect_center");
   s.proposal_message = result.string("message");
-  // Recorded since session 9; earlier results have none.
+  // Results recorded by older plans may have none.
   s.unseen_rim.clear();
   if (result.has("unseen_rim")) {
     const Json& stretches = result.value("unseen_rim");

@@ -50,7 +50,7 @@ TEST(Autoplan, OneSidedDefectInASymmetricSkullIsFilled) {
 }
 
 // Across the midline the mirror cannot help: rim-only fitting bridges the opening (the issue's
-// target, DSC >= 0.85; 0.96 in session 5).
+// target, DSC >= 0.85; measured 0.96).
 TEST(Autoplan, DefectAcrossTheMidlineIsBridgedByRimFitting) {
   const InjectDefectResult d = defect_at({0.0, -0.3, 1.0}, 50);
   ASSERT_TRUE(d.usable());
@@ -69,8 +69,9 @@ TEST(Autoplan, DefectAcrossTheMidlineIsBridgedByRimFitting) {
 // Next to such a face the rays from inside meet the bone's inner corner while the outer table
 // goes on a few millimetres further out: the outer edge markers belong on the outer table (the
 // fitted outer surface), else the implant tapers down to the corner and leaves the wedge
-// between the cut face and the rays empty. Before session 5, 3 of 33 markers here (and on
-// SkullFix whole sides of the cube) sat at the inner corner, 7.4 mm below the outer table.
+// between the cut face and the rays empty (markers at the last bone the rays meet put 3 of
+// 33 here, and whole sides of SkullFix's cubes, at the inner corner, 7.4 mm below the outer
+// table).
 struct ObliqueCut {
   SkullMesh intact = test::make_thick_head(0.89);
   InjectDefectResult defect;
@@ -150,9 +151,7 @@ TEST(Autoplan, InnerMarkersAtAnObliqueCutStayOnTheInnerTable) {
 
 // Real data when present (../shared/data/skullfix; skipped otherwise): SkullFix case 000, a
 // cube cut across the midline at the back of the head, planned from its NRRD mask alone against
-// the ground-truth implant. Session 4 gave DSC 0.863 / HD95 2.83 mm (whole sides of the cube
-// left as wedges); session 5 0.908 / 1.50 mm; session 9 0.910 / boundary 0.928 / 1.41 mm (no
-// inner support markers on the cut faces).
+// the ground-truth implant (figures in docs/AUTOPLAN.md).
 TEST(Autoplan, SkullFixCaseAcrossTheMidlineMatchesTheGroundTruth) {
   const std::string dir = CRANIOPLAN_SKULLFIX_DIR;
   if (!std::filesystem::exists(dir + "/000_defective_skull.nrrd") ||
@@ -263,8 +262,8 @@ TEST(Autoplan, BilateralDefectsArePlannedOneByOneFromTheRim) {
 
 // A skull file may come in any pose (an STL from another tool, a scan of a patient lying
 // prone). Here the skull is turned so that its one-sided defect faces straight down, where a
-// rule "the skull base is the opening below" (sessions 1–5) took the defect for the base and
-// found no defect. The base is now the opening facing away from the vault, and the rays are
+// rule "the skull base is the opening below" would take the defect for the base and find no
+// defect. The base is the opening facing away from the vault, and the rays are
 // laid out in the skull's own frame: the plan is the same as in the upright pose.
 TEST(Autoplan, TheSkullsPoseDoesNotChangeThePlan) {
   const Eigen::Vector3d direction = Eigen::Vector3d(0.75, 0.2, 0.6).normalized();

@@ -137,10 +137,10 @@ TEST(CheckImplant, ATaperedEdgeOnTheBoneIsPrintableUpToItsWidth) {
 }
 
 // The rim gap's arcs slide: a gap 5° wide or more is found wherever it lies, and the same
-// points turned by any angle, or listed in another order, give the same gap. (Until session 12
-// the gap was taken over 72 fixed 5° sectors that began at the mesh's first wall vertex: the
-// gap below, 6.5° wide, hid from sectors beginning at 0°, each of which also held a vertex on
-// the bone, and reordering the vertices moved the sectors.)
+// points turned by any angle, or listed in another order, give the same gap. (Over 72 fixed 5°
+// sectors beginning at the mesh's first wall vertex, the gap below, 6.5° wide, hides from
+// sectors beginning at 0°, each of which also holds a vertex on the bone, and reordering the
+// vertices moves the sectors.)
 TEST(CheckImplant, TheRimGapIsTheWorstArcWhereverItLies) {
   const double deg = M_PI / 180;
   std::vector<double> angle, distance;

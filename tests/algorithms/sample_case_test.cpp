@@ -78,11 +78,8 @@ TEST(SampleCase, AutoplanFillsTheRealDefect) {
   // The target on the sample's real defect, from autoplan alone: a watertight shell
   // with a rim gap of at most 0.5 mm and no penetration into the skull (the shell is fitted to
   // the bone: built 4 mm over it and trimmed by it), and printable by the quality report (its
-  // edge on the bone tapers over 1.5 mm; docs/IMPLANT.md). Measured 0.09 mm (session 10; 0.14 in
-  // session 9; the STL of scripts/run-sample is read as this very mesh; it was 0.50 / 0.19 mm
-  // before the ring's rays through cut faces were left out, and at most 0.19 mm over 14 readings
-  // and poses: the figure was then a maximum over 72 fixed sectors; since session 12 it is the
-  // worst 5° arc, sliding, and reads 0.090 mm).
+  // edge on the bone tapers over 1.5 mm; docs/IMPLANT.md). Measured 0.09 mm over the worst 5°
+  // arc of the rim (the STL of scripts/run-sample is read as this very mesh).
   EXPECT_TRUE(r.quality.watertight);
   EXPECT_TRUE(r.quality.manifold);
   EXPECT_EQ(r.quality.self_intersections, 0);
@@ -92,10 +89,11 @@ TEST(SampleCase, AutoplanFillsTheRealDefect) {
   // flush contact is placed within half a voxel (TrimToBone tests), so 0.25 mm³ (16 voxels)
   // is the floor; the unfitted shell overlaps the bone by about 43 mm³.
   EXPECT_LT(r.quality.penetration_mm3, 0.25);
-  // The fit to the bone's two rules of session 10, on this defect: planned with fills kept as
-  // made, the implant has a rod from its edge to a fragment by the orbit that the quality report
-  // rejects (a corner reaching 0.85 mm past 1 mm thick, measured); with session 9's one-voxel
-  // keep-out it stands further off the bone (rim gap 0.16 mm against 0.09 mm, measured).
+  // The fit to the bone's two rules (thin fills removed, a clearance to the bone), on this
+  // defect: planned with fills kept as made, the implant has a rod from its edge to a fragment
+  // by the orbit that the quality report rejects (a corner reaching 0.85 mm past 1 mm thick,
+  // measured); with a one-voxel keep-out instead of the clearance it stands further off the
+  // bone (rim gap 0.16 mm against 0.09 mm, measured).
   {
     AutoplanParams kept;
     kept.implant.trim.thin_fills_removed = false;
@@ -116,9 +114,10 @@ TEST(SampleCase, AutoplanFillsTheRealDefect) {
 }
 
 // The sample turned a quarter turn about the left-right axis and moved: its frontal defect
-// then faces down, where sessions 1–5 took it for the skull base and planned the foramen
-// magnum instead. The same defect must be found and the same implant built (measured: DSC
-// 0.967 between the two poses, rim gap 0.15 mm; five other poses 0.93–0.97, docs/AUTOPLAN.md).
+// then faces down, where a rule "the skull base is the opening below" would take it for the
+// base and plan the foramen magnum instead. The same defect must be found and the same implant
+// built (measured: DSC 0.967 between the two poses, rim gap 0.15 mm; five other poses 0.93–0.97,
+// docs/AUTOPLAN.md).
 TEST(SampleCase, TurnedSkullGivesTheSamePlan) {
   const std::string path = sample_case_path();
   if (!std::filesystem::exists(path))
@@ -143,8 +142,8 @@ TEST(SampleCase, TurnedSkullGivesTheSamePlan) {
 // The same surface from another file plans to the same implant: the CT mesh, an STL of it (the
 // STL reader welds the CT mesh's 682 duplicate vertices and lists the rest in another order) and
 // a PLY of it. Meshes are read in a canonical form (make_canonical), so the plane's and the
-// registration's samples, taken by vertex index, are the same; in session 8 the CT mesh and its
-// STL gave planes 0.6° apart and implants with DSC 0.82 between them.
+// registration's samples, taken by vertex index, are the same (read as the files give them, the
+// CT mesh and its STL gave planes 0.6° apart and implants with DSC 0.82 between them).
 TEST(SampleCase, TheSameSurfaceFromAnotherFileGivesTheSameImplant) {
   const std::string path = sample_case_path();
   if (!std::filesystem::exists(path))
@@ -172,11 +171,11 @@ TEST(SampleCase, TheSameSurfaceFromAnotherFileGivesTheSameImplant) {
 // a few rim points then lie on bone 20-30 mm below their neighbours on the rim (the sinus wall
 // and orbital roof seen past the crushed supraorbital bone), where the mirror has no bone to
 // fit either; edge markers there pulled the implant down into a funnel that the fit to the
-// bone cut away (session 8's code: a bay with a 4.8 mm rim gap; session 9 before the rule on
-// neighbours: 7.2 mm). The implant meets the bone within the printable limit (1 mm) all round,
+// bone cut away (a bay with a rim gap of 4.8-7.2 mm without the rule on neighbours). The
+// implant meets the bone within the printable limit (1 mm) all round,
 // not within the 0.5 mm it does on the CT mesh: where the orbit's thin bone is lost to the
 // decimation, its free edge over the orbit stands 0.54 mm off the last fragment along a 5° arc
-// (0.09 mm by the fixed sectors before session 12, which cut across that arc).
+// (fixed sectors, which cut across that arc, read 0.09 mm).
 TEST(SampleCase, ADecimatedCopyIsPlannedAsWell) {
   const std::string path = sample_case_path();
   if (!std::filesystem::exists(path))
@@ -226,9 +225,9 @@ TEST(SampleCase, AnExportOpenWhereTheScanEndsIsPlannedOnTheBone) {
 
 // Decimated much further (60,000 triangles, edges about 3.5 mm), the thin bone around the
 // foramen magnum and the orbits opens up: the foramen's mean direction came to lie 113° from the
-// vault's (124° on the CT mesh), inside session 10's limit for the base (114°), and the largest
-// opening beyond the limit was an orbit, so the foramen magnum was planned as the defect. The
-// base is now the largest opening more than 105° from the vault: the frontal defect is found,
+// vault's (124° on the CT mesh): with a limit of 114° for the base the largest opening beyond
+// it was an orbit, and the foramen magnum was planned as the defect. The base is the largest
+// opening more than 105° from the vault: the frontal defect is found,
 // mirror-guided. Its plan is not printable (the rim is unseen along 59 mm by the crushed orbit,
 // and the implant stands 1.7 mm off the bone there; docs/AUTOPLAN.md) and says so.
 TEST(SampleCase, ACoarseCopyStillHasItsDefectFoundNotItsBase) {
@@ -304,11 +303,10 @@ TEST(SampleCase, ALargeDefectLowOnTheSideIsNotTakenForTheBase) {
 
 // The same defect planned from the rim alone, as for a defect the mirror cannot fill: the
 // implant must still meet the real bone all round and be printable. Next to a real defect's rim
-// the bone thins and bends, and the support markers there carry that to the implant (session 5
-// briefly kept only rays through both tables for them: the rim gap opened to 4 mm). Before
-// session 9 the STL of this skull planned so had a bay 6.8 mm deep above the orbit (the orbital
-// roof seen past the rim taken for the vault, BoneSeenThroughTheOpeningIsNotTheVault), and this
-// mesh a thin corner; the STL is now read as this very mesh
+// the bone thins and bends, and the support markers there carry that to the implant (only rays
+// through both tables for them open the rim gap to 4 mm). The orbital roof seen past the rim
+// must not be taken for the vault (BoneSeenThroughTheOpeningIsNotTheVault): that made a bay
+// 6.8 mm deep above the orbit. The STL is read as this very mesh
 // (TheSameSurfaceFromAnotherFileGivesTheSameImplant). Over 14 readings and poses of the sample
 // every rim-only plan is printable (docs/AUTOPLAN.md).
 TEST(SampleCase, RimOnlyPlanMeetsTheRealBone) {

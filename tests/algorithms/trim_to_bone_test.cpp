@@ -110,8 +110,8 @@ std::vector<double> wall_distances(const SkullMesh& implant, const SkullMesh& bo
 
 // The gap between two plates, turned obliquely to every axis and trimmed on a coarse grid
 // (0.45 mm, as for a large implant): the implant's walls lie the clearance (0.1 mm) off the cut
-// faces to a fraction of the grid, not where the bone's voxels end. Sessions up to 9's rule (the
-// bone's voxels grown by one kept out) leaves it about a voxel off.
+// faces to a fraction of the grid, not where the bone's voxels end. Without a clearance (the
+// bone's voxels grown by one kept out, build_implant 3) it lies about a voxel off.
 TEST(TrimToBone, HoldsTheClearanceOffObliqueCutFacesOnACoarseGrid) {
   const Eigen::Matrix3d r =
       (Eigen::AngleAxisd(0.5, Eigen::Vector3d(1, 2, 3).normalized())).toRotationMatrix();
@@ -140,7 +140,7 @@ TEST(TrimToBone, HoldsTheClearanceOffObliqueCutFacesOnACoarseGrid) {
 // A fragment of bone 1 mm across floats 2.5 mm above the implant, within the bridge's reach
 // (3 mm here): the bridge fills the crack between them, but that fill is a rod thinner than the
 // feature size, most of it over a millimetre from the bone, and goes; the implant ends at its
-// own top. Session 9's fit (fills kept as made) grew the rod. (A speck of implant high above
+// own top. With fills kept as made (build_implant 3) the rod grows. (A speck of implant high above
 // widens the trim's grid to hold the fragment; being apart, it goes as well.)
 TEST(TrimToBone, ARodOfFillToAFragmentGoes) {
   const SkullMesh bone = [&] {

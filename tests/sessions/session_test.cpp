@@ -157,11 +157,11 @@ TEST(Commands, PlansSavedBeforeThePatientFrameReadTheirSkullAsThen) {
   EXPECT_EQ(back.dicom_series, "");
 }
 
-// Plans saved before session 9 replay to the implants they exported: their load_skull (1)
-// reads the skull as the file gave it, not in canonical form, and their build_implant (1, 2)
-// fits to the bone as sessions 4-8 did (slivers under 1.25 mm removed, cracks under 2 mm
-// bridged). Today's commands record both, and read them back as recorded.
-TEST(Commands, PlansSavedBeforeSession9ReadTheSkullAndFitTheBoneAsThen) {
+// Older plans replay to the implants they exported: a load_skull 1 reads the skull as the file
+// gave it, not in canonical form, and a build_implant 1 or 2 fits to the bone as it was made
+// to (slivers under 1.25 mm removed, cracks under 2 mm bridged). Today's commands record both,
+// and read them back as recorded.
+TEST(Commands, OlderPlansReadTheSkullAndFitTheBoneAsTheyWereMade) {
   const Json load = to_json(commands::load_skull("skull.stl"));
   EXPECT_EQ(load["version"], 4);
   ExtractBoneSurfaceParams import;
@@ -188,7 +188,7 @@ TEST(Commands, PlansSavedBeforeSession9ReadTheSkullAndFitTheBoneAsThen) {
   EXPECT_EQ(back.trim.min_feature_mm, 1.25);
   EXPECT_EQ(back.trim.bridge_mm, 1.0);
   EXPECT_EQ(ImplantParams{}.trim.min_feature_mm, 1.5) << "today's default";
-  EXPECT_FALSE(back.trim.clearance_mm.has_value()) << "sessions 4-8: the bone grown by a voxel";
+  EXPECT_FALSE(back.trim.clearance_mm.has_value()) << "build_implant 2: the bone grown by a voxel";
   EXPECT_FALSE(back.trim.thin_fills_removed);
   EXPECT_FALSE(back.trim.vote_through_holes);
 }
@@ -209,8 +209,8 @@ TEST(Commands, PlansSavedBeforeVotingThroughHolesFitTheBoneAsThen) {
 }
 
 // A mesh's length unit is part of the load: recorded, replayed, and read as millimetres from
-// plans saved before session 13, which had none (nor turned a skull that winds inward
-// outward). A unit that is no length is refused.
+// a load_skull 1 or 2, which had none (nor turned a skull that winds inward outward). A unit that
+// is no length is refused.
 TEST(Commands, TheLoadRecordsTheMeshesLengthUnit) {
   test::TempDir dir;
   const std::string p = dir.path("head-m.stl");
@@ -246,7 +246,7 @@ TEST(Commands, TheLoadRecordsTheMeshesLengthUnit) {
   old_load.erase("orient_outward");
   params_from_json(ParamReader(old_load, "test"), import);
   EXPECT_EQ(import.mesh_unit_mm, 1.0);
-  EXPECT_FALSE(import.orient_outward) << "plans before session 13 read the skull as it came";
+  EXPECT_FALSE(import.orient_outward) << "load_skull 2 read the skull as it came";
   EXPECT_EQ(load["params"]["import"]["orient_outward"], true);
   // The reader's warnings reach the load's message (the wizard's status bar): here a head whose
   // triangles wind inward, turned outward.
@@ -313,9 +313,9 @@ TEST(Commands, TheLoadRecordsWhatTheSkullHeldAndAReplaySaysWhenItDiffers) {
 }
 
 // build_implant 4 holds the implant a set clearance off the bone's surface and removes thin
-// fills; a version-3 command (session 9: "trim" without either) is read as session 9 fitted
-// it, and a bad clearance is named.
-TEST(Commands, PlansSavedInSession9FitTheBoneAsThen) {
+// fills; a version-3 command ("trim" without either) is read as it was fitted then, and a bad
+// clearance is named.
+TEST(Commands, BuildImplant3FitsTheBoneAsItWasMadeTo) {
   ImplantParams p;
   p.trim.clearance_mm = 0.25;
   const Json build = to_json(commands::build_implant(p));
@@ -573,9 +573,9 @@ TEST(Session, AProposalIsRecordedAndReplayedAsRecorded) {
   EXPECT_EQ(t.state().proposal_message, "3 markers recorded");
   EXPECT_EQ(t.effective_commands().back().params["result"], recorded.params["result"])
       << "a recorded result is kept, not recorded again";
-  EXPECT_TRUE(t.state().unseen_rim.empty()) << "a result recorded before session 9 has none";
+  EXPECT_TRUE(t.state().unseen_rim.empty()) << "an older recorded result has none";
 
-  // The rim's unseen stretches (since session 9) are applied as recorded, for the view to draw;
+  // The rim's unseen stretches are applied as recorded, for the view to draw;
   // a malformed list is named.
   Command with_stretch = recorded;
   with_stretch.params["result"]["unseen_rim"] = {

@@ -46,9 +46,9 @@ struct QualityReport {
 /// The rim gap over arcs of the rim: for every arc `arc_rad` wide around the circle (sliding,
 /// not fixed sectors), the smallest of `distance[i]` over the points `angle[i]` (radians, any
 /// range) inside it; the largest over the arcs that hold a point. 0 without points. It is the
-/// same for the points turned by any angle: the fixed sectors it replaces (session 12) started
-/// at the mesh's first wall vertex, so the same implant gave other gaps when its vertices were
-/// listed in another order, and a gap straddling two sectors could hide in both.
+/// same for the points turned by any angle: fixed sectors would start at the mesh's first wall
+/// vertex, so the same implant would give other gaps with its vertices listed in another order,
+/// and a gap straddling two sectors could hide in both.
 double worst_arc_gap(const std::vector<double>& angle, const std::vector<double>& distance,
                      double arc_rad);
 

@@ -20,13 +20,14 @@ struct ExtractBoneSurfaceParams {
   long long target_triangles = 0;
   /// The surface in canonical form (make_canonical), as every mesh read is, so that the same
   /// triangles from any file give the same plan; false: as the import (or, through load_skull,
-  /// the file) gives it, as plans saved before session 9 were made.
+  /// the file) gives it, as plans whose load_skull is version 1 were made.
   bool canonical = true;
   /// Through load_skull, a mesh file's length unit in millimetres (STL, PLY, OBJ and OFF carry
   /// none): 1 for mm, 10 for cm, 1000 for metres, 25.4 for inches. Volumes carry their spacing.
   double mesh_unit_mm = 1.0;
   /// Through load_skull, a mesh whose triangles wind inward is turned outward (with a warning);
-  /// false: as the file gives it, as plans saved before session 13 read it. CT surfaces are
+  /// false: as the file gives it, as plans whose load_skull is version 1 or 2 read it. CT
+  /// surfaces are
   /// made outward.
   bool orient_outward = true;
   /// Through load_skull, a volume's positions in the patient's LPS frame, whatever space the

@@ -70,8 +70,8 @@ class DefectSurfaces {
   bool mirror_guided = false;
   int ring_rays = 0;  ///< intact rays on the ring (both tables met)
   int sites = 0;      ///< fitting sites used (after thinning and outliers)
-  /// RMS residual of the fit over the ring's rays within the outlier limit, outer table (until
-  /// session 10 over all the rays: a few rays past an orbit, 30-50 mm off, dominated it).
+  /// RMS residual of the fit over the ring's rays within the outlier limit, outer table (over
+  /// all the rays, a few rays past an orbit, 30-50 mm off, would dominate it).
   double outer_rms_mm = 0.0;
   double thickness_rms_mm = 0.0;  ///< the same, bone thickness (rays through both tables)
   /// Rays off the fit by more than the outlier limit (`outlier_sigmas` robust σ, at least 1 mm):

@@ -17,10 +17,10 @@ struct TrimToBoneParams {
   double max_voxels = 6e6;
   /// Parts thinner than this (slivers on the bone, filaments between bone fragments) go, mm
   /// (≥ 0). Half a millimetre above the quality report's 1 mm minimum: the surface is then
-  /// blurred and (in session 9) kept a voxel off the bone, which thins what is left. With 1.25 mm
-  /// the sample's plans kept edges under 1 mm up to 3.8 mm wide between the crushed bone fragments
-  /// above the orbit (docs/AUTOPLAN.md: 28 plans in other readings and poses, 2 of them not
-  /// printable and 2 more with a rim gap over 0.5 mm with 1.25 mm and 1 mm bridges; none now).
+  /// blurred (and, without a clearance, kept a voxel off the bone), which thins what is left.
+  /// With 1.25 mm the sample's plans keep edges under 1 mm up to 3.8 mm wide between the
+  /// crushed bone fragments above the orbit (over other readings and poses, 2 plans not
+  /// printable and 2 more with a rim gap over 0.5 mm with 1.25 mm and 1 mm bridges).
   double min_feature_mm = 1.5;
   double smoothing_mm = 0.3;  ///< Gaussian blur of the mask before meshing (σ), mm (≥ 0)
   /// Cracks narrower than twice this between the implant and the bone (the implant on one side,
@@ -29,11 +29,12 @@ struct TrimToBoneParams {
   double bridge_mm = 1.5;
   /// Where a fill leaves material thinner than min_feature_mm more than 1 mm from the bone (a
   /// rod between the implant's edge and a fragment, rather than a wall against a cut face), it
-  /// goes. False: fills are kept as made (sessions up to 9).
+  /// goes. False: fills are kept as made (build_implant commands before version 4).
   bool thin_fills_removed = true;
   /// The implant's surface keeps this far off the skull's surface where it meets it, mm (≥ 0),
   /// to a fraction of the grid (from the distance to the skull's triangles). Unset: the bone's
-  /// voxels grown by one voxel are kept out, as in sessions up to 9; the surface then lies
+  /// voxels grown by one voxel are kept out (build_implant commands before version 4); the
+  /// surface then lies
   /// 0.5-1.5 voxels off the bone (up to 0.7 mm on a large implant's 0.45 mm grid), which left
   /// a layer of the defect unfilled along its cut face.
   std::optional<double> clearance_mm = 0.1;

@@ -40,9 +40,8 @@ struct SharedSurface {
 /// The mirrored skull where the plan has put it: not a mesh of its own but the skull itself,
 /// moved by `placement` (the reflection across the plane, then the registration and any hand
 /// moves: an improper motion). On a skull of two million triangles a mirrored copy is about
-/// 300 MB, and every registration kept in the session's history held one until session 4 (and
-/// the state one until session 8). The view draws the skull's mesh moved by `placement`; the
-/// locator answers in place (the skull's own tree, moved).
+/// 300 MB, too much to keep one per registration in the session's history. The view draws the
+/// skull's mesh moved by `placement`; the locator answers in place (the skull's own tree, moved).
 struct MovedSurface {
   std::shared_ptr<const SharedSurface> skull;  ///< the skull's mesh and tree
   RigidTransform placement;                    ///< skull → the mirror where the plan has put it
