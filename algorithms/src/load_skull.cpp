@@ -45,10 +45,16 @@ LoadedSkull load(const std::string& path, const ExtractBoneSurfaceParams& import
     read.unit_mm = import.mesh_unit_mm;
     read.orient_outward = as_skull && import.orient_outward;
     read.far_piece_mm = as_skull && import.drop_far_pieces ? kFarPieceMm : 0.0;
-    MeshFile file = read_mesh(path, read);
-    out.mesh = file.mesh;  // a copy (OpenMesh meshes cannot be moved); `file` goes at once
+    {
+      // A copy (OpenMesh meshes cannot be moved): `file` goes before anything else is
+      // allocated, so that the skull is held twice only for the copy.
+      MeshFile file = read_mesh(path, read);
+      out.mesh = file.mesh;
+      out.description = file.format;
+      out.warnings = std::move(file.warnings);
+      out.pieces_dropped = file.pieces_dropped;
+    }
     out.source_kind = "mesh";
-    out.description = file.format;
     if (import.mesh_unit_mm != 1.0) {
       char unit[48];
       std::snprintf(unit, sizeof(unit), "units of %g mm", import.mesh_unit_mm);
@@ -57,13 +63,11 @@ LoadedSkull load(const std::string& path, const ExtractBoneSurfaceParams& import
         if (u.mm == import.mesh_unit_mm) named = u.label;
       out.description += " in " + named;
     }
-    out.warnings = std::move(file.warnings);
     // Where a skull's surface is open, and what planning does about it.
     if (as_skull)
       for (const std::string& s : describe_openings(report_mesh(out.mesh)))
         out.warnings.push_back(path + ": " + s);
     out.frame = "the file's own coordinates (a mesh file declares no frame), taken as LPS";
-    out.pieces_dropped = file.pieces_dropped;
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;
