@@ -281,6 +281,21 @@ void MainWindow::build_menus() {
     finish_training_if_done();
     show_training_report();
   });
+
+  QMenu* help = menuBar()->addMenu(tr("&Help"));
+  QAction* about = help->addAction(tr("About Cranioplan"), this, [this] {
+    QMessageBox::about(
+        this, tr("About Cranioplan"),
+        tr("<h3>Cranioplan %1</h3>"
+           "<p>Plan a patient-specific cranial implant from a CT or a skull mesh, step by "
+           "step.</p>"
+           "<p>Every plan is a session of commands: it records this version, and replays, "
+           "verifies and audits with <tt>cranioplan-cli</tt>.</p>"
+           "<p>Open source under the MIT licence. Not a medical device: every implant must "
+           "be checked by a qualified person before it is made.</p>")
+            .arg(CRANIOPLAN_VERSION));
+  });
+  about->setObjectName("about");
 }
 
 void MainWindow::show_training_report() {

@@ -9,10 +9,12 @@
 #include <QDir>
 #include <QLabel>
 #include <QListWidget>
+#include <QMessageBox>
 #include <QMouseEvent>
 #include <QPushButton>
 #include <QSlider>
 #include <QTest>
+#include <QTimer>
 #include <filesystem>
 
 #include "cranioplan/algorithms/load_skull.h"
@@ -376,6 +378,24 @@ TEST(WizardUnits, AMeshInMetresLoadsOnceItsUnitIsChosen) {
   EXPECT_EQ(plan.state().current_step, 2);
   const Json load = to_json(plan.session().effective_commands().front());
   EXPECT_EQ(load["params"]["import"]["mesh_unit_mm"], 1000.0);
+}
+
+// Help → About names the program's version (the one sessions record and `--version` prints).
+TEST(WizardAbout, TheAboutBoxShowsTheVersion) {
+  MainWindow w;
+  w.set_interactive(false);
+  w.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&w));
+  QString text;
+  QTimer::singleShot(0, [&] {
+    auto* box = qobject_cast<QMessageBox*>(QApplication::activeModalWidget());
+    if (!box) return;
+    text = box->text();
+    box->accept();
+  });
+  trigger(w, "about");
+  EXPECT_TRUE(text.contains(QString("Cranioplan ") + CRANIOPLAN_VERSION)) << text.toStdString();
+  EXPECT_TRUE(text.contains("Not a medical device")) << text.toStdString();
 }
 
 // The orientation cube in the view's lower-left corner turns with the camera: seen from the front
