@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "cranioplan/algorithms/mirror_mesh.h"
+#include "cranioplan/algorithms/detect_defect.h"
 #include "cranioplan/algorithms/propose_markers.h"
 #include "cranioplan/algorithms/surface_locator.h"
 
@@ -29,7 +30,7 @@ class StageTimer {
 void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const AutoplanParams& params,
                   StageTimer& timer, AutoplanResult& r) {
   const RigidTransform reflection = reflection_across(r.plane.plane);
-  r.defect = detect_defect_near_plane(skull, bone, r.plane.plane, params.propose.detect);
+  r.defect = autoplan_stages::detect(skull, bone, r.plane.plane, params);
   timer.stage("detect");
   auto mirror_motion = [&] {
     return r.registration.usable() ? r.registration.transform * reflection : reflection;
@@ -40,18 +41,15 @@ void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const Auto
     r.message = r.defect.message;
     return;
   }
-
-  if (params.local_registration_mm > 0.0 && r.registration.usable()) {
-    RegisterParams local = params.registration;
-    local.initial = r.registration.transform;
-    local.roi = local_registration_region(r.defect, params.local_registration_mm);
-    const RegisterResult lr = register_mirror(skull, r.plane.plane, local);
-    if (lr.usable()) r.registration = lr;
+  const std::optional<autoplan_stages::LocalRegistration> local =
+      autoplan_stages::local_registration(skull, r.plane.plane, r.defect, r.registration, params);
+  if (local) {
+    r.registration = autoplan_stages::registration_used(r.registration, local);
     timer.stage("local register");
   }
   r.mirror_motion = mirror_motion();
   const SurfaceLocator mirror = bone.moved(r.mirror_motion);
-  MarkerProposal proposal = propose_markers_for_defect(r.defect, bone, mirror, params.propose);
+  MarkerProposal proposal = autoplan_stages::markers(r.defect, bone, mirror, params);
   r.mirror_coverage = proposal.mirror_coverage;
   r.method_used = proposal.method_used;
   r.surfaces_message = proposal.surfaces_message;
@@ -62,9 +60,7 @@ void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const Auto
     return;
   }
 
-  ImplantParams implant = params.implant;
-  implant.radial_center = r.defect.center;  // the rays that found the opening
-  r.implant = build_implant(r.markers, &skull, &bone, implant);
+  r.implant = build_implant(r.markers, &skull, &bone, autoplan_stages::implant_params(r.defect, params));
   timer.stage("implant");
   if (!r.implant.usable()) {
     r.message = "implant: " + r.implant.message;
@@ -83,21 +79,70 @@ void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const Auto
 // The plane and the global registration; false (and `r` says why) when the plane fails.
 bool plane_and_registration(const SkullMesh& skull, const Landmarks& landmarks,
                             const AutoplanParams& params, StageTimer& timer, AutoplanResult& r) {
-  r.plane = fit_sagittal_plane(skull, landmarks, params.plane);
+  r.plane = autoplan_stages::plane(skull, landmarks, params);
   timer.stage("plane");
   if (!r.plane.usable()) {
     r.message = "midsagittal plane: " + r.plane.message;
     return false;
   }
-  // The mirror is never built as a mesh here (register_mirror), and its locator is the skull's
-  // locator moved (on a skull of two million triangles a mesh and a locator are a few hundred
-  // megabytes each).
-  r.registration = register_mirror(skull, r.plane.plane, params.registration);
+  r.registration = autoplan_stages::registration(skull, r.plane.plane, params);
   timer.stage("register");
   return true;
 }
 
 }  // namespace
+
+namespace autoplan_stages {
+
+PlaneFit plane(const SkullMesh& skull, const Landmarks& landmarks, const AutoplanParams& params) {
+  return fit_sagittal_plane(skull, landmarks, params.plane);
+}
+
+RegisterResult registration(const SkullMesh& skull, const Plane& plane,
+                            const AutoplanParams& params) {
+  return register_mirror(skull, plane, params.registration);
+}
+
+DefectRegion detect(const SkullMesh& skull, const SurfaceLocator& bone, const Plane& plane,
+                    const AutoplanParams& params) {
+  return detect_defect_near_plane(skull, bone, plane, params.propose.detect);
+}
+
+std::optional<LocalRegistration> local_registration(const SkullMesh& skull, const Plane& plane,
+                                                    const DefectRegion& defect,
+                                                    const RegisterResult& global,
+                                                    const AutoplanParams& params) {
+  if (params.local_registration_mm <= 0.0 || !defect.found() || !global.usable())
+    return std::nullopt;
+  LocalRegistration local;
+  local.params = params.registration;
+  local.params.initial = global.transform;
+  local.params.roi = local_registration_region(defect, params.local_registration_mm);
+  local.result = register_mirror(skull, plane, local.params);
+  return local;
+}
+
+const RegisterResult& registration_used(const RegisterResult& global,
+                                        const std::optional<LocalRegistration>& local) {
+  return local && local->result.usable() ? local->result : global;
+}
+
+MarkerProposal markers(const DefectRegion& defect, const SurfaceLocator& bone,
+                       const SurfaceLocator& mirror, const AutoplanParams& params, int first_id) {
+  return propose_markers_for_defect(defect, bone, mirror, params.propose, first_id);
+}
+
+ImplantParams implant_params(const DefectRegion& defect, const AutoplanParams& params) {
+  ImplantParams implant = params.implant;
+  implant.radial_center = defect.center;  // the rays that found the opening
+  return implant;
+}
+
+}  // namespace autoplan_stages
+
+Eigen::Vector3d point_towards_other_opening(const DefectRegion& first, size_t k) {
+  return first.center + 100.0 * first.other_axes.at(k);
+}
 
 AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
                         const AutoplanParams& params) {
@@ -123,11 +168,10 @@ std::vector<AutoplanResult> autoplan_all_openings(const SkullMesh& skull,
   std::vector<AutoplanResult> plans;
   plans.push_back(std::move(first));
   if (!plans.front().defect.found()) return plans;
-  const Eigen::Vector3d centre = plans.front().defect.center;
-  const std::vector<Eigen::Vector3d> axes = plans.front().defect.other_axes;
-  for (const Eigen::Vector3d& axis : axes) {
+  const DefectRegion first_opening = plans.front().defect;
+  for (size_t k = 0; k < first_opening.other_axes.size(); ++k) {
     AutoplanParams each = params;
-    each.propose.detect.near = centre + 100.0 * axis;
+    each.propose.detect.near = point_towards_other_opening(first_opening, k);
     AutoplanResult r = shared;
     StageTimer each_timer(r.stage_seconds);
     plan_opening(skull, bone, each, each_timer, r);

@@ -1,10 +1,34 @@
 #include "cranioplan/sessions/autoplan_session.h"
 
+#include <chrono>
 #include <filesystem>
 
-#include "cranioplan/algorithms/propose_markers.h"
+#include "cranioplan/sessions/plan_files.h"
 
 namespace cranioplan {
+
+namespace {
+
+// A search run outside its command, and the time it took, for the command to carry.
+class Stopwatch {
+ public:
+  double ms() const {
+    return std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start_)
+        .count();
+  }
+
+ private:
+  std::chrono::steady_clock::time_point start_ = std::chrono::steady_clock::now();
+};
+
+// `command` carrying what its search found, and how long the search took.
+Command recorded(Command command, const Json& result, double ms) {
+  command.params["result"] = result;
+  command.meta.duration_ms = ms;
+  return command;
+}
+
+}  // namespace
 
 AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks& landmarks,
                                  const AutoplanParams& params, const std::string& export_path,
@@ -29,36 +53,45 @@ AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks&
   if (landmarks.orbit_left) run(commands::set_landmark("orbit_left", *landmarks.orbit_left));
   if (landmarks.orbit_right) run(commands::set_landmark("orbit_right", *landmarks.orbit_right));
   for (const auto& p : landmarks.midline) run(commands::set_landmark("midline", p));
-  run(commands::fit_plane(params.plane));
-  if (!s.state().plane) return stop("midsagittal plane: " + s.state().message);
-  run(commands::mirror());
-  run(commands::register_mirror(params.registration));
-  // The opening, found here as the markers' command would find it (the same skull, plane and
-  // detection): the mirror is registered again around it, as autoplan() does, with the region
-  // recorded as the command's parameter so that replay needs no detection.
+  // The engine's stages (autoplan_stages), each recorded as the command that would have found
+  // the same: a replay applies what they found instead of searching again.
+  const std::shared_ptr<const SkullInput> skull = s.state().skull;
+  const SkullMesh& mesh = skull->surface->mesh;
+  const SurfaceLocator& bone = skull->surface->locator;
   {
-    const PlanState& st = s.state();
-    out.defect = detect_defect_near_plane(st.skull->surface->mesh, st.skull->surface->locator,
-                                          *st.plane, params.propose.detect);
+    const Stopwatch t;
+    const PlaneFit fit = autoplan_stages::plane(mesh, s.state().landmarks, params);
+    run(recorded(commands::fit_plane(params.plane), to_json(fit), t.ms()));
   }
-  if (params.local_registration_mm > 0.0 && out.defect.found() && s.state().registration &&
-      s.state().registration->usable()) {
-    RegisterParams local = params.registration;
-    local.initial = s.state().registration->transform;
-    local.roi = local_registration_region(out.defect, params.local_registration_mm);
-    run(commands::register_mirror(local));
+  if (!s.state().plane) return stop("midsagittal plane: " + s.state().message);
+  const Plane plane = *s.state().plane;
+  run(commands::mirror());
+  RegisterResult global;
+  {
+    const Stopwatch t;
+    global = autoplan_stages::registration(mesh, plane, params);
+    run(recorded(commands::register_mirror(params.registration), to_json(global), t.ms()));
   }
-  // An unusable registration leaves the mirror where mirroring put it, as autoplan() does.
+  out.defect = autoplan_stages::detect(mesh, bone, plane, params);
+  {
+    // Found by the proposal's search below, and recorded with it; the registration around the
+    // opening (an unusable one keeps the global registration, as in autoplan()).
+    const Stopwatch t;
+    const auto local =
+        autoplan_stages::local_registration(mesh, plane, out.defect, global, params);
+    if (local) run(recorded(commands::register_mirror(local->params), to_json(local->result), t.ms()));
+  }
   if (!step_complete(s.state(), 3)) run(commands::complete_step(3));
   run(commands::complete_step(4));
-  // The markers are proposed for the opening found above, and the proposal goes into the
-  // command as its result.
   Command propose = commands::propose_markers(params.propose);
   if (out.defect.found() && s.state().mirrored) {
+    const Stopwatch t;
     const PlanState& st = s.state();
-    propose.params["result"] = proposal_result(
-        propose_markers_for_defect(out.defect, st.skull->surface->locator, st.mirrored->locator,
-                                   params.propose, st.next_marker_id));
+    propose = recorded(std::move(propose),
+                       proposal_result(autoplan_stages::markers(out.defect, bone,
+                                                                st.mirrored->locator, params,
+                                                                st.next_marker_id)),
+                       t.ms());
   }
   run(std::move(propose));
   if (s.state().markers.empty()) {

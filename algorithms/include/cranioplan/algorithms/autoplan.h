@@ -1,7 +1,10 @@
 #pragma once
 // Automatic planning: the starting point a surgeon then edits. plane → mirror → register →
-// detect the defect → propose markers → smooth → implant → quality report, with every stage's
-// output kept for the caller.
+// detect the defect → register again around it → propose markers → implant → quality report,
+// with every stage's output kept for the caller. The stages are named functions
+// (`autoplan_stages`); autoplan() chains them, and a session records each one's result as the
+// command that would have found it (autoplan_session), so a plan is the same however it is made.
+#include <optional>
 #include <string>
 #include <utility>
 #include <vector>
@@ -58,6 +61,49 @@ struct AutoplanResult {
 
 AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
                         const AutoplanParams& params = {});
+
+/// The stages of the automatic plan, in the order autoplan() runs them.
+namespace autoplan_stages {
+
+/// The midsagittal plane (from the landmarks when they give one).
+PlaneFit plane(const SkullMesh& skull, const Landmarks& landmarks, const AutoplanParams& params);
+/// The skull's mirror image across `plane` registered onto the skull (no mirrored mesh is built:
+/// on a skull of two million triangles a mesh and its locator are a few hundred megabytes each).
+RegisterResult registration(const SkullMesh& skull, const Plane& plane,
+                            const AutoplanParams& params);
+/// The opening to plan, seen from the skull's centroid on the plane (`params.propose.detect`:
+/// `near` chooses among several).
+DefectRegion detect(const SkullMesh& skull, const SurfaceLocator& bone, const Plane& plane,
+                    const AutoplanParams& params);
+
+struct LocalRegistration {
+  RegisterParams params;  ///< the global registration's, started from it, within a region
+  RegisterResult result;  ///< usable or not (an unusable one keeps the global registration)
+};
+/// The mirror registered again within `params.local_registration_mm` of the opening, started from
+/// the global registration; none when that margin is 0, or without a defect or a usable global
+/// registration to start from.
+std::optional<LocalRegistration> local_registration(const SkullMesh& skull, const Plane& plane,
+                                                    const DefectRegion& defect,
+                                                    const RegisterResult& global,
+                                                    const AutoplanParams& params);
+/// The registration a plan goes on with: the local one when it is usable, else the global one.
+const RegisterResult& registration_used(const RegisterResult& global,
+                                        const std::optional<LocalRegistration>& local);
+/// Markers for the opening, from `first_id` on; `mirror` locates the registered mirror.
+MarkerProposal markers(const DefectRegion& defect, const SurfaceLocator& bone,
+                       const SurfaceLocator& mirror, const AutoplanParams& params,
+                       int first_id = 1);
+/// The implant's parameters: the automatic plan's, in the frame of the rays that found the
+/// opening.
+ImplantParams implant_params(const DefectRegion& defect, const AutoplanParams& params);
+
+}  // namespace autoplan_stages
+
+/// A point that chooses the `k`-th further opening of a plan whose opening is `first`: along
+/// a ray through it from the first's centre (`DefectRegion::other_axes`), for
+/// `DetectDefectParams::near`.
+Eigen::Vector3d point_towards_other_opening(const DefectRegion& first, size_t k);
 
 /// Every opening large enough to be a defect (bilateral defects), each planned to its own
 /// implant. The first plan is autoplan's (the largest opening, or the one `near` chooses); each

@@ -1,5 +1,5 @@
 #pragma once
-// The automatic planner run as session commands, so every automatic plan can be reopened,
+// The automatic planner recorded as session commands, so every automatic plan can be reopened,
 // edited, replayed and audited like a hand-made one.
 #include <string>
 
@@ -14,16 +14,18 @@ struct AutoplanSession {
   Status status = Status::Failed;
   std::string message;  ///< what happened, or the stage that stopped and why
   Session session;      ///< every command run, whether or not it planned
-  /// The opening planned (found by the same detection as the markers' command), with the
+  /// The opening planned (the engine's detection, whose markers the proposal records), with the
   /// other openings' rays (`other_axes`) for planning them in sessions of their own.
   DefectRegion defect;
   bool planned() const { return status == Status::Planned; }
 };
 
-/// Load → landmarks → fit plane → mirror → register → inspect → propose markers → build
-/// implant → review, and, when `export_path` is not empty, export. The same algorithms and
-/// parameters as `autoplan()`, so the implant is the same. `import`: how the skull file is read
-/// (a CT's threshold, a mesh's length unit). Throws InputError for a bad skull.
+/// Load → landmarks → fit plane → mirror → register → (register around the opening) → inspect
+/// → propose markers → build implant → review, and, when `export_path` is not empty, export.
+/// The searches are autoplan()'s stages (`autoplan_stages`), each recorded in its command with
+/// what it found and how long it took, so the implant is autoplan()'s and a replay searches
+/// nothing again. `import`: how the skull file is read (a CT's threshold, a mesh's length unit).
+/// Throws InputError for a bad skull.
 AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks& landmarks,
                                  const AutoplanParams& params, const std::string& export_path,
                                  const SessionInfo& info = {},
