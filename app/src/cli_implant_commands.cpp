@@ -171,7 +171,7 @@ int autoplan_sessions(const std::string& skull, const ExtractBoneSurfaceParams& 
   bool all_planned = first.planned();
   for (size_t k = 0; k < first.defect.other_axes.size(); ++k) {
     AutoplanParams each = params;
-    each.propose.detect.near = first.defect.center + 100.0 * first.defect.other_axes[k];
+    each.propose.detect.near = point_towards_other_opening(first.defect, k);
     AutoplanSession a;
     Json one = autoplan_with_session(skull, import, lm, each, numbered_path(output, k + 2),
                                      markers_out.empty() ? "" : numbered_path(markers_out, k + 2),
@@ -222,479 +222,482 @@ double median(std::vector<double> v) {
   return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
+// smooth
+Subcommand add_smooth(CLI::App& app, const bool& json) {
+  struct Opts {
+    std::string markers, output, mirrored;
+    SmoothParams params;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* cmd = app.add_subcommand("smooth", "The paper's Laplacian smoother on surface markers");
+  cmd->add_option("MARKERS", o->markers, "markers (.json or .csv)")->required();
+  cmd->add_option("--radius", o->params.radius_mm, "neighbourhood radius (mm)")
+      ->required()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--edge-weight", o->params.edge_weight, "weight of edge markers (>= 1)")
+      ->required()
+      ->check(CLI::Range(1.0, 1e6));
+  cmd->add_option("--iterations", o->params.iterations, "iterations (default 1)")
+      ->check(CLI::Range(1, 1000));
+  cmd->add_option("--project-onto", o->mirrored,
+                  "put smoothed surface markers back onto this mesh (the mirrored skull)");
+  cmd->add_option("-o,--output", o->output, "markers to write (.json or .csv)")->required();
+  return Subcommand{cmd, [o, &json] {
+                      const auto markers = read_markers_file(o->markers);
+                      std::unique_ptr<SurfaceLocator> surface;
+                      SkullMesh mirrored;
+                      if (!o->mirrored.empty()) {
+                        mirrored = load_skull(o->mirrored).mesh;
+                        surface = std::make_unique<SurfaceLocator>(mirrored);
+                      }
+                      const SmoothResult r = smooth_markers(markers, o->params, surface.get());
+                      const bool ok = r.status == SmoothResult::Status::Smoothed;
+                      if (ok) write_markers_file(r.markers, o->output);
+                      print_result(Json{{"status", ok ? "smoothed" : "too_few_markers"},
+                                        {"message", r.message},
+                                        {"markers", r.markers.size()},
+                                        {"max_move_mm", r.max_move_mm}},
+                                   json);
+                      return ok ? kOk : kUnusable;
+                    }};
+}
+
+// implant
+Subcommand add_implant(CLI::App& app, const bool& json) {
+  struct Opts {
+    std::string skull, mirrored, markers, output, method = "shell";
+    ImplantParams params;
+    bool no_snap = false;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* cmd = app.add_subcommand("implant", "Build an implant from markers");
+  cmd->add_option("--skull", o->skull, "the original (defective) skull")->required();
+  cmd->add_option("--mirrored", o->mirrored,
+                  "the registered mirrored skull (surface markers are snapped onto it)");
+  cmd->add_option("--markers", o->markers, "markers (.json or .csv)")->required();
+  cmd->add_option("--method", o->method, "shell (default) or delaunay3d")
+      ->check(CLI::IsMember({"shell", "delaunay3d"}));
+  cmd->add_option("--resolution", o->params.resolution_mm, "shell edge length (mm)")
+      ->check(CLI::Range(0.2, 10.0));
+  cmd->add_option("--thickness", o->params.thickness_mm,
+                  "thickness without inner markers (mm; default: bone around the rim)")
+      ->check(CLI::Range(0.5, 30.0));
+  cmd->add_flag("--no-rim-snap", o->no_snap,
+                "keep the rim between markers where the spline puts it");
+  cmd->add_option("--alpha", o->params.delaunay_alpha, "delaunay3d alpha (mm; 0 = convex hull)");
+  cmd->add_option("--tolerance", o->params.delaunay_tolerance, "delaunay3d tolerance");
+  cmd->add_option("--offset", o->params.delaunay_offset, "delaunay3d offset");
+  cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
+  return Subcommand{
+      cmd, [o, &json] {
+        const std::vector<Marker> raw = read_markers_file(o->markers);
+        const LoadedSkull loaded = load_skull(o->skull);
+        const SkullMesh& skull = loaded.mesh;
+        const SurfaceLocator skull_surface(skull);
+        SkullMesh mirrored;
+        std::unique_ptr<SurfaceLocator> mirrored_surface;
+        if (!o->mirrored.empty()) {
+          mirrored = load_skull(o->mirrored).mesh;
+          mirrored_surface = std::make_unique<SurfaceLocator>(mirrored);
+        }
+        const SnapMarkersResult snapped = snap_markers(raw, skull_surface, mirrored_surface.get());
+        if (snapped.status != SnapMarkersResult::Status::Snapped)
+          throw InputError(o->markers, snapped.message);
+        o->params.method = o->method == "shell" ? ImplantMethod::Shell : ImplantMethod::Delaunay3D;
+        o->params.snap_rim_to_skull = !o->no_snap;
+        const ImplantResult r = build_implant(snapped.markers, &skull, o->params);
+        Json j = implant_json(r);
+        j["method"] = o->method;
+        j["marker_snap_max_mm"] = snapped.max_distance_mm;
+        if (!r.usable()) {
+          print_result(j, json);
+          return kUnusable;
+        }
+        write_mesh(r.mesh, o->output);
+        j["output"] = o->output;
+        j["quality"] = to_json(check_implant(r.mesh, &skull));
+        print_result(j, json);
+        return kOk;
+      }};
+}
+
+// qa
+Subcommand add_qa(CLI::App& app, const bool& json) {
+  struct Opts {
+    std::string implant, skull;
+    QualityParams params;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* cmd = app.add_subcommand("qa", "Quality report of an implant before printing");
+  cmd->add_option("IMPLANT", o->implant, "implant mesh")->required();
+  cmd->add_option("--skull", o->skull, "the (defective) skull it is made for");
+  cmd->add_option("--min-thickness", o->params.min_thickness_mm, "thinnest printable (mm)");
+  cmd->add_option("--max-taper", o->params.max_taper_mm,
+                  "widest edge on the bone that may be thinner (mm)");
+  cmd->add_option("--max-rim-gap", o->params.max_rim_gap_mm, "largest acceptable rim gap (mm)");
+  cmd->add_option("--max-penetration", o->params.max_penetration_mm3,
+                  "largest acceptable overlap (mm³)");
+  return Subcommand{cmd, [o, &json] {
+                      const SkullMesh implant = load_surface(o->implant).mesh;
+                      SkullMesh skull;
+                      if (!o->skull.empty()) skull = load_skull(o->skull).mesh;
+                      const QualityReport q =
+                          check_implant(implant, o->skull.empty() ? nullptr : &skull, o->params);
+                      print_result(to_json(q), json);
+                      return q.printable ? kOk : kUnusable;
+                    }};
+}
+
+// compare
+Subcommand add_compare(CLI::App& app, const bool& json) {
+  struct Opts {
+    std::string a, b, skull;
+    CompareParams params;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* cmd = app.add_subcommand("compare", "Dice, boundary Dice, HD, HD95 between two implants");
+  cmd->add_option("IMPLANT", o->a, "implant (mesh or NRRD/NIfTI mask)")->required();
+  cmd->add_option("REFERENCE", o->b, "reference implant (mesh or mask)")->required();
+  cmd->add_option("--defective-skull", o->skull,
+                  "defective skull for boundary Dice (mesh or mask)");
+  cmd->add_option("--spacing", o->params.spacing_mm, "voxel size of the common grid (mm)")
+      ->check(CLI::Range(0.1, 2.0));
+  return Subcommand{cmd, [o, &json] {
+                      const SkullMesh a = load_any(o->a), b = load_any(o->b);
+                      SkullMesh skull;
+                      if (!o->skull.empty()) skull = load_any(o->skull);
+                      const CompareResult r =
+                          compare_implants(a, b, o->skull.empty() ? nullptr : &skull, o->params);
+                      print_result(to_json(r), json);
+                      return kOk;
+                    }};
+}
+
+// inject-defect
+Subcommand add_inject_defect(CLI::App& app, const bool& json) {
+  struct Opts {
+    std::string skull, center, shape = "sphere", output, implant;
+    InjectDefectParams params;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* cmd = app.add_subcommand("inject-defect",
+                                 "Cut a defect out of a healthy skull, keeping the ground truth");
+  cmd->add_option("SKULL", o->skull, "healthy skull (closed mesh or volume)")->required();
+  cmd->add_option("--center", o->center, "defect centre x,y,z (mm)")->required();
+  cmd->add_option("--size", o->params.size_mm, "sphere diameter or cube edge (mm)")
+      ->required()
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--shape", o->shape, "sphere or cube")->check(CLI::IsMember({"sphere", "cube"}));
+  cmd->add_option("--voxel", o->params.voxel_mm, "resolution of the cut (mm)")
+      ->check(CLI::Range(0.1, 2.0));
+  cmd->add_option("-o,--output", o->output, "defective skull to write")->required();
+  cmd->add_option("--implant", o->implant, "ground-truth implant to write")->required();
+  return Subcommand{cmd, [o, &json] {
+                      o->params.center = parse_point(o->center, "--center");
+                      o->params.shape = o->shape == "cube" ? InjectDefectParams::Shape::Cube
+                                                           : InjectDefectParams::Shape::Sphere;
+                      const LoadedSkull loaded = load_skull(o->skull);
+                      const SkullMesh& skull = loaded.mesh;
+                      const InjectDefectResult r = inject_defect(skull, o->params);
+                      Json j{{"status", r.usable() ? "injected" : "no_bone_in_defect"},
+                             {"message", r.message},
+                             {"removed_volume_mm3", r.removed_volume_mm3},
+                             {"seconds", r.seconds}};
+                      if (!r.usable()) {
+                        print_result(j, json);
+                        return kUnusable;
+                      }
+                      write_mesh(r.defective, o->output);
+                      write_mesh(r.implant, o->implant);
+                      j["defective"] = o->output;
+                      j["implant"] = o->implant;
+                      print_result(j, json);
+                      return kOk;
+                    }};
+}
+
+// autoplan
+Subcommand add_autoplan(CLI::App& app, const bool& json) {
+  struct Opts {
+    std::string skull, landmarks, output, markers_out, session, method = "auto";
+    std::vector<double> near;
+    bool all_openings = false;
+    AutoplanParams params;
+    ExtractBoneSurfaceParams import;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* cmd =
+      app.add_subcommand("autoplan", "Plan an implant automatically from a defective skull");
+  cmd->add_option("SKULL", o->skull, "defective skull (mesh or volume)")->required();
+  cmd->add_option("--landmarks", o->landmarks, "landmarks JSON for the midsagittal plane");
+  cmd->add_option("--method", o->method, "auto, mirror or rim-only")
+      ->check(CLI::IsMember({"auto", "mirror", "rim-only"}));
+  cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
+  cmd->add_option("--markers-out", o->markers_out, "proposed markers to write (.json or .csv)");
+  add_units_option(cmd, o->import.mesh_unit_mm);
+  add_series_option(cmd, o->import.dicom_series);
+  cmd->add_option("--near", o->near,
+                  "X Y Z (mm): with several openings, plan the one in this point's direction "
+                  "(default: the largest)")
+      ->expected(3);
+  add_fit_option(cmd, o->params);
+  cmd->add_option("--session", o->session,
+                  "plan through session commands and save the session (.json): reopen, edit, "
+                  "replay and audit it (with --all-openings, SESSION_2... for the others)");
+  cmd->add_flag("--all-openings", o->all_openings,
+                "plan every opening large enough to be a defect (bilateral defects), each to "
+                "its own implant: IMPLANT, then IMPLANT_2, IMPLANT_3... (markers and sessions "
+                "likewise)");
+  return Subcommand{
+      cmd, [o, &json]() -> int {
+        if (o->near.size() == 3)
+          o->params.propose.detect.near = Eigen::Vector3d(o->near[0], o->near[1], o->near[2]);
+        const Landmarks lm = o->landmarks.empty() ? Landmarks{} : read_landmarks_file(o->landmarks);
+        plan_method_from_string(o->method, o->params.propose.method);
+        auto markers_path = [&](size_t k) {
+          return o->markers_out.empty() ? std::string() : numbered_path(o->markers_out, k);
+        };
+        if (!o->session.empty())
+          return autoplan_sessions(o->skull, o->import, lm, o->params, o->output, o->markers_out,
+                                   o->session, o->all_openings, json);
+        const LoadedSkull loaded = load_skull(o->skull, o->import);
+        const SkullMesh& skull = loaded.mesh;
+        // The reader's warnings (a skull turned outward, non-manifold edges) with the plan.
+        auto with_warnings = [&loaded](Json j) {
+          if (!loaded.warnings.empty()) j["warnings"] = loaded.warnings;
+          return j;
+        };
+        if (!o->all_openings) {
+          const AutoplanResult r = autoplan(skull, lm, o->params);
+          print_result(with_warnings(write_autoplan(r, o->output, o->markers_out)), json);
+          return r.planned() ? kOk : kUnusable;
+        }
+        // Every opening in turn; the first is the one planned without
+        // --all-openings.
+        const std::vector<AutoplanResult> all = autoplan_all_openings(skull, lm, o->params);
+        if (!all.front().defect.found()) {  // no defect, or no plane
+          print_result(with_warnings(write_autoplan(all.front(), o->output, o->markers_out)), json);
+          return all.front().planned() ? kOk : kUnusable;
+        }
+        Json plans = Json::array();
+        bool all_planned = true;
+        for (size_t k = 0; k < all.size(); ++k) {
+          plans.push_back(with_warnings(
+              write_autoplan(all[k], numbered_path(o->output, k + 1), markers_path(k + 1))));
+          all_planned = all_planned && all[k].planned();
+        }
+        print_plans(plans, json);
+        return all_planned ? kOk : kUnusable;
+      }};
+}
+
+// evaluate
+Subcommand add_evaluate(CLI::App& app, const bool& json) {
+  struct Opts {
+    std::string dir, implants_out;
+    AutoplanParams params;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* cmd = app.add_subcommand(
+      "evaluate",
+      "Autoplan every NNN_defective_skull.* against its NNN_implant.* (exit 1 if a case could "
+      "not be planned, 3 if a case's file could not be read; every case is in the table)");
+  cmd->add_option("CASES_DIR", o->dir, "folder of cases (meshes or NRRD/NIfTI masks)")->required();
+  cmd->add_option("--implants-out", o->implants_out,
+                  "folder to write each planned implant to (NNN_planned_implant.stl)");
+  add_fit_option(cmd, o->params);
+  return Subcommand{
+      cmd, [o, &json] {
+        namespace fs = std::filesystem;
+        if (!fs::is_directory(o->dir)) throw InputError(o->dir, "is not a folder");
+        if (!o->implants_out.empty() && !fs::is_directory(o->implants_out))
+          throw InputError(o->implants_out, "is not a folder (--implants-out)");
+        std::map<std::string, std::pair<std::string, std::string>>
+            cases;  // id → (defective, implant)
+        for (const auto& e : fs::directory_iterator(o->dir)) {
+          const std::string name = e.path().filename().string();
+          const size_t us = name.find('_');
+          if (us == std::string::npos) continue;
+          const std::string id = name.substr(0, us), rest = name.substr(us + 1);
+          if (rest.rfind("defective_skull.", 0) == 0) cases[id].first = e.path().string();
+          if (rest.rfind("implant.", 0) == 0) cases[id].second = e.path().string();
+        }
+        Json rows = Json::array();
+        std::vector<double> dsc, bdsc, hd95, secs;
+        int failed = 0, unreadable = 0, printable = 0;
+        for (const auto& [id, files] : cases) {
+          if (files.first.empty() || files.second.empty()) continue;
+          double seconds = 0.0;
+          bool read = true;
+          Json row{{"case", id}};
+          // One case's unreadable file is that case's row, not the end of the run: the
+          // others are still planned and scored.
+          try {
+            // The truth is read first (to fail before planning) and not timed: the time is
+            // the plan's, from reading the skull to the implant.
+            const SkullMesh truth = load_any(files.second);
+            const auto t0 = std::chrono::steady_clock::now();
+            const LoadedSkull loaded = load_skull(files.first);
+            const SkullMesh& skull = loaded.mesh;
+            const AutoplanResult r = autoplan(skull, Landmarks{}, o->params);
+            seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            row["status"] = r.planned() ? "planned" : "failed";
+            row["message"] = r.message;
+            if (r.planned()) {
+              const CompareResult c = compare_implants(r.implant.mesh, truth, &skull);
+              if (!o->implants_out.empty()) {
+                const std::string path =
+                    (fs::path(o->implants_out) / (id + "_planned_implant.stl")).string();
+                write_mesh(r.implant.mesh, path);
+                row["implant"] = path;
+              }
+              add_scores(row, r, c);
+              printable += r.quality.printable;
+              dsc.push_back(c.dice);
+              bdsc.push_back(c.boundary_dice);
+              hd95.push_back(c.hd95_mm);
+            } else {
+              // No implant overlaps nothing: a failed plan counts as Dice 0 in the medians
+              // (as a missing prediction does in the challenge); it has no distance.
+              ++failed;
+              dsc.push_back(0.0);
+              bdsc.push_back(0.0);
+            }
+          } catch (const Error& e) {
+            ++unreadable;
+            read = false;
+            row["status"] = "bad_input";
+            row["message"] = e.what();
+          }
+          row["seconds"] = read ? Json(seconds) : Json(nullptr);  // no plan, no time
+          if (read) secs.push_back(seconds);
+          if (!json) {
+            if (row["status"] == "planned")
+              std::cout << id << "  " << row["method"].get<std::string>() << "  DSC "
+                        << row["dice"].get<double>() << "  bDSC "
+                        << row["boundary_dice"].get<double>() << "  HD95 "
+                        << row["hd95_mm"].get<double>() << " mm  " << seconds << " s  "
+                        << printable_text(row) << row["message"].get<std::string>() << std::endl;
+            else
+              std::cout << id << "  " << row["status"].get<std::string>() << "  "
+                        << row["message"].get<std::string>() << std::endl;
+          }
+          rows.push_back(row);
+        }
+        if (rows.empty())
+          throw InputError(o->dir,
+                           "holds no NNN_defective_skull.* with an NNN_implant.* beside it");
+        // No figure where no case gave one (null, not 0).
+        auto median_of = [](const std::vector<double>& v) {
+          return v.empty() ? Json(nullptr) : Json(median(v));
+        };
+        const Json summary{{"cases", rows.size()},
+                           {"printable", printable},
+                           {"failed", failed},
+                           {"bad_input", unreadable},
+                           {"median_dice", median_of(dsc)},
+                           {"median_boundary_dice", median_of(bdsc)},
+                           {"median_hd95_mm", median_of(hd95)},
+                           {"median_seconds", median_of(secs)}};
+        if (json)
+          print_result(Json{{"cases", rows}, {"median", summary}}, true);
+        else
+          print_result(Json{{"median", summary}}, false);
+        // Every case is in the table; the exit code says whether all of them were planned.
+        if (unreadable > 0) return kBadInput;
+        if (failed > 0) return kUnusable;
+        return kOk;
+      }};
+}
+
+// study: inject one-sided defects into a healthy skull, plan them, score them
+Subcommand add_study(CLI::App& app, const bool& json) {
+  struct Opts {
+    std::string skull;
+    int count = 10;
+    double min_size = 30.0, max_size = 50.0;
+    AutoplanParams params;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* cmd = app.add_subcommand(
+      "study", "Inject one-sided defects into a healthy skull, autoplan and score each");
+  cmd->add_option("SKULL", o->skull, "healthy skull (mesh or volume)")->required();
+  cmd->add_option("--count", o->count, "number of defects (default 10)")->check(CLI::Range(1, 100));
+  cmd->add_option("--min-size", o->min_size, "smallest sphere diameter (mm)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--max-size", o->max_size, "largest sphere diameter (mm)")
+      ->check(CLI::PositiveNumber);
+  add_fit_option(cmd, o->params);
+  return Subcommand{
+      cmd, [o, &json] {
+        const LoadedSkull loaded = load_skull(o->skull);
+        const SkullMesh& skull = loaded.mesh;
+        const SurfaceLocator bone(skull);
+        // Directions on the upper vault, alternately left and right, spread by the golden angle;
+        // each defect's centre is in the middle of the bone along that ray from the centroid.
+        Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+        for (auto vh : skull.vertices()) centroid += to_eigen(skull.point(vh));
+        centroid /= static_cast<double>(skull.n_vertices());
+        Json rows = Json::array();
+        std::vector<double> dsc, hd95;
+        int printable = 0;
+        for (int k = 0; k < o->count; ++k) {
+          const double side = k % 2 == 0 ? 1.0 : -1.0;
+          const double phi = 2.39996 * k, up = 0.25 + 0.5 * std::fmod(0.618034 * k, 1.0);
+          const Eigen::Vector3d dir =
+              Eigen::Vector3d(side * (0.55 + 0.25 * std::abs(std::cos(phi))), 0.6 * std::sin(phi),
+                              up)
+                  .normalized();
+          const auto out_hit = bone.first_hit(centroid + 400.0 * dir, centroid);
+          const auto in_hit = bone.first_hit(centroid, centroid + 400.0 * dir);
+          if (!out_hit || !in_hit) continue;
+          InjectDefectParams ip;
+          ip.center = 0.5 * (out_hit->point + in_hit->point);
+          ip.size_mm =
+              o->min_size + (o->max_size - o->min_size) * std::fmod(0.381966 * (k + 1), 1.0);
+          ip.voxel_mm = 0.5;
+          const InjectDefectResult d = inject_defect(skull, ip);
+          if (!d.usable()) continue;
+          // The skull may have a defect of its own (the sample has): the planner is told
+          // which opening is meant, as a user would point at it.
+          AutoplanParams params = o->params;
+          params.propose.detect.near = ip.center;
+          const AutoplanResult r = autoplan(d.defective, Landmarks{}, params);
+          Json row{{"center", to_json(ip.center)}, {"size_mm", ip.size_mm}, {"message", r.message}};
+          if (r.planned()) {
+            const CompareResult c = compare_implants(r.implant.mesh, d.implant, &d.defective);
+            add_scores(row, r, c);
+            printable += r.quality.printable;
+            dsc.push_back(c.dice);
+            hd95.push_back(c.hd95_mm);
+          } else {
+            dsc.push_back(0.0);
+          }
+          if (!json)
+            std::cout << k << "  size " << ip.size_mm << " mm  " << row.value("method", "-")
+                      << "  DSC " << row.value("dice", 0.0) << "  HD95 "
+                      << row.value("hd95_mm", 0.0) << " mm  " << printable_text(row) << r.message
+                      << std::endl;
+          rows.push_back(row);
+        }
+        const Json summary{{"defects", rows.size()},
+                           {"printable", printable},
+                           {"median_dice", median(dsc)},
+                           {"median_hd95_mm", median(hd95)}};
+        if (json)
+          print_result(Json{{"defects", rows}, {"median", summary}}, true);
+        else
+          print_result(Json{{"median", summary}}, false);
+        return kOk;
+      }};
+}
+
 }  // namespace
 
 std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
-  std::vector<Subcommand> out;
-
-  {  // smooth
-    struct Opts {
-      std::string markers, output, mirrored;
-      SmoothParams params;
-    };
-    auto o = std::make_shared<Opts>();
-    auto* cmd = app.add_subcommand("smooth", "The paper's Laplacian smoother on surface markers");
-    cmd->add_option("MARKERS", o->markers, "markers (.json or .csv)")->required();
-    cmd->add_option("--radius", o->params.radius_mm, "neighbourhood radius (mm)")
-        ->required()
-        ->check(CLI::PositiveNumber);
-    cmd->add_option("--edge-weight", o->params.edge_weight, "weight of edge markers (>= 1)")
-        ->required()
-        ->check(CLI::Range(1.0, 1e6));
-    cmd->add_option("--iterations", o->params.iterations, "iterations (default 1)")
-        ->check(CLI::Range(1, 1000));
-    cmd->add_option("--project-onto", o->mirrored,
-                    "put smoothed surface markers back onto this mesh (the mirrored skull)");
-    cmd->add_option("-o,--output", o->output, "markers to write (.json or .csv)")->required();
-    out.push_back({cmd, [o, &json] {
-                     const auto markers = read_markers_file(o->markers);
-                     std::unique_ptr<SurfaceLocator> surface;
-                     SkullMesh mirrored;
-                     if (!o->mirrored.empty()) {
-                       mirrored = load_skull(o->mirrored).mesh;
-                       surface = std::make_unique<SurfaceLocator>(mirrored);
-                     }
-                     const SmoothResult r = smooth_markers(markers, o->params, surface.get());
-                     const bool ok = r.status == SmoothResult::Status::Smoothed;
-                     if (ok) write_markers_file(r.markers, o->output);
-                     print_result(Json{{"status", ok ? "smoothed" : "too_few_markers"},
-                                       {"message", r.message},
-                                       {"markers", r.markers.size()},
-                                       {"max_move_mm", r.max_move_mm}},
-                                  json);
-                     return ok ? kOk : kUnusable;
-                   }});
-  }
-
-  {  // implant
-    struct Opts {
-      std::string skull, mirrored, markers, output, method = "shell";
-      ImplantParams params;
-      bool no_snap = false;
-    };
-    auto o = std::make_shared<Opts>();
-    auto* cmd = app.add_subcommand("implant", "Build an implant from markers");
-    cmd->add_option("--skull", o->skull, "the original (defective) skull")->required();
-    cmd->add_option("--mirrored", o->mirrored,
-                    "the registered mirrored skull (surface markers are snapped onto it)");
-    cmd->add_option("--markers", o->markers, "markers (.json or .csv)")->required();
-    cmd->add_option("--method", o->method, "shell (default) or delaunay3d")
-        ->check(CLI::IsMember({"shell", "delaunay3d"}));
-    cmd->add_option("--resolution", o->params.resolution_mm, "shell edge length (mm)")
-        ->check(CLI::Range(0.2, 10.0));
-    cmd->add_option("--thickness", o->params.thickness_mm,
-                    "thickness without inner markers (mm; default: bone around the rim)")
-        ->check(CLI::Range(0.5, 30.0));
-    cmd->add_flag("--no-rim-snap", o->no_snap,
-                  "keep the rim between markers where the spline puts it");
-    cmd->add_option("--alpha", o->params.delaunay_alpha, "delaunay3d alpha (mm; 0 = convex hull)");
-    cmd->add_option("--tolerance", o->params.delaunay_tolerance, "delaunay3d tolerance");
-    cmd->add_option("--offset", o->params.delaunay_offset, "delaunay3d offset");
-    cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
-    out.push_back({cmd, [o, &json] {
-                     const std::vector<Marker> raw = read_markers_file(o->markers);
-                     const LoadedSkull loaded = load_skull(o->skull);
-                     const SkullMesh& skull = loaded.mesh;
-                     const SurfaceLocator skull_surface(skull);
-                     SkullMesh mirrored;
-                     std::unique_ptr<SurfaceLocator> mirrored_surface;
-                     if (!o->mirrored.empty()) {
-                       mirrored = load_skull(o->mirrored).mesh;
-                       mirrored_surface = std::make_unique<SurfaceLocator>(mirrored);
-                     }
-                     const SnapMarkersResult snapped =
-                         snap_markers(raw, skull_surface, mirrored_surface.get());
-                     if (snapped.status != SnapMarkersResult::Status::Snapped)
-                       throw InputError(o->markers, snapped.message);
-                     o->params.method =
-                         o->method == "shell" ? ImplantMethod::Shell : ImplantMethod::Delaunay3D;
-                     o->params.snap_rim_to_skull = !o->no_snap;
-                     const ImplantResult r = build_implant(snapped.markers, &skull, o->params);
-                     Json j = implant_json(r);
-                     j["method"] = o->method;
-                     j["marker_snap_max_mm"] = snapped.max_distance_mm;
-                     if (!r.usable()) {
-                       print_result(j, json);
-                       return kUnusable;
-                     }
-                     write_mesh(r.mesh, o->output);
-                     j["output"] = o->output;
-                     j["quality"] = to_json(check_implant(r.mesh, &skull));
-                     print_result(j, json);
-                     return kOk;
-                   }});
-  }
-
-  {  // qa
-    struct Opts {
-      std::string implant, skull;
-      QualityParams params;
-    };
-    auto o = std::make_shared<Opts>();
-    auto* cmd = app.add_subcommand("qa", "Quality report of an implant before printing");
-    cmd->add_option("IMPLANT", o->implant, "implant mesh")->required();
-    cmd->add_option("--skull", o->skull, "the (defective) skull it is made for");
-    cmd->add_option("--min-thickness", o->params.min_thickness_mm, "thinnest printable (mm)");
-    cmd->add_option("--max-taper", o->params.max_taper_mm,
-                    "widest edge on the bone that may be thinner (mm)");
-    cmd->add_option("--max-rim-gap", o->params.max_rim_gap_mm, "largest acceptable rim gap (mm)");
-    cmd->add_option("--max-penetration", o->params.max_penetration_mm3,
-                    "largest acceptable overlap (mm³)");
-    out.push_back({cmd, [o, &json] {
-                     const SkullMesh implant = load_surface(o->implant).mesh;
-                     SkullMesh skull;
-                     if (!o->skull.empty()) skull = load_skull(o->skull).mesh;
-                     const QualityReport q =
-                         check_implant(implant, o->skull.empty() ? nullptr : &skull, o->params);
-                     print_result(to_json(q), json);
-                     return q.printable ? kOk : kUnusable;
-                   }});
-  }
-
-  {  // compare
-    struct Opts {
-      std::string a, b, skull;
-      CompareParams params;
-    };
-    auto o = std::make_shared<Opts>();
-    auto* cmd = app.add_subcommand("compare", "Dice, boundary Dice, HD, HD95 between two implants");
-    cmd->add_option("IMPLANT", o->a, "implant (mesh or NRRD/NIfTI mask)")->required();
-    cmd->add_option("REFERENCE", o->b, "reference implant (mesh or mask)")->required();
-    cmd->add_option("--defective-skull", o->skull,
-                    "defective skull for boundary Dice (mesh or mask)");
-    cmd->add_option("--spacing", o->params.spacing_mm, "voxel size of the common grid (mm)")
-        ->check(CLI::Range(0.1, 2.0));
-    out.push_back({cmd, [o, &json] {
-                     const SkullMesh a = load_any(o->a), b = load_any(o->b);
-                     SkullMesh skull;
-                     if (!o->skull.empty()) skull = load_any(o->skull);
-                     const CompareResult r =
-                         compare_implants(a, b, o->skull.empty() ? nullptr : &skull, o->params);
-                     print_result(to_json(r), json);
-                     return kOk;
-                   }});
-  }
-
-  {  // inject-defect
-    struct Opts {
-      std::string skull, center, shape = "sphere", output, implant;
-      InjectDefectParams params;
-    };
-    auto o = std::make_shared<Opts>();
-    auto* cmd = app.add_subcommand("inject-defect",
-                                   "Cut a defect out of a healthy skull, keeping the ground truth");
-    cmd->add_option("SKULL", o->skull, "healthy skull (closed mesh or volume)")->required();
-    cmd->add_option("--center", o->center, "defect centre x,y,z (mm)")->required();
-    cmd->add_option("--size", o->params.size_mm, "sphere diameter or cube edge (mm)")
-        ->required()
-        ->check(CLI::PositiveNumber);
-    cmd->add_option("--shape", o->shape, "sphere or cube")
-        ->check(CLI::IsMember({"sphere", "cube"}));
-    cmd->add_option("--voxel", o->params.voxel_mm, "resolution of the cut (mm)")
-        ->check(CLI::Range(0.1, 2.0));
-    cmd->add_option("-o,--output", o->output, "defective skull to write")->required();
-    cmd->add_option("--implant", o->implant, "ground-truth implant to write")->required();
-    out.push_back({cmd, [o, &json] {
-                     o->params.center = parse_point(o->center, "--center");
-                     o->params.shape = o->shape == "cube" ? InjectDefectParams::Shape::Cube
-                                                          : InjectDefectParams::Shape::Sphere;
-                     const LoadedSkull loaded = load_skull(o->skull);
-                     const SkullMesh& skull = loaded.mesh;
-                     const InjectDefectResult r = inject_defect(skull, o->params);
-                     Json j{{"status", r.usable() ? "injected" : "no_bone_in_defect"},
-                            {"message", r.message},
-                            {"removed_volume_mm3", r.removed_volume_mm3},
-                            {"seconds", r.seconds}};
-                     if (!r.usable()) {
-                       print_result(j, json);
-                       return kUnusable;
-                     }
-                     write_mesh(r.defective, o->output);
-                     write_mesh(r.implant, o->implant);
-                     j["defective"] = o->output;
-                     j["implant"] = o->implant;
-                     print_result(j, json);
-                     return kOk;
-                   }});
-  }
-  {  // autoplan
-    struct Opts {
-      std::string skull, landmarks, output, markers_out, session, method = "auto";
-      std::vector<double> near;
-      bool all_openings = false;
-      AutoplanParams params;
-      ExtractBoneSurfaceParams import;
-    };
-    auto o = std::make_shared<Opts>();
-    auto* cmd =
-        app.add_subcommand("autoplan", "Plan an implant automatically from a defective skull");
-    cmd->add_option("SKULL", o->skull, "defective skull (mesh or volume)")->required();
-    cmd->add_option("--landmarks", o->landmarks, "landmarks JSON for the midsagittal plane");
-    cmd->add_option("--method", o->method, "auto, mirror or rim-only")
-        ->check(CLI::IsMember({"auto", "mirror", "rim-only"}));
-    cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
-    cmd->add_option("--markers-out", o->markers_out, "proposed markers to write (.json or .csv)");
-    add_units_option(cmd, o->import.mesh_unit_mm);
-    add_series_option(cmd, o->import.dicom_series);
-    cmd->add_option("--near", o->near,
-                    "X Y Z (mm): with several openings, plan the one in this point's direction "
-                    "(default: the largest)")
-        ->expected(3);
-    add_fit_option(cmd, o->params);
-    cmd->add_option("--session", o->session,
-                    "plan through session commands and save the session (.json): reopen, edit, "
-                    "replay and audit it (with --all-openings, SESSION_2... for the others)");
-    cmd->add_flag("--all-openings", o->all_openings,
-                  "plan every opening large enough to be a defect (bilateral defects), each to "
-                  "its own implant: IMPLANT, then IMPLANT_2, IMPLANT_3... (markers and sessions "
-                  "likewise)");
-    out.push_back(
-        {cmd, [o, &json]() -> int {
-           if (o->near.size() == 3)
-             o->params.propose.detect.near = Eigen::Vector3d(o->near[0], o->near[1], o->near[2]);
-           const Landmarks lm =
-               o->landmarks.empty() ? Landmarks{} : read_landmarks_file(o->landmarks);
-           plan_method_from_string(o->method, o->params.propose.method);
-           auto markers_path = [&](size_t k) {
-             return o->markers_out.empty() ? std::string() : numbered_path(o->markers_out, k);
-           };
-           if (!o->session.empty())
-             return autoplan_sessions(o->skull, o->import, lm, o->params, o->output, o->markers_out,
-                                      o->session, o->all_openings, json);
-           const LoadedSkull loaded = load_skull(o->skull, o->import);
-           const SkullMesh& skull = loaded.mesh;
-           // The reader's warnings (a skull turned outward, non-manifold edges) with the plan.
-           auto with_warnings = [&loaded](Json j) {
-             if (!loaded.warnings.empty()) j["warnings"] = loaded.warnings;
-             return j;
-           };
-           if (!o->all_openings) {
-             const AutoplanResult r = autoplan(skull, lm, o->params);
-             print_result(with_warnings(write_autoplan(r, o->output, o->markers_out)), json);
-             return r.planned() ? kOk : kUnusable;
-           }
-           // Every opening in turn; the first is the one planned without
-           // --all-openings.
-           const std::vector<AutoplanResult> all = autoplan_all_openings(skull, lm, o->params);
-           if (!all.front().defect.found()) {  // no defect, or no plane
-             print_result(with_warnings(write_autoplan(all.front(), o->output, o->markers_out)),
-                          json);
-             return all.front().planned() ? kOk : kUnusable;
-           }
-           Json plans = Json::array();
-           bool all_planned = true;
-           for (size_t k = 0; k < all.size(); ++k) {
-             plans.push_back(with_warnings(
-                 write_autoplan(all[k], numbered_path(o->output, k + 1), markers_path(k + 1))));
-             all_planned = all_planned && all[k].planned();
-           }
-           print_plans(plans, json);
-           return all_planned ? kOk : kUnusable;
-         }});
-  }
-
-  {  // evaluate
-    struct Opts {
-      std::string dir, implants_out;
-      AutoplanParams params;
-    };
-    auto o = std::make_shared<Opts>();
-    auto* cmd = app.add_subcommand(
-        "evaluate",
-        "Autoplan every NNN_defective_skull.* against its NNN_implant.* (exit 1 if a case could "
-        "not be planned, 3 if a case's file could not be read; every case is in the table)");
-    cmd->add_option("CASES_DIR", o->dir, "folder of cases (meshes or NRRD/NIfTI masks)")
-        ->required();
-    cmd->add_option("--implants-out", o->implants_out,
-                    "folder to write each planned implant to (NNN_planned_implant.stl)");
-    add_fit_option(cmd, o->params);
-    out.push_back(
-        {cmd, [o, &json] {
-           namespace fs = std::filesystem;
-           if (!fs::is_directory(o->dir)) throw InputError(o->dir, "is not a folder");
-           if (!o->implants_out.empty() && !fs::is_directory(o->implants_out))
-             throw InputError(o->implants_out, "is not a folder (--implants-out)");
-           std::map<std::string, std::pair<std::string, std::string>>
-               cases;  // id → (defective, implant)
-           for (const auto& e : fs::directory_iterator(o->dir)) {
-             const std::string name = e.path().filename().string();
-             const size_t us = name.find('_');
-             if (us == std::string::npos) continue;
-             const std::string id = name.substr(0, us), rest = name.substr(us + 1);
-             if (rest.rfind("defective_skull.", 0) == 0) cases[id].first = e.path().string();
-             if (rest.rfind("implant.", 0) == 0) cases[id].second = e.path().string();
-           }
-           Json rows = Json::array();
-           std::vector<double> dsc, bdsc, hd95, secs;
-           int failed = 0, unreadable = 0, printable = 0;
-           for (const auto& [id, files] : cases) {
-             if (files.first.empty() || files.second.empty()) continue;
-             double seconds = 0.0;
-             bool read = true;
-             Json row{{"case", id}};
-             // One case's unreadable file is that case's row, not the end of the run: the
-             // others are still planned and scored.
-             try {
-               // The truth is read first (to fail before planning) and not timed: the time is
-               // the plan's, from reading the skull to the implant.
-               const SkullMesh truth = load_any(files.second);
-               const auto t0 = std::chrono::steady_clock::now();
-               const LoadedSkull loaded = load_skull(files.first);
-               const SkullMesh& skull = loaded.mesh;
-               const AutoplanResult r = autoplan(skull, Landmarks{}, o->params);
-               seconds =
-                   std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-               row["status"] = r.planned() ? "planned" : "failed";
-               row["message"] = r.message;
-               if (r.planned()) {
-                 const CompareResult c = compare_implants(r.implant.mesh, truth, &skull);
-                 if (!o->implants_out.empty()) {
-                   const std::string path =
-                       (fs::path(o->implants_out) / (id + "_planned_implant.stl")).string();
-                   write_mesh(r.implant.mesh, path);
-                   row["implant"] = path;
-                 }
-                 add_scores(row, r, c);
-                 printable += r.quality.printable;
-                 dsc.push_back(c.dice);
-                 bdsc.push_back(c.boundary_dice);
-                 hd95.push_back(c.hd95_mm);
-               } else {
-                 // No implant overlaps nothing: a failed plan counts as Dice 0 in the medians
-                 // (as a missing prediction does in the challenge); it has no distance.
-                 ++failed;
-                 dsc.push_back(0.0);
-                 bdsc.push_back(0.0);
-               }
-             } catch (const Error& e) {
-               ++unreadable;
-               read = false;
-               row["status"] = "bad_input";
-               row["message"] = e.what();
-             }
-             row["seconds"] = read ? Json(seconds) : Json(nullptr);  // no plan, no time
-             if (read) secs.push_back(seconds);
-             if (!json) {
-               if (row["status"] == "planned")
-                 std::cout << id << "  " << row["method"].get<std::string>() << "  DSC "
-                           << row["dice"].get<double>() << "  bDSC "
-                           << row["boundary_dice"].get<double>() << "  HD95 "
-                           << row["hd95_mm"].get<double>() << " mm  " << seconds << " s  "
-                           << printable_text(row) << row["message"].get<std::string>() << std::endl;
-               else
-                 std::cout << id << "  " << row["status"].get<std::string>() << "  "
-                           << row["message"].get<std::string>() << std::endl;
-             }
-             rows.push_back(row);
-           }
-           if (rows.empty())
-             throw InputError(o->dir,
-                              "holds no NNN_defective_skull.* with an NNN_implant.* beside it");
-           // No figure where no case gave one (null, not 0).
-           auto median_of = [](const std::vector<double>& v) {
-             return v.empty() ? Json(nullptr) : Json(median(v));
-           };
-           const Json summary{{"cases", rows.size()},
-                              {"printable", printable},
-                              {"failed", failed},
-                              {"bad_input", unreadable},
-                              {"median_dice", median_of(dsc)},
-                              {"median_boundary_dice", median_of(bdsc)},
-                              {"median_hd95_mm", median_of(hd95)},
-                              {"median_seconds", median_of(secs)}};
-           if (json)
-             print_result(Json{{"cases", rows}, {"median", summary}}, true);
-           else
-             print_result(Json{{"median", summary}}, false);
-           // Every case is in the table; the exit code says whether all of them were planned.
-           if (unreadable > 0) return kBadInput;
-           if (failed > 0) return kUnusable;
-           return kOk;
-         }});
-  }
-  {  // study: inject one-sided defects into a healthy skull, plan them, score them
-    struct Opts {
-      std::string skull;
-      int count = 10;
-      double min_size = 30.0, max_size = 50.0;
-      AutoplanParams params;
-    };
-    auto o = std::make_shared<Opts>();
-    auto* cmd = app.add_subcommand(
-        "study", "Inject one-sided defects into a healthy skull, autoplan and score each");
-    cmd->add_option("SKULL", o->skull, "healthy skull (mesh or volume)")->required();
-    cmd->add_option("--count", o->count, "number of defects (default 10)")
-        ->check(CLI::Range(1, 100));
-    cmd->add_option("--min-size", o->min_size, "smallest sphere diameter (mm)")
-        ->check(CLI::PositiveNumber);
-    cmd->add_option("--max-size", o->max_size, "largest sphere diameter (mm)")
-        ->check(CLI::PositiveNumber);
-    add_fit_option(cmd, o->params);
-    out.push_back(
-        {cmd, [o, &json] {
-           const LoadedSkull loaded = load_skull(o->skull);
-           const SkullMesh& skull = loaded.mesh;
-           const SurfaceLocator bone(skull);
-           // Directions on the upper vault, alternately left and right, spread by the golden angle;
-           // each defect's centre is in the middle of the bone along that ray from the centroid.
-           Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-           for (auto vh : skull.vertices()) centroid += to_eigen(skull.point(vh));
-           centroid /= static_cast<double>(skull.n_vertices());
-           Json rows = Json::array();
-           std::vector<double> dsc, hd95;
-           int printable = 0;
-           for (int k = 0; k < o->count; ++k) {
-             const double side = k % 2 == 0 ? 1.0 : -1.0;
-             const double phi = 2.39996 * k, up = 0.25 + 0.5 * std::fmod(0.618034 * k, 1.0);
-             const Eigen::Vector3d dir =
-                 Eigen::Vector3d(side * (0.55 + 0.25 * std::abs(std::cos(phi))),
-                                 0.6 * std::sin(phi), up)
-                     .normalized();
-             const auto out_hit = bone.first_hit(centroid + 400.0 * dir, centroid);
-             const auto in_hit = bone.first_hit(centroid, centroid + 400.0 * dir);
-             if (!out_hit || !in_hit) continue;
-             InjectDefectParams ip;
-             ip.center = 0.5 * (out_hit->point + in_hit->point);
-             ip.size_mm =
-                 o->min_size + (o->max_size - o->min_size) * std::fmod(0.381966 * (k + 1), 1.0);
-             ip.voxel_mm = 0.5;
-             const InjectDefectResult d = inject_defect(skull, ip);
-             if (!d.usable()) continue;
-             // The skull may have a defect of its own (the sample has): the planner is told
-             // which opening is meant, as a user would point at it.
-             AutoplanParams params = o->params;
-             params.propose.detect.near = ip.center;
-             const AutoplanResult r = autoplan(d.defective, Landmarks{}, params);
-             Json row{
-                 {"center", to_json(ip.center)}, {"size_mm", ip.size_mm}, {"message", r.message}};
-             if (r.planned()) {
-               const CompareResult c = compare_implants(r.implant.mesh, d.implant, &d.defective);
-               add_scores(row, r, c);
-               printable += r.quality.printable;
-               dsc.push_back(c.dice);
-               hd95.push_back(c.hd95_mm);
-             } else {
-               dsc.push_back(0.0);
-             }
-             if (!json)
-               std::cout << k << "  size " << ip.size_mm << " mm  " << row.value("method", "-")
-                         << "  DSC " << row.value("dice", 0.0) << "  HD95 "
-                         << row.value("hd95_mm", 0.0) << " mm  " << printable_text(row) << r.message
-                         << std::endl;
-             rows.push_back(row);
-           }
-           const Json summary{{"defects", rows.size()},
-                              {"printable", printable},
-                              {"median_dice", median(dsc)},
-                              {"median_hd95_mm", median(hd95)}};
-           if (json)
-             print_result(Json{{"defects", rows}, {"median", summary}}, true);
-           else
-             print_result(Json{{"median", summary}}, false);
-           return kOk;
-         }});
-  }
-  return out;
+  return {add_smooth(app, json),   add_implant(app, json),       add_qa(app, json),
+          add_compare(app, json),  add_inject_defect(app, json), add_autoplan(app, json),
+          add_evaluate(app, json), add_study(app, json)};
 }
 
 }  // namespace cranioplan::cli
