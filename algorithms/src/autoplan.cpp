@@ -3,8 +3,8 @@
 #include <chrono>
 #include <cstdio>
 
-#include "cranioplan/algorithms/mirror_mesh.h"
 #include "cranioplan/algorithms/detect_defect.h"
+#include "cranioplan/algorithms/mirror_mesh.h"
 #include "cranioplan/algorithms/propose_markers.h"
 #include "cranioplan/algorithms/surface_locator.h"
 
@@ -26,11 +26,13 @@ class StageTimer {
   std::chrono::steady_clock::time_point last_ = std::chrono::steady_clock::now();
 };
 
-// From the detection on: `r` holds the plane and the global registration.
+// From the detection on: `r` holds the plane and the global registration. `all_openings`: the
+// other openings are planned as well, and the messages say so.
 void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const AutoplanParams& params,
-                  StageTimer& timer, AutoplanResult& r) {
+                  bool all_openings, StageTimer& timer, AutoplanResult& r) {
   const RigidTransform reflection = reflection_across(r.plane.plane);
   r.defect = autoplan_stages::detect(skull, bone, r.plane.plane, params);
+  if (all_openings) r.defect.message = r.defect.describe(true);
   timer.stage("detect");
   auto mirror_motion = [&] {
     return r.registration.usable() ? r.registration.transform * reflection : reflection;
@@ -60,7 +62,8 @@ void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const Auto
     return;
   }
 
-  r.implant = build_implant(r.markers, &skull, &bone, autoplan_stages::implant_params(r.defect, params));
+  r.implant =
+      build_implant(r.markers, &skull, &bone, autoplan_stages::implant_params(r.defect, params));
   timer.stage("implant");
   if (!r.implant.usable()) {
     r.message = "implant: " + r.implant.message;
@@ -69,11 +72,8 @@ void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const Auto
   r.quality = check_implant(r.implant.mesh, &skull, &bone, QualityParams{});
   timer.stage("quality");
   r.status = AutoplanResult::Status::Planned;
-  char buf[80];  // the fixed part; the messages around it can be long (they name rim stretches)
-  std::snprintf(buf, sizeof(buf), "%s (mirror covers %.0f%% of the opening); ",
-                r.method_used == PlanMethod::Mirror ? "mirror-guided" : "rim-only fitting",
-                100.0 * r.mirror_coverage);
-  r.message = r.defect.message + "; " + buf + r.surfaces_message;
+  r.message = r.defect.message + "; " + describe_method(r.method_used, r.mirror_coverage) + "; " +
+              r.surfaces_message;
 }
 
 // The plane and the global registration; false (and `r` says why) when the plane fails.
@@ -150,7 +150,7 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
   StageTimer timer(r.stage_seconds);
   if (!plane_and_registration(skull, landmarks, params, timer, r)) return r;
   const SurfaceLocator bone(skull);
-  plan_opening(skull, bone, params, timer, r);
+  plan_opening(skull, bone, params, false, timer, r);
   return r;
 }
 
@@ -164,7 +164,7 @@ std::vector<AutoplanResult> autoplan_all_openings(const SkullMesh& skull,
   shared.plane = first.plane;
   shared.registration = first.registration;
   const SurfaceLocator bone(skull);
-  plan_opening(skull, bone, params, timer, first);
+  plan_opening(skull, bone, params, true, timer, first);
   std::vector<AutoplanResult> plans;
   plans.push_back(std::move(first));
   if (!plans.front().defect.found()) return plans;
@@ -174,10 +174,9 @@ std::vector<AutoplanResult> autoplan_all_openings(const SkullMesh& skull,
     each.propose.detect.near = point_towards_other_opening(first_opening, k);
     AutoplanResult r = shared;
     StageTimer each_timer(r.stage_seconds);
-    plan_opening(skull, bone, each, each_timer, r);
+    plan_opening(skull, bone, each, true, each_timer, r);
     plans.push_back(std::move(r));
   }
-  for (AutoplanResult& r : plans) r.message = with_other_openings_planned(r.message);
   return plans;
 }
 

@@ -364,11 +364,6 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
     }
     region.outer_rim = std::move(sorted_outer);
     region.inner_rim = std::move(sorted_inner);
-    region.message = "opening of " + std::to_string(static_cast<long long>(area)) + " mm² found";
-    if (region.other_openings > 0)
-      region.message += " (" + std::to_string(region.other_openings) +
-                        (region.other_openings == 1 ? " other opening" : " other openings") +
-                        kUnplannedOpeningsNote;
     // Asked for the opening towards a point, and none lies that way: the nearest was planned,
     // and the message says so (a point on intact bone, or at a cut that did not go through,
     // would otherwise plan another opening without a word).
@@ -377,35 +372,38 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
       double closest = -1.0;
       for (int i : comp) closest = std::max(closest, dirs[i].dot(want));
       region.near_miss_deg = std::acos(std::clamp(closest, -1.0, 1.0)) * 180.0 / M_PI;
-      if (region.near_miss_deg > kNearMissDeg)
-        region.message += "; no opening lies towards the point given: the nearest, planned, is " +
-                          std::to_string(std::lround(region.near_miss_deg)) + "° from it";
     }
     region.unseen_rim = unseen_rim_stretches(region.outer_rim);
-    if (!region.unseen_rim.empty()) {
-      std::string lengths;
-      for (size_t k = 0; k < region.unseen_rim.size(); ++k)
-        lengths +=
-            (k == 0                              ? ""
-             : k + 1 == region.unseen_rim.size() ? " and "
-                                                 : ", ") +
-            std::to_string(static_cast<long long>(std::lround(region.unseen_rim[k].length_mm())));
-      region.message += "; rim not seen along " + lengths +
-                        " mm (rays graze the bone there): check the edge markers";
-    }
     break;
   }
-  if (!region.found())
-    region.message = "no defect found (no opening in the skull besides its base)";
+  region.message = region.describe();
   region.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return region;
 }
 
-std::string with_other_openings_planned(std::string message) {
-  const std::string note = kUnplannedOpeningsNote;
-  const size_t at = message.find(note);
-  if (at != std::string::npos) message.replace(at, note.size(), ", planned as well)");
-  return message;
+std::string DefectRegion::describe(bool others_planned) const {
+  if (!found()) return "no defect found (no opening in the skull besides its base)";
+  std::string text =
+      "opening of " + std::to_string(static_cast<long long>(area_mm2)) + " mm² found";
+  if (other_openings > 0)
+    text += " (" + std::to_string(other_openings) +
+            (other_openings == 1 ? " other opening" : " other openings") +
+            (others_planned ? ", planned as well)"
+                            : " not planned: choose with a point near the defect)");
+  if (near_miss_deg > kNearMissDeg)
+    text += "; no opening lies towards the point given: the nearest, planned, is " +
+            std::to_string(std::lround(near_miss_deg)) + "° from it";
+  if (!unseen_rim.empty()) {
+    std::string lengths;
+    for (size_t k = 0; k < unseen_rim.size(); ++k)
+      lengths += (k == 0                       ? ""
+                  : k + 1 == unseen_rim.size() ? " and "
+                                               : ", ") +
+                 std::to_string(static_cast<long long>(std::lround(unseen_rim[k].length_mm())));
+    text += "; rim not seen along " + lengths +
+            " mm (rays graze the bone there): check the edge markers";
+  }
+  return text;
 }
 
 }  // namespace cranioplan

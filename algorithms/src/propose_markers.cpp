@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "cranioplan/algorithms/point_index.h"
 #include "cranioplan/algorithms/surface_locator.h"
@@ -28,6 +29,14 @@ bool plan_method_from_string(const std::string& text, PlanMethod& out) {
       return true;
     }
   return false;
+}
+
+std::string describe_method(PlanMethod method, double mirror_coverage) {
+  char buf[80];
+  std::snprintf(buf, sizeof(buf), "%s (mirror covers %.0f%% of the opening)",
+                method == PlanMethod::Mirror ? "mirror-guided" : "rim-only fitting",
+                100.0 * mirror_coverage);
+  return buf;
 }
 
 namespace {

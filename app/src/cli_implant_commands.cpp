@@ -132,8 +132,8 @@ void print_plans(const Json& plans, bool json) {
 Json autoplan_with_session(const std::string& skull, const ExtractBoneSurfaceParams& import,
                            const Landmarks& lm, const AutoplanParams& params,
                            const std::string& output, const std::string& markers_out,
-                           const std::string& session_path, AutoplanSession& a) {
-  a = autoplan_session(skull, lm, params, output, {}, import);
+                           const std::string& session_path, bool all_openings, AutoplanSession& a) {
+  a = autoplan_session(skull, lm, params, output, {}, import, all_openings);
   a.session.save(session_path);
   const PlanState& s = a.session.state();
   Json j{{"status", a.planned()                                     ? "planned"
@@ -161,12 +161,12 @@ int autoplan_sessions(const std::string& skull, const ExtractBoneSurfaceParams& 
                       const std::string& markers_out, const std::string& session, bool all_openings,
                       bool json) {
   AutoplanSession first;
-  Json j = autoplan_with_session(skull, import, lm, params, output, markers_out, session, first);
+  Json j = autoplan_with_session(skull, import, lm, params, output, markers_out, session,
+                                 all_openings, first);
   if (!all_openings || !first.defect.found()) {
     print_result(j, json);
     return first.planned() ? kOk : kUnusable;
   }
-  j["message"] = with_other_openings_planned(j["message"].get<std::string>());
   Json plans = Json::array({j});
   bool all_planned = first.planned();
   for (size_t k = 0; k < first.defect.other_axes.size(); ++k) {
@@ -175,8 +175,7 @@ int autoplan_sessions(const std::string& skull, const ExtractBoneSurfaceParams& 
     AutoplanSession a;
     Json one = autoplan_with_session(skull, import, lm, each, numbered_path(output, k + 2),
                                      markers_out.empty() ? "" : numbered_path(markers_out, k + 2),
-                                     numbered_path(session, k + 2), a);
-    one["message"] = with_other_openings_planned(one["message"].get<std::string>());
+                                     numbered_path(session, k + 2), true, a);
     plans.push_back(one);
     all_planned = all_planned && a.planned();
   }

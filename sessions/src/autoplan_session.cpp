@@ -32,7 +32,8 @@ Command recorded(Command command, const Json& result, double ms) {
 
 AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks& landmarks,
                                  const AutoplanParams& params, const std::string& export_path,
-                                 const SessionInfo& info, const ExtractBoneSurfaceParams& import) {
+                                 const SessionInfo& info, const ExtractBoneSurfaceParams& import,
+                                 bool others_planned) {
   AutoplanSession out;
   SessionInfo with_case = info;
   if (with_case.case_id.empty())
@@ -73,13 +74,14 @@ AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks&
     run(recorded(commands::register_mirror(params.registration), to_json(global), t.ms()));
   }
   out.defect = autoplan_stages::detect(mesh, bone, plane, params);
+  if (others_planned) out.defect.message = out.defect.describe(true);
   {
     // Found by the proposal's search below, and recorded with it; the registration around the
     // opening (an unusable one keeps the global registration, as in autoplan()).
     const Stopwatch t;
-    const auto local =
-        autoplan_stages::local_registration(mesh, plane, out.defect, global, params);
-    if (local) run(recorded(commands::register_mirror(local->params), to_json(local->result), t.ms()));
+    const auto local = autoplan_stages::local_registration(mesh, plane, out.defect, global, params);
+    if (local)
+      run(recorded(commands::register_mirror(local->params), to_json(local->result), t.ms()));
   }
   if (!step_complete(s.state(), 3)) run(commands::complete_step(3));
   run(commands::complete_step(4));
@@ -88,9 +90,8 @@ AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks&
     const Stopwatch t;
     const PlanState& st = s.state();
     propose = recorded(std::move(propose),
-                       proposal_result(autoplan_stages::markers(out.defect, bone,
-                                                                st.mirrored->locator, params,
-                                                                st.next_marker_id)),
+                       proposal_result(autoplan_stages::markers(
+                           out.defect, bone, st.mirrored->locator, params, st.next_marker_id)),
                        t.ms());
   }
   run(std::move(propose));

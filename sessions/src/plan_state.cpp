@@ -726,11 +726,8 @@ Json proposal_result(const MarkerProposal& p) {
                 {"defect_center", nullptr},
                 {"unseen_rim", Json::array()},
                 {"message", "no markers proposed: " + p.message}};
-  char buf[120];  // the fixed part; the detection's message can be long (it names rim stretches)
-  std::snprintf(
-      buf, sizeof(buf), "%zu markers proposed, %s (mirror covers %.0f%% of the opening); ",
-      p.markers.size(), p.method_used == PlanMethod::Mirror ? "mirror-guided" : "rim-only fitting",
-      100.0 * p.mirror_coverage);
+  const std::string proposed = std::to_string(p.markers.size()) + " markers proposed, " +
+                               describe_method(p.method_used, p.mirror_coverage) + "; ";
   Json unseen = Json::array();
   for (const RimStretch& g : p.defect.unseen_rim)
     unseen.push_back(Json{{"from", to_json(g.from)}, {"to", to_json(g.to)}});
@@ -738,7 +735,7 @@ Json proposal_result(const MarkerProposal& p) {
               {"markers", markers_to_json(p.markers)["markers"]},
               {"defect_center", to_json(p.defect.center)},
               {"unseen_rim", unseen},
-              {"message", buf + p.message + "; " + p.surfaces_message}};
+              {"message", proposed + p.message + "; " + p.surfaces_message}};
 }
 
 ApplyOutcome apply_command(const PlanState& before, const Command& command,

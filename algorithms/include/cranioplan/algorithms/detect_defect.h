@@ -96,20 +96,17 @@ struct DefectRegion {
   double near_miss_deg = 0.0;
   double seconds = 0.0;
   bool found() const { return status == Status::Found; }
+  /// What was found, said from the fields above: the opening's area, the further openings
+  /// (left unplanned, or `others_planned` as well, as `autoplan --all-openings` does), a point
+  /// that missed every opening, the rim's unseen stretches. `message` is this with
+  /// `others_planned` false.
+  std::string describe(bool others_planned = false) const;
 };
 
 /// A point given to choose the opening (DetectDefectParams::near) that lies further than this
 /// from every ray through the opening planned, degrees, is said to miss it (a point on the rim
 /// lies within a ray spacing or two, about 3°).
 inline constexpr double kNearMissDeg = 10.0;
-
-/// What the message says after the count of further openings it left unplanned.
-inline constexpr char kUnplannedOpeningsNote[] =
-    " not planned: choose with a point near the defect)";
-
-/// `message` with the note on unplanned openings saying instead that they are planned as well
-/// (for plans made of every opening, e.g. `autoplan --all-openings`).
-std::string with_other_openings_planned(std::string message);
 
 /// A rim stretch without a rim point is reported when it is longer than this (mm) and than
 /// kUnseenRimTimesMedian times the rim's median spacing (large openings have sparser rims).

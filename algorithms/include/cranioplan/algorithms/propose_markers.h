@@ -53,6 +53,10 @@ struct MarkerProposal {
   bool proposed() const { return status == Status::Proposed; }
 };
 
+/// How the surfaces were found, for messages: "mirror-guided (mirror covers 97% of the opening)"
+/// or "rim-only fitting (…)".
+std::string describe_method(PlanMethod method, double mirror_coverage);
+
 /// The defect seen from the skull's centroid moved onto the midsagittal plane.
 DefectRegion detect_defect_near_plane(const SkullMesh& skull, const SurfaceLocator& bone,
                                       const Plane& plane, const DetectDefectParams& params);

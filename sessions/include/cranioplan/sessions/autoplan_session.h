@@ -25,10 +25,12 @@ struct AutoplanSession {
 /// The searches are autoplan()'s stages (`autoplan_stages`), each recorded in its command with
 /// what it found and how long it took, so the implant is autoplan()'s and a replay searches
 /// nothing again. `import`: how the skull file is read (a CT's threshold, a mesh's length unit).
-/// Throws InputError for a bad skull.
+/// `others_planned`: the skull's other openings are planned in sessions of their own, and the
+/// messages say so. Throws InputError for a bad skull.
 AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks& landmarks,
                                  const AutoplanParams& params, const std::string& export_path,
                                  const SessionInfo& info = {},
-                                 const ExtractBoneSurfaceParams& import = {});
+                                 const ExtractBoneSurfaceParams& import = {},
+                                 bool others_planned = false);
 
 }  // namespace cranioplan
