@@ -44,6 +44,7 @@
 #include "cranioplan/algorithms/load_skull.h"
 #include "cranioplan/algorithms/read_volume.h"
 #include "cranioplan/model/error.h"
+#include "cranioplan/sessions/audit.h"
 #include "cranioplan/sessions/marker_files.h"
 #include "cranioplan/sessions/sha256.h"
 
@@ -59,42 +60,7 @@ QPushButton* button(const QString& text, const char* name, QWidget* parent = nul
   return b;
 }
 
-QString quality_html(const QualityReport& r) {
-  auto yes = [](bool b) { return b ? QStringLiteral("yes") : QStringLiteral("<b>no</b>"); };
-  QString h = QStringLiteral("<table cellspacing=2>");
-  auto row = [&](const QString& k, const QString& v) {
-    h += QStringLiteral("<tr><td>%1</td><td><b>%2</b></td></tr>").arg(k, v);
-  };
-  row(QObject::tr("Printable"), r.printable ? QObject::tr("yes") : QObject::tr("NO"));
-  row(QObject::tr("Watertight"), yes(r.watertight));
-  row(QObject::tr("Manifold"), yes(r.manifold));
-  row(QObject::tr("Outward normals"), yes(r.outward));
-  row(QObject::tr("Self-intersections"), QString::number(r.self_intersections));
-  row(QObject::tr("Pieces"), QString::number(r.pieces));
-  row(QObject::tr("Volume"), QString::number(r.volume_mm3, 'f', 0) + " mm³");
-  row(QObject::tr("Area"), QString::number(r.area_mm2, 'f', 0) + " mm²");
-  row(QObject::tr("Thickness min / median / max"), QStringLiteral("%1 / %2 / %3 mm")
-                                                       .arg(r.thickness_min_mm, 0, 'f', 1)
-                                                       .arg(r.thickness_median_mm, 0, 'f', 1)
-                                                       .arg(r.thickness_max_mm, 0, 'f', 1));
-  row(QObject::tr("Thinner than the minimum"),
-      r.taper_reach_mm < 0 ? QObject::tr("everywhere")
-                           : QObject::tr("%1 mm³: edge on the bone %2 mm wide, elsewhere %3 mm")
-                                 .arg(r.thin_volume_mm3, 0, 'f', 1)
-                                 .arg(r.taper_reach_mm, 0, 'f', 1)
-                                 .arg(r.corner_reach_mm, 0, 'f', 1));
-  if (r.rim_gap_mm >= 0)
-    row(QObject::tr("Gap to bone (rim)"), QString::number(r.rim_gap_mm, 'f', 2) + " mm");
-  if (r.penetration_mm3 >= 0)
-    row(QObject::tr("Overlap with skull"), QString::number(r.penetration_mm3, 'f', 1) + " mm³");
-  h += QStringLiteral("</table>");
-  if (!r.reasons.empty()) {
-    h += QStringLiteral("<p><b>") + QObject::tr("Problems:") + QStringLiteral("</b></p><ul>");
-    for (const auto& reason : r.reasons) h += "<li>" + q(reason).toHtmlEscaped() + "</li>";
-    h += QStringLiteral("</ul>");
-  }
-  return h;
-}
+QString quality_html(const QualityReport& r) { return q(quality_report_html(r)); }
 
 // The landmark names of the step-2 list, in order.
 const char* kLandmarkNames[] = {"nasion", "orbit_left", "orbit_right", "midline"};

@@ -371,4 +371,42 @@ std::string training_report_html(const TrainingReport& r) {
   return out.str();
 }
 
+std::string quality_report_html(const QualityReport& r) {
+  auto fixed = [](double v, int decimals) {
+    char buf[64];
+    std::snprintf(buf, sizeof(buf), "%.*f", decimals, v);
+    return std::string(buf);
+  };
+  auto yes = [](bool b) { return std::string(b ? "yes" : "<b>no</b>"); };
+  std::string h = "<table cellspacing=2>";
+  auto row = [&](const std::string& k, const std::string& v) {
+    h += "<tr><td>" + k + "</td><td><b>" + v + "</b></td></tr>";
+  };
+  row("Printable", r.printable ? "yes" : "NO");
+  row("Watertight", yes(r.watertight));
+  row("Manifold", yes(r.manifold));
+  row("Outward normals", yes(r.outward));
+  row("Self-intersections", std::to_string(r.self_intersections));
+  row("Pieces", std::to_string(r.pieces));
+  row("Volume", fixed(r.volume_mm3, 0) + " mm³");
+  row("Area", fixed(r.area_mm2, 0) + " mm²");
+  row("Thickness min / median / max", fixed(r.thickness_min_mm, 1) + " / " +
+                                          fixed(r.thickness_median_mm, 1) + " / " +
+                                          fixed(r.thickness_max_mm, 1) + " mm");
+  row("Thinner than the minimum", r.taper_reach_mm < 0
+                                      ? std::string("everywhere")
+                                      : fixed(r.thin_volume_mm3, 1) + " mm³: edge on the bone " +
+                                            fixed(r.taper_reach_mm, 1) + " mm wide, elsewhere " +
+                                            fixed(r.corner_reach_mm, 1) + " mm");
+  if (r.rim_gap_mm >= 0) row("Gap to bone (rim)", fixed(r.rim_gap_mm, 2) + " mm");
+  if (r.penetration_mm3 >= 0) row("Overlap with skull", fixed(r.penetration_mm3, 1) + " mm³");
+  h += "</table>";
+  if (!r.reasons.empty()) {
+    h += "<p><b>Problems:</b></p><ul>";
+    for (const auto& reason : r.reasons) h += "<li>" + html_escape(reason) + "</li>";
+    h += "</ul>";
+  }
+  return h;
+}
+
 }  // namespace cranioplan

@@ -260,3 +260,50 @@ TEST(SessionCli, AutoplanWritesASessionThatAuditAndTrainingReportRead) {
 
 }  // namespace
 }  // namespace cranioplan
+
+namespace cranioplan {
+namespace {
+
+// The quality report's HTML (the wizard's Quality panel): every figure at its precision, the
+// verdict, and the reasons escaped.
+TEST(QualityHtml, ShowsEveryFigureAndEscapesTheReasons) {
+  QualityReport r;
+  r.printable = false;
+  r.watertight = true;
+  r.manifold = false;
+  r.outward = true;
+  r.self_intersections = 3;
+  r.pieces = 2;
+  r.volume_mm3 = 5866.65;
+  r.area_mm2 = 3487.4;
+  r.thickness_min_mm = 0.04;
+  r.thickness_median_mm = 4.02;
+  r.thickness_max_mm = 10.06;
+  r.thin_volume_mm3 = 104.33;
+  r.taper_reach_mm = 1.46;
+  r.corner_reach_mm = 0.31;
+  r.rim_gap_mm = 0.0895;
+  r.penetration_mm3 = 0.04;
+  r.reasons = {"gap of 1.2 mm < the rim & \"more\""};
+  const std::string h = quality_report_html(r);
+  for (const char* part :
+       {"<td>Printable</td><td><b>NO</b>", "<td>Manifold</td><td><b><b>no</b></b>",
+        "<td>Self-intersections</td><td><b>3</b>", "<td>Volume</td><td><b>5867 mm³</b>",
+        "<td>Area</td><td><b>3487 mm²</b>", "<b>0.0 / 4.0 / 10.1 mm</b>",
+        "104.3 mm³: edge on the bone 1.5 mm wide, elsewhere 0.3 mm", "<b>0.09 mm</b>",
+        "<td>Overlap with skull</td><td><b>0.0 mm³</b>",
+        "<li>gap of 1.2 mm &lt; the rim &amp; &quot;more&quot;</li>"})
+    EXPECT_NE(h.find(part), std::string::npos) << part << "\n" << h;
+  r.taper_reach_mm = -1.0;
+  r.rim_gap_mm = -1.0;
+  r.penetration_mm3 = -1.0;
+  r.reasons.clear();
+  const std::string without = quality_report_html(r);
+  EXPECT_NE(without.find("<td>Thinner than the minimum</td><td><b>everywhere</b>"),
+            std::string::npos);
+  EXPECT_EQ(without.find("Gap to bone"), std::string::npos) << "not measured, not shown";
+  EXPECT_EQ(without.find("Problems"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace cranioplan

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "cranioplan/algorithms/check_implant.h"
 #include "cranioplan/algorithms/compare_implants.h"
 #include "cranioplan/sessions/session.h"
 
@@ -66,5 +67,9 @@ TrainingReport training_report(const Session& trainee, const Session& reference,
                                const CompareParams& params = {});
 std::string training_report_text(const TrainingReport& report);
 std::string training_report_html(const TrainingReport& report);
+
+/// The quality report as an HTML table and its problems as a list (the wizard's Quality panel
+/// and its export check).
+std::string quality_report_html(const QualityReport& report);
 
 }  // namespace cranioplan
