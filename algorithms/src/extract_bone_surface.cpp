@@ -1,13 +1,10 @@
 #include "cranioplan/algorithms/extract_bone_surface.h"
 
-#include <vtkCellArray.h>
 #include <vtkFloatArray.h>
 #include <vtkFlyingEdges3D.h>
-#include <vtkIdList.h>
 #include <vtkImageData.h>
 #include <vtkNew.h>
 #include <vtkPointData.h>
-#include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkQuadricDecimation.h>
 
@@ -16,48 +13,9 @@
 #include <cmath>
 
 #include "cranioplan/algorithms/mesh_components.h"
+#include "soup_building.h"
 
 namespace cranioplan {
-namespace {
-
-TriangleSoup soup_from_vtk(vtkPolyData* pd) {
-  TriangleSoup soup;
-  const vtkIdType np = pd->GetNumberOfPoints();
-  soup.vertices.resize(static_cast<size_t>(np));
-  for (vtkIdType i = 0; i < np; ++i) {
-    double p[3];
-    pd->GetPoint(i, p);
-    soup.vertices[static_cast<size_t>(i)] = {p[0], p[1], p[2]};
-  }
-  vtkNew<vtkIdList> ids;
-  vtkCellArray* polys = pd->GetPolys();
-  soup.triangles.reserve(static_cast<size_t>(polys->GetNumberOfCells()));
-  for (polys->InitTraversal(); polys->GetNextCell(ids);)
-    if (ids->GetNumberOfIds() == 3)
-      soup.triangles.emplace_back(ids->GetId(0), ids->GetId(1), ids->GetId(2));
-  return soup;
-}
-
-vtkNew<vtkPolyData> vtk_from_soup(const TriangleSoup& soup) {
-  vtkNew<vtkPoints> pts;
-  pts->SetDataTypeToDouble();
-  pts->SetNumberOfPoints(static_cast<vtkIdType>(soup.vertices.size()));
-  for (size_t i = 0; i < soup.vertices.size(); ++i)
-    pts->SetPoint(static_cast<vtkIdType>(i), soup.vertices[i].data());
-  vtkNew<vtkCellArray> polys;
-  polys->AllocateExact(static_cast<vtkIdType>(soup.triangles.size()),
-                       static_cast<vtkIdType>(soup.triangles.size() * 3));
-  for (const auto& t : soup.triangles) {
-    const vtkIdType ids[3] = {t[0], t[1], t[2]};
-    polys->InsertNextCell(3, ids);
-  }
-  vtkNew<vtkPolyData> pd;
-  pd->SetPoints(pts);
-  pd->SetPolys(polys);
-  return pd;
-}
-
-}  // namespace
 
 ExtractBoneSurfaceResult extract_bone_surface(const Volume& volume,
                                               const ExtractBoneSurfaceParams& params) {
@@ -104,7 +62,7 @@ ExtractBoneSurfaceResult extract_bone_surface(const Volume& volume,
     fe->ComputeGradientsOff();
     fe->ComputeScalarsOff();
     fe->Update();
-    soup = soup_from_vtk(fe->GetOutput());
+    soup = detail::soup_from_polydata("", fe->GetOutput());
   }
   for (auto& p : soup.vertices) p = volume.world(p);
 
@@ -124,14 +82,14 @@ ExtractBoneSurfaceResult extract_bone_surface(const Volume& volume,
 
   if (params.target_triangles > 0 &&
       params.target_triangles < static_cast<long long>(soup.triangles.size())) {
-    vtkNew<vtkPolyData> pd = vtk_from_soup(soup);
+    const vtkSmartPointer<vtkPolyData> pd = detail::polydata_from_soup(soup);
     vtkNew<vtkQuadricDecimation> dec;
     dec->SetInputData(pd);
     dec->SetTargetReduction(1.0 - static_cast<double>(params.target_triangles) /
                                       static_cast<double>(soup.triangles.size()));
     dec->VolumePreservationOn();
     dec->Update();
-    soup = soup_from_vtk(dec->GetOutput());
+    soup = detail::soup_from_polydata("", dec->GetOutput());
   }
 
   if (signed_volume(soup) < 0)

@@ -1,9 +1,6 @@
 #include "cranioplan/algorithms/read_mesh.h"
 
-#include <vtkCellArray.h>
-#include <vtkIdList.h>
 #include <vtkNew.h>
-#include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
 #include <vtkXMLPolyDataReader.h>
@@ -23,6 +20,7 @@
 #include "file_bytes.h"
 #include "isolated_read.h"
 #include "mesh_formats.h"
+#include "soup_building.h"
 #include "vtk_errors.h"
 
 namespace cranioplan {
@@ -337,36 +335,6 @@ TriangleSoup read_obj(const std::string& path, const std::string& bytes) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// VTP through VTK's reader, its errors turned into messages.
-TriangleSoup soup_from_polydata(const std::string& path, vtkPolyData* pd) {
-  TriangleSoup soup;
-  if (!pd || !pd->GetPoints()) return soup;
-  const vtkIdType np = pd->GetNumberOfPoints();
-  soup.vertices.resize(static_cast<size_t>(np));
-  for (vtkIdType i = 0; i < np; ++i) {
-    double p[3];
-    pd->GetPoint(i, p);
-    soup.vertices[static_cast<size_t>(i)] = {p[0], p[1], p[2]};
-  }
-  std::vector<int> poly;
-  vtkCellArray* cells = pd->GetPolys();
-  vtkNew<vtkIdList> ids;
-  long long cell = 0;
-  for (cells->InitTraversal(); cells->GetNextCell(ids);) {
-    poly.assign(ids->begin(), ids->end());
-    if (poly.size() >= 3)
-      detail::add_polygon(path, poly, static_cast<int>(np), soup.triangles, "polygon", ++cell);
-  }
-  vtkCellArray* strips = pd->GetStrips();
-  for (strips->InitTraversal(); strips->GetNextCell(ids);)
-    for (vtkIdType k = 0; k + 2 < ids->GetNumberOfIds(); ++k) {
-      const int a = static_cast<int>(ids->GetId(k)), b = static_cast<int>(ids->GetId(k + 1)),
-                c = static_cast<int>(ids->GetId(k + 2));
-      soup.triangles.push_back(k % 2 == 0 ? Eigen::Vector3i(a, b, c) : Eigen::Vector3i(b, a, c));
-    }
-  return soup;
-}
-
 // VTK's XML reader leaks on some malformed files and is not proved against crashing on them:
 // it runs in a child process (isolated_read.h), which sends the soup back.
 TriangleSoup read_vtp(const std::string& path) {
@@ -379,7 +347,7 @@ TriangleSoup read_vtp(const std::string& path) {
         reader->Update();
         const std::string error = errors.message();
         if (!error.empty()) fail(path, "not a readable VTP file (" + error + ")");
-        const TriangleSoup soup = soup_from_polydata(path, reader->GetOutput());
+        const TriangleSoup soup = detail::soup_from_polydata(path, reader->GetOutput());
         detail::ByteWriter w;
         w.pod<uint64_t>(soup.vertices.size());
         w.raw(soup.vertices.data(), soup.vertices.size() * sizeof(Eigen::Vector3d));
@@ -433,15 +401,6 @@ void drop_far_pieces(const std::string& path, double far_mm, TriangleSoup& soup,
 }
 
 }  // namespace
-
-void detail::add_polygon(const std::string& path, const std::vector<int>& poly, int nv,
-                         std::vector<Eigen::Vector3i>& tris, const char* what, long long number) {
-  for (int idx : poly)
-    if (idx < 0 || idx >= nv)
-      fail(path, what + (" " + format_count(number)) + " uses vertex " + std::to_string(idx) +
-                     " but the file has " + format_count(nv) + " vertices (numbered from 0)");
-  for (size_t k = 1; k + 1 < poly.size(); ++k) tris.emplace_back(poly[0], poly[k], poly[k + 1]);
-}
 
 TriangleSoup read_mesh_soup(const std::string& path, std::string* format_out) {
   const std::string bytes = read_file_bytes(path);

@@ -10,6 +10,7 @@
 #include "cranioplan/model/error.h"
 #include "file_bytes.h"
 #include "mesh_formats.h"
+#include "soup_building.h"
 
 namespace cranioplan::detail {
 namespace {

@@ -160,6 +160,28 @@ struct SurfaceLocator::Tree {
     nodes[index].count = 0;
     return index;
   }
+
+  // The one depth-first walk both queries make: a node `prune(node)` rejects is skipped; a
+  // leaf's faces go to `visit(face)` in leaf order; an inner node's children (left at
+  // index + 1, right at node.first) are pushed by `push_children(index, node, push)`, the one
+  // to visit first pushed last.
+  template <class Prune, class PushChildren, class Visit>
+  void walk(const Prune& prune, const PushChildren& push_children, const Visit& visit) const {
+    int stack[kMaxDepth];
+    int top = 0;
+    auto push = [&](int child) { stack[top++] = child; };
+    if (!nodes.empty()) push(0);
+    while (top > 0) {
+      const int index = stack[--top];
+      const Node& node = nodes[index];
+      if (prune(node)) continue;
+      if (node.count > 0) {
+        for (int i = node.first; i < node.first + node.count; ++i) visit(order[i]);
+        continue;
+      }
+      push_children(index, node, push);
+    }
+  }
 };
 
 SurfaceLocator::SurfaceLocator(const SkullMesh& mesh) {
@@ -209,39 +231,30 @@ SurfaceLocator::Closest SurfaceLocator::closest(const Eigen::Vector3d& world_que
   const Eigen::Vector3d query = moved_ ? motion_.inverse().apply(world_query) : world_query;
   Closest best;
   double best_d2 = std::numeric_limits<double>::infinity();
-  int stack[kMaxDepth];
-  int top = 0;
-  if (!t.nodes.empty()) stack[top++] = 0;
-  while (top > 0) {
-    const int index = stack[--top];
-    const Node& node = t.nodes[index];
-    if (node.box.squared_distance(query) >= best_d2) continue;
-    if (node.count > 0) {
-      for (int i = node.first; i < node.first + node.count; ++i) {
-        const int f = t.order[i];
-        const Eigen::Vector3d c =
-            closest_on_triangle(query, t.corner(f, 0), t.corner(f, 1), t.corner(f, 2));
-        const double d2 = (c - query).squaredNorm();
-        if (d2 < best_d2) {
-          best_d2 = d2;
-          best.point = c;
-          best.face = f;
-        }
-      }
-      continue;
-    }
-    const int left = index + 1, right = node.first;
-    const double dl = t.nodes[left].box.squared_distance(query);
-    const double dr = t.nodes[right].box.squared_distance(query);
-    // The nearer child is visited first (pushed last).
-    if (dl <= dr) {
-      if (dr < best_d2) stack[top++] = right;
-      if (dl < best_d2) stack[top++] = left;
-    } else {
-      if (dl < best_d2) stack[top++] = left;
-      if (dr < best_d2) stack[top++] = right;
-    }
-  }
+  t.walk([&](const Node& node) { return node.box.squared_distance(query) >= best_d2; },
+         [&](int index, const Node& node, const auto& push) {
+           const int left = index + 1, right = node.first;
+           const double dl = t.nodes[left].box.squared_distance(query);
+           const double dr = t.nodes[right].box.squared_distance(query);
+           // The nearer child is visited first (pushed last).
+           if (dl <= dr) {
+             if (dr < best_d2) push(right);
+             if (dl < best_d2) push(left);
+           } else {
+             if (dl < best_d2) push(left);
+             if (dr < best_d2) push(right);
+           }
+         },
+         [&](int f) {
+           const Eigen::Vector3d c =
+               closest_on_triangle(query, t.corner(f, 0), t.corner(f, 1), t.corner(f, 2));
+           const double d2 = (c - query).squaredNorm();
+           if (d2 < best_d2) {
+             best_d2 = d2;
+             best.point = c;
+             best.face = f;
+           }
+         });
   best.distance = std::sqrt(best_d2);
   if (moved_) best.point = motion_.apply(best.point);
   return best;
@@ -257,27 +270,18 @@ std::optional<SurfaceLocator::Hit> SurfaceLocator::first_hit(
   const Eigen::Vector3d inv_d = d.cwiseInverse();
   double best_t = 1.0;
   int best_face = -1;
-  int stack[kMaxDepth];
-  int top = 0;
-  if (!t.nodes.empty()) stack[top++] = 0;
-  while (top > 0) {
-    const int index = stack[--top];
-    const Node& node = t.nodes[index];
-    if (!node.box.meets(o, inv_d, best_t)) continue;
-    if (node.count > 0) {
-      for (int i = node.first; i < node.first + node.count; ++i) {
-        const int f = t.order[i];
-        const double s = segment_triangle(o, d, t.corner(f, 0), t.corner(f, 1), t.corner(f, 2));
-        if (s >= 0.0 && (s < best_t || (best_face < 0 && s <= best_t))) {
-          best_t = s;
-          best_face = f;
-        }
-      }
-      continue;
-    }
-    stack[top++] = node.first;  // right
-    stack[top++] = index + 1;   // left
-  }
+  t.walk([&](const Node& node) { return !node.box.meets(o, inv_d, best_t); },
+         [](int index, const Node& node, const auto& push) {
+           push(node.first);  // right
+           push(index + 1);   // left
+         },
+         [&](int f) {
+           const double s = segment_triangle(o, d, t.corner(f, 0), t.corner(f, 1), t.corner(f, 2));
+           if (s >= 0.0 && (s < best_t || (best_face < 0 && s <= best_t))) {
+             best_t = s;
+             best_face = f;
+           }
+         });
   if (best_face < 0) return std::nullopt;
   Hit h;
   h.point = world_from + best_t * (world_to - world_from);

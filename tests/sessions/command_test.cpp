@@ -1,0 +1,365 @@
+#include "cranioplan/sessions/command.h"
+
+#include <gtest/gtest.h>
+
+#include <filesystem>
+
+#include "cranioplan/algorithms/mesh_report.h"
+#include "cranioplan/algorithms/write_mesh.h"
+#include "cranioplan/model/error.h"
+#include "cranioplan/sessions/session.h"
+#include "cranioplan/sessions/session_error.h"
+#include "support/session_cases.h"
+#include "support/synthetic.h"
+#include "support/test_files.h"
+
+namespace cranioplan {
+namespace {
+
+namespace fs = std::filesystem;
+using test::push_ok;
+
+TEST(Commands, EveryTypeRoundTripsThroughJson) {
+  std::vector<Command> all = {
+      commands::load_skull("skull.stl", {}, std::string(64, 'a')),
+      commands::set_landmark("nasion", {1, 2, 3}),
+      commands::clear_landmark("midline"),
+      commands::fit_plane(),
+      commands::adjust_plane({0, 0, 1}, 2.5, -1.0),
+      commands::mirror(),
+      commands::register_mirror(),
+      commands::move_mirrored({0, 1, 0}, 1.0, {1, 2, 3}, {0.5, 0, 0}),
+      commands::set_clip_plane(Plane{Eigen::Vector3d::UnitZ(), 12.0}),
+      commands::add_marker(MarkerType::InnerSurface, {4, 5, 6}),
+      commands::move_marker(3, {7, 8, 9}),
+      commands::delete_marker(3),
+      commands::retype_marker(4, MarkerType::OuterEdge),
+      commands::import_markers({{1, MarkerType::OuterEdge, {1, 1, 1}, MarkerSurface::Original}},
+                               "m.json", std::string(64, 'b')),
+      commands::clear_markers(),
+      commands::propose_markers(),
+      commands::smooth_markers({8.0, 3.0, 2}, false),
+      commands::build_implant(),
+      commands::export_implant("implant.ply", std::string(64, 'c')),
+      commands::go_to_step(4),
+      commands::complete_step(4),
+      commands::note("checked with the surgeon"),
+  };
+  RegisterParams with_roi;
+  with_roi.roi = RegionOfInterest{RegionOfInterest::Shape::Box, {1, 2, 3}, 10, {4, 5, 6}};
+  all.push_back(commands::register_mirror(with_roi));
+  std::set<CommandType> seen;
+  for (const Command& c : all) {
+    seen.insert(c.type);
+    const Json j = to_json(c);
+    const Command back = command_from_json(j, "test");
+    EXPECT_EQ(to_json(back), j) << type_tag(c.type);
+    EXPECT_FALSE(describe(c).empty());
+  }
+  EXPECT_EQ(seen.size(), all_command_types().size()) << "a command type has no round-trip case";
+  // Parameters read back into the algorithms' structs equal what was written.
+  RegisterParams back;
+  params_from_json(ParamReader(all.back().params["params"], "test"), back);
+  ASSERT_TRUE(back.roi);
+  EXPECT_EQ(back.roi->half_size, Eigen::Vector3d(4, 5, 6));
+  ImplantParams implant;
+  implant.thickness_mm = 5.5;
+  implant.radial_center = Eigen::Vector3d(1, 2, 3);
+  ImplantParams implant_back;
+  params_from_json(ParamReader(params_to_json(implant), "test"), implant_back);
+  EXPECT_EQ(implant_back.thickness_mm, 5.5);
+  EXPECT_EQ(*implant_back.radial_center, Eigen::Vector3d(1, 2, 3));
+  ImplantParams nan_thickness;  // NaN (the default: measured) goes through JSON as null
+  params_from_json(ParamReader(params_to_json(nan_thickness), "test"), implant_back);
+  EXPECT_TRUE(std::isnan(implant_back.thickness_mm));
+}
+
+// A build_implant of version 1 (written before fitting to the bone existed) still applies:
+// read as recorded, built without the fit.
+TEST(Commands, BuildImplantVersionOneIsReadByItsOwnRules) {
+  Json v1 = to_json(commands::build_implant());
+  EXPECT_EQ(v1["version"], 5);
+  v1["version"] = 1;
+  v1["params"]["params"].erase("trim");
+  v1["params"]["params"].erase("fit_to_bone_mm");
+  const Command c = command_from_json(v1, "old plan");
+  EXPECT_EQ(c.version, 1);
+  EXPECT_EQ(to_json(c), v1) << "kept as recorded: the journal's hashes cover it";
+}
+
+// load_skull 4 reads volumes in the patient's frame, a DICOM folder's named series, and drops a
+// mesh's far pieces; a plan saved before (no such fields) reads its skull as it was then.
+TEST(Commands, PlansSavedBeforeThePatientFrameReadTheirSkullAsThen) {
+  ExtractBoneSurfaceParams now;
+  now.dicom_series = "1.2.3";
+  const Json load = to_json(commands::load_skull("ct", now));
+  ExtractBoneSurfaceParams back;
+  params_from_json(ParamReader(load["params"]["import"], "test"), back);
+  EXPECT_TRUE(back.patient_frame);
+  EXPECT_TRUE(back.drop_far_pieces);
+  EXPECT_EQ(back.dicom_series, "1.2.3");
+  Json old = load["params"]["import"];
+  for (const char* k : {"patient_frame", "drop_far_pieces", "dicom_series"}) old.erase(k);
+  params_from_json(ParamReader(old, "test"), back);
+  EXPECT_FALSE(back.patient_frame);
+  EXPECT_FALSE(back.drop_far_pieces);
+  EXPECT_EQ(back.dicom_series, "");
+}
+
+// Older plans replay to the implants they exported: a load_skull 1 reads the skull as the file
+// gave it, not in canonical form, and a build_implant 1 or 2 fits to the bone as it was made
+// to (slivers under 1.25 mm removed, cracks under 2 mm bridged). Today's commands record both,
+// and read them back as recorded.
+TEST(Commands, OlderPlansReadTheSkullAndFitTheBoneAsTheyWereMade) {
+  const Json load = to_json(commands::load_skull("skull.stl"));
+  EXPECT_EQ(load["version"], 4);
+  ExtractBoneSurfaceParams import;
+  params_from_json(ParamReader(load["params"]["import"], "test"), import);
+  EXPECT_TRUE(import.canonical);
+  Json old_load = load["params"]["import"];
+  old_load.erase("canonical");
+  params_from_json(ParamReader(old_load, "test"), import);
+  EXPECT_FALSE(import.canonical);
+
+  ImplantParams p;
+  p.trim.min_feature_mm = 1.7;
+  p.trim.bridge_mm = 0.8;
+  const Json build = to_json(commands::build_implant(p));
+  EXPECT_EQ(build["version"], 5);
+  ImplantParams back;
+  params_from_json(ParamReader(build["params"]["params"], "test"), back);
+  EXPECT_EQ(back.trim.min_feature_mm, 1.7);
+  EXPECT_EQ(back.trim.bridge_mm, 0.8);
+  EXPECT_EQ(back.trim.voxel_mm, p.trim.voxel_mm);
+  Json old_build = build["params"]["params"];
+  old_build.erase("trim");
+  params_from_json(ParamReader(old_build, "test"), back);
+  EXPECT_EQ(back.trim.min_feature_mm, 1.25);
+  EXPECT_EQ(back.trim.bridge_mm, 1.0);
+  EXPECT_EQ(ImplantParams{}.trim.min_feature_mm, 1.5) << "today's default";
+  EXPECT_FALSE(back.trim.clearance_mm.has_value()) << "build_implant 2: the bone grown by a voxel";
+  EXPECT_FALSE(back.trim.thin_fills_removed);
+  EXPECT_FALSE(back.trim.vote_through_holes);
+}
+
+// build_implant 5 decides the skull's inside by votes where its surface is open; version 4 (no
+// "vote_through_holes") by parity along z, as it fitted its implants.
+TEST(Commands, PlansSavedBeforeVotingThroughHolesFitTheBoneAsThen) {
+  const Json build = to_json(commands::build_implant(ImplantParams{}));
+  EXPECT_EQ(build["params"]["params"]["trim"]["vote_through_holes"], true);
+  ImplantParams back;
+  params_from_json(ParamReader(build["params"]["params"], "test"), back);
+  EXPECT_TRUE(back.trim.vote_through_holes);
+  Json v4 = build["params"]["params"];
+  v4["trim"].erase("vote_through_holes");
+  params_from_json(ParamReader(v4, "test"), back);
+  EXPECT_FALSE(back.trim.vote_through_holes);
+  EXPECT_TRUE(back.trim.thin_fills_removed) << "the rest of version 4 as recorded";
+}
+
+// A mesh's length unit is part of the load: recorded, replayed, and read as millimetres from
+// a load_skull 1 or 2, which had none (nor turned a skull that winds inward outward). A unit that
+// is no length is refused.
+TEST(Commands, TheLoadRecordsTheMeshesLengthUnit) {
+  test::TempDir dir;
+  const std::string p = dir.path("head-m.stl");
+  write_mesh(test::scaled(test::make_symmetric_head(3), 1e-3), p);
+
+  Session refused;
+  try {
+    refused.push(commands::load_skull(p));
+    ADD_FAILURE() << "a head in metres was loaded as millimetres";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("looks to be in metres"), std::string::npos) << e.what();
+  }
+  EXPECT_FALSE(refused.state().skull);
+
+  ExtractBoneSurfaceParams metres;
+  metres.mesh_unit_mm = 1000.0;
+  Session s;
+  push_ok(s, commands::load_skull(p, metres));
+  ASSERT_TRUE(s.state().skull);
+  const MeshReport size = report_mesh(s.state().skull->surface->loaded.mesh);
+  EXPECT_GT((size.bbox_max - size.bbox_min).maxCoeff(), 100.0) << "read in mm, not metres";
+  const Json load = to_json(s.effective_commands().front());
+  EXPECT_EQ(load["params"]["import"]["mesh_unit_mm"], 1000.0);
+  const std::string saved = dir.path("plan.json");
+  s.save(saved);
+  const Session back = Session::open(saved);
+  ASSERT_TRUE(back.state().skull);
+  EXPECT_LT((back.state().skull->centroid - s.state().skull->centroid).norm(), 1e-9);
+
+  ExtractBoneSurfaceParams import;
+  Json old_load = load["params"]["import"];
+  old_load.erase("mesh_unit_mm");
+  old_load.erase("orient_outward");
+  params_from_json(ParamReader(old_load, "test"), import);
+  EXPECT_EQ(import.mesh_unit_mm, 1.0);
+  EXPECT_FALSE(import.orient_outward) << "load_skull 2 read the skull as it came";
+  EXPECT_EQ(load["params"]["import"]["orient_outward"], true);
+  // The reader's warnings reach the load's message (the wizard's status bar): here a head whose
+  // triangles wind inward, turned outward.
+  TriangleSoup inward = to_soup(test::make_symmetric_head(3));
+  for (auto& t : inward.triangles) std::swap(t[1], t[2]);
+  write_mesh(build_mesh(inward), dir.path("inward.stl"));
+  Session turned;
+  push_ok(turned, commands::load_skull(dir.path("inward.stl")));
+  EXPECT_NE(turned.state().message.find("inward.stl: the surface was inside out"),
+            std::string::npos)
+      << turned.state().message;
+  for (const Json& bad : {Json(0.0), Json(-25.4), Json("m")}) {
+    Json j = load["params"]["import"];
+    j["mesh_unit_mm"] = bad;
+    EXPECT_THROW(params_from_json(ParamReader(j, "test"), import), SessionError) << bad;
+  }
+}
+
+// What the skull's file held and what the reading did about it is recorded in the load when it
+// is first done ("input_report": triangles, pieces dropped, the warnings without the file's
+// path): a skull left open, the opening said and how its inside is taken. A
+// replay repairs the same way (the import's parameters are in the command) and says so when the
+// file reads otherwise than recorded.
+TEST(Commands, TheLoadRecordsWhatTheSkullHeldAndAReplaySaysWhenItDiffers) {
+  test::TempDir dir;
+  const SkullMesh head = test::make_symmetric_head(3);
+  const MeshReport whole = report_mesh(head);
+  const std::string p = dir.path("open.stl");
+  write_mesh(
+      test::cut_open(head, whole.bbox_min + Eigen::Vector3d(0, 0, 20), Eigen::Vector3d::UnitZ()),
+      p);
+  Session s;
+  push_ok(s, commands::load_skull(p));
+  const Json load = to_json(s.effective_commands().front());
+  ASSERT_TRUE(load["params"].contains("input_report")) << load.dump();
+  const Json& report = load["params"]["input_report"];
+  EXPECT_EQ(report["triangles"], static_cast<long long>(s.state().skull->surface->mesh.n_faces()));
+  EXPECT_EQ(report["pieces_dropped"], 0);
+  bool says_open = false;
+  for (const Json& w : report["warnings"]) {
+    says_open = says_open || w.get<std::string>().find("open edge") != std::string::npos;
+    EXPECT_EQ(w.get<std::string>().find(p), std::string::npos) << "no path: " << w;
+  }
+  EXPECT_TRUE(says_open) << report.dump();
+
+  // Replayed from its file: the same report, nothing said.
+  const std::string saved = dir.path("plan.json");
+  s.save(saved);
+  const Session back = Session::open(saved);
+  ASSERT_TRUE(back.state().skull);
+  EXPECT_EQ(back.state().message.find("reads otherwise"), std::string::npos)
+      << back.state().message;
+  EXPECT_EQ(to_json(back.effective_commands().front())["params"]["input_report"], report);
+
+  // A load whose record says otherwise (as a file read by an older program would): said.
+  Command recorded = commands::load_skull(p);
+  recorded.params["input_report"] = report;
+  recorded.params["input_report"]["triangles"] = 12;
+  Session t;
+  push_ok(t, recorded);
+  EXPECT_NE(t.state().message.find("the file reads otherwise than when this plan was made"),
+            std::string::npos)
+      << t.state().message;
+}
+
+// build_implant 4 holds the implant a set clearance off the bone's surface and removes thin
+// fills; a version-3 command ("trim" without either) is read as it was fitted then, and a bad
+// clearance is named.
+TEST(Commands, BuildImplant3FitsTheBoneAsItWasMadeTo) {
+  ImplantParams p;
+  p.trim.clearance_mm = 0.25;
+  const Json build = to_json(commands::build_implant(p));
+  ImplantParams back;
+  params_from_json(ParamReader(build["params"]["params"], "test"), back);
+  ASSERT_TRUE(back.trim.clearance_mm.has_value());
+  EXPECT_EQ(*back.trim.clearance_mm, 0.25);
+  EXPECT_TRUE(back.trim.thin_fills_removed);
+  EXPECT_EQ(ImplantParams{}.trim.clearance_mm, 0.1) << "today's default";
+
+  Json unset = build["params"]["params"];
+  unset["trim"]["clearance_mm"] = nullptr;
+  unset["trim"]["thin_fills_removed"] = false;
+  params_from_json(ParamReader(unset, "test"), back);
+  EXPECT_FALSE(back.trim.clearance_mm.has_value()) << "recorded as unset, read as unset";
+  EXPECT_FALSE(back.trim.thin_fills_removed);
+
+  Json session9 = build["params"]["params"];
+  session9["trim"].erase("clearance_mm");
+  session9["trim"].erase("thin_fills_removed");
+  back = ImplantParams{};
+  params_from_json(ParamReader(session9, "test"), back);
+  EXPECT_FALSE(back.trim.clearance_mm.has_value());
+  EXPECT_FALSE(back.trim.thin_fills_removed);
+  EXPECT_EQ(back.trim.min_feature_mm, 1.5) << "the rest as recorded";
+
+  Json bad = build["params"]["params"];
+  bad["trim"]["clearance_mm"] = -0.5;
+  try {
+    params_from_json(ParamReader(bad, "plan.json command 7"), back);
+    ADD_FAILURE() << "a negative clearance is accepted";
+  } catch (const SessionError& e) {
+    EXPECT_NE(std::string(e.what()).find("clearance_mm"), std::string::npos) << e.what();
+    EXPECT_NE(std::string(e.what()).find("plan.json command 7"), std::string::npos) << e.what();
+  }
+}
+
+// propose_markers 2 records how the surfaces are fitted and which opening was asked for; a
+// version-1 command (neither) is read with their defaults.
+TEST(Commands, ProposeMarkersVersionTwoRoundTripsAndVersionOneGetsDefaults) {
+  ProposeParams p;
+  p.surfaces.ring_width_mm = 31.0;
+  p.surfaces.smoothing = 0.07;
+  p.detect.near = Eigen::Vector3d(1.5, -2.0, 70.25);
+  const Json j = to_json(commands::propose_markers(p));
+  EXPECT_EQ(j["version"], 3);
+  ProposeParams back;
+  params_from_json(ParamReader(j["params"]["params"], "test"), back);
+  EXPECT_EQ(back.surfaces.ring_width_mm, 31.0);
+  EXPECT_EQ(back.surfaces.smoothing, 0.07);
+  ASSERT_TRUE(back.detect.near.has_value());
+  EXPECT_EQ(*back.detect.near, *p.detect.near);
+
+  Json v1 = j;
+  v1["version"] = 1;
+  v1["params"]["params"].erase("surfaces");
+  v1["params"]["params"]["detect"].erase("near");
+  const Command c = command_from_json(v1, "old plan");
+  EXPECT_EQ(c.version, 1);
+  ProposeParams old;
+  params_from_json(ParamReader(c.params["params"], "test"), old);
+  EXPECT_FALSE(old.detect.near.has_value());
+  EXPECT_EQ(old.surfaces.ring_width_mm, DefectSurfaceParams{}.ring_width_mm);
+}
+
+TEST(Commands, UnknownTypeVersionAndMissingParameterAreNamed) {
+  Json j = to_json(commands::smooth_markers({8, 2, 1}));
+  Json unknown = j;
+  unknown["type"] = "paint_skull";
+  EXPECT_THROW(
+      {
+        try {
+          command_from_json(unknown, "plan.json: commands[4]");
+        } catch (const SessionError& e) {
+          EXPECT_NE(std::string(e.what()).find("plan.json: commands[4]"), std::string::npos);
+          EXPECT_NE(std::string(e.what()).find("unknown command type \"paint_skull\""),
+                    std::string::npos);
+          throw;
+        }
+      },
+      SessionError);
+  Json newer = j;
+  newer["version"] = 7;
+  EXPECT_THROW(command_from_json(newer, "x"), SessionError);
+  Json missing = j;
+  missing["params"].erase("project_onto_mirror");
+  try {
+    command_from_json(missing, "plan.json: commands[4]");
+    ADD_FAILURE() << "missing parameter accepted";
+  } catch (const SessionError& e) {
+    EXPECT_NE(std::string(e.what()).find("missing parameter 'project_onto_mirror'"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+}  // namespace
+}  // namespace cranioplan
