@@ -41,8 +41,8 @@
 #include <cmath>
 #include <filesystem>
 
-#include "cranioplan/algorithms/load_skull.h"
-#include "cranioplan/algorithms/read_volume.h"
+#include "cranioplan/algorithms/io/load_skull.h"
+#include "cranioplan/algorithms/io/read_volume.h"
 #include "cranioplan/model/error.h"
 #include "cranioplan/sessions/audit.h"
 #include "cranioplan/sessions/marker_files.h"

@@ -11,14 +11,14 @@
 #include <filesystem>
 #include <functional>
 
-#include "cranioplan/algorithms/autoplan.h"
-#include "cranioplan/algorithms/fit_sagittal_plane.h"
-#include "cranioplan/algorithms/load_skull.h"
-#include "cranioplan/algorithms/mirror_mesh.h"
-#include "cranioplan/algorithms/read_mesh.h"
-#include "cranioplan/algorithms/register_icp.h"
-#include "cranioplan/algorithms/surface_locator.h"
-#include "cranioplan/algorithms/write_mesh.h"
+#include "cranioplan/algorithms/alignment/fit_sagittal_plane.h"
+#include "cranioplan/algorithms/alignment/mirror_mesh.h"
+#include "cranioplan/algorithms/alignment/register_icp.h"
+#include "cranioplan/algorithms/geometry/surface_locator.h"
+#include "cranioplan/algorithms/io/load_skull.h"
+#include "cranioplan/algorithms/io/read_mesh.h"
+#include "cranioplan/algorithms/io/write_mesh.h"
+#include "cranioplan/algorithms/planning/autoplan.h"
 #include "cranioplan/sessions/autoplan_session.h"
 
 namespace cranioplan::cli {

@@ -6,14 +6,14 @@
 
 #include "cli_bench.h"
 #include "cli_output.h"
-#include "cranioplan/algorithms/autoplan.h"
-#include "cranioplan/algorithms/fit_sagittal_plane.h"
-#include "cranioplan/algorithms/load_skull.h"
-#include "cranioplan/algorithms/mesh_report.h"
-#include "cranioplan/algorithms/mirror_mesh.h"
-#include "cranioplan/algorithms/read_volume.h"
-#include "cranioplan/algorithms/register_icp.h"
-#include "cranioplan/algorithms/write_mesh.h"
+#include "cranioplan/algorithms/alignment/fit_sagittal_plane.h"
+#include "cranioplan/algorithms/alignment/mirror_mesh.h"
+#include "cranioplan/algorithms/alignment/register_icp.h"
+#include "cranioplan/algorithms/io/load_skull.h"
+#include "cranioplan/algorithms/io/mesh_report.h"
+#include "cranioplan/algorithms/io/read_volume.h"
+#include "cranioplan/algorithms/io/write_mesh.h"
+#include "cranioplan/algorithms/planning/autoplan.h"
 #include "cranioplan/model/error.h"
 
 namespace cranioplan::cli {

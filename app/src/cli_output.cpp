@@ -5,7 +5,7 @@
 #include <map>
 #include <sstream>
 
-#include "cranioplan/algorithms/load_skull.h"
+#include "cranioplan/algorithms/io/load_skull.h"
 
 namespace cranioplan::cli {
 namespace {

@@ -3,8 +3,8 @@
 #include <memory>
 
 #include "cli_output.h"
-#include "cranioplan/algorithms/file_io.h"
-#include "cranioplan/algorithms/write_mesh.h"
+#include "cranioplan/algorithms/io/file_io.h"
+#include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/sessions/audit.h"
 #include "cranioplan/sessions/session.h"
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "cranioplan/algorithms/write_mesh.h"
+#include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/sessions/marker_files.h"
 #include "cranioplan/sessions/session_error.h"
 

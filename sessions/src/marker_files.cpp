@@ -6,7 +6,7 @@
 #include <set>
 #include <sstream>
 
-#include "cranioplan/algorithms/file_io.h"
+#include "cranioplan/algorithms/io/file_io.h"
 #include "cranioplan/model/error.h"
 
 namespace cranioplan {

@@ -9,7 +9,7 @@
 #include <fstream>
 #include <sstream>
 
-#include "cranioplan/algorithms/file_io.h"
+#include "cranioplan/algorithms/io/file_io.h"
 #include "cranioplan/model/error.h"
 
 namespace cranioplan {

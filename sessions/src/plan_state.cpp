@@ -5,13 +5,13 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "cranioplan/algorithms/file_io.h"
-#include "cranioplan/algorithms/load_skull.h"
-#include "cranioplan/algorithms/mirror_mesh.h"
-#include "cranioplan/algorithms/propose_markers.h"
-#include "cranioplan/algorithms/smooth_markers.h"
-#include "cranioplan/algorithms/snap_markers.h"
-#include "cranioplan/algorithms/write_mesh.h"
+#include "cranioplan/algorithms/alignment/mirror_mesh.h"
+#include "cranioplan/algorithms/implant/smooth_markers.h"
+#include "cranioplan/algorithms/implant/snap_markers.h"
+#include "cranioplan/algorithms/io/file_io.h"
+#include "cranioplan/algorithms/io/load_skull.h"
+#include "cranioplan/algorithms/io/write_mesh.h"
+#include "cranioplan/algorithms/planning/propose_markers.h"
 #include "cranioplan/sessions/marker_files.h"
 #include "cranioplan/sessions/session_error.h"
 #include "cranioplan/sessions/sha256.h"

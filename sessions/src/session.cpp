@@ -12,8 +12,8 @@
 #include <limits>
 #include <unordered_set>
 
-#include "cranioplan/algorithms/file_io.h"
-#include "cranioplan/algorithms/write_mesh.h"
+#include "cranioplan/algorithms/io/file_io.h"
+#include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/sessions/session_error.h"
 #include "cranioplan/sessions/sha256.h"
 

@@ -7,7 +7,7 @@
 #include <filesystem>
 #include <vector>
 
-#include "cranioplan/algorithms/file_io.h"
+#include "cranioplan/algorithms/io/file_io.h"
 #include "cranioplan/model/error.h"
 
 namespace cranioplan {

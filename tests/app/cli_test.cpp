@@ -4,9 +4,9 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "cranioplan/algorithms/load_skull.h"
-#include "cranioplan/algorithms/read_volume.h"
-#include "cranioplan/algorithms/write_mesh.h"
+#include "cranioplan/algorithms/io/load_skull.h"
+#include "cranioplan/algorithms/io/read_volume.h"
+#include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/sessions/plan_files.h"
 #include "support/dicom_writer.h"
 #include "support/synthetic.h"

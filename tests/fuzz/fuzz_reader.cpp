@@ -11,8 +11,8 @@
 #include <string>
 #include <string_view>
 
-#include "cranioplan/algorithms/read_mesh.h"
-#include "cranioplan/algorithms/read_volume.h"
+#include "cranioplan/algorithms/io/read_mesh.h"
+#include "cranioplan/algorithms/io/read_volume.h"
 #include "cranioplan/model/error.h"
 #include "cranioplan/sessions/marker_files.h"
 #include "cranioplan/sessions/plan_files.h"

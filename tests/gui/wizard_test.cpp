@@ -17,8 +17,8 @@
 #include <QTimer>
 #include <filesystem>
 
-#include "cranioplan/algorithms/load_skull.h"
-#include "cranioplan/algorithms/write_mesh.h"
+#include "cranioplan/algorithms/io/load_skull.h"
+#include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/sessions/session.h"
 #include "cranioplan/sessions/sha256.h"
 #include "main_window.h"

@@ -2,9 +2,9 @@
 
 #include <gtest/gtest.h>
 
-#include "cranioplan/algorithms/autoplan.h"
-#include "cranioplan/algorithms/load_skull.h"
-#include "cranioplan/algorithms/write_mesh.h"
+#include "cranioplan/algorithms/io/load_skull.h"
+#include "cranioplan/algorithms/io/write_mesh.h"
+#include "cranioplan/algorithms/planning/autoplan.h"
 #include "cranioplan/model/error.h"
 #include "cranioplan/sessions/autoplan_session.h"
 #include "cranioplan/sessions/marker_files.h"

@@ -4,8 +4,8 @@
 
 #include <filesystem>
 
-#include "cranioplan/algorithms/mesh_report.h"
-#include "cranioplan/algorithms/write_mesh.h"
+#include "cranioplan/algorithms/io/mesh_report.h"
+#include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/model/error.h"
 #include "cranioplan/sessions/session.h"
 #include "cranioplan/sessions/session_error.h"

@@ -6,8 +6,8 @@
 #include <filesystem>
 #include <random>
 
-#include "cranioplan/algorithms/mesh_report.h"
-#include "cranioplan/algorithms/write_mesh.h"
+#include "cranioplan/algorithms/io/mesh_report.h"
+#include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/model/error.h"
 #include "cranioplan/sessions/audit.h"
 #include "cranioplan/sessions/marker_files.h"

@@ -2,8 +2,8 @@
 
 #include <gtest/gtest.h>
 
-#include "cranioplan/algorithms/inject_defect.h"
-#include "cranioplan/algorithms/write_mesh.h"
+#include "cranioplan/algorithms/io/write_mesh.h"
+#include "cranioplan/algorithms/quality/inject_defect.h"
 #include "support/synthetic.h"
 #include "support/test_files.h"
 

@@ -4,8 +4,8 @@
 #include <cmath>
 #include <map>
 
-#include "cranioplan/algorithms/extract_bone_surface.h"
-#include "cranioplan/algorithms/voxelize_mesh.h"
+#include "cranioplan/algorithms/geometry/voxelize_mesh.h"
+#include "cranioplan/algorithms/io/extract_bone_surface.h"
 
 namespace cranioplan::test {
 namespace {

@@ -6,8 +6,8 @@
 #include <string>
 #include <vector>
 
-#include "cranioplan/algorithms/check_implant.h"
-#include "cranioplan/algorithms/compare_implants.h"
+#include "cranioplan/algorithms/quality/check_implant.h"
+#include "cranioplan/algorithms/quality/compare_implants.h"
 #include "cranioplan/sessions/session.h"
 
 namespace cranioplan {

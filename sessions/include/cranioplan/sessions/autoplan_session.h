@@ -3,7 +3,7 @@
 // edited, replayed and audited like a hand-made one.
 #include <string>
 
-#include "cranioplan/algorithms/autoplan.h"
+#include "cranioplan/algorithms/planning/autoplan.h"
 #include "cranioplan/model/landmarks.h"
 #include "cranioplan/sessions/session.h"
 

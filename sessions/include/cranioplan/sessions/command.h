@@ -8,12 +8,12 @@
 #include <string>
 #include <vector>
 
-#include "cranioplan/algorithms/build_implant.h"
-#include "cranioplan/algorithms/extract_bone_surface.h"
-#include "cranioplan/algorithms/fit_sagittal_plane.h"
-#include "cranioplan/algorithms/propose_markers.h"
-#include "cranioplan/algorithms/register_icp.h"
-#include "cranioplan/algorithms/smooth_markers.h"
+#include "cranioplan/algorithms/alignment/fit_sagittal_plane.h"
+#include "cranioplan/algorithms/alignment/register_icp.h"
+#include "cranioplan/algorithms/implant/build_implant.h"
+#include "cranioplan/algorithms/implant/smooth_markers.h"
+#include "cranioplan/algorithms/io/extract_bone_surface.h"
+#include "cranioplan/algorithms/planning/propose_markers.h"
 #include "cranioplan/model/marker.h"
 #include "cranioplan/model/plane.h"
 #include "cranioplan/model/rigid_transform.h"

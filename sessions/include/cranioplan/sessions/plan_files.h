@@ -4,13 +4,13 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
-#include "cranioplan/algorithms/build_implant.h"
-#include "cranioplan/algorithms/check_implant.h"
-#include "cranioplan/algorithms/compare_implants.h"
-#include "cranioplan/algorithms/extract_bone_surface.h"
-#include "cranioplan/algorithms/fit_sagittal_plane.h"
-#include "cranioplan/algorithms/mesh_report.h"
-#include "cranioplan/algorithms/register_icp.h"
+#include "cranioplan/algorithms/alignment/fit_sagittal_plane.h"
+#include "cranioplan/algorithms/alignment/register_icp.h"
+#include "cranioplan/algorithms/implant/build_implant.h"
+#include "cranioplan/algorithms/io/extract_bone_surface.h"
+#include "cranioplan/algorithms/io/mesh_report.h"
+#include "cranioplan/algorithms/quality/check_implant.h"
+#include "cranioplan/algorithms/quality/compare_implants.h"
 #include "cranioplan/model/landmarks.h"
 #include "cranioplan/model/plane.h"
 #include "cranioplan/model/rigid_transform.h"

@@ -10,13 +10,13 @@
 #include <string>
 #include <vector>
 
-#include "cranioplan/algorithms/build_implant.h"
-#include "cranioplan/algorithms/check_implant.h"
-#include "cranioplan/algorithms/detect_defect.h"
-#include "cranioplan/algorithms/fit_sagittal_plane.h"
-#include "cranioplan/algorithms/load_skull.h"
-#include "cranioplan/algorithms/register_icp.h"
-#include "cranioplan/algorithms/surface_locator.h"
+#include "cranioplan/algorithms/alignment/fit_sagittal_plane.h"
+#include "cranioplan/algorithms/alignment/register_icp.h"
+#include "cranioplan/algorithms/geometry/surface_locator.h"
+#include "cranioplan/algorithms/implant/build_implant.h"
+#include "cranioplan/algorithms/io/load_skull.h"
+#include "cranioplan/algorithms/planning/detect_defect.h"
+#include "cranioplan/algorithms/quality/check_implant.h"
 #include "cranioplan/model/landmarks.h"
 #include "cranioplan/model/marker.h"
 #include "cranioplan/model/mesh.h"

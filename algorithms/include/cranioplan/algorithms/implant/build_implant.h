@@ -1,0 +1,82 @@
+#pragma once
+// From markers to an implant: the paper's Delaunay 3D, and a closed fitted shell.
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cranioplan/algorithms/implant/trim_to_bone.h"
+#include "cranioplan/model/marker.h"
+#include "cranioplan/model/mesh.h"
+
+namespace cranioplan {
+
+enum class ImplantMethod { Shell, Delaunay3D };
+/// How the shell parametrises the defect: over the plane of the outer markers, or along rays
+/// from a centre inside the skull (large and strongly curved defects).
+enum class ImplantFrame { Radial, Planar };
+const char* to_string(ImplantMethod m);
+
+struct ImplantParams {
+  ImplantMethod method = ImplantMethod::Shell;
+  // shell
+  double resolution_mm = 1.0;  ///< target edge length of the shell, mm (0.2..10)
+  /// Thickness when there are no inner markers, mm; NaN: the bone thickness measured around
+  /// the rim (6 mm when no skull is given).
+  double thickness_mm = std::numeric_limits<double>::quiet_NaN();
+  bool snap_rim_to_skull = true;  ///< rim points between edge markers are put onto the bone
+  /// Surface markers are approximated rather than interpolated with this spline smoothing
+  /// weight (dimensionless, ≥ 0; 0: the surfaces pass through them). Edge markers are always
+  /// met exactly. Automatic plans use a little, to ride over noise in sampled bone.
+  double surface_smoothing = 0.0;
+  double max_rim_snap_mm = 3.0;  ///< rim points farther than this from bone stay where they are
+  /// Fit to the bone: the shell is built this far beyond the rim (over the bone, mm), then the
+  /// skull is subtracted (trim_to_bone.h), so the implant meets the defect's cut face all
+  /// around and never enters the bone. Where no bone lies that far out (an oblique cut face,
+  /// whose missing wedge the surface passes over first), up to three times as far; where there
+  /// is none even then (an orbit), the rim stays at the edge markers. 0: off (the rims pass
+  /// through the edge markers).
+  double fit_to_bone_mm = 0.0;
+  TrimToBoneParams trim;  ///< how the shell is fitted to the bone (when fit_to_bone_mm > 0)
+  /// Radial needs a skull (its centroid is the centre) or `radial_center`; otherwise planar.
+  ImplantFrame frame = ImplantFrame::Radial;
+  std::optional<Eigen::Vector3d> radial_center;  ///< centre of the rays (inside the skull)
+  // delaunay3d (VTK's vtkDelaunay3D parameters)
+  double delaunay_alpha = 0.0;        ///< 0: convex hull; >0: alpha shape radius, mm
+  double delaunay_tolerance = 0.001;  ///< point merge tolerance, fraction of the bounding box
+  double delaunay_offset = 2.5;       ///< bounding triangulation size multiplier
+};
+
+struct ImplantResult {
+  enum class Status { Built, TooFewMarkers, Failed };
+  Status status = Status::Failed;
+  std::string message;
+  SkullMesh mesh;  ///< closed and outward-oriented for the shell method
+  bool watertight = false;
+  double thickness_used_mm = 0.0;    ///< shell without inner markers: the offset applied
+  double rim_marker_error_mm = 0.0;  ///< largest distance from an edge marker to its rim
+  int rim_points = 0;                ///< samples along each rim
+  double seconds = 0.0;
+  bool usable() const { return status == Status::Built; }
+};
+
+/// Builds an implant from markers (types 0–3). `skull` is the original skull: the shell's rims
+/// are snapped onto it and the default thickness is measured on it; may be null.
+///
+/// Shell: the outer and inner surfaces are thin-plate spline height fields, passing through
+/// their markers, over a parametrisation of the defect (radial from the skull's centre by
+/// default, or planar); both are sampled on rings that shrink from the rim (the edge markers in
+/// angular order, densified to `resolution_mm`) to the centre, and a side wall joins the two
+/// rims. The rim must be star-shaped around its centre in that parametrisation, which holds for
+/// cranial defects seen from inside the skull.
+ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh* skull,
+                            const ImplantParams& params = {});
+
+class SurfaceLocator;
+/// The same with the skull's locator built once by the caller: an interactive editor rebuilds
+/// the implant on every marker edit, and building the locator of a 500k-triangle skull costs
+/// more than the implant.
+ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh* skull,
+                            const SurfaceLocator* skull_locator, const ImplantParams& params);
+
+}  // namespace cranioplan

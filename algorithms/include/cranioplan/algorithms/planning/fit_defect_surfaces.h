@@ -1,0 +1,124 @@
+#pragma once
+// The outer and inner surfaces of the missing bone, fitted to the intact bone all around a
+// detected opening. Rays from inside the skull (the detection's centre) sample the outer and
+// inner table on a wide ring of intact bone. The outer surface is a radius field r(d) over the
+// ray directions d, a thin-plate spline with a quadratic trend (so the curvature of the
+// surroundings carries across the opening); the inner one lies a thickness field t(d) below it
+// (a spline with an affine trend: fitting the inner radius on its own lets the two surfaces'
+// trends drift apart across a wide opening).
+//
+// Mirror-guided: the registered mirror gives a first guess of both radii inside the opening;
+// the splines then fit only the mirror's mismatch with the original skull on the ring (smooth
+// correction fields), so the healthy side's shape is kept but bent to meet the bone around the
+// defect. Rim-only (the mirror does not cover the opening): the radii themselves are fitted.
+//
+// Rays that pass within `rim_clearance_mm` of the opening are not used: at a cut face that is
+// not along the rays they graze the bone and see neither table where it would continue.
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cranioplan/algorithms/geometry/thin_plate_spline.h"
+#include "cranioplan/algorithms/planning/detect_defect.h"
+
+namespace cranioplan {
+
+class SurfaceLocator;
+
+struct DefectSurfaceParams {
+  double ring_width_mm = 25.0;    ///< width of the intact ring the surfaces are fitted to, mm
+  double rim_clearance_mm = 3.0;  ///< rays nearer the opening are not used, mm (≥ 0)
+  /// Rays whose entry and exit surfaces are further from parallel than this are not used, deg:
+  /// near an oblique cut face a ray enters or leaves through the cut instead of a table, and
+  /// its thickness is too small (0: off).
+  double max_table_angle_deg = 30.0;
+  /// Rays that leave the bone through a surface tilted more than this from the ray are not
+  /// used at all, deg: they left through a cut face, below the outer table (0: off).
+  double max_outer_tilt_deg = 50.0;
+  double ray_spacing_mm = 2.0;   ///< between sampled rays at the rim's radius, mm (0.5..10)
+  double site_spacing_mm = 4.0;  ///< fitting sites on the ring at least this far apart, mm
+  /// Spline smoothing weight per site (dimensionless, ≥ 0) of the thickness and of the
+  /// mirror's corrections: fields that vary gently, so it rides over the bone's roughness.
+  double smoothing = 0.03;
+  /// The same for the outer radius itself (rim-only): the shape of the surroundings is the
+  /// only guide across the opening, and smoothing it flattens the vault (on SkullFix the
+  /// middle of the openings came out 0.3–1 mm low with 0.03).
+  double outer_smoothing = 0.003;
+  /// Rim-only: the outer radius as it is, with the spline's quadratic trend (Quadratic), or as
+  /// its excess over the sphere fitted to the ring (Sphere); Best: whichever predicts the
+  /// ring's band next to the opening better from the rest of the ring.
+  enum class Vault { Best, Quadratic, Sphere };
+  Vault vault = Vault::Best;
+  /// Sites whose residual after a first fit exceeds this many robust standard deviations
+  /// (and 1 mm) are dropped before the final fit: foramina, sutures, cut-face fragments.
+  double outlier_sigmas = 3.0;
+};
+
+/// A sphere fitted to the vault around an opening.
+struct VaultSphere {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  double radius = 0.0;
+  /// Distance from `from` (inside the sphere) along unit `dir` to the sphere.
+  double radius_along(const Eigen::Vector3d& from, const Eigen::Vector3d& dir) const;
+};
+
+class DefectSurfaces {
+ public:
+  enum class Status { Fitted, Failed };
+  Status status = Status::Failed;
+  std::string message;
+  bool mirror_guided = false;
+  int ring_rays = 0;  ///< intact rays on the ring (both tables met)
+  int sites = 0;      ///< fitting sites used (after thinning and outliers)
+  /// RMS residual of the fit over the ring's rays within the outlier limit, outer table (over
+  /// all the rays, a few rays past an orbit, 30-50 mm off, would dominate it).
+  double outer_rms_mm = 0.0;
+  double thickness_rms_mm = 0.0;  ///< the same, bone thickness (rays through both tables)
+  /// Rays off the fit by more than the outlier limit (`outlier_sigmas` robust σ, at least 1 mm):
+  /// bone the fitted surface does not describe (an orbital roof, a fragment of a cut face).
+  int outer_off_rays = 0;
+  int thickness_off_rays = 0;
+  double outer_off_limit_mm = 0.0;      ///< that limit, outer table
+  double thickness_off_limit_mm = 0.0;  ///< that limit, thickness
+  /// Rim-only: the sphere the outer surface was fitted beyond, when the ring preferred it to
+  /// the spline's quadratic trend alone.
+  const std::optional<VaultSphere>& vault() const { return vault_; }
+  /// The ring's bone: outer and inner table points of the intact rays (both tables met) and
+  /// each ray's distance from the opening, mm.
+  std::vector<Eigen::Vector3d> ring_outer, ring_inner;
+  std::vector<double> ring_distance_mm;
+  /// For each ring ray, how squarely its first bone faces it: the cosine between the ray and
+  /// the inward normal there (1: the inner table met square on; near 0: a cut face met
+  /// side-on, above where the inner table would go on).
+  std::vector<double> ring_inner_facing;
+
+  bool fitted() const { return status == Status::Fitted; }
+  /// The fitted outer and inner surface points along the ray from the centre in direction
+  /// `dir` (unit); none when the direction is outside the fitted cap or, mirror-guided, the
+  /// mirror has no bone there.
+  std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> at(const Eigen::Vector3d& dir) const;
+
+ private:
+  friend DefectSurfaces fit_defect_surfaces(const DefectRegion&, const SurfaceLocator&,
+                                            const SurfaceLocator*, const DefectSurfaceParams&,
+                                            const DetectDefectParams&);
+  Eigen::Vector2d uv(const Eigen::Vector3d& dir) const;
+  Eigen::Vector3d center_ = Eigen::Vector3d::Zero(), axis_ = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d e1_ = Eigen::Vector3d::UnitX(), e2_ = Eigen::Vector3d::UnitY();
+  double scale_ = 1.0;                      // mm per unit of the gnomonic projection
+  double max_cos_ = 0.0;                    // cosine of the cap's half-angle
+  const SurfaceLocator* mirror_ = nullptr;  // prior (not owned); null: rim-only
+  double max_thickness_mm_ = 15.0;
+  ThinPlateSpline outer_, thickness_;
+  std::optional<VaultSphere> vault_;  // set: outer_ fits the radius beyond this sphere
+};
+
+/// Fits the surfaces of `defect` (found by detect_defect on the skull that `bone` locates).
+/// `mirror`: the registered mirrored skull, or null for rim-only fitting; it must outlive the
+/// result. `detect` gives the plausible bone thickness of a ray.
+DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLocator& bone,
+                                   const SurfaceLocator* mirror,
+                                   const DefectSurfaceParams& params = {},
+                                   const DetectDefectParams& detect = {});
+
+}  // namespace cranioplan

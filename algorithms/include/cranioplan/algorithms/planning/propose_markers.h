@@ -1,0 +1,79 @@
+#pragma once
+// Marker proposal for a detected defect. The outer and inner surfaces of the missing bone are
+// fitted to the intact bone around the opening (fit_defect_surfaces.h) — guided by the
+// registered mirror where it covers the opening, from the ring alone otherwise — and sampled
+// as markers: outer edge markers along the rim, surface markers over the opening (smoothed with
+// the paper's smoother and put back onto the fitted surfaces), and support markers on the
+// intact bone next to the rim. The wizard's "Propose markers" and the automatic planner both
+// use it.
+#include <string>
+#include <vector>
+
+#include "cranioplan/algorithms/alignment/register_icp.h"
+#include "cranioplan/algorithms/implant/smooth_markers.h"
+#include "cranioplan/algorithms/planning/detect_defect.h"
+#include "cranioplan/algorithms/planning/fit_defect_surfaces.h"
+#include "cranioplan/model/marker.h"
+#include "cranioplan/model/plane.h"
+
+namespace cranioplan {
+
+class SurfaceLocator;
+
+enum class PlanMethod { Auto, Mirror, RimOnly };
+const char* to_string(PlanMethod m);
+/// "auto", "mirror" or "rim-only"; false for anything else.
+bool plan_method_from_string(const std::string& text, PlanMethod& out);
+
+struct ProposeParams {
+  DetectDefectParams detect;
+  PlanMethod method = PlanMethod::Auto;  ///< Auto: mirror where it covers the defect, else rim
+  double min_mirror_coverage = 0.8;      ///< Auto uses the mirror above this coverage, 0..1
+  double edge_spacing_mm = 4.0;          ///< proposed edge markers along the rim, mm (>0)
+  double surface_spacing_mm = 6.0;       ///< proposed surface and support markers, mm (>0)
+  /// Inner support markers only where the ring ray's first bone faces it within this angle
+  /// (the inner table), deg (0..90; 90: every ray). Beside an oblique cut face a ray from the
+  /// centre first meets the face, above where the inner table would go on, and a marker there
+  /// lifts the implant's inner surface off the missing wedge of bone.
+  double max_support_inner_tilt_deg = 45.0;
+  SmoothParams smooth{10.0, 2.0, 1};  ///< applied to surface markers (put back after)
+  DefectSurfaceParams surfaces;       ///< fitting the surfaces to the intact ring
+};
+
+struct MarkerProposal {
+  enum class Status { Proposed, NoDefect, Failed };  ///< Failed: the surfaces could not be fitted
+  Status status = Status::NoDefect;
+  std::string message;
+  DefectRegion defect;
+  PlanMethod method_used = PlanMethod::RimOnly;
+  double mirror_coverage = 0.0;  ///< fraction of the opening's rays that meet mirrored bone
+  std::string surfaces_message;  ///< how the surfaces were fitted (ring rays, residual)
+  double ring_rms_mm = 0.0;      ///< DefectSurfaces::outer_rms_mm: the outer fit's residual
+  std::vector<Marker> markers;   ///< ids from `first_id` on
+  bool proposed() const { return status == Status::Proposed; }
+};
+
+/// How the surfaces were found, for messages: "mirror-guided (mirror covers 97% of the opening)"
+/// or "rim-only fitting (…)".
+std::string describe_method(PlanMethod method, double mirror_coverage);
+
+/// The defect seen from the skull's centroid moved onto the midsagittal plane.
+DefectRegion detect_defect_near_plane(const SkullMesh& skull, const SurfaceLocator& bone,
+                                      const Plane& plane, const DetectDefectParams& params);
+
+/// The region for registering the mirror locally: a sphere around the opening's rim reaching
+/// `margin_mm` beyond it.
+RegionOfInterest local_registration_region(const DefectRegion& defect, double margin_mm);
+
+/// Markers for an already detected defect; `bone` locates the skull it was found in, `mirror`
+/// the registered mirrored skull.
+MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const SurfaceLocator& bone,
+                                          const SurfaceLocator& mirror, const ProposeParams& params,
+                                          int first_id = 1);
+
+/// Detects the defect, then proposes markers (status NoDefect when there is none).
+MarkerProposal propose_markers(const SkullMesh& skull, const SurfaceLocator& bone,
+                               const Plane& plane, const SurfaceLocator& mirror,
+                               const ProposeParams& params, int first_id = 1);
+
+}  // namespace cranioplan

@@ -1,0 +1,328 @@
+#include "cranioplan/algorithms/implant/trim_to_bone.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <vector>
+
+#include "cranioplan/algorithms/geometry/distance_transform.h"
+#include "cranioplan/algorithms/geometry/surface_locator.h"
+#include "cranioplan/algorithms/geometry/voxelize_mesh.h"
+#include "cranioplan/algorithms/io/extract_bone_surface.h"
+
+namespace cranioplan {
+
+namespace {
+
+using Mask = std::vector<uint8_t>;
+
+// One step of 6-neighbour dilation.
+Mask dilate(const Mask& in, const VoxelGrid& g) {
+  Mask out(in.size(), 0);
+  const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const size_t c = g.index(i, j, k);
+        auto at = [&](int a, int b, int d) -> uint8_t {
+          if (a < 0 || b < 0 || d < 0 || a >= nx || b >= ny || d >= nz) return 0;
+          return in[g.index(a, b, d)];
+        };
+        out[c] = in[c] || at(i - 1, j, k) || at(i + 1, j, k) || at(i, j - 1, k) ||
+                 at(i, j + 1, k) || at(i, j, k - 1) || at(i, j, k + 1);
+      }
+  return out;
+}
+
+// Keeps the largest 6-connected piece.
+Mask largest_piece(const Mask& in, const VoxelGrid& g) {
+  std::vector<int> label(in.size(), 0);
+  std::vector<size_t> sizes{0};
+  std::vector<size_t> stack;
+  const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
+  for (size_t seed = 0; seed < in.size(); ++seed) {
+    if (!in[seed] || label[seed]) continue;
+    const int id = static_cast<int>(sizes.size());
+    sizes.push_back(0);
+    stack.push_back(seed);
+    label[seed] = id;
+    while (!stack.empty()) {
+      const size_t c = stack.back();
+      stack.pop_back();
+      ++sizes[id];
+      const int i = static_cast<int>(c % nx), j = static_cast<int>((c / nx) % ny),
+                k = static_cast<int>(c / (static_cast<size_t>(nx) * ny));
+      const int nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k},
+                            {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
+      for (const auto& n : nb) {
+        if (n[0] < 0 || n[1] < 0 || n[2] < 0 || n[0] >= nx || n[1] >= ny || n[2] >= nz) continue;
+        const size_t d = g.index(n[0], n[1], n[2]);
+        if (in[d] && !label[d]) {
+          label[d] = id;
+          stack.push_back(d);
+        }
+      }
+    }
+  }
+  const int best = static_cast<int>(std::max_element(sizes.begin(), sizes.end()) - sizes.begin());
+  Mask out(in.size(), 0);
+  for (size_t c = 0; c < in.size(); ++c) out[c] = best > 0 && label[c] == best;
+  return out;
+}
+
+// What `implant` and `bone` have on either side of voxel (i,j,k) along (di,dj,dk): 1 implant,
+// 2 bone, 0 nothing within `reach` steps (the first non-empty voxel decides).
+int first_along(const Mask& implant, const Mask& bone, const VoxelGrid& g, int i, int j, int k,
+                int di, int dj, int dk, int reach) {
+  for (int s = 1; s <= reach; ++s) {
+    const int a = i + s * di, b = j + s * dj, c = k + s * dk;
+    if (a < 0 || b < 0 || c < 0 || a >= g.dims[0] || b >= g.dims[1] || c >= g.dims[2]) return 0;
+    const size_t v = g.index(a, b, c);
+    if (implant[v]) return 1;
+    if (bone[v]) return 2;
+  }
+  return 0;
+}
+
+// Fills the voxels of cracks narrower than twice `steps` voxels between implant and bone.
+Mask bridge_cracks(const Mask& implant, const Mask& bone, const VoxelGrid& g, int steps) {
+  // Candidates: within `steps` (6-neighbour steps) of both.
+  Mask near_implant = implant, near_bone = bone;
+  for (int s = 0; s < steps; ++s) {
+    near_implant = dilate(near_implant, g);
+    near_bone = dilate(near_bone, g);
+  }
+  static const int dirs[13][3] = {{1, 0, 0},  {0, 1, 0},  {0, 0, 1}, {1, 1, 0},  {1, -1, 0},
+                                  {1, 0, 1},  {1, 0, -1}, {0, 1, 1}, {0, 1, -1}, {1, 1, 1},
+                                  {1, 1, -1}, {1, -1, 1}, {-1, 1, 1}};
+  // Steps along a diagonal are longer: the width is kept in millimetres.
+  int reach[13];
+  for (int n = 0; n < 13; ++n) {
+    const int* d = dirs[n];
+    const double len = std::sqrt(double(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]));
+    reach[n] = std::max(1, static_cast<int>(std::floor(steps / len + 1e-9)));
+  }
+  Mask out = implant;
+  for (int k = 0; k < g.dims[2]; ++k)
+    for (int j = 0; j < g.dims[1]; ++j)
+      for (int i = 0; i < g.dims[0]; ++i) {
+        const size_t c = g.index(i, j, k);
+        if (implant[c] || bone[c] || !near_implant[c] || !near_bone[c]) continue;
+        for (int n = 0; n < 13; ++n) {
+          const int* d = dirs[n];
+          const int ahead = first_along(implant, bone, g, i, j, k, d[0], d[1], d[2], reach[n]);
+          if (ahead == 0) continue;
+          const int behind = first_along(implant, bone, g, i, j, k, -d[0], -d[1], -d[2], reach[n]);
+          if (behind != 0 && behind != ahead) {
+            out[c] = 1;
+            break;
+          }
+        }
+      }
+  return out;
+}
+
+// Separable Gaussian blur of a 0/1 mask along the three axes.
+std::vector<float> blur(const Mask& in, const VoxelGrid& g, double sigma_voxels) {
+  std::vector<float> a(in.begin(), in.end());
+  if (sigma_voxels <= 0.05) return a;
+  const int r = std::max(1, static_cast<int>(std::ceil(2.5 * sigma_voxels)));
+  std::vector<float> w(2 * r + 1);
+  float sum = 0;
+  for (int t = -r; t <= r; ++t)
+    sum += w[t + r] = std::exp(-0.5f * t * t / (sigma_voxels * sigma_voxels));
+  for (auto& x : w) x /= sum;
+  std::vector<float> b(a.size());
+  const int dims[3] = {g.dims[0], g.dims[1], g.dims[2]};
+  const size_t stride[3] = {1, static_cast<size_t>(dims[0]),
+                            static_cast<size_t>(dims[0]) * dims[1]};
+  for (int axis = 0; axis < 3; ++axis) {
+    for (int k = 0; k < dims[2]; ++k)
+      for (int j = 0; j < dims[1]; ++j)
+        for (int i = 0; i < dims[0]; ++i) {
+          const int pos[3] = {i, j, k};
+          const size_t c = g.index(i, j, k);
+          float v = 0;
+          for (int t = -r; t <= r; ++t) {
+            const int q = pos[axis] + t;
+            if (q < 0 || q >= dims[axis]) continue;
+            v += w[t + r] *
+                 a[c + static_cast<std::ptrdiff_t>(t) * static_cast<std::ptrdiff_t>(stride[axis])];
+          }
+          b[c] = v;
+        }
+    a.swap(b);
+  }
+  return a;
+}
+
+// The faces of `mesh` whose bounding boxes meet [lo, hi].
+SkullMesh faces_in_box(const SkullMesh& mesh, const Eigen::Vector3d& lo,
+                       const Eigen::Vector3d& hi) {
+  TriangleSoup soup;
+  std::vector<int> index(mesh.n_vertices(), -1);
+  for (auto fh : mesh.faces()) {
+    Eigen::Vector3d a = Eigen::Vector3d::Constant(1e300), b = -a;
+    for (auto vh : mesh.fv_range(fh)) {
+      a = a.cwiseMin(to_eigen(mesh.point(vh)));
+      b = b.cwiseMax(to_eigen(mesh.point(vh)));
+    }
+    if ((b.array() < lo.array()).any() || (a.array() > hi.array()).any()) continue;
+    Eigen::Vector3i t;
+    int n = 0;
+    for (auto vh : mesh.fv_range(fh)) {
+      int& id = index[vh.idx()];
+      if (id < 0) {
+        id = static_cast<int>(soup.vertices.size());
+        soup.vertices.push_back(to_eigen(mesh.point(vh)));
+      }
+      t[n++] = id;
+    }
+    soup.triangles.push_back(t);
+  }
+  return build_mesh(soup);
+}
+
+// The implant's smooth field, held `clearance` mm off the skull's surface to a fraction of the
+// grid: the mask is blurred together with the bone it touches (so the blur does not pull the
+// surface back from the bone), then capped by a field that crosses ½ exactly `clearance` mm
+// outside the skull's surface, from the distance to its triangles. The surface then follows the
+// bone's own surface rather than its voxels.
+std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const VoxelGrid& g,
+                                    const SkullMesh& skull, double sigma_voxels, double clearance) {
+  const double h = g.spacing;
+  // Bone within two voxels of the implant joins the blur.
+  const Mask near_implant = dilate(dilate(mask, g), g);
+  Mask joined = mask;
+  for (size_t c = 0; c < joined.size(); ++c) joined[c] = mask[c] || (bone[c] && near_implant[c]);
+  std::vector<float> field = blur(joined, g, sigma_voxels);
+  Mask().swap(joined);
+  // The skull's triangles near the grid suffice for distances up to a few voxels.
+  const double reach = 3.0 * h + clearance;
+  const Eigen::Vector3d lo = g.origin - Eigen::Vector3d::Constant(reach);
+  const Eigen::Vector3d hi =
+      g.center(g.dims[0] - 1, g.dims[1] - 1, g.dims[2] - 1) + Eigen::Vector3d::Constant(reach);
+  const SkullMesh local = faces_in_box(skull, lo, hi);
+  if (local.n_faces() == 0) {  // no surface near the grid: its bone voxels stay empty
+    for (size_t c = 0; c < field.size(); ++c)
+      if (bone[c]) field[c] = 0.0f;
+    return field;
+  }
+  const SurfaceLocator locator(local);
+  const Mask near_bone = dilate(dilate(bone, g), g);
+  for (int k = 0; k < g.dims[2]; ++k)
+    for (int j = 0; j < g.dims[1]; ++j)
+      for (int i = 0; i < g.dims[0]; ++i) {
+        const size_t c = g.index(i, j, k);
+        if (field[c] <= 0.0f || !near_bone[c]) continue;
+        const double d = locator.closest(g.center(i, j, k)).distance * (bone[c] ? -1.0 : 1.0);
+        const double cap = std::clamp(0.5 + (d - clearance) / h, 0.0, 1.0);
+        field[c] = std::min(field[c], static_cast<float>(cap));
+      }
+  // Every bone voxel is in the band, and half a voxel or more inside the surface its cap is 0
+  // (a distance to fewer triangles is never shorter), so the blur leaves nothing in the bone.
+  return field;
+}
+
+}  // namespace
+
+TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
+                              const TrimToBoneParams& params) {
+  const auto t0 = std::chrono::steady_clock::now();
+  TrimToBoneResult result;
+  const auto [lo, hi] = mesh_bounds(implant);
+  const VoxelGrid grid = VoxelGrid::covering_at_most(lo, hi, std::clamp(params.voxel_mm, 0.1, 1.0),
+                                                     std::max(1e5, params.max_voxels), 4);
+  const double h = grid.spacing;
+  VoxelizeParams solid;
+  solid.vote_through_holes = params.vote_through_holes;
+  Mask mask = voxelize_mesh(implant, grid, solid);
+  Mask bone = voxelize_mesh(skull, grid, solid);
+  size_t before = 0;
+  for (size_t c = 0; c < mask.size(); ++c) {
+    before += mask[c];
+    mask[c] = mask[c] && !bone[c];
+  }
+  // Opening by a ball: slivers thinner than the feature size (left on top of intact bone, and
+  // the thin lip where the shell's outer surface grazes the bone's) disappear, so the implant
+  // ends in an edge at least that thick instead of a feather.
+  if (params.min_feature_mm > 0) mask = open_by_ball(mask, grid, 0.5 * params.min_feature_mm);
+  // The opening must not give back bone.
+  for (size_t c = 0; c < mask.size(); ++c) mask[c] = mask[c] && !bone[c];
+  // Bridging: where the implant stops short of the bone by less than twice the bridge width
+  // (ragged thin bone, e.g. by an orbit), the crack between them is filled, so the implant
+  // rests on the bone. A voxel is in a crack when, along one of 13 directions, the implant lies
+  // on one side and the bone on the other, each within the width with nothing between; so a
+  // concave corner where the implant's wall meets the top of the bone gets no fillet.
+  const int bridge = static_cast<int>(std::lround(params.bridge_mm / h));
+  if (bridge > 0) {
+    Mask bridged = bridge_cracks(mask, bone, grid, bridge);
+    // What the fills leave thinner than the feature size away from the bone goes (a rod
+    // between the implant's edge and a fragment; a wall between the implant and a cut face is
+    // thick along the cut): what lies within a millimetre of the bone is the fill's contact.
+    if (params.thin_fills_removed && params.min_feature_mm > 0) {
+      const std::vector<float> to_bone = distance_to_mask(bone, grid);
+      auto far_fill = [&](size_t c) { return bridged[c] && !mask[c] && to_bone[c] > 1.0f; };
+      bool any = false;
+      for (size_t c = 0; c < bridged.size() && !any; ++c) any = far_fill(c);
+      if (any) {  // the opening costs two distance transforms: only when there is a far fill
+        const Mask thick = open_by_ball(bridged, grid, 0.5 * params.min_feature_mm);
+        for (size_t c = 0; c < bridged.size(); ++c)
+          if (far_fill(c) && !thick[c]) bridged[c] = 0;
+      }
+    }
+    mask = std::move(bridged);
+  }
+  mask = largest_piece(mask, grid);
+  size_t after = 0;
+  for (uint8_t m : mask) after += m;
+  result.removed_mm3 = static_cast<double>(before - std::min(before, after)) * grid.voxel_volume();
+  result.volume_mm3 = static_cast<double>(after) * grid.voxel_volume();
+  auto elapsed = [&] {
+    return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+  if (after == 0) {
+    result.message = "nothing of the implant lies outside the bone";
+    result.mesh = implant;
+    result.seconds = elapsed();
+    return result;
+  }
+  std::vector<float> smooth;
+  if (params.clearance_mm) {
+    smooth = fit_against_bone(mask, bone, grid, skull, params.smoothing_mm / h,
+                              std::max(0.0, *params.clearance_mm));
+    Mask().swap(mask);
+  } else {
+    // Without a clearance (build_implant commands before version 4): neither the grid nor the
+    // smoothing may carry the surface into the
+    // bone: the bone grown by one voxel stays outside (the surface then lies a fraction of a
+    // voxel off the bone, up to a voxel and a half).
+    smooth = blur(mask, grid, params.smoothing_mm / h);
+    Mask().swap(mask);
+    const Mask keep_out = dilate(bone, grid);
+    for (size_t c = 0; c < smooth.size(); ++c)
+      if (keep_out[c]) smooth[c] = 0.0f;
+  }
+  Mask().swap(bone);
+  Volume volume = mask_volume({}, grid);
+  volume.data = std::move(smooth);
+  ExtractBoneSurfaceParams surface;
+  surface.threshold = 0.5;
+  surface.largest_piece_only = true;
+  // The implant as the meshing gives it: its order follows from the (canonical) skull and the
+  // markers already, and plans saved before meshes were made canonical replay to their bytes.
+  surface.canonical = false;
+  ExtractBoneSurfaceResult s = extract_bone_surface(volume, surface);
+  if (!s.usable()) {
+    result.message = s.message;
+    result.mesh = implant;
+    result.seconds = elapsed();
+    return result;
+  }
+  result.mesh = std::move(s.mesh);
+  result.status = TrimToBoneResult::Status::Trimmed;
+  result.seconds = elapsed();
+  return result;
+}
+
+}  // namespace cranioplan

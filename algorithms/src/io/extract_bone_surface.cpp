@@ -1,0 +1,103 @@
+#include "cranioplan/algorithms/io/extract_bone_surface.h"
+
+#include <vtkFloatArray.h>
+#include <vtkFlyingEdges3D.h>
+#include <vtkImageData.h>
+#include <vtkNew.h>
+#include <vtkPointData.h>
+#include <vtkPolyData.h>
+#include <vtkQuadricDecimation.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+
+#include "cranioplan/algorithms/geometry/mesh_components.h"
+#include "soup_building.h"
+
+namespace cranioplan {
+
+ExtractBoneSurfaceResult extract_bone_surface(const Volume& volume,
+                                              const ExtractBoneSurfaceParams& params) {
+  const auto t0 = std::chrono::steady_clock::now();
+  ExtractBoneSurfaceResult result;
+  const double threshold =
+      std::isnan(params.threshold) ? volume.default_threshold() : params.threshold;
+  result.threshold_used = threshold;
+  const auto [lo_it, hi_it] = std::minmax_element(volume.data.begin(), volume.data.end());
+  if (volume.data.empty() || *hi_it < threshold || *lo_it >= threshold) {
+    result.status = ExtractBoneSurfaceResult::Status::NoSurface;
+    result.message = "threshold " + std::to_string(threshold) + " is outside the volume's range [" +
+                     std::to_string(volume.data.empty() ? 0.0 : *lo_it) + ", " +
+                     std::to_string(volume.data.empty() ? 0.0 : *hi_it) + "]: no surface";
+    return result;
+  }
+
+  // Pad by one sample below the threshold on every side so the surface is closed where bone
+  // touches the edge of the scan. Index space: sample (i,j,k) of the volume sits at (i,j,k).
+  // The padded copy of the volume and VTK's output are let go as soon as the triangles are out
+  // (a SkullFix volume is 240 MB as floats): they are not needed while the mesh is built.
+  TriangleSoup soup;
+  {
+    const int nx = volume.dims[0] + 2, ny = volume.dims[1] + 2, nz = volume.dims[2] + 2;
+    const float pad = static_cast<float>(std::min<double>(*lo_it, threshold - 1.0));
+    vtkNew<vtkFloatArray> scalars;
+    scalars->SetNumberOfTuples(static_cast<vtkIdType>(nx) * ny * nz);
+    float* dst = scalars->GetPointer(0);
+    std::fill(dst, dst + static_cast<size_t>(nx) * ny * nz, pad);
+    for (int k = 0; k < volume.dims[2]; ++k)
+      for (int j = 0; j < volume.dims[1]; ++j)
+        std::copy_n(&volume.data[volume.index(0, j, k)], volume.dims[0],
+                    dst + ((static_cast<size_t>(k) + 1) * ny + j + 1) * nx + 1);
+    vtkNew<vtkImageData> image;
+    image->SetDimensions(nx, ny, nz);
+    image->SetOrigin(-1, -1, -1);
+    image->SetSpacing(1, 1, 1);
+    image->GetPointData()->SetScalars(scalars);
+
+    vtkNew<vtkFlyingEdges3D> fe;
+    fe->SetInputData(image);
+    fe->SetValue(0, threshold);
+    fe->ComputeNormalsOff();
+    fe->ComputeGradientsOff();
+    fe->ComputeScalarsOff();
+    fe->Update();
+    soup = detail::soup_from_polydata("", fe->GetOutput());
+  }
+  for (auto& p : soup.vertices) p = volume.world(p);
+
+  const SoupComponents comps = soup_components(soup);
+  result.pieces_found = static_cast<long long>(comps.sizes.size());
+  int keep = 1;
+  if (!params.largest_piece_only) {
+    keep = 0;
+    while (keep < static_cast<int>(comps.sizes.size()) &&
+           comps.sizes[keep] >= std::max<long long>(1, params.min_piece_triangles))
+      ++keep;
+    keep = std::max(keep, 1);
+  }
+  result.pieces_kept = keep;
+  soup = keep_largest_pieces(soup, comps, keep);
+  result.triangles_before_decimation = static_cast<long long>(soup.triangles.size());
+
+  if (params.target_triangles > 0 &&
+      params.target_triangles < static_cast<long long>(soup.triangles.size())) {
+    const vtkSmartPointer<vtkPolyData> pd = detail::polydata_from_soup(soup);
+    vtkNew<vtkQuadricDecimation> dec;
+    dec->SetInputData(pd);
+    dec->SetTargetReduction(1.0 - static_cast<double>(params.target_triangles) /
+                                      static_cast<double>(soup.triangles.size()));
+    dec->VolumePreservationOn();
+    dec->Update();
+    soup = detail::soup_from_polydata("", dec->GetOutput());
+  }
+
+  if (signed_volume(soup) < 0)
+    for (auto& t : soup.triangles) std::swap(t[1], t[2]);
+  if (params.canonical) make_canonical(soup);
+  result.mesh = build_mesh(soup);
+  result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  return result;
+}
+
+}  // namespace cranioplan

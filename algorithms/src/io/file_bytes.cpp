@@ -1,0 +1,150 @@
+#include "file_bytes.h"
+
+#include <unistd.h>
+#include <zlib.h>
+
+#include <algorithm>
+#include <cctype>
+#include <cerrno>
+#include <cstdio>
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "cranioplan/algorithms/io/file_io.h"
+#include "cranioplan/model/error.h"
+
+namespace cranioplan::detail {
+
+namespace fs = std::filesystem;
+
+std::string gunzip(const std::string& path, const char* data, size_t size, size_t expected_size) {
+  z_stream zs{};
+  // 15 + 32: accept both gzip and zlib headers.
+  if (inflateInit2(&zs, 15 + 32) != Z_OK) throw InputError(path, "cannot start decompression");
+  // Grown as the data comes, up to the size the header announces: a header may announce
+  // terabytes over a few bytes of data (a fuzzed NRRD asked for 600 GB at once).
+  const size_t guess = std::max<size_t>(size * 4, 1 << 16);
+  std::string out;
+  out.resize(expected_size > 0 ? std::min(expected_size, guess) : guess);
+  zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data));
+  zs.avail_in = static_cast<uInt>(std::min<size_t>(size, 0x7fffffff));
+  size_t produced = 0;
+  int rc = Z_OK;
+  while (true) {
+    if (produced == out.size()) {
+      if (expected_size > 0 && out.size() == expected_size) {
+        // The stream must end exactly here; one probe byte tells whether more data follows.
+        char probe;
+        zs.next_out = reinterpret_cast<Bytef*>(&probe);
+        zs.avail_out = 1;
+        rc = inflate(&zs, Z_NO_FLUSH);
+        if (zs.avail_out == 0) {
+          inflateEnd(&zs);
+          throw InputError(path, "compressed data holds more than the " +
+                                     format_count(static_cast<long long>(expected_size)) +
+                                     " bytes the header announces");
+        }
+        break;
+      }
+      out.resize(expected_size > 0 ? std::min(expected_size, out.size() * 2) : out.size() * 2);
+    }
+    zs.next_out = reinterpret_cast<Bytef*>(out.data() + produced);
+    zs.avail_out = static_cast<uInt>(std::min<size_t>(out.size() - produced, 0x7fffffff));
+    const uInt before = zs.avail_out;
+    rc = inflate(&zs, Z_NO_FLUSH);
+    produced += before - zs.avail_out;
+    if (rc == Z_STREAM_END) break;
+    if (rc != Z_OK) {
+      inflateEnd(&zs);
+      if (rc == Z_BUF_ERROR)
+        throw InputError(path, "compressed data ends early, after " +
+                                   format_count(static_cast<long long>(produced)) + " bytes");
+      throw InputError(path, std::string("compressed data is corrupt (") +
+                                 (zs.msg ? zs.msg : "zlib error") + ")");
+    }
+  }
+  inflateEnd(&zs);
+  out.resize(produced);
+  return out;
+}
+
+std::string lower_extension(const std::string& path) {
+  std::string name = fs::path(path).filename().string();
+  std::transform(name.begin(), name.end(), name.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  auto ends_with = [&](const std::string& s) {
+    return name.size() >= s.size() && name.compare(name.size() - s.size(), s.size(), s) == 0;
+  };
+  if (ends_with(".nii.gz")) return ".nii.gz";
+  const size_t dot = name.rfind('.');
+  return dot == std::string::npos ? std::string() : name.substr(dot);
+}
+
+size_t sample_size(SampleType t) {
+  switch (t) {
+    case SampleType::Int8:
+    case SampleType::UInt8:
+      return 1;
+    case SampleType::Int16:
+    case SampleType::UInt16:
+      return 2;
+    case SampleType::Int32:
+    case SampleType::UInt32:
+    case SampleType::Float32:
+      return 4;
+    case SampleType::Float64:
+      return 8;
+  }
+  return 1;
+}
+
+}  // namespace cranioplan::detail
+
+namespace cranioplan {
+
+namespace fs = std::filesystem;
+
+std::string read_file_bytes(const std::string& path) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (ec || !fs::exists(st)) throw InputError(path, "file not found");
+  if (fs::is_directory(st)) throw InputError(path, "is a folder, not a file");
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw InputError(path, std::string("cannot open file: ") + std::strerror(errno));
+  std::string bytes;
+  in.seekg(0, std::ios::end);
+  const std::streamoff size = in.tellg();
+  if (size < 0) throw InputError(path, "cannot determine the file size");
+  in.seekg(0, std::ios::beg);
+  bytes.resize(static_cast<size_t>(size));
+  if (size > 0 && !in.read(bytes.data(), size))
+    throw InputError(path, "read error after " + format_count(in.gcount()) + " bytes");
+  if (bytes.empty()) throw InputError(path, "file is empty");
+  return bytes;
+}
+
+void write_file_atomically(const std::string& path, const std::string& bytes) {
+  const fs::path target(path);
+  const fs::path dir = target.has_parent_path() ? target.parent_path() : fs::path(".");
+  std::error_code ec;
+  if (!fs::is_directory(dir, ec)) throw InputError(path, "folder does not exist");
+  const std::string tmp =
+      (dir / ("." + target.filename().string() + ".tmp" + std::to_string(::getpid()))).string();
+  FILE* f = std::fopen(tmp.c_str(), "wb");
+  if (!f) throw InputError(path, std::string("cannot write: ") + std::strerror(errno));
+  const bool ok = std::fwrite(bytes.data(), 1, bytes.size(), f) == bytes.size() &&
+                  std::fflush(f) == 0 && ::fsync(::fileno(f)) == 0;
+  const bool closed = std::fclose(f) == 0;
+  if (!ok || !closed) {
+    std::remove(tmp.c_str());
+    throw InputError(path, "write failed (disk full?)");
+  }
+  fs::rename(tmp, target, ec);
+  if (ec) {
+    std::remove(tmp.c_str());
+    throw InputError(path, "cannot replace file: " + ec.message());
+  }
+}
+
+}  // namespace cranioplan

@@ -1,0 +1,200 @@
+#include "cranioplan/algorithms/io/mesh_report.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <array>
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <map>
+#include <numeric>
+#include <unordered_map>
+#include <utility>
+
+#include "cranioplan/algorithms/geometry/mesh_components.h"
+
+namespace cranioplan {
+namespace {
+
+// The least span of a loop taken for a cut at the border (a scan's end crosses at least the
+// vault's cap); smaller flat loops at the border are holes.
+constexpr double kCutSpanMm = 30.0;
+
+// The chains of boundary edges (welded vertex ids), measured and placed.
+std::vector<BoundaryLoop> boundary_loops(const TriangleSoup& welded,
+                                         const std::vector<std::pair<int, int>>& edges,
+                                         const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  std::unordered_map<int, int> parent;
+  std::function<int(int)> find = [&](int a) {
+    int r = a;
+    while (parent[r] != r) r = parent[r];
+    while (parent[a] != r) a = std::exchange(parent[a], r);
+    return r;
+  };
+  for (const auto& [a, b] : edges) {
+    parent.emplace(a, a);
+    parent.emplace(b, b);
+  }
+  for (const auto& [a, b] : edges) parent[find(a)] = find(b);
+  std::map<int, size_t> index;  // root -> loops[]
+  std::vector<BoundaryLoop> loops;
+  std::vector<std::vector<int>> members;
+  for (const auto& [a, b] : edges) {
+    const auto [it, fresh] = index.emplace(find(a), loops.size());
+    if (fresh) {
+      loops.emplace_back();
+      members.emplace_back();
+    }
+    BoundaryLoop& l = loops[it->second];
+    ++l.edges;
+    l.length_mm += (welded.vertices[a] - welded.vertices[b]).norm();
+    members[it->second].push_back(a);
+    members[it->second].push_back(b);
+  }
+  for (size_t i = 0; i < loops.size(); ++i) {
+    std::vector<int>& m = members[i];
+    std::sort(m.begin(), m.end());
+    m.erase(std::unique(m.begin(), m.end()), m.end());
+    BoundaryLoop& l = loops[i];
+    for (int v : m) l.centroid += welded.vertices[v];
+    l.centroid /= static_cast<double>(m.size());
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (int v : m) {
+      const Eigen::Vector3d d = welded.vertices[v] - l.centroid;
+      cov += d * d.transpose();
+    }
+    l.normal = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
+    for (int v : m)
+      l.flatness_mm =
+          std::max(l.flatness_mm, std::abs((welded.vertices[v] - l.centroid).dot(l.normal)));
+    // At the border: flat, its normal along an axis, and its plane where the mesh ends.
+    int axis = 0;
+    l.normal.cwiseAbs().maxCoeff(&axis);
+    Eigen::Vector3d a = l.centroid, b = l.centroid;
+    for (int v : m) {
+      a = a.cwiseMin(welded.vertices[v]);
+      b = b.cwiseMax(welded.vertices[v]);
+    }
+    // A hole of a few millimetres on a curved surface is flat too: a cut spans a good part of
+    // the head.
+    const bool flat =
+        l.flatness_mm <= std::max(1.0, 0.01 * l.length_mm) && (b - a).norm() >= kCutSpanMm;
+    if (!flat || std::abs(l.normal[axis]) < 0.9) continue;
+    static const char* const kLow[3] = {"right", "front", "lower"};
+    static const char* const kHigh[3] = {"left", "back", "upper"};
+    if (l.centroid[axis] - lo[axis] <= 2.0) {
+      l.at_border = true;
+      l.border = kLow[axis];
+    } else if (hi[axis] - l.centroid[axis] <= 2.0) {
+      l.at_border = true;
+      l.border = kHigh[axis];
+    }
+  }
+  std::stable_sort(loops.begin(), loops.end(), [](const BoundaryLoop& a, const BoundaryLoop& b) {
+    return a.length_mm > b.length_mm;
+  });
+  return loops;
+}
+
+std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0) {
+  char buf[160];
+  std::snprintf(buf, sizeof(buf), f, a, b, c);
+  return buf;
+}
+
+}  // namespace
+
+std::vector<std::string> describe_openings(const MeshReport& report) {
+  std::vector<std::string> out;
+  static const char* const kAxis = "xyz";
+  for (const char* side : {"lower", "upper", "front", "back", "right", "left"}) {
+    long long count = 0;
+    double length = 0.0, at = 0.0;
+    int axis = 0;
+    for (const BoundaryLoop& l : report.loops) {
+      if (!l.at_border || l.border != side) continue;
+      ++count;
+      length += l.length_mm;
+      l.normal.cwiseAbs().maxCoeff(&axis);
+      at = std::round(l.centroid[axis] * 10.0) / 10.0 + 0.0;  // no "-0.0"
+    }
+    if (count == 0) continue;
+    out.push_back(std::string("open along a flat cut at its ") + side + " border (" + kAxis[axis] +
+                  fmt(" = %.1f mm): ", at) + std::to_string(count) +
+                  (count == 1 ? " loop, " : " loops, ") + fmt("%.0f mm", length) +
+                  " long, where the scan ended; the bone's inside is taken by votes through it");
+  }
+  long long holes = 0;
+  double total = 0.0;
+  const BoundaryLoop* largest = nullptr;
+  for (const BoundaryLoop& l : report.loops) {
+    if (l.at_border) continue;
+    ++holes;
+    total += l.length_mm;
+    if (!largest) largest = &l;  // longest first
+  }
+  if (largest)
+    out.push_back(std::to_string(holes) + (holes == 1 ? " hole" : " holes") +
+                  fmt(" in the surface, %.0f mm of open edge in all; the largest is %.0f mm around",
+                      total, largest->length_mm) +
+                  fmt(", at (%.0f, %.0f, %.0f) mm", largest->centroid.x(), largest->centroid.y(),
+                      largest->centroid.z()) +
+                  "; left open, the bone's inside taken by votes through them");
+  return out;
+}
+
+MeshReport report_mesh(const SkullMesh& mesh) {
+  MeshReport r;
+  TriangleSoup soup = to_soup(mesh);
+  r.vertices = static_cast<long long>(soup.vertices.size());
+  r.triangles = static_cast<long long>(soup.triangles.size());
+  if (soup.vertices.empty()) return r;
+  r.bbox_min = r.bbox_max = soup.vertices[0];
+  for (const auto& p : soup.vertices) {
+    r.bbox_min = r.bbox_min.cwiseMin(p);
+    r.bbox_max = r.bbox_max.cwiseMax(p);
+  }
+  for (const auto& t : soup.triangles) {
+    const auto &a = soup.vertices[t[0]], &b = soup.vertices[t[1]], &c = soup.vertices[t[2]];
+    r.area_mm2 += 0.5 * (b - a).cross(c - a).norm();
+  }
+  r.volume_mm3 = signed_volume(soup);
+
+  // Weld identical positions, then count triangles per undirected edge.
+  std::map<std::array<double, 3>, int> weld;
+  std::vector<int> id(soup.vertices.size());
+  for (size_t i = 0; i < soup.vertices.size(); ++i) {
+    const auto& p = soup.vertices[i];
+    id[i] = weld.emplace(std::array<double, 3>{p.x(), p.y(), p.z()}, static_cast<int>(weld.size()))
+                .first->second;
+  }
+  std::unordered_map<unsigned long long, int> edge_count;
+  edge_count.reserve(soup.triangles.size() * 2);
+  for (auto& t : soup.triangles) {
+    for (int k = 0; k < 3; ++k) t[k] = id[t[k]];
+    for (int k = 0; k < 3; ++k) {
+      const unsigned long long a = static_cast<unsigned>(t[k]),
+                               b = static_cast<unsigned>(t[(k + 1) % 3]);
+      ++edge_count[std::min(a, b) << 32 | std::max(a, b)];
+    }
+  }
+  std::vector<std::pair<int, int>> boundary;
+  for (const auto& [edge, count] : edge_count) {
+    if (count == 1) {
+      ++r.boundary_edges;
+      boundary.emplace_back(static_cast<int>(edge >> 32), static_cast<int>(edge & 0xffffffffu));
+    }
+    if (count > 2) ++r.nonmanifold_edges;
+  }
+  soup.vertices.resize(weld.size());
+  for (const auto& [p, i] : weld) soup.vertices[i] = {p[0], p[1], p[2]};
+  // In the edges' order of the welded ids, not the hash map's: the same loops on any run.
+  std::sort(boundary.begin(), boundary.end());
+  r.loops = boundary_loops(soup, boundary, r.bbox_min, r.bbox_max);
+  r.pieces = static_cast<long long>(soup_components(soup).sizes.size());
+  r.watertight = r.boundary_edges == 0 && r.nonmanifold_edges == 0;
+  return r;
+}
+
+}  // namespace cranioplan

@@ -1,0 +1,476 @@
+#include "cranioplan/algorithms/io/read_mesh.h"
+
+#include <vtkNew.h>
+#include <vtkPolyData.h>
+#include <vtkSmartPointer.h>
+#include <vtkXMLPolyDataReader.h>
+
+#include <algorithm>
+#include <cassert>
+#include <cmath>
+#include <cstdint>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <sstream>
+
+#include "cranioplan/algorithms/geometry/mesh_components.h"
+#include "cranioplan/algorithms/io/file_io.h"
+#include "cranioplan/model/error.h"
+#include "file_bytes.h"
+#include "isolated_read.h"
+#include "mesh_formats.h"
+#include "soup_building.h"
+#include "vtk_errors.h"
+
+namespace cranioplan {
+namespace {
+
+// ---------------------------------------------------------------------------------------------
+// Vertex welding of float coordinates: open-addressing hash on the exact bit patterns.
+class FloatWelder {
+ public:
+  explicit FloatWelder(size_t expected_points) {
+    size_t cap = 16;
+    while (cap < expected_points * 2) cap <<= 1;
+    slots_.assign(cap, -1);
+    mask_ = cap - 1;
+    keys_.reserve(expected_points * 3);
+  }
+  int insert(const float* xyz) {
+    uint32_t k[3];
+    for (int i = 0; i < 3; ++i) {
+      const float v = xyz[i] == 0.0f ? 0.0f : xyz[i];  // -0 and +0 weld together
+      std::memcpy(&k[i], &v, 4);
+    }
+    size_t slot = hash(k) & mask_;
+    while (true) {
+      const int idx = slots_[slot];
+      if (idx < 0) {
+        const int id = static_cast<int>(keys_.size() / 3);
+        keys_.insert(keys_.end(), k, k + 3);
+        slots_[slot] = id;
+        // At most half the slots in use: the probe above always meets a free slot (a file's
+        // triangles may name up to three new points each, more than the size guessed).
+        if (2 * (keys_.size() / 3) > slots_.size()) grow();
+        return id;
+      }
+      const uint32_t* e = &keys_[static_cast<size_t>(idx) * 3];
+      if (e[0] == k[0] && e[1] == k[1] && e[2] == k[2]) return idx;
+      slot = (slot + 1) & mask_;
+    }
+  }
+  std::vector<Eigen::Vector3d> points() const {
+    std::vector<Eigen::Vector3d> out(keys_.size() / 3);
+    for (size_t i = 0; i < out.size(); ++i) {
+      float f[3];
+      std::memcpy(f, &keys_[i * 3], 12);
+      out[i] = {f[0], f[1], f[2]};
+    }
+    return out;
+  }
+
+ private:
+  static size_t hash(const uint32_t* k) {
+    uint64_t h = (k[0] * 0x9E3779B97F4A7C15ull) ^ (k[1] * 0xC2B2AE3D27D4EB4Full) ^
+                 (k[2] * 0x165667B19E3779F9ull);
+    h ^= h >> 29;
+    return static_cast<size_t>(h);
+  }
+  void grow() {
+    slots_.assign(slots_.size() * 2, -1);
+    mask_ = slots_.size() - 1;
+    for (size_t id = 0; id < keys_.size() / 3; ++id) {
+      size_t slot = hash(&keys_[id * 3]) & mask_;
+      while (slots_[slot] >= 0) slot = (slot + 1) & mask_;
+      slots_[slot] = static_cast<int>(id);
+    }
+  }
+  std::vector<int> slots_;
+  std::vector<uint32_t> keys_;
+  size_t mask_ = 0;
+};
+
+[[noreturn]] void fail(const std::string& path, const std::string& problem) {
+  throw InputError(path, problem);
+}
+
+void check_finite(const std::string& path, const Eigen::Vector3d& p, long long triangle) {
+  if (!std::isfinite(p.x()) || !std::isfinite(p.y()) || !std::isfinite(p.z()))
+    fail(path, "triangle " + format_count(triangle + 1) +
+                   " has a coordinate that is not a number (NaN or Inf)");
+}
+
+// ---------------------------------------------------------------------------------------------
+// STL
+bool looks_like_text(const std::string& bytes) {
+  const size_t n = std::min<size_t>(bytes.size(), 1024);
+  for (size_t i = 0; i < n; ++i) {
+    const unsigned char c = static_cast<unsigned char>(bytes[i]);
+    if (c == 0 || (c < 32 && c != '\n' && c != '\r' && c != '\t' && c != '\f' && c != '\v'))
+      return false;
+  }
+  size_t i = 0;
+  while (i < bytes.size() && std::isspace(static_cast<unsigned char>(bytes[i]))) ++i;
+  return bytes.compare(i, 5, "solid") == 0;
+}
+
+TriangleSoup parse_binary_stl(const std::string& path, const std::string& bytes, uint32_t n) {
+  FloatWelder welder(static_cast<size_t>(n) / 2 + 16);
+  TriangleSoup soup;
+  soup.triangles.resize(n);
+  const char* p = bytes.data() + 84;
+  for (uint32_t t = 0; t < n; ++t, p += 50) {
+    float xyz[9];
+    std::memcpy(xyz, p + 12, 36);
+    for (int c = 0; c < 9; ++c)
+      if (!std::isfinite(xyz[c]))
+        fail(path, "triangle " + format_count(t + 1LL) +
+                       " has a coordinate that is not a number (NaN or Inf)");
+    for (int v = 0; v < 3; ++v) soup.triangles[t][v] = welder.insert(xyz + 3 * v);
+  }
+  soup.vertices = welder.points();
+  return soup;
+}
+
+// A tokenizer over a null-terminated text buffer.
+struct TextCursor {
+  const char* p;
+  const char* end;
+  long long line = 1;
+  void skip_space() {
+    while (p < end && std::isspace(static_cast<unsigned char>(*p))) {
+      if (*p == '\n') ++line;
+      ++p;
+    }
+  }
+  std::string word() {
+    skip_space();
+    const char* s = p;
+    while (p < end && !std::isspace(static_cast<unsigned char>(*p))) ++p;
+    return std::string(s, p);
+  }
+  bool number(double& out) {
+    skip_space();
+    char* e = nullptr;
+    out = std::strtod(p, &e);
+    if (e == p) return false;
+    last = std::string(p, std::min<size_t>(static_cast<size_t>(e - p), 40));
+    p = e;
+    return true;
+  }
+  const std::string& last_word() const { return last; }
+  std::string last;  // the text of the last number read, for messages
+  bool at_end() {
+    skip_space();
+    return p >= end;
+  }
+};
+
+TriangleSoup parse_ascii_stl(const std::string& path, const std::string& bytes) {
+  TextCursor cur{bytes.c_str(), bytes.c_str() + bytes.size(), 1, {}};
+  auto expect = [&](const char* w) {
+    const std::string got = cur.word();
+    if (got != w)
+      fail(path, "ASCII STL: expected '" + std::string(w) + "' on line " + format_count(cur.line) +
+                     ", found '" + got.substr(0, 40) + "'");
+  };
+  cur.word();                                         // "solid"
+  while (cur.p < cur.end && *cur.p != '\n') ++cur.p;  // the solid's name
+  std::vector<float> coords;
+  std::vector<Eigen::Vector3i> tris;
+  while (true) {
+    if (cur.at_end()) fail(path, "ASCII STL: file ends without 'endsolid'");
+    const std::string w = cur.word();
+    if (w == "endsolid") break;
+    if (w != "facet")
+      fail(path, "ASCII STL: expected 'facet' or 'endsolid' on line " + format_count(cur.line) +
+                     ", found '" + w.substr(0, 40) + "'");
+    expect("normal");
+    double d;
+    for (int i = 0; i < 3; ++i)
+      if (!cur.number(d)) fail(path, "ASCII STL: bad normal on line " + format_count(cur.line));
+    expect("outer");
+    expect("loop");
+    for (int v = 0; v < 3; ++v) {
+      expect("vertex");
+      for (int i = 0; i < 3; ++i) {
+        if (!cur.number(d))
+          fail(path, "ASCII STL: bad vertex coordinate on line " + format_count(cur.line));
+        if (!std::isfinite(d))
+          fail(path, "triangle " + format_count(static_cast<long long>(tris.size()) + 1) +
+                         " has a coordinate that is not a number (NaN or Inf)");
+        coords.push_back(static_cast<float>(d));
+      }
+    }
+    expect("endloop");
+    expect("endfacet");
+    tris.emplace_back(0, 0, 0);
+  }
+  FloatWelder welder(tris.size() / 2 + 16);
+  TriangleSoup soup;
+  soup.triangles.resize(tris.size());
+  for (size_t t = 0; t < tris.size(); ++t)
+    for (int v = 0; v < 3; ++v) soup.triangles[t][v] = welder.insert(&coords[(t * 3 + v) * 3]);
+  soup.vertices = welder.points();
+  return soup;
+}
+
+TriangleSoup read_stl(const std::string& path, const std::string& bytes, std::string& format) {
+  const size_t size = bytes.size();
+  uint32_t n = 0;
+  if (size >= 84) std::memcpy(&n, bytes.data() + 80, 4);
+  const unsigned long long expected = 84ull + 50ull * n;
+  if (size >= 84 && size >= expected && size - expected < 50 &&
+      !(n == 0 && looks_like_text(bytes))) {
+    if (n == 0) fail(path, "binary STL declares 0 triangles");
+    format = "binary STL";
+    return parse_binary_stl(path, bytes, n);
+  }
+  if (looks_like_text(bytes)) {
+    format = "ASCII STL";
+    return parse_ascii_stl(path, bytes);
+  }
+  if (size < 84) fail(path, "too short for an STL file (" + format_count(size) + " bytes)");
+  if (size < expected)
+    fail(path, "file ends after " + format_count((size - 84) / 50) + " of " + format_count(n) +
+                   " triangles");
+  fail(path, "not an STL file: binary triangle count " + format_count(n) +
+                 " does not match the file size of " + format_count(size) +
+                 " bytes, and it is not ASCII STL");
+}
+
+// ---------------------------------------------------------------------------------------------
+// OFF and OBJ (text, polygons are fan-triangulated)
+TriangleSoup read_off(const std::string& path, const std::string& bytes) {
+  // Comments start with '#': blank them out of a copy for simple tokenizing.
+  std::string text = bytes;
+  for (size_t i = 0; i < text.size(); ++i)
+    if (text[i] == '#')
+      while (i < text.size() && text[i] != '\n') text[i++] = ' ';
+  TextCursor cur{text.c_str(), text.c_str() + text.size(), 1, {}};
+  const std::string magic = cur.word();
+  if (magic != "OFF") fail(path, "not an OFF file (first word is '" + magic.substr(0, 20) + "')");
+  double nv_d, nf_d, ne_d;
+  if (!cur.number(nv_d) || !cur.number(nf_d) || !cur.number(ne_d) || nv_d < 0 || nf_d < 0 ||
+      nv_d > 1e9 || nf_d > 1e9)
+    fail(path, "OFF header must give vertex, face and edge counts");
+  const long long nv = static_cast<long long>(nv_d), nf = static_cast<long long>(nf_d);
+  TriangleSoup soup;
+  soup.vertices.reserve(static_cast<size_t>(std::min<long long>(nv, 1 << 24)));
+  for (long long i = 0; i < nv; ++i) {
+    Eigen::Vector3d p;
+    for (int c = 0; c < 3; ++c)
+      if (!cur.number(p[c]))
+        fail(path, "file ends or is malformed at vertex " + format_count(i + 1) + " of " +
+                       format_count(nv));
+    soup.vertices.push_back(p);
+  }
+  std::vector<int> poly;
+  for (long long f = 0; f < nf; ++f) {
+    double k;
+    if (!cur.number(k) || k < 3 || k > 1e6)
+      fail(path,
+           "file ends or is malformed at face " + format_count(f + 1) + " of " + format_count(nf));
+    poly.resize(static_cast<size_t>(k));
+    for (auto& idx : poly) {
+      double v;
+      if (!cur.number(v)) fail(path, "malformed face " + format_count(f + 1));
+      // Checked before the cast: a double beyond int's range has no int value (UB).
+      if (!(std::abs(v) <= 2e9))
+        fail(path, "face " + format_count(f + 1) + " uses vertex " + cur.last_word() +
+                       " but the file has " + format_count(nv) + " vertices");
+      idx = static_cast<int>(v);
+    }
+    // Colour values may follow on the same line.
+    while (cur.p < cur.end && *cur.p != '\n') ++cur.p;
+    detail::add_polygon(path, poly, static_cast<int>(nv), soup.triangles, "face on line", cur.line);
+  }
+  return soup;
+}
+
+TriangleSoup read_obj(const std::string& path, const std::string& bytes) {
+  TriangleSoup soup;
+  std::istringstream in(bytes);
+  std::string line;
+  long long line_no = 0;
+  std::vector<int> poly;
+  while (std::getline(in, line)) {
+    ++line_no;
+    if (line.size() < 2) continue;
+    if (line[0] == 'v' && line[1] == ' ') {
+      Eigen::Vector3d p;
+      char* s = line.data() + 2;
+      for (int c = 0; c < 3; ++c) {
+        char* e = nullptr;
+        p[c] = std::strtod(s, &e);
+        if (e == s) fail(path, "malformed vertex on line " + format_count(line_no));
+        s = e;
+      }
+      soup.vertices.push_back(p);
+    } else if (line[0] == 'f' && line[1] == ' ') {
+      poly.clear();
+      std::istringstream fs(line.substr(2));
+      std::string tok;
+      while (fs >> tok) {
+        char* e = nullptr;
+        const long v = std::strtol(tok.c_str(), &e, 10);
+        if (e == tok.c_str() || v == 0)
+          fail(path, "malformed face on line " + format_count(line_no));
+        // OBJ counts from 1, or back from the last vertex so far with negative numbers.
+        if (std::labs(v) > static_cast<long>(soup.vertices.size()))
+          fail(path, "face on line " + format_count(line_no) + " uses vertex " + std::to_string(v) +
+                         " but only " + format_count(soup.vertices.size()) +
+                         " vertices come before it");
+        poly.push_back(v > 0 ? static_cast<int>(v - 1)
+                             : static_cast<int>(soup.vertices.size()) + static_cast<int>(v));
+      }
+      if (poly.size() < 3)
+        fail(path, "face with fewer than 3 vertices on line " + format_count(line_no));
+      detail::add_polygon(path, poly, static_cast<int>(soup.vertices.size()), soup.triangles,
+                          "face on line", line_no);
+    }
+  }
+  return soup;
+}
+
+// ---------------------------------------------------------------------------------------------
+// VTK's XML reader leaks on some malformed files and is not proved against crashing on them:
+// it runs in a child process (isolated_read.h), which sends the soup back.
+TriangleSoup read_vtp(const std::string& path) {
+  const std::string bytes =
+      detail::run_isolated(path, "VTK's VTP reader", [&](detail::ChildReport& report) {
+        report.reading(path);
+        vtkNew<vtkXMLPolyDataReader> reader;
+        const detail::VtkErrorCatcher errors(reader);
+        reader->SetFileName(path.c_str());
+        reader->Update();
+        const std::string error = errors.message();
+        if (!error.empty()) fail(path, "not a readable VTP file (" + error + ")");
+        const TriangleSoup soup = detail::soup_from_polydata(path, reader->GetOutput());
+        detail::ByteWriter w;
+        w.pod<uint64_t>(soup.vertices.size());
+        w.raw(soup.vertices.data(), soup.vertices.size() * sizeof(Eigen::Vector3d));
+        w.pod<uint64_t>(soup.triangles.size());
+        w.raw(soup.triangles.data(), soup.triangles.size() * sizeof(Eigen::Vector3i));
+        report.result(w.take());
+      });
+  detail::ByteReader r(bytes);
+  TriangleSoup soup;
+  soup.vertices.resize(r.pod<uint64_t>());
+  r.raw(soup.vertices.data(), soup.vertices.size() * sizeof(Eigen::Vector3d));
+  soup.triangles.resize(r.pod<uint64_t>());
+  r.raw(soup.triangles.data(), soup.triangles.size() * sizeof(Eigen::Vector3i));
+  return soup;
+}
+
+// The volume the triangles enclose, taken about the vertices' centroid (for a surface with
+// holes, as a skull's base and defect are, a point inside keeps the open parts' share small).
+double enclosed_volume(const TriangleSoup& soup) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const auto& v : soup.vertices) c += v;
+  return signed_volume(soup, c / static_cast<double>(std::max<size_t>(1, soup.vertices.size())));
+}
+
+// Drops the pieces that lie more than `far_mm` from the largest piece's bounding box.
+void drop_far_pieces(const std::string& path, double far_mm, TriangleSoup& soup, MeshFile& out) {
+  const SoupComponents comps = soup_components(soup);
+  if (comps.sizes.size() < 2) return;
+  const std::vector<PieceBox> boxes = piece_boxes(soup, comps);
+  std::vector<bool> keep(comps.sizes.size(), true);
+  double farthest = 0.0;
+  for (size_t c = 1; c < keep.size(); ++c) {
+    const double gap = boxes[c].gap_to(boxes[0]);
+    if (gap <= far_mm) continue;
+    keep[c] = false;
+    ++out.pieces_dropped;
+    out.triangles_dropped += comps.sizes[c];
+    farthest = std::max(farthest, gap);
+  }
+  if (out.pieces_dropped == 0) return;
+  soup = keep_pieces(soup, comps, keep);
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), "%.0f mm", farthest);
+  out.warnings.push_back(
+      path + ": " + format_count(out.pieces_dropped) + " piece" +
+      (out.pieces_dropped == 1 ? "" : "s") + " of " + format_count(out.triangles_dropped) +
+      " triangles lying apart from the skull (up to " + buf + " from it) " +
+      (out.pieces_dropped == 1 ? "was" : "were") + " dropped; the skull is its largest piece (" +
+      format_count(comps.sizes[0]) + " triangles) and what lies within " +
+      std::to_string(static_cast<int>(far_mm)) + " mm of it");
+}
+
+}  // namespace
+
+TriangleSoup read_mesh_soup(const std::string& path, std::string* format_out) {
+  const std::string bytes = read_file_bytes(path);
+  const std::string ext = detail::lower_extension(path);
+  std::string format;
+  TriangleSoup soup;
+  if (ext == ".stl") {
+    soup = read_stl(path, bytes, format);
+  } else if (ext == ".off") {
+    format = "OFF";
+    soup = read_off(path, bytes);
+  } else if (ext == ".obj") {
+    format = "OBJ";
+    soup = read_obj(path, bytes);
+  } else if (ext == ".ply") {
+    format = "PLY";
+    soup = detail::read_ply(path, bytes);
+  } else if (ext == ".vtp") {
+    format = "VTP";
+    if (bytes.find("<VTKFile") == std::string::npos)
+      fail(path, "not a VTP file (no <VTKFile> element)");
+    soup = read_vtp(path);
+  } else {
+    fail(path, "unknown mesh format '" + ext + "' (expected .stl, .ply, .obj, .off or .vtp)");
+  }
+  if (soup.triangles.empty()) fail(path, "contains no triangles");
+  if (format != "binary STL" && format != "ASCII STL")  // STL parsers check as they read
+    for (size_t t = 0; t < soup.triangles.size(); ++t)
+      for (int v = 0; v < 3; ++v)
+        check_finite(path, soup.vertices[soup.triangles[t][v]], static_cast<long long>(t));
+  if (format_out) *format_out = format;
+  return soup;
+}
+
+MeshFile read_mesh(const std::string& path, const ReadMeshParams& params) {
+  MeshFile out;
+  TriangleSoup soup = read_mesh_soup(path, &out.format);
+  out.triangles_in_file = static_cast<long long>(soup.triangles.size());
+  assert(params.unit_mm > 0.0 && std::isfinite(params.unit_mm) && "validated by the caller");
+  if (params.unit_mm != 1.0)
+    for (auto& v : soup.vertices) v *= params.unit_mm;
+  if (params.far_piece_mm > 0.0) drop_far_pieces(path, params.far_piece_mm, soup, out);
+  if (params.orient_outward && enclosed_volume(soup) < 0.0) {
+    for (auto& t : soup.triangles) std::swap(t[1], t[2]);
+    out.turned_outward = true;
+    out.warnings.push_back(path +
+                           ": the surface was inside out (its triangles wind inward); it was "
+                           "turned outward");
+  }
+  if (params.canonical) make_canonical(soup);
+
+  BuildMeshStats stats;
+  out.mesh = build_mesh(soup, &stats);
+  out.degenerate_dropped = stats.degenerate_dropped;
+  out.nonmanifold_split = stats.nonmanifold_split;
+  if (out.mesh.n_faces() == 0)
+    fail(path, "all " + format_count(out.triangles_in_file) +
+                   " triangles have zero area; there is no surface to use");
+  if (stats.degenerate_dropped > 0) {
+    const std::string msg = format_count(stats.degenerate_dropped) + " of " +
+                            format_count(out.triangles_in_file) +
+                            " triangles have zero area or a repeated vertex";
+    if (params.strict) fail(path, msg);
+    out.warnings.push_back(path + ": " + msg + "; they were removed");
+  }
+  if (stats.nonmanifold_split > 0)
+    out.warnings.push_back(path + ": " + format_count(stats.nonmanifold_split) +
+                           " triangles share an edge with two or more others (non-manifold); "
+                           "they were kept on separate vertices");
+  return out;
+}
+
+}  // namespace cranioplan

@@ -1,0 +1,217 @@
+// NRRD (teem) volumes: attached or detached data, raw or gzip, `space directions` (possibly
+// oblique) and `space origin`; `spacings` when no directions are given.
+#include <algorithm>
+#include <cctype>
+#include <cstdlib>
+#include <filesystem>
+#include <map>
+#include <optional>
+#include <sstream>
+
+#include "cranioplan/algorithms/io/file_io.h"
+#include "cranioplan/model/error.h"
+#include "file_bytes.h"
+#include "volume_formats.h"
+
+namespace cranioplan::detail {
+namespace {
+
+std::string trim(const std::string& s) {
+  size_t a = 0, b = s.size();
+  while (a < b && std::isspace(static_cast<unsigned char>(s[a]))) ++a;
+  while (b > a && std::isspace(static_cast<unsigned char>(s[b - 1]))) --b;
+  return s.substr(a, b - a);
+}
+
+SampleType parse_type(const std::string& path, std::string t) {
+  static const std::map<std::string, SampleType> types = {
+      {"signed char", SampleType::Int8},    {"int8", SampleType::Int8},
+      {"int8_t", SampleType::Int8},         {"uchar", SampleType::UInt8},
+      {"unsigned char", SampleType::UInt8}, {"uint8", SampleType::UInt8},
+      {"uint8_t", SampleType::UInt8},       {"short", SampleType::Int16},
+      {"short int", SampleType::Int16},     {"signed short", SampleType::Int16},
+      {"int16", SampleType::Int16},         {"int16_t", SampleType::Int16},
+      {"ushort", SampleType::UInt16},       {"unsigned short", SampleType::UInt16},
+      {"uint16", SampleType::UInt16},       {"uint16_t", SampleType::UInt16},
+      {"int", SampleType::Int32},           {"signed int", SampleType::Int32},
+      {"int32", SampleType::Int32},         {"int32_t", SampleType::Int32},
+      {"uint", SampleType::UInt32},         {"unsigned int", SampleType::UInt32},
+      {"uint32", SampleType::UInt32},       {"uint32_t", SampleType::UInt32},
+      {"float", SampleType::Float32},       {"double", SampleType::Float64}};
+  std::transform(t.begin(), t.end(), t.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  const auto it = types.find(t);
+  if (it == types.end()) throw InputError(path, "NRRD type '" + t + "' is not supported");
+  return it->second;
+}
+
+// "(a,b,c)" → vector; "none" → empty.
+std::vector<Eigen::Vector3d> parse_vectors(const std::string& path, const std::string& field,
+                                           const std::string& text) {
+  std::vector<Eigen::Vector3d> out;
+  size_t p = 0;
+  while ((p = text.find_first_not_of(" \t", p)) != std::string::npos) {
+    if (text.compare(p, 4, "none") == 0) {
+      p += 4;
+      continue;
+    }
+    if (text[p] != '(') throw InputError(path, "NRRD field '" + field + "' is malformed");
+    const size_t q = text.find(')', p);
+    if (q == std::string::npos) throw InputError(path, "NRRD field '" + field + "' is malformed");
+    std::string inner = text.substr(p + 1, q - p - 1);
+    std::replace(inner.begin(), inner.end(), ',', ' ');
+    std::istringstream in(inner);
+    Eigen::Vector3d v;
+    if (!(in >> v.x() >> v.y() >> v.z()) || !v.allFinite())
+      throw InputError(path, "NRRD field '" + field + "' must hold 3 numbers per vector");
+    out.push_back(v);
+    p = q + 1;
+  }
+  return out;
+}
+
+// The NRRD `space` (its name or abbreviation) as signs of LPS's axes; none for spaces that are
+// no patient's (scanner-xyz, 3D-right-handed) or absent.
+std::optional<Eigen::Vector3d> patient_space_signs(std::string space) {
+  std::transform(space.begin(), space.end(), space.begin(),
+                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+  if (space == "left-posterior-superior" || space == "lps") return Eigen::Vector3d(1, 1, 1);
+  if (space == "right-anterior-superior" || space == "ras") return Eigen::Vector3d(-1, -1, 1);
+  if (space == "left-anterior-superior" || space == "las") return Eigen::Vector3d(1, -1, 1);
+  return std::nullopt;
+}
+
+void frame_from_space(const std::string& path, const std::string& space, bool patient_frame,
+                      Volume& v) {
+  const std::optional<Eigen::Vector3d> signs = patient_space_signs(space);
+  if (!signs) {
+    v.frame = space.empty() ? std::string("none declared (NRRD without 'space')")
+                            : "NRRD space '" + space + "' (no patient's)";
+    v.frame += "; read as LPS";
+    v.warnings.push_back(path + ": the file declares " +
+                         (space.empty() ? std::string("no patient space")
+                                        : "the space '" + space + "', which is no patient's") +
+                         ", so the patient's left and right are not known from it; its axes "
+                         "were read as left, posterior, superior");
+    return;
+  }
+  v.frame = "NRRD space " + space;
+  if (patient_frame && *signs != Eigen::Vector3d(1, 1, 1)) {
+    flip_axes(v, *signs);
+    v.frame += ", turned to LPS";
+  }
+}
+
+}  // namespace
+
+Volume read_nrrd(const std::string& path, bool patient_frame) {
+  const std::string bytes = read_file_bytes(path);
+  if (bytes.compare(0, 4, "NRRD") != 0) throw InputError(path, "not a NRRD file (no 'NRRD' magic)");
+  std::map<std::string, std::string> fields;
+  size_t pos = bytes.find('\n');
+  if (pos == std::string::npos) throw InputError(path, "NRRD header is not terminated");
+  ++pos;
+  bool header_done = false;
+  while (pos < bytes.size()) {
+    size_t eol = bytes.find('\n', pos);
+    if (eol == std::string::npos) eol = bytes.size();
+    std::string line = bytes.substr(pos, eol - pos);
+    pos = eol + 1;
+    if (!line.empty() && line.back() == '\r') line.pop_back();
+    if (line.empty()) {
+      header_done = true;
+      break;
+    }
+    if (line[0] == '#') continue;
+    const size_t colon = line.find(": ");
+    if (colon == std::string::npos) continue;  // key:=value pairs and unknown lines
+    std::string key = line.substr(0, colon);
+    std::transform(key.begin(), key.end(), key.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    fields[key] = trim(line.substr(colon + 2));
+  }
+  auto field = [&](const std::string& k) -> std::string {
+    auto it = fields.find(k);
+    return it == fields.end() ? std::string() : it->second;
+  };
+  const std::string data_file =
+      !field("data file").empty() ? field("data file") : field("datafile");
+  if (!header_done && data_file.empty())
+    throw InputError(path, "NRRD header does not end with a blank line before the data");
+  if (field("dimension") != "3")
+    throw InputError(path, "only 3-dimensional NRRD volumes are supported (dimension: " +
+                               field("dimension") + ")");
+  if (field("type").empty() || field("sizes").empty() || field("encoding").empty())
+    throw InputError(path, "NRRD header lacks type, sizes or encoding");
+  const SampleType type = parse_type(path, field("type"));
+  Volume v;
+  {
+    std::istringstream in(field("sizes"));
+    for (int a = 0; a < 3; ++a) {
+      long long s = 0;
+      if (!(in >> s) || s < 1 || s > 100000)
+        throw InputError(path, "NRRD sizes must be 3 positive numbers ('" + field("sizes") + "')");
+      v.dims[a] = static_cast<int>(s);
+    }
+  }
+  if (!field("space directions").empty()) {
+    const auto dirs = parse_vectors(path, "space directions", field("space directions"));
+    if (dirs.size() != 3)
+      throw InputError(path, "NRRD 'space directions' must give 3 vectors for a 3D volume");
+    for (int a = 0; a < 3; ++a) v.directions.col(a) = dirs[a];
+  } else if (!field("spacings").empty()) {
+    std::istringstream in(field("spacings"));
+    Eigen::Vector3d s;
+    if (!(in >> s.x() >> s.y() >> s.z()) || !(s.array() > 0).all())
+      throw InputError(path, "NRRD 'spacings' must be 3 positive numbers");
+    v.directions = s.asDiagonal();
+  }
+  if (!field("space origin").empty()) {
+    const auto o = parse_vectors(path, "space origin", field("space origin"));
+    if (o.size() != 1) throw InputError(path, "NRRD 'space origin' must be one vector");
+    v.origin = o[0];
+  }
+  frame_from_space(path, field("space"), patient_frame, v);
+  const std::string encoding = field("encoding");
+  const bool big_endian = field("endian") == "big";
+  std::string detached;
+  const char* data = nullptr;
+  size_t available = 0;
+  if (!data_file.empty()) {
+    std::filesystem::path dp(data_file);
+    if (dp.is_relative()) dp = std::filesystem::path(path).parent_path() / dp;
+    detached = read_file_bytes(dp.string());
+    data = detached.data();
+    available = detached.size();
+  } else {
+    data = bytes.data() + pos;
+    available = bytes.size() - std::min(pos, bytes.size());
+  }
+  const size_t need = v.size() * sample_size(type);
+  std::string inflated;
+  if (encoding == "gzip" || encoding == "gz") {
+    inflated = gunzip(path, data, available, need);
+    data = inflated.data();
+    available = inflated.size();
+  } else if (encoding == "raw") {
+    // "byte skip: -1" means the data is the last `need` bytes; otherwise sizes must agree.
+    if (field("byte skip") == "-1" && available > need) {
+      data += available - need;
+      available = need;
+    } else if (available > need) {
+      throw InputError(path, "the header announces " + format_count(static_cast<long long>(need)) +
+                                 " bytes of samples but the data holds " +
+                                 format_count(static_cast<long long>(available)));
+    }
+  } else {
+    throw InputError(path, "NRRD encoding '" + encoding + "' is not supported (use raw or gzip)");
+  }
+  convert_samples(path, data, available, v.size(), type, big_endian, v.data);
+  std::ostringstream d;
+  d << "NRRD " << v.dims[0] << "×" << v.dims[1] << "×" << v.dims[2] << " " << field("type");
+  v.description = d.str();
+  classify_kind(v);
+  return v;
+}
+
+}  // namespace cranioplan::detail

@@ -1,0 +1,264 @@
+#include "cranioplan/algorithms/quality/check_implant.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <deque>
+#include <memory>
+
+#include "cranioplan/algorithms/geometry/distance_transform.h"
+#include "cranioplan/algorithms/geometry/self_intersections.h"
+#include "cranioplan/algorithms/geometry/surface_locator.h"
+#include "cranioplan/algorithms/geometry/voxelize_mesh.h"
+#include "cranioplan/algorithms/io/mesh_report.h"
+#include "cranioplan/model/plane.h"
+
+namespace cranioplan {
+namespace {
+std::string fmt(const char* f, double a, double b) {
+  char buf[200];
+  std::snprintf(buf, sizeof(buf), f, a, b);
+  return buf;
+}
+std::string fmt1(const char* f, double a) {
+  char buf[64];
+  std::snprintf(buf, sizeof(buf), f, a);
+  return buf;
+}
+// Material thinner than the minimum: the solid minus its opening by a ball of that diameter
+// (the union of the balls that fit inside). Where it lies within its own thinness of the bone
+// it is the tapered edge of an implant resting on the bone; how far it reaches from the thick
+// part is the width of that taper.
+void measure_thin_material(const std::vector<uint8_t>& solid, const std::vector<float>& depth,
+                           const VoxelGrid& grid, const std::vector<float>& bone_distance,
+                           const QualityParams& params, QualityReport& q) {
+  const double r = 0.5 * std::max(0.0, params.min_thickness_mm), h = grid.spacing;
+  const std::vector<uint8_t> centres = ball_centres(depth, grid, r);
+  if (std::find(centres.begin(), centres.end(), 1) == centres.end()) {
+    q.taper_reach_mm = q.corner_reach_mm = -1.0;
+    return;
+  }
+  const std::vector<float> to_core = distance_to_mask(centres, grid);
+  size_t thin = 0, off_bone = 0;
+  for (size_t c = 0; c < solid.size(); ++c) {
+    if (!solid[c] || to_core[c] <= r + h) continue;  // within a ball that fits (one voxel slack)
+    ++thin;
+    const double reach = static_cast<double>(to_core[c]) - r;
+    if (!bone_distance.empty() && bone_distance[c] <= params.min_thickness_mm + 1.5 * h) {
+      q.taper_reach_mm = std::max(q.taper_reach_mm, reach);
+    } else {
+      ++off_bone;
+      q.corner_reach_mm = std::max(q.corner_reach_mm, reach);
+    }
+  }
+  q.thin_volume_mm3 = static_cast<double>(thin) * grid.voxel_volume();
+  q.thin_off_bone_mm3 = static_cast<double>(off_bone) * grid.voxel_volume();
+}
+
+}  // namespace
+
+double worst_arc_gap(const std::vector<double>& angle, const std::vector<double>& distance,
+                     double arc_rad) {
+  const size_t n = std::min(angle.size(), distance.size());
+  if (n == 0) return 0.0;
+  std::vector<std::pair<double, double>> at(n);  // (angle in [0, 2π), distance)
+  for (size_t i = 0; i < n; ++i) {
+    const double a = std::fmod(angle[i], 2 * M_PI);
+    at[i] = {a < 0 ? a + 2 * M_PI : a, distance[i]};
+  }
+  std::sort(at.begin(), at.end());
+  const double w = std::clamp(arc_rad, 0.0, 2 * M_PI);
+  auto angle_of = [&](size_t k) { return at[k % n].first + (k >= n ? 2 * M_PI : 0.0); };
+  // An arc's points are a run of the sorted points; the arcs whose minimum can be the largest
+  // hold the smallest runs: an arc that begins just past point j, (a_j, a_j + w], and, where
+  // the next point lies more than w further on, that point alone. Their minima by a sliding
+  // window (a deque of increasing distances) over the points taken twice around.
+  double worst = 0.0;
+  std::deque<size_t> window;
+  size_t next = 1;  // the first point not yet in the window
+  for (size_t j = 0; j < n; ++j) {
+    while (!window.empty() && window.front() <= j) window.pop_front();
+    if (next <= j) next = j + 1;
+    while (next < j + n && angle_of(next) <= angle_of(j) + w) {
+      while (!window.empty() && at[window.back() % n].second >= at[next % n].second)
+        window.pop_back();
+      window.push_back(next++);
+    }
+    if (!window.empty()) {
+      worst = std::max(worst, at[window.front() % n].second);
+    } else {
+      worst = std::max(worst, at[(j + 1) % n].second);  // the next point, alone
+    }
+  }
+  return worst;
+}
+
+namespace {
+
+// The deepest voxel along the segment from `a` to `b` (sampled every half voxel), in mm.
+double deepest_along(const std::vector<float>& depth, const VoxelGrid& grid,
+                     const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  const int steps = 1 + static_cast<int>((b - a).norm() / (0.5 * grid.spacing));
+  double deepest = 0.0;
+  for (int t = 0; t <= steps; ++t) {
+    const Eigen::Vector3d v = (a + (b - a) * (double(t) / steps) - grid.origin) / grid.spacing;
+    const int i = static_cast<int>(std::lround(v.x())), j = static_cast<int>(std::lround(v.y())),
+              k = static_cast<int>(std::lround(v.z()));
+    if (i < 0 || j < 0 || k < 0 || i >= grid.dims[0] || j >= grid.dims[1] || k >= grid.dims[2])
+      continue;
+    deepest = std::max(deepest, static_cast<double>(depth[grid.index(i, j, k)]));
+  }
+  return deepest;
+}
+
+}  // namespace
+
+QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
+                            const QualityParams& params) {
+  return check_implant(implant, skull, nullptr, params);
+}
+
+QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
+                            const SurfaceLocator* skull_locator, const QualityParams& params) {
+  QualityReport q;
+  const MeshReport rep = report_mesh(implant);
+  q.watertight = rep.watertight;
+  q.manifold = rep.nonmanifold_edges == 0;
+  q.volume_mm3 = rep.volume_mm3;
+  q.area_mm2 = rep.area_mm2;
+  q.outward = rep.volume_mm3 > 0;
+  q.pieces = rep.pieces;
+  q.self_intersections = count_self_intersections(implant);
+  if (implant.n_faces() == 0) {
+    q.reasons.push_back("the implant has no triangles");
+    return q;
+  }
+
+  // Principal axes of the implant's vertices: the thinnest one is across the plate.
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (auto vh : implant.vertices()) c += to_eigen(implant.point(vh));
+  c /= static_cast<double>(implant.n_vertices());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (auto vh : implant.vertices()) {
+    const Eigen::Vector3d d = to_eigen(implant.point(vh)) - c;
+    cov += d * d.transpose();
+  }
+  const Eigen::Vector3d axis =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
+
+  // The implant as a solid on a grid: its depth bounds the thickness, and it gives the thin
+  // material and, with a skull, the overlap.
+  const auto [lo, hi] = mesh_bounds(implant);
+  const VoxelGrid grid =
+      VoxelGrid::covering_at_most(lo, hi, std::clamp(params.overlap_voxel_mm, 0.05, 2.0),
+                                  std::max(1e5, params.overlap_max_voxels));
+  const std::vector<uint8_t> solid = voxelize_mesh(implant, grid);
+  const std::vector<float> depth = depth_in_mask(solid, grid);
+
+  const SurfaceLocator self(implant);
+  std::vector<double> thickness;
+  std::vector<int> wall_vertices;
+  // Thickness from at most 60,000 faces spread evenly over the implant (one ray each): a mesh
+  // trimmed on a fine grid has hundreds of thousands of faces, and a thin region spans many.
+  const size_t stride = std::max<size_t>(1, (implant.n_faces() + 59999) / 60000);
+  for (auto fh : implant.faces()) {
+    const bool measure = static_cast<size_t>(fh.idx()) % stride == 0;
+    Eigen::Vector3d p[3];
+    int ids[3], k = 0;
+    for (auto vh : implant.fv_range(fh)) {
+      ids[k] = vh.idx();
+      p[k++] = to_eigen(implant.point(vh));
+    }
+    Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]);
+    if (n.norm() == 0) continue;
+    n.normalize();
+    if (std::abs(n.dot(axis)) >= std::cos(M_PI / 4)) {
+      if (!measure) continue;
+      const Eigen::Vector3d centre = (p[0] + p[1] + p[2]) / 3.0;
+      const auto hit = self.first_hit(centre - 1e-4 * n, centre - 200.0 * n);
+      if (!hit) continue;
+      // Where the plate curves, a normal can leave it at a grazing angle and run along it (on
+      // the sample's frontal implant up to 27 mm through a plate 8 mm at its thickest): the
+      // thickness there is at most the diameter of the deepest ball the ray passes, twice the
+      // deepest voxel's depth plus a voxel for the sampling.
+      const double along = hit->distance + 1e-4;
+      const double ball = 2.0 * deepest_along(depth, grid, centre, hit->point) + grid.spacing;
+      thickness.push_back(std::min(along, ball));
+    } else {
+      wall_vertices.insert(wall_vertices.end(), ids, ids + 3);
+    }
+  }
+  if (!thickness.empty()) {
+    std::sort(thickness.begin(), thickness.end());
+    q.thickness_min_mm = thickness.front();
+    q.thickness_median_mm = thickness[thickness.size() / 2];
+    q.thickness_max_mm = thickness.back();
+  }
+  std::vector<float> bone_distance;  // empty without a skull
+  if (skull && skull->n_faces() > 0) {
+    std::unique_ptr<SurfaceLocator> own;
+    if (!skull_locator) own = std::make_unique<SurfaceLocator>(*skull);
+    const SurfaceLocator& bone = skull_locator ? *skull_locator : *own;
+    // The gap along the rim: over every 5° arc around the implant's axis, the side-wall vertex
+    // nearest the bone; the rim gap is the worst arc.
+    std::sort(wall_vertices.begin(), wall_vertices.end());
+    wall_vertices.erase(std::unique(wall_vertices.begin(), wall_vertices.end()),
+                        wall_vertices.end());
+    const Eigen::Vector3d e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
+    std::vector<double> angle, distance;
+    angle.reserve(wall_vertices.size());
+    distance.reserve(wall_vertices.size());
+    for (int v : wall_vertices) {
+      const Eigen::Vector3d p = to_eigen(implant.point(SkullMesh::VertexHandle(v)));
+      angle.push_back(std::atan2((p - c).dot(e2), (p - c).dot(e1)));
+      distance.push_back(bone.closest(p).distance);
+    }
+    q.rim_gap_mm = worst_arc_gap(angle, distance, M_PI / 36);
+    const std::vector<uint8_t> b = voxelize_mesh(*skull, grid);
+    long long both = 0;
+    for (size_t i = 0; i < solid.size(); ++i) both += solid[i] && b[i];
+    q.penetration_mm3 = static_cast<double>(both) * grid.voxel_volume();
+    bone_distance = distance_to_mask(b, grid);
+  }
+  measure_thin_material(solid, depth, grid, bone_distance, params, q);
+
+  if (!q.watertight)
+    q.reasons.push_back("not watertight (" + std::to_string(rep.boundary_edges) +
+                        " boundary edges)");
+  if (!q.manifold)
+    q.reasons.push_back(std::to_string(rep.nonmanifold_edges) + " non-manifold edges");
+  if (!q.outward) q.reasons.push_back("faces point inwards (negative volume)");
+  if (q.self_intersections > 0)
+    q.reasons.push_back(std::to_string(q.self_intersections) +
+                        " pairs of triangles cross each other");
+  if (q.taper_reach_mm < 0)
+    q.reasons.push_back(fmt("nowhere is the implant %.2f mm thick (thickest %.2f mm)",
+                            params.min_thickness_mm, q.thickness_max_mm));
+  if (q.corner_reach_mm > params.max_corner_mm)
+    q.reasons.push_back(
+        fmt(bone_distance.empty() ? "it is thinner than %.2f mm for %.1f mm"
+                                  : "away from the bone it is thinner than %.2f mm for %.1f mm",
+            params.min_thickness_mm, q.corner_reach_mm) +
+        " (" + fmt1("%.1f", q.thin_off_bone_mm3) + " mm³; a sharp corner may be " +
+        fmt1("%.1f", params.max_corner_mm) + " mm" +
+        (bone_distance.empty() ? "; without the skull a tapered edge on the bone cannot be told"
+                                 " from a corner: check with the skull)"
+                               : ")"));
+  if (q.taper_reach_mm > params.max_taper_mm)
+    q.reasons.push_back(fmt("its edge stays thinner than %.2f mm for %.1f mm",
+                            params.min_thickness_mm, q.taper_reach_mm) +
+                        " (a tapered edge on the bone may be " + fmt1("%.1f", params.max_taper_mm) +
+                        " mm wide)");
+  if (q.rim_gap_mm > params.max_rim_gap_mm)
+    q.reasons.push_back(fmt("gap of %.2f mm between the rim and the bone (limit %.2f mm)",
+                            q.rim_gap_mm, params.max_rim_gap_mm));
+  if (q.penetration_mm3 > params.max_penetration_mm3)
+    q.reasons.push_back(fmt("%.1f mm³ overlap the skull (limit %.1f mm³)", q.penetration_mm3,
+                            params.max_penetration_mm3));
+  q.printable = q.reasons.empty();
+  return q;
+}
+
+}  // namespace cranioplan

@@ -1,0 +1,163 @@
+#include "cranioplan/algorithms/geometry/surface_locator.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <limits>
+#include <random>
+
+#include "cranioplan/algorithms/alignment/mirror_mesh.h"
+#include "cranioplan/algorithms/alignment/register_icp.h"
+#include "support/synthetic.h"
+
+namespace cranioplan {
+namespace {
+
+struct Triangle {
+  Eigen::Vector3d a, b, c;
+};
+
+std::vector<Triangle> triangles(const SkullMesh& mesh) {
+  std::vector<Triangle> out;
+  for (auto fh : mesh.faces()) {
+    std::vector<Eigen::Vector3d> p;
+    for (auto vh : mesh.fv_range(fh)) p.push_back(to_eigen(mesh.point(vh)));
+    out.push_back({p[0], p[1], p[2]});
+  }
+  return out;
+}
+
+// Brute force: the distance to a triangle by minimising over a fine barycentric grid is too
+// coarse for 1e-9, so the reference is the exact distance to the triangle's plane when the foot
+// is inside, else to its three edges.
+double distance_to_segment(const Eigen::Vector3d& p, const Eigen::Vector3d& a,
+                           const Eigen::Vector3d& b) {
+  const Eigen::Vector3d ab = b - a;
+  const double t = std::clamp((p - a).dot(ab) / ab.squaredNorm(), 0.0, 1.0);
+  return (a + t * ab - p).norm();
+}
+
+double distance_to_triangle(const Eigen::Vector3d& p, const Triangle& t) {
+  const Eigen::Vector3d n = (t.b - t.a).cross(t.c - t.a).normalized();
+  const Eigen::Vector3d foot = p - n.dot(p - t.a) * n;
+  const auto side = [&](const Eigen::Vector3d& u, const Eigen::Vector3d& v) {
+    return (v - u).cross(foot - u).dot(n) >= 0;
+  };
+  if (side(t.a, t.b) && side(t.b, t.c) && side(t.c, t.a)) return (foot - p).norm();
+  return std::min({distance_to_segment(p, t.a, t.b), distance_to_segment(p, t.b, t.c),
+                   distance_to_segment(p, t.c, t.a)});
+}
+
+// Möller–Trumbore without tolerance: the reference for segments that miss every edge.
+std::optional<double> segment_hit(const Eigen::Vector3d& o, const Eigen::Vector3d& d,
+                                  const Triangle& t) {
+  const Eigen::Vector3d e1 = t.b - t.a, e2 = t.c - t.a, h = d.cross(e2);
+  const double det = e1.dot(h);
+  if (std::abs(det) < 1e-15) return std::nullopt;
+  const Eigen::Vector3d s = o - t.a, q = s.cross(e1);
+  const double u = s.dot(h) / det, v = d.dot(q) / det, s_t = e2.dot(q) / det;
+  if (u < 0 || v < 0 || u + v > 1 || s_t < 0 || s_t > 1) return std::nullopt;
+  return s_t;
+}
+
+// Closest points and first hits agree with brute force over every face of an open head (a hole
+// cut, so that segments leave through it too) for random queries inside, on and around it.
+TEST(SurfaceLocator, AgreesWithBruteForce) {
+  const SkullMesh head = test::cut_hole(test::make_symmetric_head(3), {40, 20, 50}, 30);
+  const std::vector<Triangle> tris = triangles(head);
+  const SurfaceLocator locator(head);
+  std::mt19937 rng(7);
+  std::uniform_real_distribution<double> u(-130.0, 130.0);
+  int hits = 0;
+  for (int i = 0; i < 400; ++i) {
+    const Eigen::Vector3d q(u(rng), u(rng), u(rng));
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& t : tris) best = std::min(best, distance_to_triangle(q, t));
+    const SurfaceLocator::Closest c = locator.closest(q);
+    EXPECT_NEAR(c.distance, best, 1e-9);
+    EXPECT_NEAR((c.point - q).norm(), c.distance, 1e-9);
+    EXPECT_NEAR(distance_to_triangle(c.point, tris[c.face]), 0.0, 1e-9) << "point on its face";
+
+    const Eigen::Vector3d to(u(rng), u(rng), u(rng));
+    std::optional<double> first;
+    for (const auto& t : tris)
+      if (const auto s = segment_hit(q, to - q, t); s && (!first || *s < *first)) first = s;
+    const auto h = locator.first_hit(q, to);
+    ASSERT_EQ(h.has_value(), first.has_value()) << "segment " << i;
+    if (!h) continue;
+    ++hits;
+    EXPECT_NEAR(h->distance, *first * (to - q).norm(), 1e-9);
+    EXPECT_NEAR(distance_to_triangle(h->point, tris[h->face]), 0.0, 1e-9);
+  }
+  EXPECT_GT(hits, 100);
+}
+
+// A segment through a vertex or along a shared edge still hits the surface.
+TEST(SurfaceLocator, SegmentsThroughVerticesAndEdgesHit) {
+  const SkullMesh head = test::make_symmetric_head(3);
+  const SurfaceLocator locator(head);
+  int tried = 0;
+  for (auto vh : head.vertices()) {
+    if (++tried > 300) break;
+    const Eigen::Vector3d p = to_eigen(head.point(vh));
+    const auto h = locator.first_hit(Eigen::Vector3d::Zero(), 2.0 * p);
+    ASSERT_TRUE(h.has_value()) << "vertex " << vh.idx();
+    EXPECT_LT((h->point - p).norm(), 1e-6);
+  }
+  for (auto eh : head.edges()) {
+    if (eh.idx() > 300) break;
+    const auto he = head.halfedge_handle(eh, 0);
+    const Eigen::Vector3d mid = 0.5 * (to_eigen(head.point(head.from_vertex_handle(he))) +
+                                       to_eigen(head.point(head.to_vertex_handle(he))));
+    EXPECT_TRUE(locator.first_hit(Eigen::Vector3d::Zero(), 2.0 * mid).has_value());
+  }
+}
+
+// The locator of a skull, moved by a reflection and a rigid motion, answers exactly as the
+// locator of the mirrored, moved mesh does (a shared tree: nothing copied), with outward normals.
+TEST(SurfaceLocator, MovedByAReflectionAnswersForTheMirror) {
+  const SkullMesh head = test::cut_hole(test::make_symmetric_head(3), {40, 20, 50}, 30);
+  const Plane plane = Plane::through({3, 4, 5}, {1, 0.2, -0.1});
+  const RigidTransform motion = RigidTransform::from_axis_angle({0.3, 1, 0.2}, 7.0, {2, -3, 1});
+  const SkullMesh mirrored = transform_mesh(mirror_mesh(head, plane), motion);
+  const SurfaceLocator own(mirrored);
+  const SurfaceLocator original(head);
+  const SurfaceLocator moved = original.moved(motion * reflection_across(plane));
+  EXPECT_EQ(moved.memory_bytes(), original.memory_bytes());
+  const std::vector<Triangle> mirrored_tris = triangles(mirrored);
+  int same_face = 0;
+  std::mt19937 rng(11);
+  std::uniform_real_distribution<double> u(-120.0, 120.0);
+  for (int i = 0; i < 200; ++i) {
+    const Eigen::Vector3d q(u(rng), u(rng), u(rng)), to(u(rng), u(rng), u(rng));
+    const auto a = own.closest(q), b = moved.closest(q);
+    EXPECT_NEAR(a.distance, b.distance, 1e-9);
+    EXPECT_LT((a.point - b.point).norm(), 1e-6);
+    // Where the closest point is a shared vertex or edge either face may be named; the same
+    // face (mirror_mesh keeps face order) has the same outward normal.
+    EXPECT_NEAR(distance_to_triangle(b.point, mirrored_tris[b.face]), 0.0, 1e-9);
+    if (a.face == b.face) {
+      ++same_face;
+      EXPECT_LT((own.face_normal(a.face) - moved.face_normal(b.face)).norm(), 1e-9);
+    }
+    const auto ha = own.first_hit(q, to), hb = moved.first_hit(q, to);
+    ASSERT_EQ(ha.has_value(), hb.has_value());
+    if (ha) {
+      EXPECT_NEAR(ha->distance, hb->distance, 1e-9);
+    }
+  }
+  EXPECT_GT(same_face, 100);
+  // Outward: the closed head's normals point away from its inside.
+  const SkullMesh closed = test::make_symmetric_head(3);
+  const SurfaceLocator mirror_of_closed = SurfaceLocator(closed).moved(reflection_across(plane));
+  const Eigen::Vector3d inside = plane.reflect(Eigen::Vector3d::Zero());
+  for (const Eigen::Vector3d& dir :
+       {Eigen::Vector3d(1, 0, 0), Eigen::Vector3d(0, -1, 0), Eigen::Vector3d(0.2, 0.3, 1)}) {
+    const auto h = mirror_of_closed.first_hit(inside, inside + 300.0 * dir.normalized());
+    ASSERT_TRUE(h.has_value());
+    EXPECT_GT(mirror_of_closed.face_normal(h->face).dot(dir.normalized()), 0.0);
+  }
+}
+
+}  // namespace
+}  // namespace cranioplan

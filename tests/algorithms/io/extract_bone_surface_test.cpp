@@ -1,0 +1,65 @@
+#include "cranioplan/algorithms/io/extract_bone_surface.h"
+
+#include <gtest/gtest.h>
+
+#include "cranioplan/algorithms/io/mesh_report.h"
+#include "support/synthetic.h"
+
+namespace cranioplan {
+namespace {
+
+TEST(ExtractBoneSurface, BallGivesClosedOutwardSurfaceOfTheRightVolume) {
+  const Volume v = test::make_ball_volume({5, 6, 7}, 12.0, 40, 0.8, true);
+  const auto r = extract_bone_surface(v);
+  ASSERT_TRUE(r.usable()) << r.message;
+  EXPECT_EQ(r.threshold_used, 300.0);
+  const MeshReport rep = report_mesh(r.mesh);
+  EXPECT_TRUE(rep.watertight);
+  EXPECT_EQ(rep.pieces, 1);
+  EXPECT_NEAR(rep.volume_mm3, 4.0 / 3.0 * M_PI * 12 * 12 * 12, 0.05 * 7238.2);
+}
+
+TEST(ExtractBoneSurface, BallTouchingTheScanEdgeIsStillClosed) {
+  Volume v = test::make_ball_volume({0, 0, 0}, 10.0, 20, 1.0, false);  // 20 mm grid, ball 20 mm
+  v.origin.x() += 4.0;  // move the grid so the ball is cut by the first slab
+  const auto r = extract_bone_surface(v);
+  EXPECT_TRUE(report_mesh(r.mesh).watertight);
+}
+
+TEST(ExtractBoneSurface, LargestPieceOrAllPiecesAboveASize) {
+  Volume v = test::make_ball_volume({0, 0, 0}, 4.0, 40, 1.0, false);
+  for (int k = 0; k < 40; ++k)
+    for (int j = 0; j < 40; ++j)
+      for (int i = 0; i < 40; ++i)
+        if ((v.world(Eigen::Vector3d(i, j, k)) - Eigen::Vector3d(10, 10, 10)).norm() < 7)
+          v.data[v.index(i, j, k)] = 1;
+  const auto largest = extract_bone_surface(v);
+  EXPECT_EQ(largest.pieces_found, 2);
+  EXPECT_EQ(report_mesh(largest.mesh).pieces, 1);
+  ExtractBoneSurfaceParams all;
+  all.largest_piece_only = false;
+  all.min_piece_triangles = 10;
+  EXPECT_EQ(report_mesh(extract_bone_surface(v, all).mesh).pieces, 2);
+}
+
+TEST(ExtractBoneSurface, DecimatesToTarget) {
+  const Volume v = test::make_ball_volume({0, 0, 0}, 15.0, 40, 1.0, false);
+  ExtractBoneSurfaceParams p;
+  p.target_triangles = 1000;
+  const auto r = extract_bone_surface(v, p);
+  EXPECT_GT(r.triangles_before_decimation, 4000);
+  EXPECT_NEAR(static_cast<double>(r.mesh.n_faces()), 1000.0, 100.0);
+  EXPECT_GT(signed_volume(r.mesh), 0.0);
+}
+
+TEST(ExtractBoneSurface, ThresholdOutsideTheDataGivesAStatusNotAnException) {
+  const Volume v = test::make_ball_volume({0, 0, 0}, 5.0, 16, 1.0, true);
+  ExtractBoneSurfaceParams p;
+  p.threshold = 5000;
+  const auto r = extract_bone_surface(v, p);
+  EXPECT_FALSE(r.usable());
+  EXPECT_NE(r.message.find("no surface"), std::string::npos);
+}
+
+}  // namespace
+}  // namespace cranioplan

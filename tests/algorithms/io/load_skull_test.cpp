@@ -1,0 +1,140 @@
+#include "cranioplan/algorithms/io/load_skull.h"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "cranioplan/algorithms/io/mesh_report.h"
+#include "cranioplan/algorithms/io/write_mesh.h"
+#include "cranioplan/model/error.h"
+#include "support/synthetic.h"
+#include "support/test_files.h"
+
+namespace cranioplan {
+namespace {
+
+using test::TempDir;
+
+// A head about 180 mm across, written in another unit: refused as a skull, naming the unit
+// that makes it head-sized, and read at its size in that unit.
+TEST(LoadSkull, ASkullInAnotherUnitIsRefusedNamingTheUnitAndReadInIt) {
+  TempDir dir;
+  const SkullMesh head = test::make_symmetric_head(2);
+  const MeshReport size = report_mesh(head);
+  const double extent = (size.bbox_max - size.bbox_min).maxCoeff();
+  ASSERT_GT(extent, kSkullMinExtentMm);
+  ASSERT_LT(extent, kSkullMaxExtentMm);
+  struct Case {
+    const char* unit;
+    const char* label;
+  };
+  for (const Case c : {Case{"m", "metres"}, Case{"in", "inches"}, Case{"cm", "centimetres"}}) {
+    const double unit_mm = length_unit_named(c.unit)->mm;
+    const std::string p = dir.path(std::string("head-") + c.unit + ".stl");
+    write_mesh(test::scaled(head, 1.0 / unit_mm), p);
+    try {
+      load_skull(p);
+      ADD_FAILURE() << "a head in " << c.label << " was planned as millimetres";
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_EQ(msg.rfind(p, 0), 0u) << msg;
+      EXPECT_NE(msg.find(std::string("looks to be in ") + c.label), std::string::npos) << msg;
+      EXPECT_NE(msg.find(std::string("(length unit '") + c.unit + "')"), std::string::npos) << msg;
+    }
+    // Any surface may be read as it is (an implant, a test shape): no size to check.
+    EXPECT_EQ(load_surface(p).mesh.n_faces(), head.n_faces());
+    ExtractBoneSurfaceParams in_unit;
+    in_unit.mesh_unit_mm = unit_mm;
+    const LoadedSkull read = load_skull(p, in_unit);
+    const MeshReport got = report_mesh(read.mesh);
+    EXPECT_NEAR((got.bbox_max - got.bbox_min).maxCoeff(), extent, 1e-3 * extent) << c.unit;
+  }
+  // No unit makes a 2 mm part a skull; a volume of the wrong size points at its spacing.
+  const SkullMesh tiny = test::scaled(head, 0.01);
+  write_mesh(tiny, dir.path("tiny.stl"));
+  auto refusal = [](const std::function<void()>& load) {
+    try {
+      load();
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("(taken for a skull)");
+  };
+  EXPECT_NE(refusal([&] {
+              load_skull(dir.path("tiny.stl"));
+            }).find("it is no skull, or not in a length unit Cranioplan reads"),
+            std::string::npos);
+  EXPECT_NE(refusal([&] {
+              check_skull_size(tiny, "ct.nrrd", 0.0);
+            }).find("check the voxel spacing in the volume's header"),
+            std::string::npos);
+  EXPECT_FALSE(length_unit_named("furlong"));
+}
+
+// Some exporters wind triangles the other way: the skull then encloses a negative volume and
+// its normals point in, which the detection reads as inner and outer tables swapped (the
+// sample turned inside out: "too little intact bone around the opening (0 rays)"). load_skull
+// turns it outward, with a warning, into the very mesh the outward file gives; load_surface
+// (an implant for the quality check) keeps it as it is.
+TEST(LoadSkull, ASkullThatWindsInwardIsTurnedOutward) {
+  TempDir dir;
+  const SkullMesh head =
+      test::cut_hole(test::make_symmetric_head(3),
+                     test::head_surface_point(Eigen::Vector3d(0.7, 0.1, 0.7).normalized()), 25);
+  TriangleSoup inward = to_soup(head);
+  for (auto& t : inward.triangles) std::swap(t[1], t[2]);
+  write_mesh(head, dir.path("out.stl"));
+  write_mesh(build_mesh(inward), dir.path("in.stl"));
+  ASSERT_LT(signed_volume(load_surface(dir.path("in.stl")).mesh), 0.0) << "kept as it is";
+  const LoadedSkull turned = load_skull(dir.path("in.stl"));
+  EXPECT_GT(signed_volume(turned.mesh), 0.0);
+  // The turn, and (as for any skull with a hole) where the surface is open.
+  ASSERT_EQ(turned.warnings.size(), 2u);
+  EXPECT_NE(turned.warnings[0].find("inside out"), std::string::npos) << turned.warnings[0];
+  EXPECT_NE(turned.warnings[1].find("1 hole in the surface"), std::string::npos)
+      << turned.warnings[1];
+  const LoadedSkull outward = load_skull(dir.path("out.stl"));
+  ASSERT_EQ(outward.warnings.size(), 1u);
+  EXPECT_EQ(outward.warnings[0].substr(outward.warnings[0].find(": ")),
+            turned.warnings[1].substr(turned.warnings[1].find(": ")));
+  const TriangleSoup a = to_soup(turned.mesh), b = to_soup(outward.mesh);
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_EQ(a.vertices, b.vertices);
+  ExtractBoneSurfaceParams as_it_came;
+  as_it_came.orient_outward = false;
+  EXPECT_LT(signed_volume(load_skull(dir.path("in.stl"), as_it_came).mesh), 0.0);
+}
+
+// A CT export may carry the table, a clip or noise far from the head: the skull is its largest
+// piece and what lies near it, and the size check sees only that.
+TEST(LoadSkull, APieceFarFromTheSkullIsDroppedBeforeTheSizeCheck) {
+  test::TempDir dir;
+  const SkullMesh head = test::make_symmetric_head(3);
+  TriangleSoup soup = to_soup(head);
+  const TriangleSoup far = test::box_soup(Eigen::Vector3d(2000, 0, 0), Eigen::Vector3d(2005, 5, 5));
+  const TriangleSoup near =
+      test::box_soup(Eigen::Vector3d(0, 0, -5), Eigen::Vector3d(3, 3, -2));  // inside the head
+  for (const TriangleSoup* piece : {&far, &near}) {
+    const int base = static_cast<int>(soup.vertices.size());
+    soup.vertices.insert(soup.vertices.end(), piece->vertices.begin(), piece->vertices.end());
+    for (const auto& t : piece->triangles)
+      soup.triangles.push_back(t + Eigen::Vector3i::Constant(base));
+  }
+  write_mesh(build_mesh(soup), dir.path("with-table.stl"));
+  const LoadedSkull s = load_skull(dir.path("with-table.stl"));
+  EXPECT_EQ(s.pieces_dropped, 1);
+  EXPECT_EQ(s.mesh.n_faces(), head.n_faces() + near.triangles.size());
+  ASSERT_EQ(s.warnings.size(), 1u);
+  EXPECT_NE(s.warnings[0].find("1 piece of 12 triangles lying apart from the skull"),
+            std::string::npos)
+      << s.warnings[0];
+  // Plans saved before keep every piece, and so refuse the file as before.
+  ExtractBoneSurfaceParams as_before;
+  as_before.drop_far_pieces = false;
+  EXPECT_THROW(load_skull(dir.path("with-table.stl"), as_before), InputError);
+  // Any surface (an implant) keeps its pieces.
+  EXPECT_EQ(load_surface(dir.path("with-table.stl")).mesh.n_faces(), soup.triangles.size());
+}
+
+}  // namespace
+}  // namespace cranioplan

@@ -1,0 +1,82 @@
+#include "cranioplan/algorithms/io/mesh_report.h"
+
+#include <gtest/gtest.h>
+
+#include "support/synthetic.h"
+
+namespace cranioplan {
+namespace {
+
+TEST(MeshReport, ClosedHeadIsWatertightWithOnePiece) {
+  const MeshReport r = report_mesh(test::make_symmetric_head(3));
+  EXPECT_TRUE(r.watertight);
+  EXPECT_EQ(r.pieces, 1);
+  EXPECT_EQ(r.boundary_edges, 0);
+  EXPECT_GT(r.volume_mm3, 0);
+  EXPECT_EQ(r.triangles, 1280);
+}
+
+TEST(MeshReport, HoleGivesBoundaryEdgesAndCubeHasKnownAreaAndVolume) {
+  EXPECT_FALSE(
+      report_mesh(test::cut_hole(test::make_symmetric_head(3), {70, 0, 0}, 20)).watertight);
+  TriangleSoup cube;
+  for (int i = 0; i < 8; ++i)
+    cube.vertices.emplace_back(i & 1 ? 2 : 0, i & 2 ? 2 : 0, i & 4 ? 2 : 0);
+  cube.triangles = {{0, 2, 1}, {1, 2, 3}, {4, 5, 6}, {5, 7, 6}, {0, 1, 4}, {1, 5, 4},
+                    {2, 6, 3}, {3, 6, 7}, {0, 4, 2}, {2, 4, 6}, {1, 3, 5}, {3, 7, 5}};
+  const MeshReport r = report_mesh(build_mesh(cube));
+  EXPECT_NEAR(r.area_mm2, 24.0, 1e-12);
+  EXPECT_NEAR(r.volume_mm3, 8.0, 1e-12);
+  EXPECT_TRUE(r.watertight);
+  EXPECT_EQ(r.bbox_max, Eigen::Vector3d(2, 2, 2));
+}
+
+TEST(MeshReport, NonManifoldEdgeIsCounted) {
+  TriangleSoup s;
+  s.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}};
+  s.triangles = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};  // three triangles on edge 0-1
+  const MeshReport r = report_mesh(build_mesh(s));
+  EXPECT_EQ(r.nonmanifold_edges, 1);
+  EXPECT_FALSE(r.watertight);
+}
+
+}  // namespace
+}  // namespace cranioplan
+
+namespace cranioplan {
+namespace {
+
+// A head cut flat across its lower part (where a scan ended) and with a small hole in its side:
+// the cut is one loop at the lower border, the hole one loop elsewhere, each measured, and both
+// described for a person.
+TEST(MeshReport, ACutAtTheBorderAndAHoleAreToldApart) {
+  const SkullMesh head = test::make_symmetric_head(5);
+  MeshReport whole = report_mesh(head);
+  const double cut_z = whole.bbox_min.z() + 30.0;
+  SkullMesh cut = test::cut_open(head, Eigen::Vector3d(0, 0, cut_z), Eigen::Vector3d::UnitZ());
+  // The cut's vertices put on the cut plane, as marching cubes ends at the scan's last slice.
+  for (auto vh : cut.vertices())
+    if (cut.is_boundary(vh)) cut.point(vh)[2] = static_cast<float>(cut_z + 0.5);
+  const Eigen::Vector3d side((whole.bbox_max.x()), 0.5 * (whole.bbox_min.y() + whole.bbox_max.y()),
+                             0.5 * (whole.bbox_min.z() + whole.bbox_max.z()));
+  const SkullMesh open = test::cut_hole(cut, side, 6.0);
+  const MeshReport r = report_mesh(open);
+  ASSERT_EQ(r.loops.size(), 2u);
+  EXPECT_TRUE(r.loops[0].at_border);
+  EXPECT_EQ(r.loops[0].border, "lower");
+  EXPECT_GT(r.loops[0].length_mm, 300.0);  // around a head 140 × 180 mm near its base
+  EXPECT_LT(r.loops[0].flatness_mm, 0.1);
+  EXPECT_FALSE(r.loops[1].at_border);
+  EXPECT_GT(r.loops[1].length_mm, 20.0);  // around a hole of about 12 mm
+  EXPECT_LT(r.loops[1].length_mm, 60.0);
+  EXPECT_LT((r.loops[1].centroid - side).norm(), 8.0);
+  const std::vector<std::string> said = describe_openings(r);
+  ASSERT_EQ(said.size(), 2u);
+  EXPECT_EQ(said[0].rfind("open along a flat cut at its lower border (z = ", 0), 0u) << said[0];
+  EXPECT_NE(said[0].find("1 loop, "), std::string::npos) << said[0];
+  EXPECT_EQ(said[1].rfind("1 hole in the surface", 0), 0u) << said[1];
+  EXPECT_TRUE(describe_openings(whole).empty());
+}
+
+}  // namespace
+}  // namespace cranioplan

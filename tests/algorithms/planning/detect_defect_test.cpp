@@ -1,0 +1,109 @@
+#include "cranioplan/algorithms/planning/detect_defect.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+
+#include "cranioplan/algorithms/geometry/surface_locator.h"
+#include "cranioplan/algorithms/io/mesh_report.h"
+#include "cranioplan/algorithms/quality/inject_defect.h"
+#include "support/synthetic.h"
+
+namespace cranioplan {
+namespace {
+
+double angle_deg(const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+  return std::acos(std::clamp(a.normalized().dot(b.normalized()), -1.0, 1.0)) * 180.0 / M_PI;
+}
+
+// The plane z = -40 (normal −z: the scan ended below) within the box [-70, 70]² × [-40, 80].
+ScanBorder lower_border() {
+  ScanBorder b;
+  b.normal = -Eigen::Vector3d::UnitZ();
+  b.offset = 40.0;
+  b.box_min = Eigen::Vector3d(-70, -70, -40);
+  b.box_max = Eigen::Vector3d(70, 70, 80);
+  return b;
+}
+
+TEST(ScanBorder, IsReachedByRaysThatMeetItsPlaneWithinTheBox) {
+  const ScanBorder b = lower_border();
+  const Eigen::Vector3d o = Eigen::Vector3d::Zero();
+  EXPECT_TRUE(b.reached_by(o, -Eigen::Vector3d::UnitZ()));                // at (0,0,-40)
+  EXPECT_TRUE(b.reached_by(o, Eigen::Vector3d(1, 0, -1).normalized()));   // at x = 40
+  EXPECT_FALSE(b.reached_by(o, Eigen::Vector3d(2, 0, -1).normalized()));  // x = 80: out
+  EXPECT_FALSE(b.reached_by(o, Eigen::Vector3d::UnitZ()));                // away from it
+  EXPECT_FALSE(b.reached_by(o, Eigen::Vector3d::UnitX()));                // parallel
+  EXPECT_FALSE(b.reached_by(Eigen::Vector3d(0, 0, -50), -Eigen::Vector3d::UnitZ()));  // behind
+}
+
+TEST(ScanBorder, AHeadOpenWhereTheScanEndedHasOneBorderThere) {
+  const SkullMesh head = test::make_symmetric_head(5);
+  EXPECT_TRUE(scan_borders(report_mesh(head)).empty()) << "a closed surface has no border";
+  const SkullMesh open =
+      test::cut_open(head, Eigen::Vector3d(0, 0, -30.0), Eigen::Vector3d::UnitZ());
+  const MeshReport report = report_mesh(open);
+  const std::vector<ScanBorder> borders = scan_borders(report);
+  ASSERT_EQ(borders.size(), 1u);
+  EXPECT_LT(angle_deg(borders[0].normal, -Eigen::Vector3d::UnitZ()), 1e-9);
+  // The cut keeps whole faces above the plane: the border lies within a face's size above it.
+  EXPECT_NEAR(-borders[0].offset, -30.0, 6.0);
+  EXPECT_GE(-borders[0].offset, -30.0);
+  EXPECT_EQ(borders[0].box_min, report.bbox_min);
+  EXPECT_EQ(borders[0].box_max, report.bbox_max);
+}
+
+// A thick head with a known defect, open on its right side where the scan (or an exporter's
+// crop) ended. With the scan's border the defect is the only opening, and a defect that reaches
+// into the cut is found as itself, not merged with the cut (its rays leave past the cut's
+// extent).
+struct OpenHead {
+  SkullMesh skull;
+  Eigen::Vector3d defect_direction;
+};
+
+OpenHead open_head_with_defect(const Eigen::Vector3d& direction, double right_x) {
+  const SkullMesh intact = test::make_thick_head(0.93, 1.0);
+  InjectDefectParams p;
+  p.center = test::head_surface_point(direction.normalized()) * 0.965;
+  p.size_mm = 55;
+  p.voxel_mm = 1.0;
+  const SkullMesh defective = inject_defect(intact, p).defective;
+  return {test::cut_open(defective, Eigen::Vector3d(right_x, 0, 0), Eigen::Vector3d::UnitX()),
+          direction.normalized()};
+}
+
+DefectRegion detect(const SkullMesh& skull, bool with_borders) {
+  DetectDefectParams params;
+  // The head's own frame, its midsagittal plane x = 0 (as detect_defect_near_plane gives it).
+  params.frame = skull_frame(skull, Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX());
+  if (with_borders) params.scan_borders = scan_borders(report_mesh(skull));
+  return detect_defect(skull, SurfaceLocator(skull), Eigen::Vector3d::Zero(), params);
+}
+
+TEST(DetectDefect, TheScansCutIsNeverTheDefect) {
+  const OpenHead h = open_head_with_defect(Eigen::Vector3d(0.7, 0.1, 0.7), -45.0);
+  const DefectRegion with = detect(h.skull, true);
+  ASSERT_TRUE(with.found()) << with.message;
+  EXPECT_LT(angle_deg(with.axis, h.defect_direction), 10.0);
+  EXPECT_EQ(with.other_openings, 0) << with.message;
+}
+
+TEST(DetectDefect, ADefectThatReachesTheScansCutIsStillADefect) {
+  // A defect on the right, high on the head; the cut runs through its right part.
+  const Eigen::Vector3d dir = Eigen::Vector3d(-0.5, 0.1, 0.85).normalized();
+  const double defect_x = test::head_surface_point(dir).x();
+  const OpenHead h = open_head_with_defect(dir, defect_x - 12.0);
+  const DefectRegion without = detect(h.skull, false);
+  ASSERT_TRUE(without.found()) << without.message;
+  const DefectRegion with = detect(h.skull, true);
+  ASSERT_TRUE(with.found()) << with.message;
+  EXPECT_LT(angle_deg(with.axis, h.defect_direction), 20.0) << with.message;
+  EXPECT_GT(angle_deg(without.axis, h.defect_direction), 20.0) << without.message;
+  EXPECT_GT(with.area_mm2, 300.0);
+  EXPECT_LT(with.area_mm2, 0.5 * without.area_mm2);
+}
+
+}  // namespace
+}  // namespace cranioplan

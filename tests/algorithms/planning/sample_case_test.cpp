@@ -1,0 +1,330 @@
+// The whole foundation chain on the real sample case (Debian's invesalius-examples).
+#include <gtest/gtest.h>
+
+#include <Eigen/LU>
+#include <filesystem>
+
+#include "cranioplan/algorithms/alignment/fit_sagittal_plane.h"
+#include "cranioplan/algorithms/alignment/mirror_mesh.h"
+#include "cranioplan/algorithms/alignment/register_icp.h"
+#include "cranioplan/algorithms/geometry/surface_locator.h"
+#include "cranioplan/algorithms/io/load_skull.h"
+#include "cranioplan/algorithms/io/mesh_report.h"
+#include "cranioplan/algorithms/io/read_volume.h"
+#include "cranioplan/algorithms/io/write_mesh.h"
+#include "cranioplan/algorithms/planning/autoplan.h"
+#include "cranioplan/algorithms/quality/compare_implants.h"
+#include "cranioplan/algorithms/quality/inject_defect.h"
+#include "support/synthetic.h"
+#include "support/test_files.h"
+
+namespace cranioplan {
+namespace {
+
+TEST(SampleCase, ImportPlaneMirrorRegister) {
+  const std::string path = sample_case_path();
+  if (!std::filesystem::exists(path))
+    GTEST_SKIP() << path << " not installed (scripts/install-deps)";
+  const Volume volume = read_volume(path);
+  // InVesalius stores rows flipped: the reader's index-to-world map must undo that mirror
+  // (negative determinant), so the world coordinates are patient-true.
+  EXPECT_LT(volume.directions.determinant(), 0.0);
+  EXPECT_LT(volume.directions(1, 1), 0.0);
+  const LoadedSkull skull = load_skull(path);
+  const MeshReport rep = report_mesh(skull.mesh);
+  EXPECT_GT(rep.triangles, 300000);
+  EXPECT_EQ(rep.pieces, 1);
+  EXPECT_EQ(rep.boundary_edges, 0);  // closed by the padding, even where bone meets the scan edge
+  EXPECT_GT(rep.volume_mm3, 0);
+  // A head: 12–25 cm across in every direction.
+  const Eigen::Vector3d size = rep.bbox_max - rep.bbox_min;
+  EXPECT_GT(size.minCoeff(), 120.0);
+  EXPECT_LT(size.maxCoeff(), 250.0);
+
+  const PlaneFit fit = fit_sagittal_plane(skull.mesh, Landmarks{});
+  ASSERT_TRUE(fit.usable()) << fit.message;
+  // The scan is roughly aligned: the left-right axis is the image x axis.
+  EXPECT_GT(std::abs(fit.plane.normal.x()), 0.98);
+  EXPECT_LT(fit.symmetry_rms_mm, 1.2);
+  EXPECT_GT(fit.inlier_fraction, 0.6);
+  // The plane passes through the middle of the head.
+  const double mid = 0.5 * (rep.bbox_min.x() + rep.bbox_max.x());
+  EXPECT_LT(std::abs(fit.plane.offset / fit.plane.normal.x() - mid), 15.0);
+
+  const SkullMesh mirrored = mirror_mesh(skull.mesh, fit.plane);
+  EXPECT_GT(signed_volume(mirrored), 0);
+  const RegisterResult reg = register_icp(mirrored, skull.mesh);
+  ASSERT_TRUE(reg.usable()) << reg.message;
+  // The plane was already good: registration only corrects a little.
+  EXPECT_LT(reg.transform.rotation_angle_deg(), 2.0);
+  EXPECT_LT(reg.transform.translation.norm(), 3.0);
+  EXPECT_LT(reg.rms_mm, 1.2);
+}
+
+// The sample's real right frontal defect, planned automatically and built as a shell.
+TEST(SampleCase, AutoplanFillsTheRealDefect) {
+  const std::string path = sample_case_path();
+  if (!std::filesystem::exists(path))
+    GTEST_SKIP() << path << " not installed (scripts/install-deps)";
+  const LoadedSkull skull = load_skull(path);
+  const AutoplanResult r = autoplan(skull.mesh, Landmarks{});
+  ASSERT_TRUE(r.planned()) << r.message;
+  EXPECT_EQ(r.method_used, PlanMethod::Mirror);
+  // The defect is on the patient's right (−x in the patient-true frame) and in front (−y).
+  const Eigen::Vector3d c = r.plane.plane.project(r.defect.center);
+  EXPECT_LT(r.plane.plane.signed_distance(c + 100.0 * r.defect.axis) * r.plane.plane.normal.x(),
+            0.0);
+  EXPECT_LT(r.defect.axis.y(), 0.0);
+  // The target on the sample's real defect, from autoplan alone: a watertight shell
+  // with a rim gap of at most 0.5 mm and no penetration into the skull (the shell is fitted to
+  // the bone: built 4 mm over it and trimmed by it), and printable by the quality report (its
+  // edge on the bone tapers over 1.5 mm; docs/IMPLANT.md). Measured 0.09 mm over the worst 5°
+  // arc of the rim (the STL of scripts/run-sample is read as this very mesh).
+  EXPECT_TRUE(r.quality.watertight);
+  EXPECT_TRUE(r.quality.manifold);
+  EXPECT_EQ(r.quality.self_intersections, 0);
+  EXPECT_LE(r.quality.rim_gap_mm, 0.5);
+  EXPECT_TRUE(r.quality.printable) << (r.quality.reasons.empty() ? "" : r.quality.reasons[0]);
+  // "None" at the resolution of the measurement: the overlap is counted in 0.25 mm voxels and a
+  // flush contact is placed within half a voxel (TrimToBone tests), so 0.25 mm³ (16 voxels)
+  // is the floor; the unfitted shell overlaps the bone by about 43 mm³.
+  EXPECT_LT(r.quality.penetration_mm3, 0.25);
+  // The fit to the bone's two rules (thin fills removed, a clearance to the bone), on this
+  // defect: planned with fills kept as made, the implant has a rod from its edge to a fragment
+  // by the orbit that the quality report rejects (a corner reaching 0.85 mm past 1 mm thick,
+  // measured); with a one-voxel keep-out instead of the clearance it stands further off the
+  // bone (rim gap 0.16 mm against 0.09 mm, measured).
+  {
+    AutoplanParams kept;
+    kept.implant.trim.thin_fills_removed = false;
+    const AutoplanResult rod = autoplan(skull.mesh, Landmarks{}, kept);
+    ASSERT_TRUE(rod.planned()) << rod.message;
+    EXPECT_GT(rod.quality.corner_reach_mm, 0.8) << "the case has the rod the rule removes";
+    EXPECT_FALSE(rod.quality.printable);
+    AutoplanParams voxel_rule;
+    voxel_rule.implant.trim.clearance_mm.reset();
+    voxel_rule.implant.trim.thin_fills_removed = false;
+    const AutoplanResult off = autoplan(skull.mesh, Landmarks{}, voxel_rule);
+    ASSERT_TRUE(off.planned()) << off.message;
+    EXPECT_GT(off.quality.rim_gap_mm, r.quality.rim_gap_mm + 0.03);
+  }
+  RecordProperty("rim_gap_mm", std::to_string(r.quality.rim_gap_mm));
+  RecordProperty("penetration_mm3", std::to_string(r.quality.penetration_mm3));
+  RecordProperty("thickness_min_mm", std::to_string(r.quality.thickness_min_mm));
+}
+
+// The sample turned a quarter turn about the left-right axis and moved: its frontal defect
+// then faces down, where a rule "the skull base is the opening below" would take it for the
+// base and plan the foramen magnum instead. The same defect must be found and the same implant
+// built (measured: DSC 0.967 between the two poses, rim gap 0.15 mm; five other poses 0.93–0.97,
+// docs/AUTOPLAN.md).
+TEST(SampleCase, TurnedSkullGivesTheSamePlan) {
+  const std::string path = sample_case_path();
+  if (!std::filesystem::exists(path))
+    GTEST_SKIP() << path << " not installed (scripts/install-deps)";
+  const LoadedSkull skull = load_skull(path);
+  const RigidTransform pose =
+      RigidTransform::from_axis_angle(Eigen::Vector3d::UnitX(), 90.0, {40.0, -250.0, 80.0});
+  const AutoplanResult upright = autoplan(skull.mesh, Landmarks{});
+  const AutoplanResult turned = autoplan(test::transformed(skull.mesh, pose), Landmarks{});
+  ASSERT_TRUE(upright.planned()) << upright.message;
+  ASSERT_TRUE(turned.planned()) << turned.message;
+  EXPECT_GT(turned.defect.axis.dot(pose.rotation * upright.defect.axis), std::cos(M_PI / 36));
+  EXPECT_EQ(turned.method_used, PlanMethod::Mirror);
+  EXPECT_LE(turned.quality.rim_gap_mm, 0.5);
+  EXPECT_LT(turned.quality.penetration_mm3, 0.25);
+  const CompareResult same = compare_implants(
+      test::transformed(turned.implant.mesh, pose.inverse()), upright.implant.mesh, &skull.mesh);
+  RecordProperty("dice_between_poses", std::to_string(same.dice));
+  EXPECT_GE(same.dice, 0.9) << "HD95 " << same.hd95_mm;
+}
+
+// The same surface from another file plans to the same implant: the CT mesh, an STL of it (the
+// STL reader welds the CT mesh's 682 duplicate vertices and lists the rest in another order) and
+// a PLY of it. Meshes are read in a canonical form (make_canonical), so the plane's and the
+// registration's samples, taken by vertex index, are the same (read as the files give them, the
+// CT mesh and its STL gave planes 0.6° apart and implants with DSC 0.82 between them).
+TEST(SampleCase, TheSameSurfaceFromAnotherFileGivesTheSameImplant) {
+  const std::string path = sample_case_path();
+  if (!std::filesystem::exists(path))
+    GTEST_SKIP() << path << " not installed (scripts/install-deps)";
+  const LoadedSkull skull = load_skull(path);
+  const test::TempDir dir;
+  write_mesh(skull.mesh, dir.path("skull.stl"));
+  write_mesh(skull.mesh, dir.path("skull.ply"));
+  const AutoplanResult reference = autoplan(skull.mesh, Landmarks{});
+  ASSERT_TRUE(reference.planned()) << reference.message;
+  const TriangleSoup expected = to_soup(reference.implant.mesh);
+  for (const char* name : {"skull.stl", "skull.ply"}) {
+    const LoadedSkull copy = load_skull(dir.path(name));
+    EXPECT_EQ(copy.mesh.n_vertices(), skull.mesh.n_vertices()) << name;
+    const AutoplanResult r = autoplan(copy.mesh, Landmarks{});
+    ASSERT_TRUE(r.planned()) << name << ": " << r.message;
+    EXPECT_EQ(r.plane.plane.normal, reference.plane.plane.normal) << name;
+    const TriangleSoup got = to_soup(r.implant.mesh);
+    EXPECT_EQ(got.vertices, expected.vertices) << name;
+    EXPECT_EQ(got.triangles, expected.triangles) << name;
+  }
+}
+
+// The sample decimated to 250,000 triangles (as a lighter export from another tool would be):
+// a few rim points then lie on bone 20-30 mm below their neighbours on the rim (the sinus wall
+// and orbital roof seen past the crushed supraorbital bone), where the mirror has no bone to
+// fit either; edge markers there pulled the implant down into a funnel that the fit to the
+// bone cut away (a bay with a rim gap of 4.8-7.2 mm without the rule on neighbours). The
+// implant meets the bone within the printable limit (1 mm) all round,
+// not within the 0.5 mm it does on the CT mesh: where the orbit's thin bone is lost to the
+// decimation, its free edge over the orbit stands 0.54 mm off the last fragment along a 5° arc
+// (fixed sectors, which cut across that arc, read 0.09 mm).
+TEST(SampleCase, ADecimatedCopyIsPlannedAsWell) {
+  const std::string path = sample_case_path();
+  if (!std::filesystem::exists(path))
+    GTEST_SKIP() << path << " not installed (scripts/install-deps)";
+  ExtractBoneSurfaceParams import;
+  import.target_triangles = 250000;
+  const LoadedSkull skull = load_skull(path, import);
+  ASSERT_LT(skull.mesh.n_faces(), 260000u);
+  const AutoplanResult r = autoplan(skull.mesh, Landmarks{});
+  ASSERT_TRUE(r.planned()) << r.message;
+  EXPECT_EQ(r.method_used, PlanMethod::Mirror);
+  EXPECT_LE(r.quality.rim_gap_mm, 1.0);
+  EXPECT_LT(r.quality.penetration_mm3, 0.25);
+  EXPECT_TRUE(r.quality.printable) << (r.quality.reasons.empty() ? "" : r.quality.reasons[0]);
+  RecordProperty("rim_gap_mm", std::to_string(r.quality.rim_gap_mm));
+}
+
+// Most exporters leave the skull open where the scan ends: the sample's own import without the
+// cap over its lowest slice (the faces below z = 0, where the padding closed it), as marching
+// cubes gives it on the unpadded volume. Its inside must be the bone's: planned, printable, no
+// overlap and the rim on the bone as on the closed import (measured: rim gap 0.09 mm, no
+// overlap, Dice 0.90 against the closed import's plan; with parity along z alone the fit and
+// the check took the air above the cut for bone: rim gap 1.25 mm, 2.7 mm³ overlap).
+TEST(SampleCase, AnExportOpenWhereTheScanEndsIsPlannedOnTheBone) {
+  const std::string path = sample_case_path();
+  if (!std::filesystem::exists(path))
+    GTEST_SKIP() << path << " not installed (scripts/install-deps)";
+  const LoadedSkull skull = load_skull(path);
+  const SkullMesh open =
+      test::cut_open(skull.mesh, Eigen::Vector3d(0, 0, -1e-3), Eigen::Vector3d::UnitZ());
+  const MeshReport rep = report_mesh(open);
+  ASSERT_GT(rep.boundary_edges, 500) << "the export is open along the scan's lower border";
+
+  const AutoplanResult closed_plan = autoplan(skull.mesh, Landmarks{});
+  ASSERT_TRUE(closed_plan.planned()) << closed_plan.message;
+  const AutoplanResult r = autoplan(open, Landmarks{});
+  ASSERT_TRUE(r.planned()) << r.message;
+  EXPECT_EQ(r.method_used, PlanMethod::Mirror);
+  EXPECT_LE(r.quality.rim_gap_mm, 0.5);
+  EXPECT_LT(r.quality.penetration_mm3, 0.25);
+  EXPECT_TRUE(r.quality.printable) << (r.quality.reasons.empty() ? "" : r.quality.reasons[0]);
+  const CompareResult c = compare_implants(r.implant.mesh, closed_plan.implant.mesh);
+  EXPECT_GT(c.dice, 0.88);
+  RecordProperty("rim_gap_mm", std::to_string(r.quality.rim_gap_mm));
+  RecordProperty("dice_vs_closed", std::to_string(c.dice));
+}
+
+// Decimated much further (60,000 triangles, edges about 3.5 mm), the thin bone around the
+// foramen magnum and the orbits opens up: the foramen's mean direction came to lie 113° from the
+// vault's (124° on the CT mesh): with a limit of 114° for the base the largest opening beyond
+// it was an orbit, and the foramen magnum was planned as the defect. The base is the largest
+// opening more than 105° from the vault: the frontal defect is found,
+// mirror-guided. Its plan is not printable (the rim is unseen along 59 mm by the crushed orbit,
+// and the implant stands 1.7 mm off the bone there; docs/AUTOPLAN.md) and says so.
+TEST(SampleCase, ACoarseCopyStillHasItsDefectFoundNotItsBase) {
+  const std::string path = sample_case_path();
+  if (!std::filesystem::exists(path))
+    GTEST_SKIP() << path << " not installed (scripts/install-deps)";
+  ExtractBoneSurfaceParams import;
+  import.target_triangles = 60000;
+  const LoadedSkull skull = load_skull(path, import);
+  ASSERT_LT(skull.mesh.n_faces(), 65000u);
+  const AutoplanResult r = autoplan(skull.mesh, Landmarks{});
+  ASSERT_TRUE(r.planned()) << r.message;
+  // The frontal defect (on the CT mesh: axis (−0.39, −0.80, 0.46), 853 mm²), on the patient's
+  // right and in front, not the foramen magnum (behind and below: (0.00, 0.54, −0.84)).
+  EXPECT_GT(r.defect.axis.dot(Eigen::Vector3d(-0.39, -0.80, 0.46).normalized()), 0.95)
+      << r.defect.axis.transpose();
+  EXPECT_GT(r.defect.area_mm2, 600.0);
+  EXPECT_EQ(r.method_used, PlanMethod::Mirror);
+  EXPECT_GT(r.mirror_coverage, 0.9);
+  EXPECT_TRUE(r.quality.watertight);
+  // Where the rim gap is over the limit (on this copy it is: the crushed orbit, 1.7 mm), the
+  // report says so in a reason of its own.
+  bool names_the_gap = false;
+  for (const std::string& why : r.quality.reasons)
+    names_the_gap = names_the_gap || why.find("between the rim and the bone") != std::string::npos;
+  EXPECT_EQ(names_the_gap, r.quality.rim_gap_mm > QualityParams{}.max_rim_gap_mm)
+      << r.quality.rim_gap_mm;
+  // The overlap with the bone is not asserted: this copy of the skull is not closed (its STL
+  // has 95 boundary edges and 174 non-manifold ones), so its inside is not well defined
+  // (measured 0.7 mm³).
+  RecordProperty("rim_gap_mm", std::to_string(r.quality.rim_gap_mm));
+  RecordProperty("penetration_mm3", std::to_string(r.quality.penetration_mm3));
+  RecordProperty("area_mm2", std::to_string(r.defect.area_mm2));
+}
+
+// A large one-sided defect low on the side of the head (100 mm, as a decompressive
+// craniectomy reaching down to the temporal fossa) points 109° from the vault: further from it
+// than the 105° beyond which an opening may be the skull base, and larger than the foramen
+// magnum, so the rule on the angle alone took it for the base and planned another opening.
+// The base must also lie within 30° of the midsagittal plane; this defect lies 45° from it.
+TEST(SampleCase, ALargeDefectLowOnTheSideIsNotTakenForTheBase) {
+  const std::string path = sample_case_path();
+  if (!std::filesystem::exists(path))
+    GTEST_SKIP() << path << " not installed (scripts/install-deps)";
+  const LoadedSkull skull = load_skull(path);
+  const SurfaceLocator bone(skull.mesh);
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+  for (auto vh : skull.mesh.vertices()) centroid += to_eigen(skull.mesh.point(vh));
+  centroid /= static_cast<double>(skull.mesh.n_vertices());
+  // On the patient's left (+x), in front (−y) and low (−z), in the middle of the bone.
+  const Eigen::Vector3d dir = Eigen::Vector3d(1.0, -0.6, -0.6).normalized();
+  const auto outside = bone.first_hit(centroid + 400.0 * dir, centroid);
+  const auto inside = bone.first_hit(centroid, centroid + 400.0 * dir);
+  ASSERT_TRUE(outside && inside);
+  InjectDefectParams cut;
+  cut.center = 0.5 * (outside->point + inside->point);
+  cut.size_mm = 100.0;
+  cut.voxel_mm = 0.5;
+  const InjectDefectResult d = inject_defect(skull.mesh, cut);
+  ASSERT_TRUE(d.usable());
+  AutoplanParams params;
+  params.propose.detect.near = cut.center;  // the skull's own defect is there too
+  const AutoplanResult r = autoplan(d.defective, Landmarks{}, params);
+  ASSERT_TRUE(r.planned()) << r.message;
+  const Eigen::Vector3d towards = (cut.center - r.defect.center).normalized();
+  EXPECT_GT(r.defect.axis.dot(towards), std::cos(15.0 * M_PI / 180.0)) << r.message;
+  EXPECT_GT(r.defect.area_mm2, 8000.0) << r.message;
+  EXPECT_LT(r.defect.axis.dot(r.defect.up), std::cos(105.0 * M_PI / 180.0))
+      << "the case reaches past the base's angle";
+  RecordProperty("angle_from_vault_deg",
+                 std::to_string(std::acos(r.defect.axis.dot(r.defect.up)) * 180.0 / M_PI));
+}
+
+// The same defect planned from the rim alone, as for a defect the mirror cannot fill: the
+// implant must still meet the real bone all round and be printable. Next to a real defect's rim
+// the bone thins and bends, and the support markers there carry that to the implant (only rays
+// through both tables for them open the rim gap to 4 mm). The orbital roof seen past the rim
+// must not be taken for the vault (BoneSeenThroughTheOpeningIsNotTheVault): that made a bay
+// 6.8 mm deep above the orbit. The STL is read as this very mesh
+// (TheSameSurfaceFromAnotherFileGivesTheSameImplant). Over 14 readings and poses of the sample
+// every rim-only plan is printable (docs/AUTOPLAN.md).
+TEST(SampleCase, RimOnlyPlanMeetsTheRealBone) {
+  const std::string path = sample_case_path();
+  if (!std::filesystem::exists(path))
+    GTEST_SKIP() << path << " not installed (scripts/install-deps)";
+  const LoadedSkull skull = load_skull(path);
+  AutoplanParams params;
+  params.propose.method = PlanMethod::RimOnly;
+  const AutoplanResult r = autoplan(skull.mesh, Landmarks{}, params);
+  ASSERT_TRUE(r.planned()) << r.message;
+  EXPECT_EQ(r.method_used, PlanMethod::RimOnly);
+  EXPECT_TRUE(r.quality.watertight);
+  EXPECT_LE(r.quality.rim_gap_mm, 0.5);
+  EXPECT_LT(r.quality.penetration_mm3, 0.25);
+  EXPECT_TRUE(r.quality.printable) << (r.quality.reasons.empty() ? "" : r.quality.reasons[0]);
+  RecordProperty("rim_gap_mm", std::to_string(r.quality.rim_gap_mm));
+}
+
+}  // namespace
+}  // namespace cranioplan

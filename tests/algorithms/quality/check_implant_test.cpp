@@ -1,0 +1,186 @@
+#include "cranioplan/algorithms/quality/check_implant.h"
+
+#include <gtest/gtest.h>
+
+#include "cranioplan/algorithms/geometry/self_intersections.h"
+#include "cranioplan/algorithms/geometry/voxelize_mesh.h"
+#include "cranioplan/algorithms/io/extract_bone_surface.h"
+#include "support/synthetic.h"
+
+namespace cranioplan {
+namespace {
+
+SkullMesh box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  return build_mesh(test::box_soup(lo, hi));
+}
+
+bool has_reason(const QualityReport& q, const std::string& part) {
+  for (const auto& r : q.reasons)
+    if (r.find(part) != std::string::npos) return true;
+  return false;
+}
+
+bool judged_thin(const QualityReport& q) {
+  return has_reason(q, "thinner than") || has_reason(q, "nowhere is the implant");
+}
+
+TEST(SelfIntersections, CrossingTrianglesAreCountedAndAClosedSurfaceHasNone) {
+  TriangleSoup s;
+  s.vertices = {{0, 0, 0}, {4, 0, 0}, {0, 4, 0}, {1, 1, -1}, {1, 1, 1}, {3, 3, 0.5}};
+  s.triangles = {{0, 1, 2}, {3, 4, 5}};  // the second pierces the first
+  EXPECT_EQ(count_self_intersections(build_mesh(s)), 1);
+  EXPECT_EQ(count_self_intersections(test::make_symmetric_head(3)), 0);
+}
+
+TEST(CheckImplant, ThicknessVolumeAndReasonsOnKnownBoxes) {
+  // A 30 × 30 × 4 mm plate: thickness 4 mm everywhere on its large faces.
+  const QualityReport plate = check_implant(box({0, 0, 0}, {30, 30, 4}), nullptr);
+  EXPECT_TRUE(plate.watertight);
+  EXPECT_TRUE(plate.outward);
+  EXPECT_NEAR(plate.volume_mm3, 3600.0, 1e-9);
+  EXPECT_NEAR(plate.thickness_min_mm, 4.0, 1e-3);
+  EXPECT_NEAR(plate.thickness_max_mm, 4.0, 1e-3);
+  EXPECT_TRUE(plate.printable) << (plate.reasons.empty() ? "" : plate.reasons[0]);
+
+  // Too thin to print, and overlapping a "skull" box by 30 × 30 × 0.2 mm = 180 mm³ (measured on
+  // 0.25 mm voxels: within one voxel layer, 225 mm³).
+  const SkullMesh thin = box({0, 0, 0}, {30, 30, 0.5});
+  const SkullMesh skull = box({-10, -10, 0.3}, {40, 40, 10});
+  const QualityReport q = check_implant(thin, &skull);
+  EXPECT_FALSE(q.printable);
+  EXPECT_NEAR(q.penetration_mm3, 180.0, 60.0);
+  EXPECT_TRUE(has_reason(q, "nowhere is the implant 1.00 mm thick")) << q.reasons[0];
+  EXPECT_TRUE(has_reason(q, "overlap the skull"));
+}
+
+// A 4 mm spherical cap (radii 60 and 64 mm, 50° around +z) meshed from a 0.5 mm voxel mask, as
+// trimmed implants are: the staircase tilts facets by up to 45° from the plate, and their
+// normals run along it (on the sample's implant up to 27 mm). The thickness is still 4 mm.
+TEST(CheckImplant, ThicknessOfAVoxelMeshedCurvedPlateIsItsThickness) {
+  const VoxelGrid grid = VoxelGrid::covering({-60, -60, 30}, {60, 60, 66}, 0.5);
+  std::vector<uint8_t> cap(grid.size());
+  for (int k = 0; k < grid.dims[2]; ++k)
+    for (int j = 0; j < grid.dims[1]; ++j)
+      for (int i = 0; i < grid.dims[0]; ++i) {
+        const Eigen::Vector3d p = grid.center(i, j, k);
+        const double r = p.norm();
+        cap[grid.index(i, j, k)] = r >= 60 && r <= 64 && p.z() >= r * std::cos(50 * M_PI / 180);
+      }
+  const SkullMesh plate = extract_bone_surface(mask_volume(cap, grid)).mesh;
+  ASSERT_GT(plate.n_faces(), 10000u);
+  const QualityReport q = check_implant(plate, nullptr);
+  EXPECT_TRUE(q.watertight);
+  EXPECT_NEAR(q.thickness_median_mm, 4.0, 0.5);
+  EXPECT_GT(q.thickness_max_mm, 4.0);
+  EXPECT_LT(q.thickness_max_mm, 5.5) << "a normal that ran along the plate was taken for its "
+                                        "thickness";
+}
+
+// A wedge lying on the bone: the cross-section (x, z) is the quadrilateral (0,0), (L,0), (L,H),
+// (H/tan θ, H), extruded over y in [−w, w], so its only sharp edge is the apex of angle θ at
+// x = 0, resting on the bone's top face z = 0 (lifted by `lift`).
+SkullMesh wedge(double angle_deg, double lift) {
+  const double L = 30.0, H = 6.0, w = 10.0, x_top = H / std::tan(angle_deg * M_PI / 180.0);
+  const std::vector<Eigen::Vector2d> section = {{0, 0}, {L, 0}, {L, H}, {x_top, H}};
+  TriangleSoup s;
+  for (double y : {-w, w})
+    for (const auto& p : section) s.vertices.push_back({p.x(), y, p.y() + lift});
+  s.triangles = {{0, 1, 2}, {0, 2, 3}, {4, 6, 5}, {4, 7, 6}};  // caps
+  for (int i = 0; i < 4; ++i) {
+    const int j = (i + 1) % 4;
+    s.triangles.push_back({i, i + 4, j + 4});
+    s.triangles.push_back({i, j + 4, j});
+  }
+  SkullMesh m = build_mesh(s);
+  if (signed_volume(m) < 0) flip_orientation(m);
+  return m;
+}
+
+// Thin material is the wedge's tip: a ball of 1 mm fits at r / sin(θ/2) from the apex, so the
+// tapered edge reaches r / sin(θ/2) − r beyond the thick part (0.96 mm at 40°, 3.3 mm at 15°).
+// On 0.25 mm voxels the last of the tip, thinner than about half a voxel, has no voxel: the
+// measure falls short by up to h / tan θ.
+TEST(CheckImplant, ATaperedEdgeOnTheBoneIsPrintableUpToItsWidth) {
+  const SkullMesh bone = box({-50, -50, -10}, {50, 50, 0});
+  const double r = 0.5, h = 0.25;
+  auto expect_reach = [&](double reach, double angle_deg) {
+    const double a = angle_deg * M_PI / 180, truth = r / std::sin(a / 2) - r;
+    EXPECT_GT(reach, truth - h / std::tan(a) - 0.2) << angle_deg << "°";
+    EXPECT_LT(reach, truth + 0.3) << angle_deg << "°";
+  };
+  const QualityReport blunt = check_implant(wedge(40, 0), &bone);
+  expect_reach(blunt.taper_reach_mm, 40);
+  EXPECT_LT(blunt.corner_reach_mm, 0.8);
+  EXPECT_GT(blunt.thin_volume_mm3, 0.0);
+  EXPECT_FALSE(judged_thin(blunt)) << blunt.reasons[0];
+
+  const QualityReport sharp = check_implant(wedge(15, 0), &bone);
+  expect_reach(sharp.taper_reach_mm, 15);
+  EXPECT_TRUE(has_reason(sharp, "its edge stays thinner than 1.00 mm"));
+
+  // A 30° wedge: on the bone its taper (1.4 mm) is printable; 5 mm above the bone its thin tip
+  // is a sharp corner, not an edge resting on the bone (at most 0.8 mm: 45° and more).
+  const QualityReport resting = check_implant(wedge(30, 0), &bone);
+  expect_reach(resting.taper_reach_mm, 30);
+  EXPECT_FALSE(judged_thin(resting)) << resting.reasons[0];
+  // Without the skull the same taper cannot be told from a corner, and the report says so.
+  EXPECT_TRUE(has_reason(check_implant(wedge(30, 0), nullptr), "without the skull"));
+  const QualityReport lifted = check_implant(wedge(30, 5), &bone);
+  expect_reach(lifted.corner_reach_mm, 30);
+  EXPECT_NEAR(lifted.thin_off_bone_mm3, lifted.thin_volume_mm3, 1e-9);
+  EXPECT_TRUE(has_reason(lifted, "away from the bone it is thinner than 1.00 mm"));
+
+  // A box's 90° corners are not thin material.
+  const QualityReport plate = check_implant(box({0, 0, 0.1}, {30, 30, 4.1}), &bone);
+  EXPECT_LT(plate.corner_reach_mm, 0.8);
+  EXPECT_FALSE(judged_thin(plate));
+}
+
+// The rim gap's arcs slide: a gap 5° wide or more is found wherever it lies, and the same
+// points turned by any angle, or listed in another order, give the same gap. (Over 72 fixed 5°
+// sectors beginning at the mesh's first wall vertex, the gap below, 6.5° wide, hides from
+// sectors beginning at 0°, each of which also holds a vertex on the bone, and reordering the
+// vertices moves the sectors.)
+TEST(CheckImplant, TheRimGapIsTheWorstArcWhereverItLies) {
+  const double deg = M_PI / 180;
+  std::vector<double> angle, distance;
+  for (int k = 0; k < 720; ++k) {  // a vertex every 0.5°, 0.1 mm from the bone
+    angle.push_back(k * 0.5 * deg);
+    distance.push_back(0.1);
+  }
+  // Over 7° from 101.25° (14 vertices) the wall stands 1.2 mm off, and 1.5 mm in the middle.
+  for (int k = 203; k < 217; ++k) distance[k] = k == 210 ? 1.5 : 1.2;
+  EXPECT_DOUBLE_EQ(worst_arc_gap(angle, distance, 5 * deg), 1.2);
+  double fixed_sectors = 0.0;  // the old measure, sectors beginning at 0°
+  for (int s = 0; s < 72; ++s) {
+    double nearest = 1e9;
+    for (size_t k = 0; k < angle.size(); ++k)
+      if (static_cast<int>(angle[k] / (5 * deg) + 1e-9) == s)
+        nearest = std::min(nearest, distance[k]);
+    fixed_sectors = std::max(fixed_sectors, nearest);
+  }
+  EXPECT_DOUBLE_EQ(fixed_sectors, 0.1) << "the sectors 100°–105° and 105°–110° reach the bone";
+  for (double turn : {0.0, 0.3, 17.0, 103.0, -250.0}) {
+    std::vector<double> turned = angle;
+    for (double& a : turned) a += turn * deg;
+    EXPECT_NEAR(worst_arc_gap(turned, distance, 5 * deg), 1.2, 1e-12) << turn;
+  }
+  // Listed in another order.
+  std::vector<size_t> order(angle.size());
+  for (size_t i = 0; i < order.size(); ++i) order[i] = (i * 389) % order.size();
+  std::vector<double> a2, d2;
+  for (size_t i : order) {
+    a2.push_back(angle[i]);
+    d2.push_back(distance[i]);
+  }
+  EXPECT_DOUBLE_EQ(worst_arc_gap(a2, d2, 5 * deg), 1.2);
+  // Narrower than the gap's core, the arc finds the 1.5 mm vertex alone only where no other
+  // vertex shares its arc: with vertices 0.5° apart an arc of 0.4° can hold it alone.
+  EXPECT_DOUBLE_EQ(worst_arc_gap(angle, distance, 0.4 * deg), 1.5);
+  // Without points, no gap; one point is its own gap.
+  EXPECT_EQ(worst_arc_gap({}, {}, 5 * deg), 0.0);
+  EXPECT_DOUBLE_EQ(worst_arc_gap({2.0}, {0.7}, 5 * deg), 0.7);
+}
+
+}  // namespace
+}  // namespace cranioplan
