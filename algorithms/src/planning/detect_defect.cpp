@@ -126,6 +126,265 @@ std::vector<RimStretch> unseen_rim_stretches(const std::vector<Eigen::Vector3d>&
   return gaps;
 }
 
+namespace {
+
+// Rays from one centre, each cast through the bone.
+struct RayCaster {
+  const SurfaceLocator& locator;
+  Eigen::Vector3d center;
+  double reach;
+  const DetectDefectParams& params;
+  RayThroughBone operator()(const Eigen::Vector3d& d) const {
+    return cast_through_bone(locator, center, d, reach, params.min_thickness_mm,
+                             params.max_thickness_mm);
+  }
+};
+
+// The detection's rays and what each met.
+struct RayFan {
+  std::vector<Eigen::Vector3d> dirs;
+  std::vector<std::optional<Eigen::Vector3d>> inner, outer;
+  std::vector<char> paired;
+  std::vector<std::vector<int>> nbrs;  // neighbours on the sphere (within 1.6 ray spacings)
+  Eigen::Vector3d up = Eigen::Vector3d::Zero();
+  int size() const { return static_cast<int>(dirs.size()); }
+};
+
+// Casts the rays (laid out in `frame`) and finds the vault: rays through a regular shell, both
+// tables facing the ray within 45°. The skull base, the face and the orbits are bone met
+// obliquely or several times; the vault is the dome above them. The mean direction of these
+// rays and of the openings' rays (a defect is vault too) is the skull's superior direction:
+// tilted back on a skull with a face (37° on the sample), 0–14° on SkullFix's crania; on a
+// shell closed all round it is no direction.
+RayFan cast_fan(const RayCaster& cast, int n, const Eigen::Matrix3d& frame, bool framed) {
+  RayFan fan;
+  fan.dirs = fibonacci_sphere(n);
+  if (framed)
+    for (auto& d : fan.dirs) d = frame * d;
+  fan.inner.resize(n);
+  fan.outer.resize(n);
+  fan.paired.assign(n, 0);
+  Eigen::Vector3d vault_sum = Eigen::Vector3d::Zero();
+  int vault_rays = 0;
+  for (int i = 0; i < n; ++i) {
+    const RayThroughBone h = cast(fan.dirs[i]);
+    fan.inner[i] = h.inner;
+    fan.outer[i] = h.outer;
+    fan.paired[i] = h.paired;
+    if (!h.inner || (h.paired && h.outer_normal.dot(fan.dirs[i]) > M_SQRT1_2 &&
+                     -h.inner_normal.dot(fan.dirs[i]) > M_SQRT1_2)) {
+      vault_sum += fan.dirs[i];
+      ++vault_rays;
+    }
+  }
+  fan.up = vault_rays > 0 && vault_sum.norm() > kVaultDirected * vault_rays
+               ? Eigen::Vector3d(vault_sum.normalized())
+               : Eigen::Vector3d::Zero();
+  const PointIndex index(fan.dirs);
+  const double spacing = std::sqrt(4.0 * M_PI / n);  // radians between neighbouring rays
+  fan.nbrs.resize(n);
+  for (int i = 0; i < n; ++i)
+    for (int j : index.within_radius(fan.dirs[i], 1.6 * spacing))
+      if (j != i) fan.nbrs[i].push_back(j);
+  return fan;
+}
+
+// Connected directions without bone, largest first.
+struct Openings {
+  std::vector<std::vector<int>> comps;    // the rays of each
+  std::vector<int> label;                 // each ray's opening, -1 for none
+  std::vector<size_t> order;              // openings by size, largest first
+  std::vector<Eigen::Vector3d> mean_dir;  // unit
+};
+
+// Openings: connected directions without bone, but for those that leave through the scan's
+// border (closed there by the scan's end, not open in the bone).
+Openings find_openings(const RayFan& fan, const Eigen::Vector3d& center,
+                       const std::vector<ScanBorder>& borders) {
+  const int n = fan.size();
+  Openings o;
+  std::vector<char> blocked(n, 0);
+  for (int i = 0; i < n; ++i) {
+    blocked[i] = fan.inner[i].has_value();
+    for (const ScanBorder& border : borders)
+      if (!blocked[i] && border.reached_by(center, fan.dirs[i])) blocked[i] = 1;
+  }
+  o.label.assign(n, -1);
+  for (int i = 0; i < n; ++i) {
+    if (blocked[i] || o.label[i] >= 0) continue;
+    std::vector<int> comp{i}, stack{i};
+    o.label[i] = static_cast<int>(o.comps.size());
+    while (!stack.empty()) {
+      const int v = stack.back();
+      stack.pop_back();
+      for (int w : fan.nbrs[v])
+        if (!blocked[w] && o.label[w] < 0) {
+          o.label[w] = o.label[i];
+          comp.push_back(w);
+          stack.push_back(w);
+        }
+    }
+    o.comps.push_back(std::move(comp));
+  }
+  o.order.resize(o.comps.size());
+  std::iota(o.order.begin(), o.order.end(), 0);
+  std::sort(o.order.begin(), o.order.end(),
+            [&](size_t a, size_t b) { return o.comps[a].size() > o.comps[b].size(); });
+  o.mean_dir.assign(o.comps.size(), Eigen::Vector3d::Zero());
+  for (size_t c = 0; c < o.comps.size(); ++c) {
+    for (int i : o.comps[c]) o.mean_dir[c] += fan.dirs[i];
+    o.mean_dir[c].normalize();
+  }
+  return o;
+}
+
+// The skull base (or the scan's cut): the rank (in `o.order`) of the largest opening whose mean
+// direction points away from the vault, more than 105° from its direction; o.order.size() for
+// none. The sample's foramen magnum lies at 124° from the CT, but at 118°, 115° and 113° on
+// copies decimated to 250,000, 120,000 and 60,000 triangles (the thin bone around it and the
+// orbits opens up, which moves both the opening's mean and the vault's direction), and its
+// frontal defect at 96°, 89°, 84°, 82°; SkullFix's bases 125–154°, their defects 26–53°. The
+// orbits lie further still (120–150°) but are smaller than the foramen (a limit of 114° took an
+// orbit of the 60,000-triangle copy for the base, and planned the foramen magnum as the
+// defect). With the skull's frame (its third axis the midsagittal plane's normal), the base must
+// also lie within 30° of the plane, as the foramen magnum and a scan's cut do (on the sample 0°,
+// and 17–27° for its orbits): a large one-sided defect low on the side of the head (a
+// decompressive hemicraniectomy, 8,000 mm² and more) is larger than the foramen magnum and
+// would otherwise be taken for the base if it reached 105°. Without such an opening, or without
+// a vault direction, the skull is closed below.
+size_t skull_base(const Openings& o, const Eigen::Vector3d& up, const Eigen::Matrix3d& frame,
+                  bool framed) {
+  constexpr double kBaseAwayFromVault = -0.2588;  // cos 105°
+  constexpr double kBaseNearMidline = 0.5;        // sin 30°
+  for (size_t r = 0; r < o.order.size() && up.norm() > 0; ++r) {
+    const Eigen::Vector3d& mean = o.mean_dir[o.order[r]];
+    const bool near_midline = !framed || std::abs(mean.dot(frame.col(2))) < kBaseNearMidline;
+    if (mean.dot(up) < kBaseAwayFromVault && near_midline) return r;
+  }
+  return o.order.size();
+}
+
+// An opening large enough to be a defect: its rank in Openings::order, its rim (bone rays next
+// to it) and its area at the radius of the rim.
+struct Candidate {
+  size_t r;
+  std::vector<int> rim;
+  double area;
+};
+
+// The openings large enough to be defects but the base, largest first; with a point given, the
+// one holding the ray nearest that point's direction first.
+std::vector<Candidate> defect_candidates(const RayFan& fan, const Openings& o, size_t base,
+                                         const Eigen::Vector3d& center,
+                                         const DetectDefectParams& params) {
+  std::vector<Candidate> candidates;
+  for (size_t r = 0; r < o.order.size(); ++r) {
+    if (r == base) continue;
+    const std::vector<int>& comp = o.comps[o.order[r]];
+    std::vector<int> rim;
+    for (int i : comp)
+      for (int j : fan.nbrs[i])
+        if (fan.paired[j]) rim.push_back(j);
+    std::sort(rim.begin(), rim.end());
+    rim.erase(std::unique(rim.begin(), rim.end()), rim.end());
+    if (rim.empty()) continue;
+    double radius = 0.0;
+    for (int j : rim) radius += (*fan.outer[j] - center).norm();
+    radius /= static_cast<double>(rim.size());
+    const double area =
+        static_cast<double>(comp.size()) * 4.0 * M_PI / fan.size() * radius * radius;
+    if (area < params.min_area_mm2) break;  // sorted by size: the rest are smaller
+    candidates.push_back({r, std::move(rim), area});
+  }
+  if (params.near && candidates.size() > 1 && (*params.near - center).norm() > 1e-9) {
+    const Eigen::Vector3d want = (*params.near - center).normalized();
+    auto closeness = [&](const Candidate& c) {
+      double best = -2.0;
+      for (int i : o.comps[o.order[c.r]]) best = std::max(best, fan.dirs[i].dot(want));
+      return best;
+    };
+    std::stable_sort(
+        candidates.begin(), candidates.end(),
+        [&](const Candidate& a, const Candidate& b) { return closeness(a) > closeness(b); });
+  }
+  return candidates;
+}
+
+// A ray through an opening: the one nearest its mean direction (the mean itself may fall outside
+// an opening that is not convex, even into another), so that a caller can plan it with a point
+// along it.
+Eigen::Vector3d ray_through(const RayFan& fan, const Openings& o, const Candidate& c) {
+  const std::vector<int>& comp = o.comps[o.order[c.r]];
+  const Eigen::Vector3d& mean = o.mean_dir[o.order[c.r]];
+  int through = comp.front();
+  for (int i : comp)
+    if (fan.dirs[i].dot(mean) > fan.dirs[through].dot(mean)) through = i;
+  return fan.dirs[through];
+}
+
+// The rim of the opening `c`, in order around `region.axis`: in each angular sector the rim ray
+// nearest the axis (the innermost bone), so the rim is a simple loop even where the ray grid is
+// ragged; each refined towards its nearest opening ray by bisection, so the rim sits where the
+// bone ends rather than up to a ray spacing inside it (rays must still cross bone of a
+// plausible thickness on both tables: they share the ray).
+void trace_rim(const RayFan& fan, const Openings& o, const Candidate& c, const RayCaster& cast,
+               DefectRegion& region) {
+  const std::vector<int>& rim = c.rim;
+  const Eigen::Vector3d e1 = across_axis(region.axis, region.frame), e2 = region.axis.cross(e1);
+  const int sectors = std::clamp(static_cast<int>(rim.size()) / 2, 8, 360);
+  std::vector<int> best(sectors, -1);
+  for (int j : rim) {
+    const double a = std::atan2(fan.dirs[j].dot(e2), fan.dirs[j].dot(e1));
+    const int sct = std::clamp(static_cast<int>((a + M_PI) / (2 * M_PI) * sectors), 0, sectors - 1);
+    if (best[sct] < 0 || fan.dirs[j].dot(region.axis) > fan.dirs[best[sct]].dot(region.axis))
+      best[sct] = j;
+  }
+  for (int j : best) {
+    if (j < 0) continue;
+    Eigen::Vector3d in_pt = *fan.inner[j], out_pt = *fan.outer[j];
+    int open_nbr = -1;
+    for (int w : fan.nbrs[j])
+      if (o.label[w] == static_cast<int>(o.order[c.r]) &&
+          (open_nbr < 0 || fan.dirs[w].dot(fan.dirs[j]) > fan.dirs[open_nbr].dot(fan.dirs[j])))
+        open_nbr = w;
+    if (open_nbr >= 0) {
+      Eigen::Vector3d bone_dir = fan.dirs[j], open_dir = fan.dirs[open_nbr];
+      for (int it = 0; it < 6; ++it) {
+        const Eigen::Vector3d mid = (bone_dir + open_dir).normalized();
+        const RayThroughBone h = cast(mid);
+        if (h.paired) {
+          bone_dir = mid;
+          in_pt = *h.inner;
+          out_pt = *h.outer;
+        } else {
+          open_dir = mid;
+        }
+      }
+    }
+    region.outer_rim.push_back(out_pt);
+    region.inner_rim.push_back(in_pt);
+  }
+  // Refinement moves rays sideways a little: restore the angular order around the axis.
+  std::vector<size_t> by_angle(region.outer_rim.size());
+  std::iota(by_angle.begin(), by_angle.end(), 0);
+  auto polar = [&](const Eigen::Vector3d& p) {
+    const Eigen::Vector3d d = p - region.center;
+    return std::atan2(d.dot(e2), d.dot(e1));
+  };
+  std::sort(by_angle.begin(), by_angle.end(), [&](size_t a, size_t b) {
+    return polar(region.outer_rim[a]) < polar(region.outer_rim[b]);
+  });
+  std::vector<Eigen::Vector3d> sorted_outer, sorted_inner;
+  for (size_t k : by_angle) {
+    sorted_outer.push_back(region.outer_rim[k]);
+    sorted_inner.push_back(region.inner_rim[k]);
+  }
+  region.outer_rim = std::move(sorted_outer);
+  region.inner_rim = std::move(sorted_inner);
+}
+
+}  // namespace
+
 DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator,
                            const Eigen::Vector3d& center, const DetectDefectParams& params) {
   const auto t0 = std::chrono::steady_clock::now();
@@ -135,237 +394,37 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
   for (auto vh : skull.vertices())
     reach = std::max(reach, (to_eigen(skull.point(vh)) - center).norm());
   reach += 10.0;
-
-  const int n = std::clamp(params.directions, 2000, 200000);
-  std::vector<Eigen::Vector3d> dirs = fibonacci_sphere(n);
-  if (params.frame) {
-    region.frame = *params.frame;
-    for (auto& d : dirs) d = region.frame * d;
-  }
-  auto cast = [&](const Eigen::Vector3d& d) {
-    return cast_through_bone(locator, center, d, reach, params.min_thickness_mm,
-                             params.max_thickness_mm);
-  };
-  std::vector<std::optional<Eigen::Vector3d>> inner(n), outer(n);
-  std::vector<char> paired(n, 0);
-  // The vault: rays through a regular shell, both tables facing the ray within 45°. The skull
-  // base, the face and the orbits are bone met obliquely or several times; the vault is the
-  // dome above them. The mean direction of these rays and of the openings' rays (a defect is
-  // vault too) is the skull's superior direction: tilted back on a skull with a face (37° on
-  // the sample), 0–14° on SkullFix's crania; on a shell closed all round it is no direction.
-  Eigen::Vector3d vault_sum = Eigen::Vector3d::Zero();
-  int vault_rays = 0;
-  for (int i = 0; i < n; ++i) {
-    const RayThroughBone h = cast(dirs[i]);
-    inner[i] = h.inner;
-    outer[i] = h.outer;
-    paired[i] = h.paired;
-    if (!h.inner || (h.paired && h.outer_normal.dot(dirs[i]) > M_SQRT1_2 &&
-                     -h.inner_normal.dot(dirs[i]) > M_SQRT1_2)) {
-      vault_sum += dirs[i];
-      ++vault_rays;
-    }
-  }
-  region.up = vault_rays > 0 && vault_sum.norm() > kVaultDirected * vault_rays
-                  ? Eigen::Vector3d(vault_sum.normalized())
-                  : Eigen::Vector3d::Zero();
-  // Neighbours on the sphere: the 6 nearest directions.
-  const PointIndex index(dirs);
-  const double spacing = std::sqrt(4.0 * M_PI / n);  // radians between neighbouring rays
-  std::vector<std::vector<int>> nbrs(n);
-  for (int i = 0; i < n; ++i)
-    for (int j : index.within_radius(dirs[i], 1.6 * spacing))
-      if (j != i) nbrs[i].push_back(j);
-
-  // Openings: connected directions without bone, but for those that leave through the scan's
-  // border (closed there by the scan's end, not open in the bone).
-  std::vector<char> blocked(n, 0);
-  for (int i = 0; i < n; ++i) {
-    blocked[i] = inner[i].has_value();
-    for (const ScanBorder& border : params.scan_borders)
-      if (!blocked[i] && border.reached_by(center, dirs[i])) blocked[i] = 1;
-  }
-  std::vector<int> label(n, -1);
-  std::vector<std::vector<int>> comps;
-  for (int i = 0; i < n; ++i) {
-    if (blocked[i] || label[i] >= 0) continue;
-    std::vector<int> comp{i}, stack{i};
-    label[i] = static_cast<int>(comps.size());
-    while (!stack.empty()) {
-      const int v = stack.back();
-      stack.pop_back();
-      for (int w : nbrs[v])
-        if (!blocked[w] && label[w] < 0) {
-          label[w] = label[i];
-          comp.push_back(w);
-          stack.push_back(w);
-        }
-    }
-    comps.push_back(std::move(comp));
-  }
-  std::vector<size_t> order(comps.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(),
-            [&](size_t a, size_t b) { return comps[a].size() > comps[b].size(); });
-  // Each opening's mean direction (unit).
-  std::vector<Eigen::Vector3d> mean_dir(comps.size(), Eigen::Vector3d::Zero());
-  for (size_t c = 0; c < comps.size(); ++c) {
-    for (int i : comps[c]) mean_dir[c] += dirs[i];
-    mean_dir[c].normalize();
-  }
-
-  // The skull base (or the scan's cut) is the largest opening whose mean direction points away
-  // from the vault, more than 105° from its direction. The sample's foramen magnum lies at 124°
-  // from the CT, but at 118°, 115° and 113° on copies decimated to 250,000, 120,000 and 60,000
-  // triangles (the thin bone around it and the orbits opens up, which moves both the opening's
-  // mean and the vault's direction), and its frontal defect at 96°, 89°, 84°, 82°; SkullFix's
-  // bases 125–154°, their defects 26–53°. The orbits lie further still (120–150°) but are
-  // smaller than the foramen (a limit of 114° took an orbit of the 60,000-triangle copy for
-  // the base, and planned the foramen magnum as the defect). With the skull's frame (its third axis
-  // the midsagittal plane's normal), the base must also lie within 30° of the plane, as the foramen
-  // magnum and a scan's cut do (on the sample 0°, and 17–27° for its orbits): a large one-sided
-  // defect low on the side of the head (a decompressive hemicraniectomy, 8,000 mm² and more) is
-  // larger than the foramen magnum and would otherwise be taken for the base if it reached 105°.
-  // Without such an opening, or without a vault direction, the skull is closed below. The defect is
-  // the largest of the others whose area, at the radius of its rim, is large enough.
-  constexpr double kBaseAwayFromVault = -0.2588;  // cos 105°
-  constexpr double kBaseNearMidline = 0.5;        // sin 30°
-  size_t base = order.size();
-  for (size_t r = 0; r < order.size() && region.up.norm() > 0; ++r) {
-    const Eigen::Vector3d& mean = mean_dir[order[r]];
-    const bool near_midline =
-        !params.frame || std::abs(mean.dot(region.frame.col(2))) < kBaseNearMidline;
-    if (mean.dot(region.up) < kBaseAwayFromVault && near_midline) {
-      base = r;
-      break;
-    }
-  }
-  // The openings large enough to be defects, largest first (area at the radius of the rim):
-  // each with its rim (bone rays next to it) and area.
-  struct Candidate {
-    size_t r;
-    std::vector<int> rim;
-    double area;
-  };
-  std::vector<Candidate> candidates;
-  for (size_t r = 0; r < order.size(); ++r) {
-    if (r == base) continue;
-    const std::vector<int>& comp = comps[order[r]];
-    std::vector<int> rim;
-    for (int i : comp)
-      for (int j : nbrs[i])
-        if (paired[j]) rim.push_back(j);
-    std::sort(rim.begin(), rim.end());
-    rim.erase(std::unique(rim.begin(), rim.end()), rim.end());
-    if (rim.empty()) continue;
-    double radius = 0.0;
-    for (int j : rim) radius += (*outer[j] - center).norm();
-    radius /= static_cast<double>(rim.size());
-    const double area = static_cast<double>(comp.size()) * 4.0 * M_PI / n * radius * radius;
-    if (area < params.min_area_mm2) break;  // sorted by size: the rest are smaller
-    candidates.push_back({r, std::move(rim), area});
-  }
-  // Asked for the one towards a point: the opening holding the ray nearest that direction.
-  if (params.near && candidates.size() > 1 && (*params.near - center).norm() > 1e-9) {
-    const Eigen::Vector3d want = (*params.near - center).normalized();
-    auto closeness = [&](const Candidate& c) {
-      double best = -2.0;
-      for (int i : comps[order[c.r]]) best = std::max(best, dirs[i].dot(want));
-      return best;
-    };
-    std::stable_sort(
-        candidates.begin(), candidates.end(),
-        [&](const Candidate& a, const Candidate& b) { return closeness(a) > closeness(b); });
-  }
-  // The openings not planned: a ray through each, the one nearest its mean direction (the mean
-  // itself may fall outside an opening that is not convex, even into another), so that a
-  // caller can plan each in turn with a point along it.
-  for (size_t k = 1; k < candidates.size(); ++k) {
-    const std::vector<int>& comp = comps[order[candidates[k].r]];
-    const Eigen::Vector3d& mean = mean_dir[order[candidates[k].r]];
-    int through = comp.front();
-    for (int i : comp)
-      if (dirs[i].dot(mean) > dirs[through].dot(mean)) through = i;
-    region.other_axes.push_back(dirs[through]);
-  }
-  for (const Candidate& cand : candidates) {
-    const size_t r = cand.r;
-    const std::vector<int>& comp = comps[order[r]];
-    const std::vector<int>& rim = cand.rim;
-    const double area = cand.area;
+  if (params.frame) region.frame = *params.frame;
+  const RayCaster cast{locator, center, reach, params};
+  const RayFan fan = cast_fan(cast, std::clamp(params.directions, 2000, 200000), region.frame,
+                              params.frame.has_value());
+  region.up = fan.up;
+  const Openings openings = find_openings(fan, center, params.scan_borders);
+  const size_t base = skull_base(openings, region.up, region.frame, params.frame.has_value());
+  // The defect is the largest of the others whose area, at the radius of its rim, is large
+  // enough (or the one towards a point given); the rest are named by a ray through each.
+  const std::vector<Candidate> candidates = defect_candidates(fan, openings, base, center, params);
+  for (size_t k = 1; k < candidates.size(); ++k)
+    region.other_axes.push_back(ray_through(fan, openings, candidates[k]));
+  if (!candidates.empty()) {
+    const Candidate& chosen = candidates.front();
+    const std::vector<int>& comp = openings.comps[openings.order[chosen.r]];
     region.status = DefectRegion::Status::Found;
     region.other_openings = static_cast<int>(candidates.size()) - 1;
-    region.area_mm2 = area;
-    for (int i : comp) region.hole_directions.push_back(dirs[i]);
-    region.axis = mean_dir[order[r]];
-    // The rim, in order around the axis: in each angular sector the rim ray nearest the axis
-    // (the innermost bone), so the rim is a simple loop even where the ray grid is ragged.
-    const Eigen::Vector3d e1 = across_axis(region.axis, region.frame), e2 = region.axis.cross(e1);
-    const int sectors = std::clamp(static_cast<int>(rim.size()) / 2, 8, 360);
-    std::vector<int> best(sectors, -1);
-    for (int j : rim) {
-      const double a = std::atan2(dirs[j].dot(e2), dirs[j].dot(e1));
-      const int sct =
-          std::clamp(static_cast<int>((a + M_PI) / (2 * M_PI) * sectors), 0, sectors - 1);
-      if (best[sct] < 0 || dirs[j].dot(region.axis) > dirs[best[sct]].dot(region.axis))
-        best[sct] = j;
-    }
-    // Refine each rim ray towards its nearest opening ray by bisection, so the rim sits where
-    // the bone ends rather than up to a ray spacing inside it. Rays must still cross bone of
-    // a plausible thickness on both tables (they share the ray).
-    for (int j : best) {
-      if (j < 0) continue;
-      Eigen::Vector3d in_pt = *inner[j], out_pt = *outer[j];
-      int open_nbr = -1;
-      for (int w : nbrs[j])
-        if (label[w] == static_cast<int>(order[r]) &&
-            (open_nbr < 0 || dirs[w].dot(dirs[j]) > dirs[open_nbr].dot(dirs[j])))
-          open_nbr = w;
-      if (open_nbr >= 0) {
-        Eigen::Vector3d bone_dir = dirs[j], open_dir = dirs[open_nbr];
-        for (int it = 0; it < 6; ++it) {
-          const Eigen::Vector3d mid = (bone_dir + open_dir).normalized();
-          const RayThroughBone h = cast(mid);
-          if (h.paired) {
-            bone_dir = mid;
-            in_pt = *h.inner;
-            out_pt = *h.outer;
-          } else {
-            open_dir = mid;
-          }
-        }
-      }
-      region.outer_rim.push_back(out_pt);
-      region.inner_rim.push_back(in_pt);
-    }
-    // Refinement moves rays sideways a little: restore the angular order around the axis.
-    std::vector<size_t> by_angle(region.outer_rim.size());
-    std::iota(by_angle.begin(), by_angle.end(), 0);
-    auto polar = [&](const Eigen::Vector3d& p) {
-      const Eigen::Vector3d d = p - center;
-      return std::atan2(d.dot(e2), d.dot(e1));
-    };
-    std::sort(by_angle.begin(), by_angle.end(), [&](size_t a, size_t b) {
-      return polar(region.outer_rim[a]) < polar(region.outer_rim[b]);
-    });
-    std::vector<Eigen::Vector3d> sorted_outer, sorted_inner;
-    for (size_t k : by_angle) {
-      sorted_outer.push_back(region.outer_rim[k]);
-      sorted_inner.push_back(region.inner_rim[k]);
-    }
-    region.outer_rim = std::move(sorted_outer);
-    region.inner_rim = std::move(sorted_inner);
+    region.area_mm2 = chosen.area;
+    for (int i : comp) region.hole_directions.push_back(fan.dirs[i]);
+    region.axis = openings.mean_dir[openings.order[chosen.r]];
+    trace_rim(fan, openings, chosen, cast, region);
     // Asked for the opening towards a point, and none lies that way: the nearest was planned,
     // and the message says so (a point on intact bone, or at a cut that did not go through,
     // would otherwise plan another opening without a word).
     if (params.near && (*params.near - center).norm() > 1e-9) {
       const Eigen::Vector3d want = (*params.near - center).normalized();
       double closest = -1.0;
-      for (int i : comp) closest = std::max(closest, dirs[i].dot(want));
+      for (int i : comp) closest = std::max(closest, fan.dirs[i].dot(want));
       region.near_miss_deg = std::acos(std::clamp(closest, -1.0, 1.0)) * 180.0 / M_PI;
     }
     region.unseen_rim = unseen_rim_stretches(region.outer_rim);
-    break;
   }
   region.message = region.describe();
   region.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

@@ -187,121 +187,124 @@ std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> DefectSurfaces::at(
                         Eigen::Vector3d(center_ + r_in * dir));
 }
 
-DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLocator& bone,
-                                   const SurfaceLocator* mirror, const DefectSurfaceParams& params,
-                                   const DetectDefectParams& detect) {
-  DefectSurfaces s;
-  if (!defect.found() || defect.hole_directions.empty() || defect.outer_rim.size() < 3) {
-    s.message = "no defect to fit surfaces to";
-    return s;
+// The fit's stages, in order (DefectSurfaces' friend: each sets part of the result).
+struct DefectSurfaceFit {
+  // The projection around the opening's axis, scaled to the rim's radius, and the cap: the
+  // opening's widest angle from its axis plus the ring, capped at 70° (the gnomonic projection
+  // stretches without bound towards 90°).
+  static void frame(DefectSurfaces& s, const DefectRegion& defect, const SurfaceLocator* mirror,
+                    const DefectSurfaceParams& params, const DetectDefectParams& detect) {
+    s.center_ = defect.center;
+    s.axis_ = defect.axis;
+    s.e1_ = across_axis(s.axis_, defect.frame);
+    s.e2_ = s.axis_.cross(s.e1_);
+    s.mirror_ = mirror;
+    s.mirror_guided = mirror != nullptr;
+    s.max_thickness_mm_ = detect.max_thickness_mm;
+    double rim_radius = 0.0;
+    for (const auto& p : defect.outer_rim) rim_radius += (p - s.center_).norm();
+    rim_radius /= static_cast<double>(defect.outer_rim.size());
+    s.scale_ = rim_radius;
+    double hole_cos = 1.0;
+    for (const auto& d : defect.hole_directions) hole_cos = std::min(hole_cos, d.dot(s.axis_));
+    const double clearance = std::max(0.0, params.rim_clearance_mm);
+    const double width = std::max(1.0, params.ring_width_mm);
+    const double cap_angle = std::min(
+        std::acos(std::clamp(hole_cos, -1.0, 1.0)) + (clearance + width) / rim_radius * 1.2,
+        70.0 * M_PI / 180.0);
+    s.max_cos_ = std::cos(cap_angle);
   }
-  s.center_ = defect.center;
-  s.axis_ = defect.axis;
-  s.e1_ = across_axis(s.axis_, defect.frame);
-  s.e2_ = s.axis_.cross(s.e1_);
-  s.mirror_ = mirror;
-  s.mirror_guided = mirror != nullptr;
-  s.max_thickness_mm_ = detect.max_thickness_mm;
-  double rim_radius = 0.0;
-  for (const auto& p : defect.outer_rim) rim_radius += (p - s.center_).norm();
-  rim_radius /= static_cast<double>(defect.outer_rim.size());
-  s.scale_ = rim_radius;
 
-  // The cap: the opening's widest angle from its axis plus the ring, capped at 70° (the
-  // gnomonic projection stretches without bound towards 90°).
-  double hole_cos = 1.0;
-  for (const auto& d : defect.hole_directions) hole_cos = std::min(hole_cos, d.dot(s.axis_));
-  const double clearance = std::max(0.0, params.rim_clearance_mm);
-  const double width = std::max(1.0, params.ring_width_mm);
-  const double cap_angle =
-      std::min(std::acos(std::clamp(hole_cos, -1.0, 1.0)) + (clearance + width) / rim_radius * 1.2,
-               70.0 * M_PI / 180.0);
-  s.max_cos_ = std::cos(cap_angle);
-
-  // Rays over the cap, spaced about `ray_spacing_mm` apart at the rim's radius.
-  const double spacing = std::clamp(params.ray_spacing_mm, 0.5, 10.0) / rim_radius;
-  const int n = std::clamp(static_cast<int>(4.0 * M_PI / (spacing * spacing)), 2000, 400000);
-  const PointIndex hole(defect.hole_directions);
-  std::vector<Sample> ring;
-  for (const Eigen::Vector3d& lattice : fibonacci_sphere(n)) {
-    const Eigen::Vector3d d = defect.frame * lattice;  // in the skull's frame, as the rim's rays
-    if (d.dot(s.axis_) < s.max_cos_) continue;
-    const RayThroughBone o = cast_through_bone(bone, s.center_, d, kReach, detect.min_thickness_mm,
-                                               detect.max_thickness_mm);
-    if (!o.paired) continue;
-    double chord2 = 0.0;
-    hole.nearest(d, &chord2);
-    const double r_out = (*o.outer - s.center_).norm(), r_in = (*o.inner - s.center_).norm();
-    const double dist = 2.0 * std::asin(std::min(1.0, 0.5 * std::sqrt(chord2))) * r_out;
-    if (dist < clearance || dist > clearance + width) continue;
-    // Near an oblique cut face a ray enters or leaves through the cut instead of a table: its
-    // thickness is too small, so it does not inform the thickness (measured on SkullFix: the
-    // fitted bone 2.5 mm too thin across the opening).
-    const bool parallel =
-        params.max_table_angle_deg <= 0 ||
-        -o.inner_normal.dot(o.outer_normal) >= std::cos(params.max_table_angle_deg * M_PI / 180.0);
-    if (params.max_outer_tilt_deg > 0 &&
-        o.outer_normal.dot(d) < std::cos(params.max_outer_tilt_deg * M_PI / 180.0))
-      continue;  // left through a cut face rather than the outer table
-    Sample smp{d, r_out, r_out - r_in, parallel};
-    if (mirror) {
-      const RayThroughBone m =
-          cast_through_bone(*mirror, s.center_, d, kReach, 0.5, detect.max_thickness_mm);
-      if (!m.paired) continue;
-      smp.r_out -= (*m.outer - s.center_).norm();
-      smp.t -= (*m.outer - *m.inner).norm();
+  // Rays over the cap, spaced about `ray_spacing_mm` apart at the rim's radius, that cross the
+  // intact bone of the ring (between the clearance and the ring's width from the opening):
+  // their samples, and the ring's points in `s`.
+  static std::vector<Sample> ring(DefectSurfaces& s, const DefectRegion& defect,
+                                  const SurfaceLocator& bone, const SurfaceLocator* mirror,
+                                  const DefectSurfaceParams& params,
+                                  const DetectDefectParams& detect) {
+    const double clearance = std::max(0.0, params.rim_clearance_mm);
+    const double width = std::max(1.0, params.ring_width_mm);
+    const double spacing = std::clamp(params.ray_spacing_mm, 0.5, 10.0) / s.scale_;
+    const int n = std::clamp(static_cast<int>(4.0 * M_PI / (spacing * spacing)), 2000, 400000);
+    const PointIndex hole(defect.hole_directions);
+    std::vector<Sample> ring;
+    for (const Eigen::Vector3d& lattice : fibonacci_sphere(n)) {
+      const Eigen::Vector3d d = defect.frame * lattice;  // in the skull's frame, as the rim's rays
+      if (d.dot(s.axis_) < s.max_cos_) continue;
+      const RayThroughBone o = cast_through_bone(bone, s.center_, d, kReach,
+                                                 detect.min_thickness_mm, detect.max_thickness_mm);
+      if (!o.paired) continue;
+      double chord2 = 0.0;
+      hole.nearest(d, &chord2);
+      const double r_out = (*o.outer - s.center_).norm(), r_in = (*o.inner - s.center_).norm();
+      const double dist = 2.0 * std::asin(std::min(1.0, 0.5 * std::sqrt(chord2))) * r_out;
+      if (dist < clearance || dist > clearance + width) continue;
+      // Near an oblique cut face a ray enters or leaves through the cut instead of a table: its
+      // thickness is too small, so it does not inform the thickness (measured on SkullFix: the
+      // fitted bone 2.5 mm too thin across the opening).
+      const bool parallel = params.max_table_angle_deg <= 0 ||
+                            -o.inner_normal.dot(o.outer_normal) >=
+                                std::cos(params.max_table_angle_deg * M_PI / 180.0);
+      if (params.max_outer_tilt_deg > 0 &&
+          o.outer_normal.dot(d) < std::cos(params.max_outer_tilt_deg * M_PI / 180.0))
+        continue;  // left through a cut face rather than the outer table
+      Sample smp{d, r_out, r_out - r_in, parallel};
+      if (mirror) {
+        const RayThroughBone m =
+            cast_through_bone(*mirror, s.center_, d, kReach, 0.5, detect.max_thickness_mm);
+        if (!m.paired) continue;
+        smp.r_out -= (*m.outer - s.center_).norm();
+        smp.t -= (*m.outer - *m.inner).norm();
+      }
+      ring.push_back(smp);
+      s.ring_outer.push_back(*o.outer);
+      s.ring_inner.push_back(*o.inner);
+      s.ring_distance_mm.push_back(dist);
+      s.ring_inner_facing.push_back(-o.inner_normal.dot(d));
     }
-    ring.push_back(smp);
-    s.ring_outer.push_back(*o.outer);
-    s.ring_inner.push_back(*o.inner);
-    s.ring_distance_mm.push_back(dist);
-    s.ring_inner_facing.push_back(-o.inner_normal.dot(d));
+    return ring;
   }
+
   // Rim-only, only bone that continues from the rim: past an orbit the rays meet the orbital
   // roof 30-40 mm nearer the centre than the frontal bone, and a ring holding it bent the fitted
   // surfaces and the support markers down to it (the sample from its STL: a bay 6.8 mm deep in
   // the implant's edge above the orbit). Mirror-guided, the fit takes the mismatch with the
   // mirror, which meets the same roof on the other side: that bone fits as well as any.
-  if (!mirror) {
+  static void keep_continuing(DefectSurfaces& s, std::vector<Sample>& ring,
+                              const DefectRegion& defect, const DefectSurfaceParams& params) {
+    const double clearance = std::max(0.0, params.rim_clearance_mm);
+    const double spacing = std::clamp(params.ray_spacing_mm, 0.5, 10.0) / s.scale_;
     const std::vector<char> continuing = continuing_from_rim(
         s.ring_outer, defect.outer_rim, s.center_, 1.6 * spacing,
-        (clearance + 2.0 * std::clamp(params.ray_spacing_mm, 0.5, 10.0)) / rim_radius);
+        (clearance + 2.0 * std::clamp(params.ray_spacing_mm, 0.5, 10.0)) / s.scale_);
     keep_where(ring, continuing);
     keep_where(s.ring_outer, continuing);
     keep_where(s.ring_inner, continuing);
     keep_where(s.ring_distance_mm, continuing);
     keep_where(s.ring_inner_facing, continuing);
   }
-  s.ring_rays = static_cast<int>(ring.size());
-  if (ring.size() < 12) {
-    s.message = "too little intact bone around the opening to fit its surfaces (" +
-                std::to_string(ring.size()) + " rays)";
-    return s;
-  }
 
-  if (!mirror) {
+  // Rim-only, the vault's model (choose_vault); the outer radii then become their excess over it.
+  static void vault(DefectSurfaces& s, std::vector<Sample>& ring,
+                    const DefectSurfaceParams& params) {
+    const double clearance = std::max(0.0, params.rim_clearance_mm);
     s.vault_ = choose_vault(
         ring, s.ring_outer, s.ring_distance_mm, s.center_,
         [&s](const Eigen::Vector3d& d) { return s.uv(d); }, clearance + kNearBandMm, params);
     if (s.vault_)
       for (auto& smp : ring) smp.r_out -= s.vault_->radius_along(s.center_, smp.dir);
   }
+
   // Fitting sites: the ring's rays averaged over square cells of the site spacing on the
-  // fitting plane (uv, millimetres at the rim's radius); for the thickness, only rays through
-  // both tables. Averages, not one ray picked per site: which rays a centre a millimetre away
-  // sends through the ring changes, and a spline through single picked rays followed their
-  // noise across the opening (the same skull, its rays' centre moved 1 mm: Dice 0.91-0.94
-  // against its own plan; the averages move with the bone, not with the rays).
-  const double site_spacing = std::max(0.5, params.site_spacing_mm);
-  std::vector<size_t> all_rays, through_tables;
-  for (size_t i = 0; i < ring.size(); ++i) {
-    all_rays.push_back(i);
-    if (ring[i].tables_parallel) through_tables.push_back(i);
-  }
-  // Too few rays through both tables (a ring that is all cut faces): the thickness from all.
-  const bool thickness_from_all = through_tables.size() < 12;
-  const std::vector<size_t>& thickness_rays = thickness_from_all ? all_rays : through_tables;
-  auto fit = [&](ThinPlateSpline& tps, bool outer, const std::vector<size_t>& use) {
+  // fitting plane (uv, millimetres at the rim's radius). Averages, not one ray picked per site:
+  // which rays a centre a millimetre away sends through the ring changes, and a spline through
+  // single picked rays followed their noise across the opening (the same skull, its rays'
+  // centre moved 1 mm: Dice 0.91-0.94 against its own plan; the averages move with the bone,
+  // not with the rays). The number of sites, 0 when the spline could not be fitted.
+  static int fit_sites(const DefectSurfaces& s, ThinPlateSpline& tps, bool outer,
+                       const std::vector<Sample>& ring, const std::vector<size_t>& use,
+                       const DefectSurfaceParams& params) {
+    const double site_spacing = std::max(0.5, params.site_spacing_mm);
     std::map<std::pair<long, long>, std::tuple<Eigen::Vector2d, double, int>> cells;
     for (size_t i : use) {
       const Eigen::Vector2d q = s.uv(ring[i].dir);
@@ -319,34 +322,44 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
       uv.push_back(uv_sum / count);
       h.push_back(h_sum / count);
     }
-    const double smoothing = outer && mirror == nullptr ? params.outer_smoothing : params.smoothing;
+    const double smoothing = outer && !s.mirror_guided ? params.outer_smoothing : params.smoothing;
     const std::vector<double> lambda(uv.size(), std::max(0.0, smoothing));
     return tps.fit(uv, h, lambda, 1e-3) ? static_cast<int>(uv.size()) : 0;
-  };
-  auto residual = [&](const ThinPlateSpline& tps, bool outer, size_t i) {
-    return (outer ? ring[i].r_out : ring[i].t) - tps(s.uv(ring[i].dir));
-  };
-  for (bool outer : {true, false}) {
+  }
+
+  // One surface's spline (the outer radius, or the thickness from rays through both tables),
+  // with one round of outlier removal, and its residual; false when the ring lies on a line.
+  static bool fit(DefectSurfaces& s, bool outer, const std::vector<Sample>& ring,
+                  const DefectSurfaceParams& params) {
+    std::vector<size_t> all_rays, through_tables;
+    for (size_t i = 0; i < ring.size(); ++i) {
+      all_rays.push_back(i);
+      if (ring[i].tables_parallel) through_tables.push_back(i);
+    }
+    // Too few rays through both tables (a ring that is all cut faces): the thickness from all.
+    const bool thickness_from_all = through_tables.size() < 12;
+    const std::vector<size_t>& rays = outer                ? all_rays
+                                      : thickness_from_all ? all_rays
+                                                           : through_tables;
+    auto residual = [&](const ThinPlateSpline& tps, size_t i) {
+      return (outer ? ring[i].r_out : ring[i].t) - tps(s.uv(ring[i].dir));
+    };
     ThinPlateSpline& tps = outer ? s.outer_ : s.thickness_;
-    const std::vector<size_t>& rays = outer ? all_rays : thickness_rays;
     // The outer radius keeps the ring's curvature across the opening with a quadratic trend.
     // A thickness, and a correction of the mirror, vary gently: an affine trend suffices and
     // stays calm where the ring is open on one side (next to an orbit).
-    tps.set_quadratic_trend(outer && mirror == nullptr);
-    int sites = fit(tps, outer, rays);
-    if (sites == 0) {
-      s.message = "the intact bone around the opening lies on a line: no surface can be fitted";
-      return s;
-    }
+    tps.set_quadratic_trend(outer && !s.mirror_guided);
+    int sites = fit_sites(s, tps, outer, ring, rays, params);
+    if (sites == 0) return false;
     // One round of outlier removal: rays far off the first fit.
     std::vector<double> abs_res;
-    for (size_t i : rays) abs_res.push_back(std::abs(residual(tps, outer, i)));
+    for (size_t i : rays) abs_res.push_back(std::abs(residual(tps, i)));
     const double limit = std::max(1.0, params.outlier_sigmas * 1.4826 * median(abs_res));
     std::vector<size_t> kept;
     for (size_t i : rays)
-      if (std::abs(residual(tps, outer, i)) <= limit) kept.push_back(i);
+      if (std::abs(residual(tps, i)) <= limit) kept.push_back(i);
     if (kept.size() < rays.size() && kept.size() >= 12) {
-      const int refit = fit(tps, outer, kept);
+      const int refit = fit_sites(s, tps, outer, ring, kept, params);
       if (refit > 0) sites = refit;
     }
     s.sites = sites;
@@ -359,7 +372,7 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
     int off = 0;
     for (size_t i = 0; i < ring.size(); ++i)
       if (outer || thickness_from_all || ring[i].tables_parallel) {
-        const double e = residual(tps, outer, i);
+        const double e = residual(tps, i);
         if (std::abs(e) > limit) {
           ++off;
           continue;
@@ -371,28 +384,59 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
         count > 0 ? std::sqrt(sum / static_cast<double>(count)) : 0.0;
     (outer ? s.outer_off_rays : s.thickness_off_rays) = off;
     (outer ? s.outer_off_limit_mm : s.thickness_off_limit_mm) = limit;
+    return true;
   }
+
+  // What was fitted, and how well.
+  static std::string describe(const DefectSurfaces& s) {
+    char buf[200];
+    char model[64];
+    if (s.mirror_guided)
+      std::snprintf(model, sizeof(model), "mirror corrected");
+    else if (s.vault_)
+      std::snprintf(model, sizeof(model), "rim only, beyond a %.0f mm sphere", s.vault_->radius);
+    else
+      std::snprintf(model, sizeof(model), "rim only");
+    std::snprintf(buf, sizeof(buf),
+                  "surfaces fitted to %d rays of intact bone (%s; residual %.2f mm outer surface, "
+                  "%.2f mm thickness",
+                  s.ring_rays, model, s.outer_rms_mm, s.thickness_rms_mm);
+    std::string message = buf;
+    if (s.outer_off_rays > 0 || s.thickness_off_rays > 0) {
+      std::snprintf(buf, sizeof(buf), "; %d and %d rays left out, off by over %.1f and %.1f mm",
+                    s.outer_off_rays, s.thickness_off_rays, s.outer_off_limit_mm,
+                    s.thickness_off_limit_mm);
+      message += buf;
+    }
+    return message + ")";
+  }
+};
+
+DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLocator& bone,
+                                   const SurfaceLocator* mirror, const DefectSurfaceParams& params,
+                                   const DetectDefectParams& detect) {
+  DefectSurfaces s;
+  if (!defect.found() || defect.hole_directions.empty() || defect.outer_rim.size() < 3) {
+    s.message = "no defect to fit surfaces to";
+    return s;
+  }
+  DefectSurfaceFit::frame(s, defect, mirror, params, detect);
+  std::vector<Sample> ring = DefectSurfaceFit::ring(s, defect, bone, mirror, params, detect);
+  if (!mirror) DefectSurfaceFit::keep_continuing(s, ring, defect, params);
+  s.ring_rays = static_cast<int>(ring.size());
+  if (ring.size() < 12) {
+    s.message = "too little intact bone around the opening to fit its surfaces (" +
+                std::to_string(ring.size()) + " rays)";
+    return s;
+  }
+  if (!mirror) DefectSurfaceFit::vault(s, ring, params);
+  for (bool outer : {true, false})
+    if (!DefectSurfaceFit::fit(s, outer, ring, params)) {
+      s.message = "the intact bone around the opening lies on a line: no surface can be fitted";
+      return s;
+    }
   s.status = DefectSurfaces::Status::Fitted;
-  char buf[200];
-  char model[64];
-  if (mirror)
-    std::snprintf(model, sizeof(model), "mirror corrected");
-  else if (s.vault_)
-    std::snprintf(model, sizeof(model), "rim only, beyond a %.0f mm sphere", s.vault_->radius);
-  else
-    std::snprintf(model, sizeof(model), "rim only");
-  std::snprintf(buf, sizeof(buf),
-                "surfaces fitted to %d rays of intact bone (%s; residual %.2f mm outer surface, "
-                "%.2f mm thickness",
-                s.ring_rays, model, s.outer_rms_mm, s.thickness_rms_mm);
-  s.message = buf;
-  if (s.outer_off_rays > 0 || s.thickness_off_rays > 0) {
-    std::snprintf(buf, sizeof(buf), "; %d and %d rays left out, off by over %.1f and %.1f mm",
-                  s.outer_off_rays, s.thickness_off_rays, s.outer_off_limit_mm,
-                  s.thickness_off_limit_mm);
-    s.message += buf;
-  }
-  s.message += ")";
+  s.message = DefectSurfaceFit::describe(s);
   return s;
 }
 

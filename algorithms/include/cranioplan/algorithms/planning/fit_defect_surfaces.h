@@ -99,6 +99,7 @@ class DefectSurfaces {
   std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> at(const Eigen::Vector3d& dir) const;
 
  private:
+  friend struct DefectSurfaceFit;  // the fit's stages (fit_defect_surfaces.cpp)
   friend DefectSurfaces fit_defect_surfaces(const DefectRegion&, const SurfaceLocator&,
                                             const SurfaceLocator*, const DefectSurfaceParams&,
                                             const DetectDefectParams&);
