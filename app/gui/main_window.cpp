@@ -331,326 +331,357 @@ QWidget* MainWindow::make_page(int step) {
   auto* layout = new QVBoxLayout(page);
   auto* form = new QFormLayout;
   layout->addLayout(form);
+  const PageParts parts{page, layout, form};
   switch (step) {
-    case 1: {
-      auto* open = button(tr("Open mesh or CT…"), "pageOpen", page);
-      connect(open, &QPushButton::clicked, this, [this] {
-        const QString path = QFileDialog::getOpenFileName(
-            this, tr("Open a skull"), QString(),
-            tr("Skull (*.stl *.ply *.obj *.off *.vtp *.inv3 *.nrrd *.nhdr *.nii *.nii.gz);;All "
-               "(*)"));
-        if (!path.isEmpty()) open_input(path);
-      });
-      auto* sample = button(tr("Open the sample case"), "pageSample", page);
-      connect(sample, &QPushButton::clicked, this, [this] { open_sample(); });
-      threshold_ = new QDoubleSpinBox(page);
-      threshold_->setObjectName("threshold");
-      threshold_->setRange(-1000, 3000);
-      threshold_->setValue(300);
-      threshold_->setSuffix(" HU");
-      threshold_->setToolTip(tr("Bone threshold for CTs (masks use 0.5)"));
-      units_ = new QComboBox(page);
-      units_->setObjectName("meshUnits");
-      for (const LengthUnit& u : length_units())
-        units_->addItem(QStringLiteral("%1 (%2)").arg(tr(u.label), QString::fromLatin1(u.name)),
-                        u.mm);
-      units_->setToolTip(
-          tr("The length unit a mesh file was written in (STL, PLY, OBJ and OFF carry none). A "
-             "skull of the wrong size is refused, naming the unit it looks to be in."));
-      form->addRow(open);
-      form->addRow(sample);
-      form->addRow(tr("Mesh units"), units_);
-      form->addRow(tr("CT bone threshold"), threshold_);
-      skull_info_ = new QLabel(page);
-      skull_info_->setWordWrap(true);
-      form->addRow(skull_info_);
+    case 1:
+      fill_load_page(parts);
       break;
-    }
-    case 2: {
-      landmark_ = new QComboBox(page);
-      landmark_->setObjectName("landmark");
-      landmark_->addItems(
-          {tr("Nasion"), tr("Left orbit centre"), tr("Right orbit centre"), tr("Midline point")});
-      form->addRow(tr("Click places"), landmark_);
-      auto* clear = button(tr("Clear landmarks"), "clearLandmarks", page);
-      connect(clear, &QPushButton::clicked, this, [this] {
-        for (const char* name : kLandmarkNames) push(commands::clear_landmark(name));
-      });
-      form->addRow(clear);
-      auto* fit = button(tr("Fit plane"), "fitPlane", page);
-      fit->setToolTip(tr("Landmarks (if all three are set) or automatic, refined by symmetry"));
-      connect(fit, &QPushButton::clicked, this,
-              [this] { push(commands::fit_plane(), tr("Fitting the plane")); });
-      form->addRow(fit);
-      plane_info_ = new QLabel(page);
-      plane_info_->setWordWrap(true);
-      form->addRow(plane_info_);
-      auto* box = new QGroupBox(tr("Adjust by hand"), page);
-      auto* bl = new QFormLayout(box);
-      adjust_axis_ = new QComboBox(box);
-      adjust_axis_->addItems({tr("Up–down axis"), tr("Front–back axis")});
-      adjust_angle_ = new QDoubleSpinBox(box);
-      adjust_angle_->setRange(-20, 20);
-      adjust_angle_->setSingleStep(0.5);
-      adjust_angle_->setSuffix("°");
-      adjust_shift_ = new QDoubleSpinBox(box);
-      adjust_shift_->setRange(-20, 20);
-      adjust_shift_->setSingleStep(0.5);
-      adjust_shift_->setSuffix(" mm");
-      auto* apply = button(tr("Apply"), "adjustPlane", box);
-      connect(apply, &QPushButton::clicked, this, [this] {
-        const Eigen::Vector3d axis =
-            adjust_axis_->currentIndex() == 0 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitY();
-        push(commands::adjust_plane(axis, adjust_angle_->value(), adjust_shift_->value()),
-             tr("Moving the plane"));
-      });
-      // Sliders beside the fields, in half-degree and half-millimetre steps.
-      auto linked_slider = [box](QDoubleSpinBox* field) {
-        auto* slider = new QSlider(Qt::Horizontal, box);
-        slider->setRange(-40, 40);
-        QObject::connect(slider, &QSlider::valueChanged, field,
-                         [field](int v) { field->setValue(0.5 * v); });
-        QObject::connect(field, &QDoubleSpinBox::valueChanged, slider, [slider](double v) {
-          const QSignalBlocker block(slider);
-          slider->setValue(static_cast<int>(std::lround(2.0 * v)));
-        });
-        return slider;
-      };
-      bl->addRow(tr("Turn about"), adjust_axis_);
-      bl->addRow(tr("Angle"), adjust_angle_);
-      bl->addRow(QString(), linked_slider(adjust_angle_));
-      bl->addRow(tr("Shift"), adjust_shift_);
-      bl->addRow(QString(), linked_slider(adjust_shift_));
-      bl->addRow(apply);
-      layout->addWidget(box);
+    case 2:
+      fill_plane_page(parts);
       break;
-    }
-    case 3: {
-      auto* mirror = button(tr("Mirror skull"), "mirror", page);
-      connect(mirror, &QPushButton::clicked, this,
-              [this] { push(commands::mirror(), tr("Mirroring")); });
-      form->addRow(mirror);
-      roi_only_ = new QCheckBox(tr("Only around a point (click the skull)"), page);
-      roi_only_->setObjectName("roiOnly");
-      roi_radius_ = new QDoubleSpinBox(page);
-      roi_radius_->setRange(20, 200);
-      roi_radius_->setValue(70);
-      roi_radius_->setSuffix(" mm");
-      auto* reg = button(tr("Register"), "register", page);
-      connect(reg, &QPushButton::clicked, this, [this] {
-        RegisterParams p;
-        if (roi_only_->isChecked() && roi_center_) {
-          RegionOfInterest roi;
-          roi.center = *roi_center_;
-          roi.radius = roi_radius_->value();
-          p.roi = roi;
-        }
-        push(commands::register_mirror(p), tr("Registering"));
-      });
-      form->addRow(roi_only_);
-      form->addRow(tr("Region radius"), roi_radius_);
-      form->addRow(reg);
-      register_info_ = new QLabel(page);
-      register_info_->setWordWrap(true);
-      form->addRow(register_info_);
-      auto* box = new QGroupBox(tr("Nudge the mirror"), page);
-      auto* grid = new QHBoxLayout(box);
-      const std::pair<QString, Eigen::Vector3d> moves[] = {
-          {"←", {-1, 0, 0}},   {"→", {1, 0, 0}}, {"front", {0, -1, 0}},
-          {"back", {0, 1, 0}}, {"↑", {0, 0, 1}}, {"↓", {0, 0, -1}}};
-      for (const auto& [label, delta] : moves) {
-        auto* b = new QPushButton(label, box);
-        b->setToolTip(tr("Move the mirrored skull 1 mm"));
-        connect(b, &QPushButton::clicked, this, [this, delta = delta] {
-          push(commands::move_mirrored(Eigen::Vector3d::UnitZ(), 0.0, Eigen::Vector3d::Zero(),
-                                       delta),
-               tr("Moving the mirror"));
-        });
-        grid->addWidget(b);
-      }
-      layout->addWidget(box);
-      auto* opacity = new QSlider(Qt::Horizontal, page);
-      opacity->setRange(5, 100);
-      opacity->setValue(45);
-      connect(opacity, &QSlider::valueChanged, this,
-              [this](int v) { view_->set_mirror_opacity(v / 100.0); });
-      form->addRow(tr("Mirror opacity"), opacity);
+    case 3:
+      fill_mirror_page(parts);
       break;
-    }
-    case 4: {
-      clip_on_ = new QCheckBox(tr("Clip the skulls"), page);
-      clip_on_->setObjectName("clipOn");
-      clip_axis_ = new QComboBox(page);
-      clip_axis_->addItems({tr("Left–right"), tr("Front–back"), tr("Up–down")});
-      clip_position_ = new QSlider(Qt::Horizontal, page);
-      clip_position_->setObjectName("clipPosition");
-      clip_position_->setRange(-120, 120);
-      auto send = [this] { push(clip_command()); };
-      connect(clip_on_, &QCheckBox::toggled, this, send);
-      connect(clip_axis_, &QComboBox::currentIndexChanged, this, [this, send] {
-        if (clip_on_->isChecked()) send();
-      });
-      connect(clip_position_, &QSlider::sliderReleased, this, send);
-      connect(clip_position_, &QSlider::valueChanged, this, [this, send] {
-        if (!clip_position_->isSliderDown() && clip_on_->isChecked()) send();
-      });
-      form->addRow(clip_on_);
-      form->addRow(tr("Cut across"), clip_axis_);
-      form->addRow(tr("Position"), clip_position_);
+    case 4:
+      fill_clip_page(parts);
       break;
-    }
     case 5:
-    case 6: {
-      const bool edges = step == 5;
-      for (int t : edges ? std::vector<int>{0, 1} : std::vector<int>{2, 3}) {
-        const auto type = static_cast<MarkerType>(t);
-        auto* b = new QPushButton(
-            QStringLiteral("[%1] %2").arg(t).arg(q(to_string(type)).replace('_', ' ')), page);
-        b->setObjectName(QStringLiteral("markerType%1").arg(t));
-        b->setCheckable(true);
-        b->setAutoExclusive(true);
-        connect(b, &QPushButton::clicked, this, [this, type] { set_marker_type(type); });
-        form->addRow(b);
-      }
-      if (edges) {
-        auto* propose = button(tr("Propose markers automatically"), "propose", page);
-        connect(propose, &QPushButton::clicked, this, [this] {
-          // With several openings in the skull, the one where the user has put edge markers is
-          // meant (otherwise the largest).
-          ProposeParams params;
-          params.detect.near = edge_marker_centre(controller_->state().markers);
-          push(commands::propose_markers(params), tr("Finding the defect and proposing markers"));
-        });
-        auto* import = button(tr("Import markers…"), "importMarkers", page);
-        connect(import, &QPushButton::clicked, this, [this] {
-          const QString path = QFileDialog::getOpenFileName(this, tr("Markers"), QString(),
-                                                            tr("Markers (*.json *.csv)"));
-          if (path.isEmpty()) return;
-          try {
-            push(commands::import_markers(read_markers_file(path.toStdString()), path.toStdString(),
-                                          sha256_file(path.toStdString())));
-          } catch (const Error& e) {
-            show_message(QString::fromUtf8(e.what()), true);
-          }
-        });
-        auto* clear = button(tr("Clear markers"), "clearMarkers", page);
-        connect(clear, &QPushButton::clicked, this, [this] { push(commands::clear_markers()); });
-        form->addRow(propose);
-        form->addRow(import);
-        form->addRow(clear);
-      }
-      marker_counts_[edges ? 0 : 1] = new QLabel(page);
-      form->addRow(marker_counts_[edges ? 0 : 1]);
-      if (edges) {
-        // What the last proposal found stays in view while the markers are edited: where the
-        // rim was not seen, the outline between edge markers far apart needs a look.
-        proposal_note_ = new QLabel(page);
-        proposal_note_->setObjectName("proposalNote");
-        proposal_note_->setWordWrap(true);
-        form->addRow(proposal_note_);
-      }
+    case 6:
+      fill_markers_page(parts, step);
       break;
-    }
-    case 7: {
-      implant_method_ = new QComboBox(page);
-      implant_method_->setObjectName("implantMethod");
-      implant_method_->addItems({tr("Shell (fitted surfaces)"), tr("Delaunay 3D (the paper's)")});
-      implant_resolution_ = new QDoubleSpinBox(page);
-      implant_resolution_->setRange(0.3, 5);
-      implant_resolution_->setValue(1.0);
-      implant_resolution_->setSingleStep(0.1);
-      implant_resolution_->setSuffix(" mm");
-      implant_thickness_ = new QDoubleSpinBox(page);
-      implant_thickness_->setRange(0, 15);
-      implant_thickness_->setValue(0);
-      implant_thickness_->setSpecialValueText(tr("measured at the rim"));
-      implant_thickness_->setSuffix(" mm");
-      implant_fit_ = new QDoubleSpinBox(page);
-      implant_fit_->setObjectName("implantFit");
-      implant_fit_->setRange(0, 8);
-      implant_fit_->setSingleStep(0.5);
-      implant_fit_->setSpecialValueText(tr("off"));
-      implant_fit_->setSuffix(" mm");
-      implant_fit_->setToolTip(
-          tr("Build the shell this far over the bone and subtract the skull: the implant meets "
-             "the cut face all around and never enters the bone (about 1 s per rebuild)"));
-      auto* build = button(tr("Build implant"), "build", page);
-      connect(build, &QPushButton::clicked, this, [this] {
-        ImplantParams p;
-        p.method =
-            implant_method_->currentIndex() == 0 ? ImplantMethod::Shell : ImplantMethod::Delaunay3D;
-        p.resolution_mm = implant_resolution_->value();
-        if (implant_thickness_->value() > 0) p.thickness_mm = implant_thickness_->value();
-        p.surface_smoothing = 0.003;
-        p.fit_to_bone_mm = implant_fit_->value();
-        push(commands::build_implant(p), tr("Building the implant"));
-      });
-      form->addRow(tr("Method"), implant_method_);
-      form->addRow(tr("Resolution"), implant_resolution_);
-      form->addRow(tr("Thickness without inner markers"), implant_thickness_);
-      form->addRow(tr("Fit to the bone"), implant_fit_);
-      form->addRow(build);
-      implant_info_ = new QLabel(page);
-      implant_info_->setWordWrap(true);
-      form->addRow(implant_info_);
+    case 7:
+      fill_build_page(parts);
       break;
-    }
-    case 8: {
-      smooth_radius_ = new QSlider(Qt::Horizontal, page);
-      smooth_radius_->setObjectName("smoothRadius");
-      smooth_radius_->setRange(2, 40);
-      smooth_radius_->setValue(10);
-      smooth_weight_ = new QSlider(Qt::Horizontal, page);
-      smooth_weight_->setObjectName("smoothWeight");
-      smooth_weight_->setRange(1, 10);
-      smooth_weight_->setValue(2);
-      smooth_iterations_ = new QSpinBox(page);
-      smooth_iterations_->setRange(1, 20);
-      smooth_project_ = new QCheckBox(tr("Put smoothed markers back on the mirror"), page);
-      smooth_project_->setChecked(true);
-      smooth_info_ = new QLabel(page);
-      smooth_info_->setWordWrap(true);
-      for (QSlider* s : {smooth_radius_, smooth_weight_})
-        connect(s, &QSlider::valueChanged, this, &MainWindow::preview_smoothing);
-      connect(smooth_iterations_, &QSpinBox::valueChanged, this, &MainWindow::preview_smoothing);
-      auto* apply = button(tr("Apply smoothing"), "applySmoothing", page);
-      connect(apply, &QPushButton::clicked, this, [this] {
-        push(commands::smooth_markers(
-                 {static_cast<double>(smooth_radius_->value()),
-                  static_cast<double>(smooth_weight_->value()), smooth_iterations_->value()},
-                 smooth_project_->isChecked()),
-             tr("Smoothing"));
-      });
-      form->addRow(tr("Radius"), smooth_radius_);
-      form->addRow(tr("Edge-marker weight"), smooth_weight_);
-      form->addRow(tr("Iterations"), smooth_iterations_);
-      form->addRow(smooth_project_);
-      form->addRow(apply);
-      form->addRow(smooth_info_);
+    case 8:
+      fill_smooth_page(parts);
       break;
-    }
-    case 9: {
-      export_report_ = new QTextBrowser(page);
-      export_report_->setObjectName("exportReport");
-      layout->addWidget(export_report_, 1);
-      for (const char* ext : {"stl", "ply"}) {
-        auto* b = button(tr("Export %1…").arg(QString(ext).toUpper()),
-                         ext[0] == 's' ? "exportStl" : "exportPly", page);
-        connect(b, &QPushButton::clicked, this, [this, ext] {
-          const QString path = QFileDialog::getSaveFileName(
-              this, tr("Export the implant"), QStringLiteral("implant.%1").arg(ext),
-              QStringLiteral("%1 (*.%2)").arg(QString(ext).toUpper(), ext));
-          if (!path.isEmpty()) export_to(path);
-        });
-        layout->addWidget(b);
-      }
+    case 9:
+      fill_export_page(parts);
       break;
-    }
     default:
       break;
   }
   layout->addStretch(1);
   return page;
+}
+
+// Step 1, load skull.
+void MainWindow::fill_load_page(const PageParts& p) {
+  auto* open = button(tr("Open mesh or CT…"), "pageOpen", p.page);
+  connect(open, &QPushButton::clicked, this, [this] {
+    const QString path = QFileDialog::getOpenFileName(
+        this, tr("Open a skull"), QString(),
+        tr("Skull (*.stl *.ply *.obj *.off *.vtp *.inv3 *.nrrd *.nhdr *.nii *.nii.gz);;All "
+           "(*)"));
+    if (!path.isEmpty()) open_input(path);
+  });
+  auto* sample = button(tr("Open the sample case"), "pageSample", p.page);
+  connect(sample, &QPushButton::clicked, this, [this] { open_sample(); });
+  threshold_ = new QDoubleSpinBox(p.page);
+  threshold_->setObjectName("threshold");
+  threshold_->setRange(-1000, 3000);
+  threshold_->setValue(300);
+  threshold_->setSuffix(" HU");
+  threshold_->setToolTip(tr("Bone threshold for CTs (masks use 0.5)"));
+  units_ = new QComboBox(p.page);
+  units_->setObjectName("meshUnits");
+  for (const LengthUnit& u : length_units())
+    units_->addItem(QStringLiteral("%1 (%2)").arg(tr(u.label), QString::fromLatin1(u.name)), u.mm);
+  units_->setToolTip(
+      tr("The length unit a mesh file was written in (STL, PLY, OBJ and OFF carry none). A "
+         "skull of the wrong size is refused, naming the unit it looks to be in."));
+  p.form->addRow(open);
+  p.form->addRow(sample);
+  p.form->addRow(tr("Mesh units"), units_);
+  p.form->addRow(tr("CT bone threshold"), threshold_);
+  skull_info_ = new QLabel(p.page);
+  skull_info_->setWordWrap(true);
+  p.form->addRow(skull_info_);
+}
+
+// Step 2, landmarks and the midsagittal plane.
+void MainWindow::fill_plane_page(const PageParts& p) {
+  landmark_ = new QComboBox(p.page);
+  landmark_->setObjectName("landmark");
+  landmark_->addItems(
+      {tr("Nasion"), tr("Left orbit centre"), tr("Right orbit centre"), tr("Midline point")});
+  p.form->addRow(tr("Click places"), landmark_);
+  auto* clear = button(tr("Clear landmarks"), "clearLandmarks", p.page);
+  connect(clear, &QPushButton::clicked, this, [this] {
+    for (const char* name : kLandmarkNames) push(commands::clear_landmark(name));
+  });
+  p.form->addRow(clear);
+  auto* fit = button(tr("Fit plane"), "fitPlane", p.page);
+  fit->setToolTip(tr("Landmarks (if all three are set) or automatic, refined by symmetry"));
+  connect(fit, &QPushButton::clicked, this,
+          [this] { push(commands::fit_plane(), tr("Fitting the plane")); });
+  p.form->addRow(fit);
+  plane_info_ = new QLabel(p.page);
+  plane_info_->setWordWrap(true);
+  p.form->addRow(plane_info_);
+  auto* box = new QGroupBox(tr("Adjust by hand"), p.page);
+  auto* bl = new QFormLayout(box);
+  adjust_axis_ = new QComboBox(box);
+  adjust_axis_->addItems({tr("Up–down axis"), tr("Front–back axis")});
+  adjust_angle_ = new QDoubleSpinBox(box);
+  adjust_angle_->setRange(-20, 20);
+  adjust_angle_->setSingleStep(0.5);
+  adjust_angle_->setSuffix("°");
+  adjust_shift_ = new QDoubleSpinBox(box);
+  adjust_shift_->setRange(-20, 20);
+  adjust_shift_->setSingleStep(0.5);
+  adjust_shift_->setSuffix(" mm");
+  auto* apply = button(tr("Apply"), "adjustPlane", box);
+  connect(apply, &QPushButton::clicked, this, [this] {
+    const Eigen::Vector3d axis =
+        adjust_axis_->currentIndex() == 0 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitY();
+    push(commands::adjust_plane(axis, adjust_angle_->value(), adjust_shift_->value()),
+         tr("Moving the plane"));
+  });
+  // Sliders beside the fields, in half-degree and half-millimetre steps.
+  auto linked_slider = [box](QDoubleSpinBox* field) {
+    auto* slider = new QSlider(Qt::Horizontal, box);
+    slider->setRange(-40, 40);
+    QObject::connect(slider, &QSlider::valueChanged, field,
+                     [field](int v) { field->setValue(0.5 * v); });
+    QObject::connect(field, &QDoubleSpinBox::valueChanged, slider, [slider](double v) {
+      const QSignalBlocker block(slider);
+      slider->setValue(static_cast<int>(std::lround(2.0 * v)));
+    });
+    return slider;
+  };
+  bl->addRow(tr("Turn about"), adjust_axis_);
+  bl->addRow(tr("Angle"), adjust_angle_);
+  bl->addRow(QString(), linked_slider(adjust_angle_));
+  bl->addRow(tr("Shift"), adjust_shift_);
+  bl->addRow(QString(), linked_slider(adjust_shift_));
+  bl->addRow(apply);
+  p.layout->addWidget(box);
+}
+
+// Step 3, mirror and register.
+void MainWindow::fill_mirror_page(const PageParts& p) {
+  auto* mirror = button(tr("Mirror skull"), "mirror", p.page);
+  connect(mirror, &QPushButton::clicked, this,
+          [this] { push(commands::mirror(), tr("Mirroring")); });
+  p.form->addRow(mirror);
+  roi_only_ = new QCheckBox(tr("Only around a point (click the skull)"), p.page);
+  roi_only_->setObjectName("roiOnly");
+  roi_radius_ = new QDoubleSpinBox(p.page);
+  roi_radius_->setRange(20, 200);
+  roi_radius_->setValue(70);
+  roi_radius_->setSuffix(" mm");
+  auto* reg = button(tr("Register"), "register", p.page);
+  connect(reg, &QPushButton::clicked, this, [this] {
+    RegisterParams p;
+    if (roi_only_->isChecked() && roi_center_) {
+      RegionOfInterest roi;
+      roi.center = *roi_center_;
+      roi.radius = roi_radius_->value();
+      p.roi = roi;
+    }
+    push(commands::register_mirror(p), tr("Registering"));
+  });
+  p.form->addRow(roi_only_);
+  p.form->addRow(tr("Region radius"), roi_radius_);
+  p.form->addRow(reg);
+  register_info_ = new QLabel(p.page);
+  register_info_->setWordWrap(true);
+  p.form->addRow(register_info_);
+  auto* box = new QGroupBox(tr("Nudge the mirror"), p.page);
+  auto* grid = new QHBoxLayout(box);
+  const std::pair<QString, Eigen::Vector3d> moves[] = {{"←", {-1, 0, 0}},     {"→", {1, 0, 0}},
+                                                       {"front", {0, -1, 0}}, {"back", {0, 1, 0}},
+                                                       {"↑", {0, 0, 1}},      {"↓", {0, 0, -1}}};
+  for (const auto& [label, delta] : moves) {
+    auto* b = new QPushButton(label, box);
+    b->setToolTip(tr("Move the mirrored skull 1 mm"));
+    connect(b, &QPushButton::clicked, this, [this, delta = delta] {
+      push(commands::move_mirrored(Eigen::Vector3d::UnitZ(), 0.0, Eigen::Vector3d::Zero(), delta),
+           tr("Moving the mirror"));
+    });
+    grid->addWidget(b);
+  }
+  p.layout->addWidget(box);
+  auto* opacity = new QSlider(Qt::Horizontal, p.page);
+  opacity->setRange(5, 100);
+  opacity->setValue(45);
+  connect(opacity, &QSlider::valueChanged, this,
+          [this](int v) { view_->set_mirror_opacity(v / 100.0); });
+  p.form->addRow(tr("Mirror opacity"), opacity);
+}
+
+// Step 4, clip and inspect.
+void MainWindow::fill_clip_page(const PageParts& p) {
+  clip_on_ = new QCheckBox(tr("Clip the skulls"), p.page);
+  clip_on_->setObjectName("clipOn");
+  clip_axis_ = new QComboBox(p.page);
+  clip_axis_->addItems({tr("Left–right"), tr("Front–back"), tr("Up–down")});
+  clip_position_ = new QSlider(Qt::Horizontal, p.page);
+  clip_position_->setObjectName("clipPosition");
+  clip_position_->setRange(-120, 120);
+  auto send = [this] { push(clip_command()); };
+  connect(clip_on_, &QCheckBox::toggled, this, send);
+  connect(clip_axis_, &QComboBox::currentIndexChanged, this, [this, send] {
+    if (clip_on_->isChecked()) send();
+  });
+  connect(clip_position_, &QSlider::sliderReleased, this, send);
+  connect(clip_position_, &QSlider::valueChanged, this, [this, send] {
+    if (!clip_position_->isSliderDown() && clip_on_->isChecked()) send();
+  });
+  p.form->addRow(clip_on_);
+  p.form->addRow(tr("Cut across"), clip_axis_);
+  p.form->addRow(tr("Position"), clip_position_);
+}
+
+// Steps 5 and 6, edge and surface markers.
+void MainWindow::fill_markers_page(const PageParts& p, int step) {
+  const bool edges = step == 5;
+  for (int t : edges ? std::vector<int>{0, 1} : std::vector<int>{2, 3}) {
+    const auto type = static_cast<MarkerType>(t);
+    auto* b = new QPushButton(
+        QStringLiteral("[%1] %2").arg(t).arg(q(to_string(type)).replace('_', ' ')), p.page);
+    b->setObjectName(QStringLiteral("markerType%1").arg(t));
+    b->setCheckable(true);
+    b->setAutoExclusive(true);
+    connect(b, &QPushButton::clicked, this, [this, type] { set_marker_type(type); });
+    p.form->addRow(b);
+  }
+  if (edges) {
+    auto* propose = button(tr("Propose markers automatically"), "propose", p.page);
+    connect(propose, &QPushButton::clicked, this, [this] {
+      // With several openings in the skull, the one where the user has put edge markers is
+      // meant (otherwise the largest).
+      ProposeParams params;
+      params.detect.near = edge_marker_centre(controller_->state().markers);
+      push(commands::propose_markers(params), tr("Finding the defect and proposing markers"));
+    });
+    auto* import = button(tr("Import markers…"), "importMarkers", p.page);
+    connect(import, &QPushButton::clicked, this, [this] {
+      const QString path = QFileDialog::getOpenFileName(this, tr("Markers"), QString(),
+                                                        tr("Markers (*.json *.csv)"));
+      if (path.isEmpty()) return;
+      try {
+        push(commands::import_markers(read_markers_file(path.toStdString()), path.toStdString(),
+                                      sha256_file(path.toStdString())));
+      } catch (const Error& e) {
+        show_message(QString::fromUtf8(e.what()), true);
+      }
+    });
+    auto* clear = button(tr("Clear markers"), "clearMarkers", p.page);
+    connect(clear, &QPushButton::clicked, this, [this] { push(commands::clear_markers()); });
+    p.form->addRow(propose);
+    p.form->addRow(import);
+    p.form->addRow(clear);
+  }
+  marker_counts_[edges ? 0 : 1] = new QLabel(p.page);
+  p.form->addRow(marker_counts_[edges ? 0 : 1]);
+  if (edges) {
+    // What the last proposal found stays in view while the markers are edited: where the
+    // rim was not seen, the outline between edge markers far apart needs a look.
+    proposal_note_ = new QLabel(p.page);
+    proposal_note_->setObjectName("proposalNote");
+    proposal_note_->setWordWrap(true);
+    p.form->addRow(proposal_note_);
+  }
+}
+
+// Step 7, build the implant.
+void MainWindow::fill_build_page(const PageParts& p) {
+  implant_method_ = new QComboBox(p.page);
+  implant_method_->setObjectName("implantMethod");
+  implant_method_->addItems({tr("Shell (fitted surfaces)"), tr("Delaunay 3D (the paper's)")});
+  implant_resolution_ = new QDoubleSpinBox(p.page);
+  implant_resolution_->setRange(0.3, 5);
+  implant_resolution_->setValue(1.0);
+  implant_resolution_->setSingleStep(0.1);
+  implant_resolution_->setSuffix(" mm");
+  implant_thickness_ = new QDoubleSpinBox(p.page);
+  implant_thickness_->setRange(0, 15);
+  implant_thickness_->setValue(0);
+  implant_thickness_->setSpecialValueText(tr("measured at the rim"));
+  implant_thickness_->setSuffix(" mm");
+  implant_fit_ = new QDoubleSpinBox(p.page);
+  implant_fit_->setObjectName("implantFit");
+  implant_fit_->setRange(0, 8);
+  implant_fit_->setSingleStep(0.5);
+  implant_fit_->setSpecialValueText(tr("off"));
+  implant_fit_->setSuffix(" mm");
+  implant_fit_->setToolTip(
+      tr("Build the shell this far over the bone and subtract the skull: the implant meets "
+         "the cut face all around and never enters the bone (about 1 s per rebuild)"));
+  auto* build = button(tr("Build implant"), "build", p.page);
+  connect(build, &QPushButton::clicked, this, [this] {
+    ImplantParams p;
+    p.method =
+        implant_method_->currentIndex() == 0 ? ImplantMethod::Shell : ImplantMethod::Delaunay3D;
+    p.resolution_mm = implant_resolution_->value();
+    if (implant_thickness_->value() > 0) p.thickness_mm = implant_thickness_->value();
+    p.surface_smoothing = 0.003;
+    p.fit_to_bone_mm = implant_fit_->value();
+    push(commands::build_implant(p), tr("Building the implant"));
+  });
+  p.form->addRow(tr("Method"), implant_method_);
+  p.form->addRow(tr("Resolution"), implant_resolution_);
+  p.form->addRow(tr("Thickness without inner markers"), implant_thickness_);
+  p.form->addRow(tr("Fit to the bone"), implant_fit_);
+  p.form->addRow(build);
+  implant_info_ = new QLabel(p.page);
+  implant_info_->setWordWrap(true);
+  p.form->addRow(implant_info_);
+}
+
+// Step 8, smooth and refine.
+void MainWindow::fill_smooth_page(const PageParts& p) {
+  smooth_radius_ = new QSlider(Qt::Horizontal, p.page);
+  smooth_radius_->setObjectName("smoothRadius");
+  smooth_radius_->setRange(2, 40);
+  smooth_radius_->setValue(10);
+  smooth_weight_ = new QSlider(Qt::Horizontal, p.page);
+  smooth_weight_->setObjectName("smoothWeight");
+  smooth_weight_->setRange(1, 10);
+  smooth_weight_->setValue(2);
+  smooth_iterations_ = new QSpinBox(p.page);
+  smooth_iterations_->setRange(1, 20);
+  smooth_project_ = new QCheckBox(tr("Put smoothed markers back on the mirror"), p.page);
+  smooth_project_->setChecked(true);
+  smooth_info_ = new QLabel(p.page);
+  smooth_info_->setWordWrap(true);
+  for (QSlider* s : {smooth_radius_, smooth_weight_})
+    connect(s, &QSlider::valueChanged, this, &MainWindow::preview_smoothing);
+  connect(smooth_iterations_, &QSpinBox::valueChanged, this, &MainWindow::preview_smoothing);
+  auto* apply = button(tr("Apply smoothing"), "applySmoothing", p.page);
+  connect(apply, &QPushButton::clicked, this, [this] {
+    push(commands::smooth_markers(
+             {static_cast<double>(smooth_radius_->value()),
+              static_cast<double>(smooth_weight_->value()), smooth_iterations_->value()},
+             smooth_project_->isChecked()),
+         tr("Smoothing"));
+  });
+  p.form->addRow(tr("Radius"), smooth_radius_);
+  p.form->addRow(tr("Edge-marker weight"), smooth_weight_);
+  p.form->addRow(tr("Iterations"), smooth_iterations_);
+  p.form->addRow(smooth_project_);
+  p.form->addRow(apply);
+  p.form->addRow(smooth_info_);
+}
+
+// Step 9, check and export.
+void MainWindow::fill_export_page(const PageParts& p) {
+  export_report_ = new QTextBrowser(p.page);
+  export_report_->setObjectName("exportReport");
+  p.layout->addWidget(export_report_, 1);
+  for (const char* ext : {"stl", "ply"}) {
+    auto* b = button(tr("Export %1…").arg(QString(ext).toUpper()),
+                     ext[0] == 's' ? "exportStl" : "exportPly", p.page);
+    connect(b, &QPushButton::clicked, this, [this, ext] {
+      const QString path = QFileDialog::getSaveFileName(
+          this, tr("Export the implant"), QStringLiteral("implant.%1").arg(ext),
+          QStringLiteral("%1 (*.%2)").arg(QString(ext).toUpper(), ext));
+      if (!path.isEmpty()) export_to(path);
+    });
+    p.layout->addWidget(b);
+  }
 }
 
 void MainWindow::build_plan_dock() {

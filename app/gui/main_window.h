@@ -23,6 +23,8 @@ class QProgressBar;
 class QPushButton;
 class QSlider;
 class QSpinBox;
+class QVBoxLayout;
+class QFormLayout;
 class QStackedWidget;
 class QTableWidget;
 class QTextBrowser;
@@ -76,6 +78,20 @@ class MainWindow : public QMainWindow {
   void build_steps_dock();
   void build_plan_dock();
   QWidget* make_page(int step);
+  // A step's page: the widget, its layout and the form at its top.
+  struct PageParts {
+    QWidget* page;
+    QVBoxLayout* layout;
+    QFormLayout* form;
+  };
+  void fill_load_page(const PageParts& p);
+  void fill_plane_page(const PageParts& p);
+  void fill_mirror_page(const PageParts& p);
+  void fill_clip_page(const PageParts& p);
+  void fill_markers_page(const PageParts& p, int step);
+  void fill_build_page(const PageParts& p);
+  void fill_smooth_page(const PageParts& p);
+  void fill_export_page(const PageParts& p);
   void refresh();
   void refresh_steps();
   void refresh_history();
