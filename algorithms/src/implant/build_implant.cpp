@@ -170,316 +170,394 @@ double measure_bone_thickness(const std::vector<Eigen::Vector3d>& edge_points,
   return std::clamp(t[t.size() / 2], 1.5, 15.0);
 }
 
-ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* skull,
-                          const SurfaceLocator* skull_locator, const ImplantParams& params) {
-  ImplantResult result;
-  // Edge markers first: where a surface marker lies next to an edge marker, the edge wins.
-  std::vector<Eigen::Vector3d> outer, outer_edges, inner, inner_edges;
-  for (const auto& m : markers) {
-    if (m.type == MarkerType::OuterEdge) outer_edges.push_back(m.position);
-    if (m.type == MarkerType::InnerEdge) inner_edges.push_back(m.position);
-  }
-  outer = outer_edges;
-  inner = inner_edges;
-  for (const auto& m : markers)
-    if (!is_edge(m.type)) (is_outer(m.type) ? outer : inner).push_back(m.position);
-  if (outer_edges.size() < 3) {
-    result.status = ImplantResult::Status::TooFewMarkers;
-    result.message = "the shell needs at least 3 outer edge markers (" +
-                     std::to_string(outer_edges.size()) + " given)";
-    return result;
-  }
-  const bool has_inner = inner_edges.size() >= 3;
-  std::unique_ptr<SurfaceLocator> own_locator;
-  if (!skull_locator && skull && skull->n_faces() > 0)
-    own_locator = std::make_unique<SurfaceLocator>(*skull);
-  const SurfaceLocator* bone = skull_locator ? skull_locator : own_locator.get();
+using Height = std::function<double(const Eigen::Vector2d&)>;
 
-  Eigen::Vector3d marker_centroid = Eigen::Vector3d::Zero();
-  for (const auto& p : outer) marker_centroid += p;
-  marker_centroid /= static_cast<double>(outer.size());
-  Eigen::Vector3d skull_centre = marker_centroid;
-  if (skull && skull->n_vertices() > 0) {
-    skull_centre.setZero();
-    for (auto vh : skull->vertices()) skull_centre += to_eigen(skull->point(vh));
-    skull_centre /= static_cast<double>(skull->n_vertices());
-  }
-  Frame f;
-  if (params.radial_center ||
-      (skull && skull->n_vertices() > 0 && params.frame == ImplantFrame::Radial)) {
-    f.radial = true;
-    f.origin = params.radial_center ? *params.radial_center : skull_centre;
-    Eigen::Vector3d axis = Eigen::Vector3d::Zero();
-    f.scale = 0.0;
-    for (const auto& p : outer_edges) {
-      axis += (p - f.origin).normalized();
-      f.scale += (p - f.origin).norm();
+// The shell's construction, stage by stage (build_shell runs them in order). Each stage that
+// can fail says so in `result` and returns false.
+class ShellBuilder {
+ public:
+  ShellBuilder(const std::vector<Marker>& markers, const SkullMesh* skull,
+               const SurfaceLocator* skull_locator, const ImplantParams& params,
+               ImplantResult& result)
+      : markers_(markers),
+        skull_(skull),
+        skull_locator_(skull_locator),
+        params_(params),
+        result_(result) {}
+
+  // Edge markers first: where a surface marker lies next to an edge marker, the edge wins. The
+  // skull's locator (made here when none is given).
+  bool gather_markers() {
+    for (const auto& m : markers_) {
+      if (m.type == MarkerType::OuterEdge) outer_edges_.push_back(m.position);
+      if (m.type == MarkerType::InnerEdge) inner_edges_.push_back(m.position);
     }
-    f.n = axis.normalized();
-    f.scale /= static_cast<double>(outer_edges.size());
-    // Across the axis towards the first edge marker: the same on the skull in any pose.
-    f.e1 = unit_across(outer_edges.front() - f.origin, f.n);
-    f.e2 = f.n.cross(f.e1);
-  } else {
-    // The plane of the outer markers, normal pointing away from the skull's centre.
-    f.origin = marker_centroid;
-    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-    for (const auto& p : outer) cov += (p - f.origin) * (p - f.origin).transpose();
-    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
-    f.n = eig.eigenvectors().col(0);
-    if (f.n.dot(f.origin - skull_centre) < 0) f.n = -f.n;
-    f.e1 = eig.eigenvectors().col(2);
-    f.e2 = f.n.cross(f.e1);
+    outer_ = outer_edges_;
+    inner_ = inner_edges_;
+    for (const auto& m : markers_)
+      if (!is_edge(m.type)) (is_outer(m.type) ? outer_ : inner_).push_back(m.position);
+    if (outer_edges_.size() < 3) {
+      result_.status = ImplantResult::Status::TooFewMarkers;
+      result_.message = "the shell needs at least 3 outer edge markers (" +
+                        std::to_string(outer_edges_.size()) + " given)";
+      return false;
+    }
+    has_inner_ = inner_edges_.size() >= 3;
+    if (!skull_locator_ && skull_ && skull_->n_faces() > 0)
+      own_locator_ = std::make_unique<SurfaceLocator>(*skull_);
+    bone_ = skull_locator_ ? skull_locator_ : own_locator_.get();
+    return true;
   }
+
+  // The frame the surfaces are height fields in: rays from the centre (radial) or the plane of
+  // the outer markers, normal pointing away from the skull's centre.
+  void set_frame() {
+    marker_centroid_ = Eigen::Vector3d::Zero();
+    for (const auto& p : outer_) marker_centroid_ += p;
+    marker_centroid_ /= static_cast<double>(outer_.size());
+    Eigen::Vector3d skull_centre = marker_centroid_;
+    if (skull_ && skull_->n_vertices() > 0) {
+      skull_centre.setZero();
+      for (auto vh : skull_->vertices()) skull_centre += to_eigen(skull_->point(vh));
+      skull_centre /= static_cast<double>(skull_->n_vertices());
+    }
+    if (params_.radial_center ||
+        (skull_ && skull_->n_vertices() > 0 && params_.frame == ImplantFrame::Radial)) {
+      f_.radial = true;
+      f_.origin = params_.radial_center ? *params_.radial_center : skull_centre;
+      Eigen::Vector3d axis = Eigen::Vector3d::Zero();
+      f_.scale = 0.0;
+      for (const auto& p : outer_edges_) {
+        axis += (p - f_.origin).normalized();
+        f_.scale += (p - f_.origin).norm();
+      }
+      f_.n = axis.normalized();
+      f_.scale /= static_cast<double>(outer_edges_.size());
+      // Across the axis towards the first edge marker: the same on the skull in any pose.
+      f_.e1 = unit_across(outer_edges_.front() - f_.origin, f_.n);
+      f_.e2 = f_.n.cross(f_.e1);
+    } else {
+      f_.origin = marker_centroid_;
+      Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+      for (const auto& p : outer_) cov += (p - f_.origin) * (p - f_.origin).transpose();
+      const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+      f_.n = eig.eigenvectors().col(0);
+      if (f_.n.dot(f_.origin - skull_centre) < 0) f_.n = -f_.n;
+      f_.e1 = eig.eigenvectors().col(2);
+      f_.e2 = f_.n.cross(f_.e1);
+    }
+  }
+
   // Rays from the centre parametrise a cap, not more: a marker far off the axis (e.g. one
   // placed on the far wall of the skull through the opening) would stretch the height field
   // without bound.
-  if (f.radial) {
-    for (const auto& m : markers) {
-      const Eigen::Vector3d d = m.position - f.origin;
-      if (d.dot(f.n) < std::cos(75.0 * M_PI / 180.0) * d.norm()) {
-        result.status = ImplantResult::Status::Failed;
-        result.message = "marker " + std::to_string(m.id) +
-                         " lies more than 75° from the defect's axis, seen from inside the skull: "
-                         "it is probably on the far side of the skull (placed through the "
-                         "opening?) — move or delete it";
-        return result;
+  bool markers_within_cap() {
+    if (!f_.radial) return true;
+    for (const auto& m : markers_) {
+      const Eigen::Vector3d d = m.position - f_.origin;
+      if (d.dot(f_.n) < std::cos(75.0 * M_PI / 180.0) * d.norm()) {
+        result_.status = ImplantResult::Status::Failed;
+        result_.message = "marker " + std::to_string(m.id) +
+                          " lies more than 75° from the defect's axis, seen from inside the skull: "
+                          "it is probably on the far side of the skull (placed through the "
+                          "opening?) — move or delete it";
+        return false;
       }
     }
+    return true;
   }
 
   // The outer surface: a spline of heights through the outer markers. The inner surface: the
   // outer one less a thickness field, a spline through the inner markers' depths below the
   // outer surface. Thickness varies slowly, so its spline stays calm across the opening where
   // a spline of the inner heights themselves, pulled by noisy samples at the rim, can buckle.
-  auto fit = [&](const std::vector<Eigen::Vector3d>& pts, size_t edges, ThinPlateSpline& tps,
-                 const ThinPlateSpline* below) {
+  // Without an inner rim, inner surface markers (six or more) still give the thickness field;
+  // the inner rim is then the outer one offset by it. Else the thickness is the one given, or
+  // the bone's measured at the rim.
+  bool fit_surfaces() {
+    thickness_tps_.set_quadratic_trend(false);
+    if (!fit(outer_, outer_edges_.size(), outer_tps_, nullptr)) {
+      result_.message = "the outer markers lie on a line: no surface can be fitted";
+      return false;
+    }
+    if (has_inner_ && !fit(inner_, inner_edges_.size(), thickness_tps_, &outer_tps_)) {
+      result_.message = "the inner markers lie on a line: no surface can be fitted";
+      return false;
+    }
+    thickness_from_markers_ = !has_inner_ && inner_.size() >= 6 &&
+                              std::isnan(params_.thickness_mm) &&
+                              fit(inner_, 0, thickness_tps_, &outer_tps_);
+    result_.thickness_used_mm =
+        has_inner_                ? 0.0
+        : thickness_from_markers_ ? depth(Eigen::Vector2d::Zero())
+        : !std::isnan(params_.thickness_mm)
+            ? params_.thickness_mm
+            : (bone_ ? measure_bone_thickness(outer_edges_, marker_centroid_, *bone_) : 6.0);
+    return true;
+  }
+
+  // Rim polygons around the polar centre (the ray axis, radial; else the rim's centroid), and
+  // the rim's sample angles: every edge marker's, densified to the resolution along the rim.
+  bool rim_angles() {
+    center_ = Eigen::Vector2d::Zero();
+    if (!f_.radial) {
+      for (const auto& p : outer_edges_) center_ += f_.uv(p);
+      center_ /= static_cast<double>(outer_edges_.size());
+    }
+    outer_poly_ = polygon(outer_edges_);
+    inner_poly_ = has_inner_ ? polygon(inner_edges_) : outer_poly_;
+    res_ = std::clamp(params_.resolution_mm, 0.2, 10.0);
+    std::vector<double> marker_angles = outer_poly_.angle;
+    if (has_inner_)
+      marker_angles.insert(marker_angles.end(), inner_poly_.angle.begin(), inner_poly_.angle.end());
+    std::sort(marker_angles.begin(), marker_angles.end());
+    marker_angles.erase(std::unique(marker_angles.begin(), marker_angles.end(),
+                                    [](double a, double b) { return std::abs(a - b) < 1e-9; }),
+                        marker_angles.end());
+    auto span = [&](size_t k) {
+      const double a0 = marker_angles[k];
+      const double a1 =
+          k + 1 < marker_angles.size() ? marker_angles[k + 1] : marker_angles[0] + kTwoPi;
+      return std::make_pair(a0, a1);
+    };
+    auto length = [&](double a0, double a1) {
+      return std::max((outer_poly_.at(a1).first - outer_poly_.at(a0).first).norm(),
+                      (inner_poly_.at(a1).first - inner_poly_.at(a0).first).norm());
+    };
+    double rim_length = 0.0;
+    for (size_t k = 0; k < marker_angles.size(); ++k) {
+      const auto [a0, a1] = span(k);
+      rim_length += length(a0, a1);
+    }
+    if (rim_length / res_ > 1e5) {
+      result_.status = ImplantResult::Status::Failed;
+      result_.message = "the rim through the edge markers is " +
+                        format_count(std::lround(rim_length)) +
+                        " mm long: the markers span too large a region (check markers far from "
+                        "the defect)";
+      return false;
+    }
+    for (size_t k = 0; k < marker_angles.size(); ++k) {
+      const auto [a0, a1] = span(k);
+      const int steps = std::max(1, static_cast<int>(std::ceil(length(a0, a1) / res_)));
+      for (int s = 0; s < steps; ++s) {
+        angles_.push_back(a0 + (a1 - a0) * s / steps);
+        is_marker_angle_.push_back(s == 0);
+      }
+    }
+    result_.rim_points = static_cast<int>(angles_.size());
+    return true;
+  }
+
+  // Both rims in 3D, snapped onto the bone between markers. Where both meet the same bone point
+  // the side wall would have no height: at least 0.3 mm between them, inwards along the outer
+  // surface's normal.
+  void rims() {
+    outer_rim_ = rim_points(outer_poly_, &outer_height_);
+    inner_rim_ = rim_points(inner_poly_, has_inner_ ? &inner_height_ : nullptr);
+    for (size_t k = 0; k < angles_.size(); ++k)
+      if ((inner_rim_[k] - outer_rim_[k]).norm() < 0.3)
+        inner_rim_[k] = outer_rim_[k] - 0.3 * outer_normal(f_.uv(outer_rim_[k]));
+  }
+
+  // The number of rings from the rim to the centre, refused when the shell would be too large.
+  bool ring_count() {
+    double radius = 0.0;
+    for (const auto& p : outer_rim_) radius = std::max(radius, (f_.uv(p) - center_).norm());
+    n_rings_ = std::max(2, static_cast<int>(std::ceil(radius / res_)));
+    start_ = angles_.front() - 1e-6;
+    const double vertices = 2.0 * n_rings_ * static_cast<double>(angles_.size());
+    if (vertices > 4e6) {
+      result_.status = ImplantResult::Status::Failed;
+      char buf[200];
+      std::snprintf(buf, sizeof(buf),
+                    "the shell would need %.0f million vertices at %.2f mm: the markers span "
+                    "too large a region (check markers far from the defect)",
+                    vertices / 1e6, res_);
+      result_.message = buf;
+      return false;
+    }
+    return true;
+  }
+
+  // Both caps, facing out, and the side wall between them: one closed solid.
+  void assemble() {
+    auto [outer_tris, outer_rim_first] = build_cap(outer_rim_, &outer_height_, false);
+    auto [inner_tris, inner_rim_first] =
+        build_cap(inner_rim_, has_inner_ ? &inner_height_ : nullptr, !has_inner_);
+    soup_.triangles = outer_tris;
+    for (auto t : inner_tris) soup_.triangles.emplace_back(t[0], t[2], t[1]);  // facing inwards
+    // Side wall between rim k of both surfaces. The outer cap runs its rim o_k → o_k+1 and the
+    // inner cap (facing inwards) i_k+1 → i_k, so the wall takes the opposite directions.
+    const size_t n_rim = angles_.size();
+    for (size_t k = 0; k < n_rim; ++k) {
+      const int o0 = outer_rim_first + static_cast<int>(k);
+      const int o1 = outer_rim_first + static_cast<int>((k + 1) % n_rim);
+      const int i0 = inner_rim_first + static_cast<int>(k);
+      const int i1 = inner_rim_first + static_cast<int>((k + 1) % n_rim);
+      soup_.triangles.emplace_back(o1, o0, i0);
+      soup_.triangles.emplace_back(o1, i0, i1);
+    }
+    if (signed_volume(soup_) < 0)  // inner surface above the outer one: markers swapped
+      for (auto& t : soup_.triangles) std::swap(t[1], t[2]);
+    result_.mesh = build_mesh(soup_);
+  }
+
+  // How far the rims pass from their edge markers, and the verdict.
+  void finish() {
+    for (const auto& m : markers_) {
+      if (!is_edge(m.type)) continue;
+      const std::vector<Eigen::Vector3d>& rim =
+          m.type == MarkerType::OuterEdge ? outer_rim_ : inner_rim_;
+      double best = std::numeric_limits<double>::infinity();
+      for (const auto& p : rim) best = std::min(best, (p - m.position).norm());
+      if (m.type == MarkerType::OuterEdge || has_inner_)
+        result_.rim_marker_error_mm = std::max(result_.rim_marker_error_mm, best);
+    }
+    result_.watertight = report_mesh(result_.mesh).watertight;
+    result_.status = ImplantResult::Status::Built;
+    result_.message = has_inner_
+                          ? "shell through outer and inner markers"
+                          : "shell through outer markers, inner surface offset by the thickness";
+  }
+
+ private:
+  bool fit(const std::vector<Eigen::Vector3d>& pts, size_t edges, ThinPlateSpline& tps,
+           const ThinPlateSpline* below) const {
     std::vector<Eigen::Vector2d> uv;
     std::vector<double> h;
     for (const auto& p : pts) {
-      uv.push_back(f.uv(p));
-      h.push_back(below ? (*below)(f.uv(p)) - f.h(p) : f.h(p));
+      uv.push_back(f_.uv(p));
+      h.push_back(below ? (*below)(f_.uv(p)) - f_.h(p) : f_.h(p));
     }
     std::vector<double> smoothing(uv.size(), 0.0);
-    for (size_t i = edges; i < smoothing.size(); ++i) smoothing[i] = params.surface_smoothing;
+    for (size_t i = edges; i < smoothing.size(); ++i) smoothing[i] = params_.surface_smoothing;
     return tps.fit(uv, h, smoothing, kMinMarkerSeparation, edges);
-  };
-  ThinPlateSpline outer_tps, thickness_tps;
-  thickness_tps.set_quadratic_trend(false);
-  if (!fit(outer, outer_edges.size(), outer_tps, nullptr)) {
-    result.message = "the outer markers lie on a line: no surface can be fitted";
-    return result;
   }
-  if (has_inner && !fit(inner, inner_edges.size(), thickness_tps, &outer_tps)) {
-    result.message = "the inner markers lie on a line: no surface can be fitted";
-    return result;
-  }
-  // Without an inner rim, inner surface markers (six or more) still give the thickness field;
-  // the inner rim is then the outer one offset by it.
-  const bool thickness_from_markers = !has_inner && inner.size() >= 6 &&
-                                      std::isnan(params.thickness_mm) &&
-                                      fit(inner, 0, thickness_tps, &outer_tps);
   // Depths are kept between 0.3 mm and 20 mm: the inner surface never crosses the outer one.
-  auto depth = [&](const Eigen::Vector2d& q) { return std::clamp(thickness_tps(q), 0.3, 20.0); };
-  using Height = std::function<double(const Eigen::Vector2d&)>;
-  const Height outer_height = [&](const Eigen::Vector2d& q) { return outer_tps(q); };
-  const Height inner_height = [&](const Eigen::Vector2d& q) { return outer_tps(q) - depth(q); };
+  double depth(const Eigen::Vector2d& q) const { return std::clamp(thickness_tps_(q), 0.3, 20.0); }
   // Outward normal of the outer surface: from the spline's gradient (planar), or the ray
   // direction (radial; the surfaces of a skull are nearly perpendicular to rays from inside).
-  auto outer_normal = [&](const Eigen::Vector2d& q) {
-    if (f.radial) return f.up(q);
-    const Eigen::Vector2d g = outer_tps.gradient(q);
-    return Eigen::Vector3d(f.n - g.x() * f.e1 - g.y() * f.e2).normalized();
-  };
-  result.thickness_used_mm =
-      has_inner                ? 0.0
-      : thickness_from_markers ? depth(Eigen::Vector2d::Zero())
-      : !std::isnan(params.thickness_mm)
-          ? params.thickness_mm
-          : (bone ? measure_bone_thickness(outer_edges, marker_centroid, *bone) : 6.0);
-  auto offset = [&](const Eigen::Vector2d& q) {
-    return thickness_from_markers ? depth(q) : result.thickness_used_mm;
-  };
-
-  // Rim polygons around the centre of the outer edge markers.
-  // Polar centre: the ray axis (radial; the rim is ordered around it), or the rim's centroid.
-  Eigen::Vector2d center = Eigen::Vector2d::Zero();
-  if (!f.radial) {
-    for (const auto& p : outer_edges) center += f.uv(p);
-    center /= static_cast<double>(outer_edges.size());
+  Eigen::Vector3d outer_normal(const Eigen::Vector2d& q) const {
+    if (f_.radial) return f_.up(q);
+    const Eigen::Vector2d g = outer_tps_.gradient(q);
+    return Eigen::Vector3d(f_.n - g.x() * f_.e1 - g.y() * f_.e2).normalized();
   }
-  auto polygon = [&](const std::vector<Eigen::Vector3d>& edges) {
-    PolarPolygon poly{center, {}, {}, {}};
+  double offset(const Eigen::Vector2d& q) const {
+    return thickness_from_markers_ ? depth(q) : result_.thickness_used_mm;
+  }
+  PolarPolygon polygon(const std::vector<Eigen::Vector3d>& edges) const {
+    PolarPolygon poly{center_, {}, {}, {}};
     for (const auto& p : edges) {
-      poly.point.push_back(f.uv(p));
-      poly.angle.push_back(PolarPolygon::angle_of(center, f.uv(p)));
+      poly.point.push_back(f_.uv(p));
+      poly.angle.push_back(PolarPolygon::angle_of(center_, f_.uv(p)));
       poly.extra.push_back(0.0);
     }
     poly.sort();
     return poly;
-  };
-  const PolarPolygon outer_poly = polygon(outer_edges);
-  const PolarPolygon inner_poly = has_inner ? polygon(inner_edges) : outer_poly;
+  }
 
-  // Rim sample angles: every edge marker's, densified to the resolution along the outer rim.
-  const double res = std::clamp(params.resolution_mm, 0.2, 10.0);
-  std::vector<double> marker_angles = outer_poly.angle;
-  if (has_inner)
-    marker_angles.insert(marker_angles.end(), inner_poly.angle.begin(), inner_poly.angle.end());
-  std::sort(marker_angles.begin(), marker_angles.end());
-  marker_angles.erase(std::unique(marker_angles.begin(), marker_angles.end(),
-                                  [](double a, double b) { return std::abs(a - b) < 1e-9; }),
-                      marker_angles.end());
-  std::vector<double> angles;
-  std::vector<char> is_marker_angle;
-  double rim_length = 0.0;
-  for (size_t k = 0; k < marker_angles.size(); ++k) {
-    const double a0 = marker_angles[k];
-    const double a1 =
-        k + 1 < marker_angles.size() ? marker_angles[k + 1] : marker_angles[0] + kTwoPi;
-    rim_length += std::max((outer_poly.at(a1).first - outer_poly.at(a0).first).norm(),
-                           (inner_poly.at(a1).first - inner_poly.at(a0).first).norm());
-  }
-  if (rim_length / res > 1e5) {
-    result.status = ImplantResult::Status::Failed;
-    result.message = "the rim through the edge markers is " +
-                     format_count(std::lround(rim_length)) +
-                     " mm long: the markers span too large a region (check markers far from the "
-                     "defect)";
-    return result;
-  }
-  for (size_t k = 0; k < marker_angles.size(); ++k) {
-    const double a0 = marker_angles[k];
-    const double a1 =
-        k + 1 < marker_angles.size() ? marker_angles[k + 1] : marker_angles[0] + kTwoPi;
-    const double len = std::max((outer_poly.at(a1).first - outer_poly.at(a0).first).norm(),
-                                (inner_poly.at(a1).first - inner_poly.at(a0).first).norm());
-    const int steps = std::max(1, static_cast<int>(std::ceil(len / res)));
-    for (int s = 0; s < steps; ++s) {
-      angles.push_back(a0 + (a1 - a0) * s / steps);
-      is_marker_angle.push_back(s == 0);
-    }
-  }
-  const size_t n_rim = angles.size();
-  result.rim_points = static_cast<int>(n_rim);
-
-  const double fit_margin = skull && bone ? std::max(0.0, params.fit_to_bone_mm) : 0.0;
-  // Rim points in 3D, snapped onto the bone between markers.
-  auto rim_points = [&](const PolarPolygon& poly, const Height* tps) {
+  // One rim in 3D along `poly` at the rim's angles: on the surface `tps` (or the outer one set
+  // in by the thickness), beyond the opening into the bone when fitting to it, snapped onto the
+  // bone between markers.
+  std::vector<Eigen::Vector3d> rim_points(const PolarPolygon& poly, const Height* tps) const {
+    const size_t n_rim = angles_.size();
+    const double fit_margin = skull_ && bone_ ? std::max(0.0, params_.fit_to_bone_mm) : 0.0;
     std::vector<Eigen::Vector3d> pts(n_rim);
     auto lift_rim = [&](const Eigen::Vector2d& q) {
-      if (tps) return f.lift(q, (*tps)(q));
+      if (tps) return f_.lift(q, (*tps)(q));
       // No inner markers: the outer rim offset inwards along the surface normal.
-      return Eigen::Vector3d(f.lift(q, outer_tps(q)) - offset(q) * outer_normal(q));
+      return Eigen::Vector3d(f_.lift(q, outer_tps_(q)) - offset(q) * outer_normal(q));
     };
     for (size_t k = 0; k < n_rim; ++k) {
-      const Eigen::Vector2d q = poly.at(angles[k]).first;
+      const Eigen::Vector2d q = poly.at(angles_[k]).first;
       pts[k] = lift_rim(q);
       // Fitting to the bone: the rim goes beyond the opening, into the bone of the cut face,
       // to be trimmed there — only where there is bone to meet (not over an orbit). Where the
       // cut face is oblique, the surface beyond the rim first passes over the missing wedge:
       // the bone is sought further out, up to kFitReach times the margin.
       bool extended = false;
-      if (fit_margin > 0.0 && (q - center).norm() > 1e-9) {
-        const Eigen::Vector2d out = (q - center).normalized();
+      if (fit_margin > 0.0 && (q - center_).norm() > 1e-9) {
+        const Eigen::Vector2d out = (q - center_).normalized();
         for (double d = fit_margin; d <= kFitReach * fit_margin + 1e-9; d += 1.0) {
           const Eigen::Vector3d beyond = lift_rim(q + d * out);
-          if (bone->closest(beyond).distance < 0.5 * fit_margin) {
+          if (bone_->closest(beyond).distance < 0.5 * fit_margin) {
             pts[k] = beyond;
             extended = true;
             break;
           }
         }
       }
-      const bool exact = (is_marker_angle[k] && tps != nullptr) || extended;
+      const bool exact = (is_marker_angle_[k] && tps != nullptr) || extended;
       // An inner rim set in from the outer one is not snapped: its nearest bone is often the
       // cut face far along the rim, and snapping it there makes spikes.
-      if (bone && params.snap_rim_to_skull && !exact && tps != nullptr) {
-        const auto c = bone->closest(pts[k]);
+      if (bone_ && params_.snap_rim_to_skull && !exact && tps != nullptr) {
+        const auto c = bone_->closest(pts[k]);
         // The snapped point must keep its place in the rim's angular order (else the cap
         // folds) and not land on its predecessor (else the wall gets a zero-area face).
-        const double a = angles[k];
+        const double a = angles_[k];
         const double gap =
-            0.45 * std::min(std::remainder(angles[(k + 1) % n_rim] - a, kTwoPi),
-                            std::remainder(a - angles[(k + n_rim - 1) % n_rim], kTwoPi));
+            0.45 * std::min(std::remainder(angles_[(k + 1) % n_rim] - a, kTwoPi),
+                            std::remainder(a - angles_[(k + n_rim - 1) % n_rim], kTwoPi));
         const double moved =
-            std::abs(std::remainder(PolarPolygon::angle_of(center, f.uv(c.point)) - a, kTwoPi));
+            std::abs(std::remainder(PolarPolygon::angle_of(center_, f_.uv(c.point)) - a, kTwoPi));
         const bool collides = k > 0 && (c.point - pts[k - 1]).norm() < 0.05;
-        if (c.distance <= params.max_rim_snap_mm && moved < gap && !collides) pts[k] = c.point;
+        if (c.distance <= params_.max_rim_snap_mm && moved < gap && !collides) pts[k] = c.point;
       }
     }
     return pts;
-  };
-  const std::vector<Eigen::Vector3d> outer_rim = rim_points(outer_poly, &outer_height);
-  std::vector<Eigen::Vector3d> inner_rim =
-      rim_points(inner_poly, has_inner ? &inner_height : nullptr);
-  // Where both rims meet the same bone point the side wall would have no height: keep at
-  // least 0.3 mm between them, inwards along the outer surface's normal.
-  for (size_t k = 0; k < n_rim; ++k)
-    if ((inner_rim[k] - outer_rim[k]).norm() < 0.3)
-      inner_rim[k] = outer_rim[k] - 0.3 * outer_normal(f.uv(outer_rim[k]));
+  }
 
-  // The surfaces' interiors: rings shrinking from the rim to the centre. The rim's height
-  // correction (snapping) fades in as s⁴ towards the rim.
-  auto rim_polygon = [&](const std::vector<Eigen::Vector3d>& rim, const Height* tps) {
-    PolarPolygon poly{center, {}, {}, {}};
+  // The rim as a polygon whose `extra` is the rim's height above the surface the cap would have
+  // without it (its snapping), which fades in towards the rim.
+  PolarPolygon rim_polygon(const std::vector<Eigen::Vector3d>& rim, const Height* tps) const {
+    PolarPolygon poly{center_, {}, {}, {}};
     for (const auto& p : rim) {
-      const Eigen::Vector2d q = f.uv(p);
+      const Eigen::Vector2d q = f_.uv(p);
       poly.point.push_back(q);
-      poly.angle.push_back(PolarPolygon::angle_of(center, q));
-      const double base = tps ? (*tps)(q) : f.h(p);
-      poly.extra.push_back(f.h(p) - base);
+      poly.angle.push_back(PolarPolygon::angle_of(center_, q));
+      const double base = tps ? (*tps)(q) : f_.h(p);
+      poly.extra.push_back(f_.h(p) - base);
     }
     poly.sort();
     return poly;
-  };
-  double radius = 0.0;
-  for (const auto& p : outer_rim) radius = std::max(radius, (f.uv(p) - center).norm());
-  const int n_rings = std::max(2, static_cast<int>(std::ceil(radius / res)));
-  const double start = angles.front() - 1e-6;
-  const double vertices = 2.0 * n_rings * static_cast<double>(n_rim);
-  if (vertices > 4e6) {
-    result.status = ImplantResult::Status::Failed;
-    char buf[200];
-    std::snprintf(buf, sizeof(buf),
-                  "the shell would need %.0f million vertices at %.2f mm: the markers span too "
-                  "large a region (check markers far from the defect)",
-                  vertices / 1e6, res);
-    result.message = buf;
-    return result;
   }
 
-  TriangleSoup soup;
-  auto build_cap = [&](const std::vector<Eigen::Vector3d>& rim, const Height* tps,
-                       bool offset_from_outer) {
+  // One surface's cap: rings shrinking from the rim to the centre, the rim's height correction
+  // (snapping) fading in as s⁴ towards the rim. Its triangles (counter-clockwise in the
+  // parametrisation) and the index of its first rim vertex in the soup.
+  std::pair<std::vector<Eigen::Vector3i>, int> build_cap(const std::vector<Eigen::Vector3d>& rim,
+                                                         const Height* tps,
+                                                         bool offset_from_outer) {
     // The rim's correction is measured from the surface the cap would have without it: for an
     // inner surface set in from the outer one, that is the outer height less the offset (not
     // the outer height, which counted the offset twice at the rim).
     const Height offset_height = [&](const Eigen::Vector2d& q) {
-      return f.h(Eigen::Vector3d(f.lift(q, outer_tps(q)) - offset(q) * outer_normal(q)));
+      return f_.h(Eigen::Vector3d(f_.lift(q, outer_tps_(q)) - offset(q) * outer_normal(q)));
     };
     const PolarPolygon poly = rim_polygon(rim, offset_from_outer ? &offset_height : tps);
     auto surface_point = [&](const Eigen::Vector2d& q, double correction) {
-      if (!offset_from_outer) return f.lift(q, (*tps)(q) + correction);
-      return Eigen::Vector3d(f.lift(q, outer_tps(q) + correction) - offset(q) * outer_normal(q));
+      if (!offset_from_outer) return f_.lift(q, (*tps)(q) + correction);
+      return Eigen::Vector3d(f_.lift(q, outer_tps_(q) + correction) - offset(q) * outer_normal(q));
     };
+    const size_t n_rim = angles_.size();
     std::vector<Eigen::Vector3i> tris;
-    const int center_vertex = static_cast<int>(soup.vertices.size());
-    soup.vertices.push_back(surface_point(center, 0.0));
+    const int center_vertex = static_cast<int>(soup_.vertices.size());
+    soup_.vertices.push_back(surface_point(center_, 0.0));
     Ring previous;
-    for (int k = 1; k < n_rings; ++k) {
-      const double s = static_cast<double>(k) / n_rings;
+    for (int k = 1; k < n_rings_; ++k) {
+      const double s = static_cast<double>(k) / n_rings_;
       const int count = std::max(6, static_cast<int>(std::lround(static_cast<double>(n_rim) * s)));
       std::vector<double> ring_angles;
-      const int first = static_cast<int>(soup.vertices.size());
+      const int first = static_cast<int>(soup_.vertices.size());
       for (int j = 0; j < count; ++j) {
-        const double a = start + kTwoPi * (j + 0.5) / count;
+        const double a = start_ + kTwoPi * (j + 0.5) / count;
         const auto [boundary, correction] = poly.at(a);
-        soup.vertices.push_back(
-            surface_point(center + s * (boundary - center), std::pow(s, 4) * correction));
+        soup_.vertices.push_back(
+            surface_point(center_ + s * (boundary - center_), std::pow(s, 4) * correction));
         ring_angles.push_back(a);
       }
-      Ring ring = make_ring(ring_angles, first, start, false);
+      Ring ring = make_ring(ring_angles, first, start_, false);
       if (k == 1) {
         for (size_t j = 0; j < ring.size(); ++j)
           tris.emplace_back(center_vertex, ring[j].vertex, ring[(j + 1) % ring.size()].vertex);
@@ -488,58 +566,66 @@ ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* s
       }
       previous = std::move(ring);
     }
-    const int rim_first = static_cast<int>(soup.vertices.size());
+    const int rim_first = static_cast<int>(soup_.vertices.size());
     std::vector<double> rim_angles;
     for (const auto& p : rim) {
-      soup.vertices.push_back(p);
-      rim_angles.push_back(PolarPolygon::angle_of(center, f.uv(p)));
+      soup_.vertices.push_back(p);
+      rim_angles.push_back(PolarPolygon::angle_of(center_, f_.uv(p)));
     }
-    zipper(previous, make_ring(rim_angles, rim_first, start, true), tris);
+    zipper(previous, make_ring(rim_angles, rim_first, start_, true), tris);
     // The zipper winds every triangle the same way; turn the whole cap, if need be, so it
     // runs counter-clockwise in the parametrisation (normal outwards). Triangles are never
     // turned one by one: that would break the mesh where a sharp notch of the rim folds one.
     double signed_area = 0.0;
     for (const auto& t : tris) {
-      const Eigen::Vector2d a = f.uv(soup.vertices[t[0]]), b = f.uv(soup.vertices[t[1]]),
-                            c = f.uv(soup.vertices[t[2]]);
+      const Eigen::Vector2d a = f_.uv(soup_.vertices[t[0]]), b = f_.uv(soup_.vertices[t[1]]),
+                            c = f_.uv(soup_.vertices[t[2]]);
       signed_area += (b - a).x() * (c - a).y() - (b - a).y() * (c - a).x();
     }
     if (signed_area < 0)
       for (auto& t : tris) std::swap(t[1], t[2]);
     return std::make_pair(tris, rim_first);
-  };
-  auto [outer_tris, outer_rim_first] = build_cap(outer_rim, &outer_height, false);
-  auto [inner_tris, inner_rim_first] =
-      build_cap(inner_rim, has_inner ? &inner_height : nullptr, !has_inner);
-  soup.triangles = outer_tris;
-  for (auto t : inner_tris) soup.triangles.emplace_back(t[0], t[2], t[1]);  // facing inwards
-  // Side wall between rim k of both surfaces. The outer cap runs its rim o_k → o_k+1 and the
-  // inner cap (facing inwards) i_k+1 → i_k, so the wall takes the opposite directions.
-  for (size_t k = 0; k < n_rim; ++k) {
-    const int o0 = outer_rim_first + static_cast<int>(k);
-    const int o1 = outer_rim_first + static_cast<int>((k + 1) % n_rim);
-    const int i0 = inner_rim_first + static_cast<int>(k);
-    const int i1 = inner_rim_first + static_cast<int>((k + 1) % n_rim);
-    soup.triangles.emplace_back(o1, o0, i0);
-    soup.triangles.emplace_back(o1, i0, i1);
   }
-  if (signed_volume(soup) < 0)  // inner surface above the outer one: markers swapped
-    for (auto& t : soup.triangles) std::swap(t[1], t[2]);
-  result.mesh = build_mesh(soup);
 
-  for (const auto& m : markers) {
-    if (!is_edge(m.type)) continue;
-    const std::vector<Eigen::Vector3d>& rim =
-        m.type == MarkerType::OuterEdge ? outer_rim : inner_rim;
-    double best = std::numeric_limits<double>::infinity();
-    for (const auto& p : rim) best = std::min(best, (p - m.position).norm());
-    if (m.type == MarkerType::OuterEdge || has_inner)
-      result.rim_marker_error_mm = std::max(result.rim_marker_error_mm, best);
-  }
-  result.watertight = report_mesh(result.mesh).watertight;
-  result.status = ImplantResult::Status::Built;
-  result.message = has_inner ? "shell through outer and inner markers"
-                             : "shell through outer markers, inner surface offset by the thickness";
+  const std::vector<Marker>& markers_;
+  const SkullMesh* skull_;
+  const SurfaceLocator* skull_locator_;
+  const ImplantParams& params_;
+  ImplantResult& result_;
+  std::unique_ptr<SurfaceLocator> own_locator_;
+  const SurfaceLocator* bone_ = nullptr;
+  std::vector<Eigen::Vector3d> outer_, outer_edges_, inner_, inner_edges_;
+  bool has_inner_ = false;
+  Eigen::Vector3d marker_centroid_ = Eigen::Vector3d::Zero();
+  Frame f_;
+  ThinPlateSpline outer_tps_, thickness_tps_;
+  bool thickness_from_markers_ = false;
+  const Height outer_height_ = [this](const Eigen::Vector2d& q) { return outer_tps_(q); };
+  const Height inner_height_ = [this](const Eigen::Vector2d& q) {
+    return outer_tps_(q) - depth(q);
+  };
+  Eigen::Vector2d center_ = Eigen::Vector2d::Zero();
+  PolarPolygon outer_poly_, inner_poly_;
+  double res_ = 1.0;
+  std::vector<double> angles_;
+  std::vector<char> is_marker_angle_;
+  std::vector<Eigen::Vector3d> outer_rim_, inner_rim_;
+  int n_rings_ = 2;
+  double start_ = 0.0;
+  TriangleSoup soup_;
+};
+
+ImplantResult build_shell(const std::vector<Marker>& markers, const SkullMesh* skull,
+                          const SurfaceLocator* skull_locator, const ImplantParams& params) {
+  ImplantResult result;
+  ShellBuilder b(markers, skull, skull_locator, params, result);
+  if (!b.gather_markers()) return result;
+  b.set_frame();
+  if (!b.markers_within_cap() || !b.fit_surfaces() || !b.rim_angles()) return result;
+  b.rims();
+  if (!b.ring_count()) return result;
+  b.assemble();
+  b.finish();
   return result;
 }
 
