@@ -101,6 +101,48 @@ void make_canonical(TriangleSoup& soup) {
   soup.vertices = std::move(vertices);
 }
 
+namespace {
+
+// Each fan of triangles around a vertex beyond the first (faces joined through shared edges)
+// gets its own copy of the vertex: `corner` is renumbered to the copies, `nv` and `source` (the
+// input vertex of each mesh vertex) grow with them.
+void split_complex_vertices(const OutgoingLists& lists, std::vector<int>& corner, int& nv,
+                            std::vector<int>& source, BuildMeshStats& stats) {
+  const int original_count = nv;
+  std::vector<int> parent, copy;
+  for (int v = 0; v < original_count; ++v) {
+    const int a = lists.start[v], n = lists.start[v + 1] - a;
+    if (n < 2) continue;
+    parent.resize(n);
+    for (int i = 0; i < n; ++i) parent[i] = i;
+    auto root = [&](int x) {
+      while (parent[x] != x) x = parent[x] = parent[parent[x]];
+      return x;
+    };
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j) {
+        // Face i leaves v towards w and face j arrives at v from w: they share edge v–w.
+        const size_t hi = static_cast<size_t>(lists.out[a + i]);
+        const size_t hj = static_cast<size_t>(lists.out[a + j]);
+        if (i != j && corner[next_corner(hi)] == corner[prev_corner(hj)]) parent[root(i)] = root(j);
+      }
+    copy.assign(n, -1);
+    const int keep = root(0);
+    for (int i = 0; i < n; ++i) {
+      const int r = root(i);
+      if (r == keep) continue;
+      if (copy[r] < 0) {
+        copy[r] = nv++;
+        source.push_back(source[v]);
+        ++stats.nonmanifold_split;
+      }
+      corner[static_cast<size_t>(lists.out[a + i])] = copy[r];
+    }
+  }
+}
+
+}  // namespace
+
 // Builds the halfedge structure in bulk: sizes every OpenMesh array once (resize) and links
 // halfedges from per-vertex outgoing lists, instead of add_vertex/add_face with their per-element
 // checks. Faces that would reuse a directed edge (non-manifold edges, flipped neighbours) are
@@ -162,39 +204,7 @@ SkullMesh build_mesh(const TriangleSoup& soup, BuildMeshStats* stats) {
 
   // 2. Give each extra fan of a complex vertex its own copy of the vertex.
   const int original_count = nv;
-  {
-    std::vector<int> parent, copy;
-    for (int v = 0; v < original_count; ++v) {
-      const int a = lists->start[v], n = lists->start[v + 1] - a;
-      if (n < 2) continue;
-      parent.resize(n);
-      for (int i = 0; i < n; ++i) parent[i] = i;
-      auto root = [&](int x) {
-        while (parent[x] != x) x = parent[x] = parent[parent[x]];
-        return x;
-      };
-      for (int i = 0; i < n; ++i)
-        for (int j = 0; j < n; ++j) {
-          // Face i leaves v towards w and face j arrives at v from w: they share edge v–w.
-          const size_t hi = static_cast<size_t>(lists->out[a + i]);
-          const size_t hj = static_cast<size_t>(lists->out[a + j]);
-          if (i != j && corner[next_corner(hi)] == corner[prev_corner(hj)])
-            parent[root(i)] = root(j);
-        }
-      copy.assign(n, -1);
-      const int keep = root(0);
-      for (int i = 0; i < n; ++i) {
-        const int r = root(i);
-        if (r == keep) continue;
-        if (copy[r] < 0) {
-          copy[r] = nv++;
-          source.push_back(source[v]);
-          ++local.nonmanifold_split;
-        }
-        corner[static_cast<size_t>(lists->out[a + i])] = copy[r];
-      }
-    }
-  }
+  split_complex_vertices(*lists, corner, nv, source, local);
   if (nv != original_count) lists = std::make_unique<OutgoingLists>(corner, nv, accepted);
 
   // 3. Edges: the first halfedge of a pair creates the edge; its twin reuses it.

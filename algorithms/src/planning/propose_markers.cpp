@@ -92,54 +92,36 @@ RegionOfInterest local_registration_region(const DefectRegion& defect, double ma
   return roi;
 }
 
-MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const SurfaceLocator& bone,
-                                          const SurfaceLocator& mirror, const ProposeParams& params,
-                                          int first_id) {
-  MarkerProposal r;
-  r.defect = defect;
-  if (!defect.found()) {
-    r.message = defect.message;
-    return r;
-  }
-  // Mirror coverage: rays through the opening that meet the mirrored bone (both tables).
-  const Eigen::Vector3d c = defect.center;
+namespace {
+
+// The share of the opening's rays that meet the mirrored bone (both tables).
+double mirror_coverage(const DefectRegion& defect, const SurfaceLocator& mirror,
+                       const ProposeParams& params) {
   size_t covered = 0;
   for (const auto& d : defect.hole_directions)
-    if (cast_through_bone(mirror, c, d, 400.0, 0.5, params.detect.max_thickness_mm).paired)
+    if (cast_through_bone(mirror, defect.center, d, 400.0, 0.5, params.detect.max_thickness_mm)
+            .paired)
       ++covered;
-  r.mirror_coverage = defect.hole_directions.empty()
-                          ? 0.0
-                          : static_cast<double>(covered) / defect.hole_directions.size();
-  r.method_used = params.method == PlanMethod::Auto
-                      ? (r.mirror_coverage >= params.min_mirror_coverage ? PlanMethod::Mirror
-                                                                         : PlanMethod::RimOnly)
-                      : params.method;
+  return defect.hole_directions.empty()
+             ? 0.0
+             : static_cast<double>(covered) / defect.hole_directions.size();
+}
 
-  const bool guided = r.method_used == PlanMethod::Mirror;
-  const DefectSurfaces surfaces =
-      fit_defect_surfaces(defect, bone, guided ? &mirror : nullptr, params.surfaces, params.detect);
-  r.surfaces_message = surfaces.message;
-  if (!surfaces.fitted()) {
-    r.status = MarkerProposal::Status::Failed;
-    r.message = defect.message + "; " + surfaces.message;
-    return r;
-  }
-  r.ring_rms_mm = surfaces.outer_rms_mm;
-  const MarkerSurface fitted_on = guided ? MarkerSurface::Mirrored : MarkerSurface::Original;
-
-  int id = first_id;
-  // Outer edge markers along the rim. Where intact bone continues beyond the rim (the ring has
-  // bone just outside it), on the fitted outer surface: at a cut face that is not along the
-  // rays, the last bone the rays meet lies below where the outer table goes on. Where it does
-  // not (the rim runs along an orbit or the skull base), the fit only extrapolates there: at
-  // the last bone. No inner edge markers: the inner rim is the outer one set in by the
-  // thickness field of the inner markers (docs/IMPLANT.md).
-  // The ring is probed by direction from the centre, not by position (at an oblique cut face
-  // the rim's last bone is the cut's inner corner, a table's thickness below the ring's outer
-  // table), 5 and 7 mm out, with the ring's bone up to 15 mm out (the rays that leave through
-  // such a face are not in the ring, so it may begin several millimetres beyond the rim; probing
-  // further out found bone across the sample's orbit: rim gap 3 mm). Only ring bone on the
-  // fitted outer surface counts: bone met far below it is not the outer table going on.
+// Outer edge markers along the rim. Where intact bone continues beyond the rim (the ring has
+// bone just outside it), on the fitted outer surface: at a cut face that is not along the
+// rays, the last bone the rays meet lies below where the outer table goes on. Where it does
+// not (the rim runs along an orbit or the skull base), the fit only extrapolates there: at
+// the last bone. No inner edge markers: the inner rim is the outer one set in by the
+// thickness field of the inner markers (docs/IMPLANT.md).
+// The ring is probed by direction from the centre, not by position (at an oblique cut face
+// the rim's last bone is the cut's inner corner, a table's thickness below the ring's outer
+// table), 5 and 7 mm out, with the ring's bone up to 15 mm out (the rays that leave through
+// such a face are not in the ring, so it may begin several millimetres beyond the rim; probing
+// further out found bone across the sample's orbit: rim gap 3 mm). Only ring bone on the
+// fitted outer surface counts: bone met far below it is not the outer table going on.
+void add_edge_markers(const DefectRegion& defect, const DefectSurfaces& surfaces,
+                      const ProposeParams& params, int& id, std::vector<Marker>& out) {
+  const Eigen::Vector3d c = defect.center;
   const double clearance = params.surfaces.rim_clearance_mm;
   std::vector<Eigen::Vector3d> near_ring;
   std::vector<char> on_surface;
@@ -152,12 +134,13 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
     }
   const PointIndex near_index(near_ring.empty() ? std::vector<Eigen::Vector3d>{c} : near_ring);
   auto bone_beyond = [&](const Eigen::Vector3d& rim) {
-    Eigen::Vector3d out = rim - c;
-    out -= out.dot(defect.axis) * defect.axis;  // away from the opening's axis
+    Eigen::Vector3d outward = rim - c;
+    outward -= outward.dot(defect.axis) * defect.axis;  // away from the opening's axis
     const double radius = (rim - c).norm();
-    if (near_ring.empty() || out.norm() < 1e-9 || radius < 1e-9) return false;
+    if (near_ring.empty() || outward.norm() < 1e-9 || radius < 1e-9) return false;
     for (double step = 2.0; step <= 4.0; step += 2.0) {
-      const Eigen::Vector3d probe = (rim + (clearance + step) * out.normalized() - c).normalized();
+      const Eigen::Vector3d probe =
+          (rim + (clearance + step) * outward.normalized() - c).normalized();
       int count = 0;
       for (size_t k : near_index.within_radius(probe, 4.0 / radius)) count += on_surface[k];
       if (count >= 2) return true;
@@ -189,19 +172,23 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
       if (fitted ? radius < (fitted->second - c).norm() - 1.0
                  : radius < neighbours_radius(i) - params.detect.max_thickness_mm)
         continue;
-      r.markers.push_back({id++, MarkerType::OuterEdge, rim, MarkerSurface::Original});
+      out.push_back({id++, MarkerType::OuterEdge, rim, MarkerSurface::Original});
     } else if (const auto& p = fitted) {
-      r.markers.push_back({id++, MarkerType::OuterEdge, p->first, MarkerSurface::Original});
+      out.push_back({id++, MarkerType::OuterEdge, p->first, MarkerSurface::Original});
     }
   }
-  // Support markers: the intact bone next to the rim (the ring's nearest band). Inner ones
-  // where the ray's first bone is the inner table (it faces the ray), also where the ray did
-  // not meet both tables squarely: next to a real defect's rim the bone thins and bends, and
-  // the implant meets it only if its inner surface follows it (inner ones only where both
-  // tables are parallel open a 4 mm gap at the rim of the sample's defect planned rim-only). Not
-  // where the first bone is a cut face met side-on: it lies above where the inner table goes on,
-  // and the implant's inner surface would rise to it and leave the wedge of bone under the cut
-  // empty (SkullFix: median Dice 0.904 -> 0.910, boundary Dice 0.901 -> 0.924).
+}
+
+// Support markers: the intact bone next to the rim (the ring's nearest band). Inner ones
+// where the ray's first bone is the inner table (it faces the ray), also where the ray did
+// not meet both tables squarely: next to a real defect's rim the bone thins and bends, and
+// the implant meets it only if its inner surface follows it (inner ones only where both
+// tables are parallel open a 4 mm gap at the rim of the sample's defect planned rim-only).
+// Not where the first bone is a cut face met side-on: it lies above where the inner table
+// goes on, and the implant's inner surface would rise to it and leave the wedge of bone under
+// the cut empty (SkullFix: median Dice 0.904 -> 0.910, boundary Dice 0.901 -> 0.924).
+void add_support_markers(const DefectSurfaces& surfaces, const ProposeParams& params, int& id,
+                         std::vector<Marker>& out) {
   std::vector<Eigen::Vector3d> support_outer, support_inner;
   const double band = params.surfaces.rim_clearance_mm + params.detect.support_width_mm;
   const double min_facing =
@@ -213,12 +200,17 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
         support_inner.push_back(surfaces.ring_inner[i]);
     }
   for (size_t i : thin_points(support_outer, params.surface_spacing_mm))
-    r.markers.push_back(
-        {id++, MarkerType::OuterSurface, support_outer[i], MarkerSurface::Original});
+    out.push_back({id++, MarkerType::OuterSurface, support_outer[i], MarkerSurface::Original});
   for (size_t i : thin_points(support_inner, params.surface_spacing_mm))
-    r.markers.push_back(
-        {id++, MarkerType::InnerSurface, support_inner[i], MarkerSurface::Original});
-  // Surface markers over the opening, on the fitted surfaces.
+    out.push_back({id++, MarkerType::InnerSurface, support_inner[i], MarkerSurface::Original});
+}
+
+// Surface markers over the opening, on the fitted surfaces. The paper's smoother with the rim
+// fixed evens out their spacing; each is then put back onto its fitted surface along its ray
+// (the smoother alone would flatten the curvature).
+void add_surface_markers(const DefectRegion& defect, const DefectSurfaces& surfaces,
+                         MarkerSurface fitted_on, const ProposeParams& params, int& id,
+                         std::vector<Marker>& out) {
   std::vector<Eigen::Vector3d> hole_outer, hole_inner;
   for (const auto& d : defect.hole_directions)
     if (const auto p = surfaces.at(d)) {
@@ -230,19 +222,50 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
     inside.push_back({id++, MarkerType::OuterSurface, hole_outer[i], fitted_on});
   for (size_t i : thin_points(hole_inner, params.surface_spacing_mm))
     inside.push_back({id++, MarkerType::InnerSurface, hole_inner[i], fitted_on});
-  // The paper's smoother with the rim fixed evens out their spacing; each is then put back
-  // onto its fitted surface along its ray (the smoother alone would flatten the curvature).
   std::vector<Marker> to_smooth;
-  for (const auto& m : r.markers)
+  for (const auto& m : out)
     if (is_edge(m.type)) to_smooth.push_back(m);
   to_smooth.insert(to_smooth.end(), inside.begin(), inside.end());
   for (Marker m : smooth_markers(to_smooth, params.smooth, nullptr).markers) {
     if (is_edge(m.type)) continue;
-    const auto p = surfaces.at(m.position - c);
+    const auto p = surfaces.at(m.position - defect.center);
     if (!p) continue;
     m.position = is_outer(m.type) ? p->first : p->second;
-    r.markers.push_back(m);
+    out.push_back(m);
   }
+}
+
+}  // namespace
+
+MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const SurfaceLocator& bone,
+                                          const SurfaceLocator& mirror, const ProposeParams& params,
+                                          int first_id) {
+  MarkerProposal r;
+  r.defect = defect;
+  if (!defect.found()) {
+    r.message = defect.message;
+    return r;
+  }
+  r.mirror_coverage = mirror_coverage(defect, mirror, params);
+  r.method_used = params.method == PlanMethod::Auto
+                      ? (r.mirror_coverage >= params.min_mirror_coverage ? PlanMethod::Mirror
+                                                                         : PlanMethod::RimOnly)
+                      : params.method;
+  const bool guided = r.method_used == PlanMethod::Mirror;
+  const DefectSurfaces surfaces =
+      fit_defect_surfaces(defect, bone, guided ? &mirror : nullptr, params.surfaces, params.detect);
+  r.surfaces_message = surfaces.message;
+  if (!surfaces.fitted()) {
+    r.status = MarkerProposal::Status::Failed;
+    r.message = defect.message + "; " + surfaces.message;
+    return r;
+  }
+  r.ring_rms_mm = surfaces.outer_rms_mm;
+  int id = first_id;
+  add_edge_markers(defect, surfaces, params, id, r.markers);
+  add_support_markers(surfaces, params, id, r.markers);
+  add_surface_markers(defect, surfaces, guided ? MarkerSurface::Mirrored : MarkerSurface::Original,
+                      params, id, r.markers);
   r.status = MarkerProposal::Status::Proposed;
   r.message = defect.message;
   return r;

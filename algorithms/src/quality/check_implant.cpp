@@ -113,6 +113,111 @@ double deepest_along(const std::vector<float>& depth, const VoxelGrid& grid,
   return deepest;
 }
 
+// Thickness across the plate from at most 60,000 faces spread evenly over the implant (one ray
+// each along the inward normal, for faces within 45° of `axis`): a mesh trimmed on a fine grid
+// has hundreds of thousands of faces, and a thin region spans many. The other faces' vertices
+// are the side wall's, returned in `wall_vertices`.
+std::vector<double> thickness_samples(const SkullMesh& implant, const Eigen::Vector3d& axis,
+                                      const std::vector<float>& depth, const VoxelGrid& grid,
+                                      std::vector<int>& wall_vertices) {
+  const SurfaceLocator self(implant);
+  std::vector<double> thickness;
+  const size_t stride = std::max<size_t>(1, (implant.n_faces() + 59999) / 60000);
+  for (auto fh : implant.faces()) {
+    const bool measure = static_cast<size_t>(fh.idx()) % stride == 0;
+    Eigen::Vector3d p[3];
+    int ids[3], k = 0;
+    for (auto vh : implant.fv_range(fh)) {
+      ids[k] = vh.idx();
+      p[k++] = to_eigen(implant.point(vh));
+    }
+    Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]);
+    if (n.norm() == 0) continue;
+    n.normalize();
+    if (std::abs(n.dot(axis)) >= std::cos(M_PI / 4)) {
+      if (!measure) continue;
+      const Eigen::Vector3d centre = (p[0] + p[1] + p[2]) / 3.0;
+      const auto hit = self.first_hit(centre - 1e-4 * n, centre - 200.0 * n);
+      if (!hit) continue;
+      // Where the plate curves, a normal can leave it at a grazing angle and run along it (on
+      // the sample's frontal implant up to 27 mm through a plate 8 mm at its thickest): the
+      // thickness there is at most the diameter of the deepest ball the ray passes, twice the
+      // deepest voxel's depth plus a voxel for the sampling.
+      const double along = hit->distance + 1e-4;
+      const double ball = 2.0 * deepest_along(depth, grid, centre, hit->point) + grid.spacing;
+      thickness.push_back(std::min(along, ball));
+    } else {
+      wall_vertices.insert(wall_vertices.end(), ids, ids + 3);
+    }
+  }
+  return thickness;
+}
+
+// Against the skull: the gap along the rim (over every 5° arc around the implant's `axis`
+// through `c`, the side-wall vertex nearest the bone; the rim gap is the worst arc) and the
+// overlap on the implant's grid. The distance to the bone on that grid.
+std::vector<float> measure_against_bone(const SkullMesh& implant, const SkullMesh& skull,
+                                        const SurfaceLocator& bone, const Eigen::Vector3d& c,
+                                        const Eigen::Vector3d& axis, std::vector<int> wall_vertices,
+                                        const std::vector<uint8_t>& solid, const VoxelGrid& grid,
+                                        QualityReport& q) {
+  std::sort(wall_vertices.begin(), wall_vertices.end());
+  wall_vertices.erase(std::unique(wall_vertices.begin(), wall_vertices.end()), wall_vertices.end());
+  const Eigen::Vector3d e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
+  std::vector<double> angle, distance;
+  angle.reserve(wall_vertices.size());
+  distance.reserve(wall_vertices.size());
+  for (int v : wall_vertices) {
+    const Eigen::Vector3d p = to_eigen(implant.point(SkullMesh::VertexHandle(v)));
+    angle.push_back(std::atan2((p - c).dot(e2), (p - c).dot(e1)));
+    distance.push_back(bone.closest(p).distance);
+  }
+  q.rim_gap_mm = worst_arc_gap(angle, distance, M_PI / 36);
+  const std::vector<uint8_t> b = voxelize_mesh(skull, grid);
+  long long both = 0;
+  for (size_t i = 0; i < solid.size(); ++i) both += solid[i] && b[i];
+  q.penetration_mm3 = static_cast<double>(both) * grid.voxel_volume();
+  return distance_to_mask(b, grid);
+}
+
+// Why the implant is not printable, from what was measured.
+void add_reasons(const MeshReport& rep, const QualityParams& params, bool with_bone,
+                 QualityReport& q) {
+  if (!q.watertight)
+    q.reasons.push_back("not watertight (" + std::to_string(rep.boundary_edges) +
+                        " boundary edges)");
+  if (!q.manifold)
+    q.reasons.push_back(std::to_string(rep.nonmanifold_edges) + " non-manifold edges");
+  if (!q.outward) q.reasons.push_back("faces point inwards (negative volume)");
+  if (q.self_intersections > 0)
+    q.reasons.push_back(std::to_string(q.self_intersections) +
+                        " pairs of triangles cross each other");
+  if (q.taper_reach_mm < 0)
+    q.reasons.push_back(fmt("nowhere is the implant %.2f mm thick (thickest %.2f mm)",
+                            params.min_thickness_mm, q.thickness_max_mm));
+  if (q.corner_reach_mm > params.max_corner_mm)
+    q.reasons.push_back(
+        fmt(!with_bone ? "it is thinner than %.2f mm for %.1f mm"
+                       : "away from the bone it is thinner than %.2f mm for %.1f mm",
+            params.min_thickness_mm, q.corner_reach_mm) +
+        " (" + fmt1("%.1f", q.thin_off_bone_mm3) + " mm³; a sharp corner may be " +
+        fmt1("%.1f", params.max_corner_mm) + " mm" +
+        (!with_bone ? "; without the skull a tapered edge on the bone cannot be told"
+                      " from a corner: check with the skull)"
+                    : ")"));
+  if (q.taper_reach_mm > params.max_taper_mm)
+    q.reasons.push_back(fmt("its edge stays thinner than %.2f mm for %.1f mm",
+                            params.min_thickness_mm, q.taper_reach_mm) +
+                        " (a tapered edge on the bone may be " + fmt1("%.1f", params.max_taper_mm) +
+                        " mm wide)");
+  if (q.rim_gap_mm > params.max_rim_gap_mm)
+    q.reasons.push_back(fmt("gap of %.2f mm between the rim and the bone (limit %.2f mm)",
+                            q.rim_gap_mm, params.max_rim_gap_mm));
+  if (q.penetration_mm3 > params.max_penetration_mm3)
+    q.reasons.push_back(fmt("%.1f mm³ overlap the skull (limit %.1f mm³)", q.penetration_mm3,
+                            params.max_penetration_mm3));
+}
+
 }  // namespace
 
 QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
@@ -157,39 +262,8 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
   const std::vector<uint8_t> solid = voxelize_mesh(implant, grid);
   const std::vector<float> depth = depth_in_mask(solid, grid);
 
-  const SurfaceLocator self(implant);
-  std::vector<double> thickness;
   std::vector<int> wall_vertices;
-  // Thickness from at most 60,000 faces spread evenly over the implant (one ray each): a mesh
-  // trimmed on a fine grid has hundreds of thousands of faces, and a thin region spans many.
-  const size_t stride = std::max<size_t>(1, (implant.n_faces() + 59999) / 60000);
-  for (auto fh : implant.faces()) {
-    const bool measure = static_cast<size_t>(fh.idx()) % stride == 0;
-    Eigen::Vector3d p[3];
-    int ids[3], k = 0;
-    for (auto vh : implant.fv_range(fh)) {
-      ids[k] = vh.idx();
-      p[k++] = to_eigen(implant.point(vh));
-    }
-    Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]);
-    if (n.norm() == 0) continue;
-    n.normalize();
-    if (std::abs(n.dot(axis)) >= std::cos(M_PI / 4)) {
-      if (!measure) continue;
-      const Eigen::Vector3d centre = (p[0] + p[1] + p[2]) / 3.0;
-      const auto hit = self.first_hit(centre - 1e-4 * n, centre - 200.0 * n);
-      if (!hit) continue;
-      // Where the plate curves, a normal can leave it at a grazing angle and run along it (on
-      // the sample's frontal implant up to 27 mm through a plate 8 mm at its thickest): the
-      // thickness there is at most the diameter of the deepest ball the ray passes, twice the
-      // deepest voxel's depth plus a voxel for the sampling.
-      const double along = hit->distance + 1e-4;
-      const double ball = 2.0 * deepest_along(depth, grid, centre, hit->point) + grid.spacing;
-      thickness.push_back(std::min(along, ball));
-    } else {
-      wall_vertices.insert(wall_vertices.end(), ids, ids + 3);
-    }
-  }
+  std::vector<double> thickness = thickness_samples(implant, axis, depth, grid, wall_vertices);
   if (!thickness.empty()) {
     std::sort(thickness.begin(), thickness.end());
     q.thickness_min_mm = thickness.front();
@@ -201,62 +275,11 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
     std::unique_ptr<SurfaceLocator> own;
     if (!skull_locator) own = std::make_unique<SurfaceLocator>(*skull);
     const SurfaceLocator& bone = skull_locator ? *skull_locator : *own;
-    // The gap along the rim: over every 5° arc around the implant's axis, the side-wall vertex
-    // nearest the bone; the rim gap is the worst arc.
-    std::sort(wall_vertices.begin(), wall_vertices.end());
-    wall_vertices.erase(std::unique(wall_vertices.begin(), wall_vertices.end()),
-                        wall_vertices.end());
-    const Eigen::Vector3d e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
-    std::vector<double> angle, distance;
-    angle.reserve(wall_vertices.size());
-    distance.reserve(wall_vertices.size());
-    for (int v : wall_vertices) {
-      const Eigen::Vector3d p = to_eigen(implant.point(SkullMesh::VertexHandle(v)));
-      angle.push_back(std::atan2((p - c).dot(e2), (p - c).dot(e1)));
-      distance.push_back(bone.closest(p).distance);
-    }
-    q.rim_gap_mm = worst_arc_gap(angle, distance, M_PI / 36);
-    const std::vector<uint8_t> b = voxelize_mesh(*skull, grid);
-    long long both = 0;
-    for (size_t i = 0; i < solid.size(); ++i) both += solid[i] && b[i];
-    q.penetration_mm3 = static_cast<double>(both) * grid.voxel_volume();
-    bone_distance = distance_to_mask(b, grid);
+    bone_distance = measure_against_bone(implant, *skull, bone, c, axis, std::move(wall_vertices),
+                                         solid, grid, q);
   }
   measure_thin_material(solid, depth, grid, bone_distance, params, q);
-
-  if (!q.watertight)
-    q.reasons.push_back("not watertight (" + std::to_string(rep.boundary_edges) +
-                        " boundary edges)");
-  if (!q.manifold)
-    q.reasons.push_back(std::to_string(rep.nonmanifold_edges) + " non-manifold edges");
-  if (!q.outward) q.reasons.push_back("faces point inwards (negative volume)");
-  if (q.self_intersections > 0)
-    q.reasons.push_back(std::to_string(q.self_intersections) +
-                        " pairs of triangles cross each other");
-  if (q.taper_reach_mm < 0)
-    q.reasons.push_back(fmt("nowhere is the implant %.2f mm thick (thickest %.2f mm)",
-                            params.min_thickness_mm, q.thickness_max_mm));
-  if (q.corner_reach_mm > params.max_corner_mm)
-    q.reasons.push_back(
-        fmt(bone_distance.empty() ? "it is thinner than %.2f mm for %.1f mm"
-                                  : "away from the bone it is thinner than %.2f mm for %.1f mm",
-            params.min_thickness_mm, q.corner_reach_mm) +
-        " (" + fmt1("%.1f", q.thin_off_bone_mm3) + " mm³; a sharp corner may be " +
-        fmt1("%.1f", params.max_corner_mm) + " mm" +
-        (bone_distance.empty() ? "; without the skull a tapered edge on the bone cannot be told"
-                                 " from a corner: check with the skull)"
-                               : ")"));
-  if (q.taper_reach_mm > params.max_taper_mm)
-    q.reasons.push_back(fmt("its edge stays thinner than %.2f mm for %.1f mm",
-                            params.min_thickness_mm, q.taper_reach_mm) +
-                        " (a tapered edge on the bone may be " + fmt1("%.1f", params.max_taper_mm) +
-                        " mm wide)");
-  if (q.rim_gap_mm > params.max_rim_gap_mm)
-    q.reasons.push_back(fmt("gap of %.2f mm between the rim and the bone (limit %.2f mm)",
-                            q.rim_gap_mm, params.max_rim_gap_mm));
-  if (q.penetration_mm3 > params.max_penetration_mm3)
-    q.reasons.push_back(fmt("%.1f mm³ overlap the skull (limit %.1f mm³)", q.penetration_mm3,
-                            params.max_penetration_mm3));
+  add_reasons(rep, params, !bone_distance.empty(), q);
   q.printable = q.reasons.empty();
   return q;
 }
