@@ -1,6 +1,7 @@
 #include "cranioplan/algorithms/geometry/thin_plate_spline.h"
 
 #include <Eigen/Dense>
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 
@@ -42,6 +43,14 @@ bool ThinPlateSpline::fit(const std::vector<Eigen::Vector2d>& sites,
   for (const auto& s : sites_) scale_ = std::max(scale_, (s - shift_).norm());
   if (scale_ <= 0) scale_ = 1.0;
   for (auto& s : sites_) s = (s - shift_) / scale_;
+  // Sites on a line leave the surface across it undetermined (the system is singular, and
+  // heights that happen to be consistent along the line would still solve it).
+  Eigen::Matrix2d spread = Eigen::Matrix2d::Zero();
+  for (const auto& s : sites_) spread += s * s.transpose();
+  if (Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d>(spread).eigenvalues()[0] < 1e-10 * n) {
+    sites_.clear();
+    return false;
+  }
 
   // Quadratic trend by least squares (needs 6 sites not on a conic; otherwise none).
   trend_.setZero();
