@@ -190,6 +190,12 @@ void MainWindow::build_menus() {
   file->addSeparator();
   file->addAction(tr("Quit"), this, &QWidget::close)->setShortcut(QKeySequence::Quit);
 
+  build_edit_view_menus();
+  build_training_help_menus();
+}
+
+// Edit (undo, redo, delete, notes) and View (standard views, the mirror and the plane).
+void MainWindow::build_edit_view_menus() {
   QMenu* edit = menuBar()->addMenu(tr("&Edit"));
   undo_ = edit->addAction(tr("Undo"), controller_, &PlanController::undo);
   undo_->setShortcut(QKeySequence(Qt::CTRL | Qt::Key_Z));
@@ -236,7 +242,10 @@ void MainWindow::build_menus() {
   show_plane->setCheckable(true);
   show_plane->setChecked(true);
   connect(show_plane, &QAction::toggled, view_, &SkullView::set_plane_visible);
+}
 
+// Training (a reference plan and the report) and Help (About).
+void MainWindow::build_training_help_menus() {
   QMenu* training = menuBar()->addMenu(tr("&Training"));
   training->addAction(tr("Start training with a reference plan…"), this, [this] {
     const QString path = QFileDialog::getOpenFileName(this, tr("The expert's plan"), QString(),

@@ -74,7 +74,9 @@ class MainWindow : public QMainWindow {
   void closeEvent(QCloseEvent* event) override;
 
  private:
-  void build_menus();
+  void build_menus();  // File, then the others
+  void build_edit_view_menus();
+  void build_training_help_menus();
   void build_steps_dock();
   void build_plan_dock();
   QWidget* make_page(int step);
