@@ -73,7 +73,9 @@ AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks&
     global = autoplan_stages::registration(mesh, plane, params);
     run(recorded(commands::register_mirror(params.registration), to_json(global), t.ms()));
   }
+  const Stopwatch detect_time;
   out.defect = autoplan_stages::detect(mesh, bone, plane, params);
+  const double detect_ms = detect_time.ms();
   if (others_planned) out.defect.message = out.defect.describe(true);
   {
     // Found by the proposal's search below, and recorded with it; the registration around the
@@ -87,12 +89,12 @@ AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks&
   run(commands::complete_step(4));
   Command propose = commands::propose_markers(params.propose);
   if (out.defect.found() && s.state().mirrored) {
+    // The proposal's search is the detection and the markers.
     const Stopwatch t;
     const PlanState& st = s.state();
-    propose = recorded(std::move(propose),
-                       proposal_result(autoplan_stages::markers(
-                           out.defect, bone, st.mirrored->locator, params, st.next_marker_id)),
-                       t.ms());
+    const Json proposal = proposal_result(autoplan_stages::markers(
+        out.defect, bone, st.mirrored->locator, params, st.next_marker_id));
+    propose = recorded(std::move(propose), proposal, detect_ms + t.ms());
   }
   run(std::move(propose));
   if (s.state().markers.empty()) {

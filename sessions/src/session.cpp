@@ -446,10 +446,14 @@ PreparedCommand Session::prepare(Command command) {
 
 PushResult Session::push(Command command) {
   const auto t0 = std::chrono::steady_clock::now();
+  // A search the caller ran for the command before pushing it (autoplan_session records the
+  // plan's stages so) is part of the command's time.
+  const double searched_ms = std::max(0.0, command.meta.duration_ms);
   PreparedCommand prepared = prepare(std::move(command));
   if (!prepared.ok) return PushResult{false, false, prepared.message};
   ApplyOutcome out = apply_command(state(), prepared.command, context_);
   prepared.command.meta.duration_ms =
+      searched_ms +
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
   return commit(prepared, std::move(out));
 }

@@ -273,6 +273,21 @@ TEST(Session, AProposalIsRecordedAndReplayedAsRecorded) {
   }
 }
 
+// A search run for a command before it is pushed (autoplan_session runs the plan's stages so)
+// counts in the command's time, which the audit shows; a command without one is timed alone.
+TEST(Session, ASearchRunBeforeACommandCountsInItsTime) {
+  Session s(SessionInfo{"small", "tester", ""});
+  push_ok(s, commands::load_skull(test::small_skull_stl()));
+  Command note = commands::note("searched for a while");
+  note.meta.duration_ms = 1234.0;
+  push_ok(s, note);
+  push_ok(s, commands::note("not searched"));
+  const std::vector<Command>& done = s.effective_commands();
+  ASSERT_EQ(done.size(), 3u);
+  EXPECT_GE(done[1].meta.duration_ms, 1234.0);
+  EXPECT_LT(done[2].meta.duration_ms, 1234.0);
+}
+
 TEST(Session, MarkersSnapToTheirSurfaceAndKeepStableIds) {
   Session s = session_at_markers();
   push_ok(s, commands::add_marker(MarkerType::OuterEdge, on_head(0.6, 0.0, 0.8) * 1.02));
