@@ -55,9 +55,9 @@ TEST(ScanBorder, AHeadOpenWhereTheScanEndedHasOneBorderThere) {
 }
 
 // A thick head with a known defect, open on its right side where the scan (or an exporter's
-// crop) ended. With the scan's border the defect is the only opening, and a defect that reaches
-// into the cut is found as itself, not merged with the cut (its rays leave past the cut's
-// extent).
+// crop) ended. Without the scan's border a deep cut is the largest opening and is planned; with
+// it the defect is the only opening, and a defect that reaches into the cut is found as itself,
+// not merged with the cut (its rays leave past the cut's extent).
 struct OpenHead {
   SkullMesh skull;
   Eigen::Vector3d defect_direction;
@@ -83,7 +83,12 @@ DefectRegion detect(const SkullMesh& skull, bool with_borders) {
 }
 
 TEST(DetectDefect, TheScansCutIsNeverTheDefect) {
-  const OpenHead h = open_head_with_defect(Eigen::Vector3d(0.7, 0.1, 0.7), -45.0);
+  // Cut 20 mm right of the midline: the opening it leaves is far larger than the defect.
+  const OpenHead h = open_head_with_defect(Eigen::Vector3d(0.7, 0.1, 0.7), -20.0);
+  const DefectRegion without = detect(h.skull, false);
+  ASSERT_TRUE(without.found()) << without.message;
+  EXPECT_LT(angle_deg(without.axis, -Eigen::Vector3d::UnitX()), 10.0) << "the cut, planned";
+  EXPECT_EQ(without.other_openings, 1) << without.message;
   const DefectRegion with = detect(h.skull, true);
   ASSERT_TRUE(with.found()) << with.message;
   EXPECT_LT(angle_deg(with.axis, h.defect_direction), 10.0);

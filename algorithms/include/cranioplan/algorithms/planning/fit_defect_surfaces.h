@@ -100,9 +100,6 @@ class DefectSurfaces {
 
  private:
   friend struct DefectSurfaceFit;  // the fit's stages (fit_defect_surfaces.cpp)
-  friend DefectSurfaces fit_defect_surfaces(const DefectRegion&, const SurfaceLocator&,
-                                            const SurfaceLocator*, const DefectSurfaceParams&,
-                                            const DetectDefectParams&);
   Eigen::Vector2d uv(const Eigen::Vector3d& dir) const;
   Eigen::Vector3d center_ = Eigen::Vector3d::Zero(), axis_ = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d e1_ = Eigen::Vector3d::UnitX(), e2_ = Eigen::Vector3d::UnitY();
