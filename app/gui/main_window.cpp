@@ -2,20 +2,14 @@
 
 #include <QAction>
 #include <QApplication>
-#include <QCheckBox>
 #include <QCloseEvent>
-#include <QComboBox>
 #include <QDateTime>
 #include <QDialog>
 #include <QDialogButtonBox>
 #include <QDir>
 #include <QDockWidget>
-#include <QDoubleSpinBox>
 #include <QFileDialog>
 #include <QFileInfo>
-#include <QFormLayout>
-#include <QGroupBox>
-#include <QHBoxLayout>
 #include <QHeaderView>
 #include <QInputDialog>
 #include <QKeySequence>
@@ -29,7 +23,6 @@
 #include <QSettings>
 #include <QShortcut>
 #include <QSlider>
-#include <QSpinBox>
 #include <QStackedWidget>
 #include <QStandardPaths>
 #include <QStatusBar>
@@ -39,14 +32,12 @@
 #include <QTimer>
 #include <QVBoxLayout>
 #include <cmath>
-#include <filesystem>
 
 #include "cranioplan/algorithms/io/load_skull.h"
 #include "cranioplan/algorithms/io/read_volume.h"
 #include "cranioplan/model/error.h"
 #include "cranioplan/sessions/audit.h"
-#include "cranioplan/sessions/marker_files.h"
-#include "cranioplan/sessions/sha256.h"
+#include "pages/step_pages.h"
 
 namespace cranioplan::gui {
 
@@ -61,9 +52,6 @@ QPushButton* button(const QString& text, const char* name, QWidget* parent = nul
 }
 
 QString quality_html(const QualityReport& r) { return q(quality_report_html(r)); }
-
-// The landmark names of the step-2 list, in order.
-const char* kLandmarkNames[] = {"nasion", "orbit_left", "orbit_right", "midline"};
 
 }  // namespace
 
@@ -324,7 +312,12 @@ void MainWindow::build_steps_dock() {
       "QLabel{background:#f4f1e8;color:#222;padding:6px;border-radius:4px}");
   layout->addWidget(instructions_);
   pages_ = new QStackedWidget(panel);
-  for (int step = 1; step <= 9; ++step) pages_->addWidget(make_page(step));
+  for (int step = 1; step <= 9; ++step) {
+    StepPage* page = make_step_page(step, *this).release();
+    pages_->addWidget(page);
+    step_pages_.push_back(page);
+  }
+  load_page_ = static_cast<LoadPage*>(step_pages_[0]);
   layout->addWidget(pages_, 1);
   done_button_ = button(tr("Done — next step"), "done", panel);
   connect(done_button_, &QPushButton::clicked, this,
@@ -333,364 +326,6 @@ void MainWindow::build_steps_dock() {
   dock->setWidget(panel);
   dock->setMinimumWidth(360);
   addDockWidget(Qt::LeftDockWidgetArea, dock);
-}
-
-QWidget* MainWindow::make_page(int step) {
-  auto* page = new QWidget;
-  auto* layout = new QVBoxLayout(page);
-  auto* form = new QFormLayout;
-  layout->addLayout(form);
-  const PageParts parts{page, layout, form};
-  switch (step) {
-    case 1:
-      fill_load_page(parts);
-      break;
-    case 2:
-      fill_plane_page(parts);
-      break;
-    case 3:
-      fill_mirror_page(parts);
-      break;
-    case 4:
-      fill_clip_page(parts);
-      break;
-    case 5:
-    case 6:
-      fill_markers_page(parts, step);
-      break;
-    case 7:
-      fill_build_page(parts);
-      break;
-    case 8:
-      fill_smooth_page(parts);
-      break;
-    case 9:
-      fill_export_page(parts);
-      break;
-    default:
-      break;
-  }
-  layout->addStretch(1);
-  return page;
-}
-
-// Step 1, load skull.
-void MainWindow::fill_load_page(const PageParts& p) {
-  auto* open = button(tr("Open mesh or CT…"), "pageOpen", p.page);
-  connect(open, &QPushButton::clicked, this, [this] {
-    const QString path = QFileDialog::getOpenFileName(
-        this, tr("Open a skull"), QString(),
-        tr("Skull (*.stl *.ply *.obj *.off *.vtp *.inv3 *.nrrd *.nhdr *.nii *.nii.gz);;All "
-           "(*)"));
-    if (!path.isEmpty()) open_input(path);
-  });
-  auto* sample = button(tr("Open the sample case"), "pageSample", p.page);
-  connect(sample, &QPushButton::clicked, this, [this] { open_sample(); });
-  threshold_ = new QDoubleSpinBox(p.page);
-  threshold_->setObjectName("threshold");
-  threshold_->setRange(-1000, 3000);
-  threshold_->setValue(300);
-  threshold_->setSuffix(" HU");
-  threshold_->setToolTip(tr("Bone threshold for CTs (masks use 0.5)"));
-  units_ = new QComboBox(p.page);
-  units_->setObjectName("meshUnits");
-  for (const LengthUnit& u : length_units())
-    units_->addItem(QStringLiteral("%1 (%2)").arg(tr(u.label), QString::fromLatin1(u.name)), u.mm);
-  units_->setToolTip(
-      tr("The length unit a mesh file was written in (STL, PLY, OBJ and OFF carry none). A "
-         "skull of the wrong size is refused, naming the unit it looks to be in."));
-  p.form->addRow(open);
-  p.form->addRow(sample);
-  p.form->addRow(tr("Mesh units"), units_);
-  p.form->addRow(tr("CT bone threshold"), threshold_);
-  skull_info_ = new QLabel(p.page);
-  skull_info_->setWordWrap(true);
-  p.form->addRow(skull_info_);
-}
-
-// Step 2, landmarks and the midsagittal plane.
-void MainWindow::fill_plane_page(const PageParts& p) {
-  landmark_ = new QComboBox(p.page);
-  landmark_->setObjectName("landmark");
-  landmark_->addItems(
-      {tr("Nasion"), tr("Left orbit centre"), tr("Right orbit centre"), tr("Midline point")});
-  p.form->addRow(tr("Click places"), landmark_);
-  auto* clear = button(tr("Clear landmarks"), "clearLandmarks", p.page);
-  connect(clear, &QPushButton::clicked, this, [this] {
-    for (const char* name : kLandmarkNames) push(commands::clear_landmark(name));
-  });
-  p.form->addRow(clear);
-  auto* fit = button(tr("Fit plane"), "fitPlane", p.page);
-  fit->setToolTip(tr("Landmarks (if all three are set) or automatic, refined by symmetry"));
-  connect(fit, &QPushButton::clicked, this,
-          [this] { push(commands::fit_plane(), tr("Fitting the plane")); });
-  p.form->addRow(fit);
-  plane_info_ = new QLabel(p.page);
-  plane_info_->setWordWrap(true);
-  p.form->addRow(plane_info_);
-  auto* box = new QGroupBox(tr("Adjust by hand"), p.page);
-  auto* bl = new QFormLayout(box);
-  adjust_axis_ = new QComboBox(box);
-  adjust_axis_->addItems({tr("Up–down axis"), tr("Front–back axis")});
-  adjust_angle_ = new QDoubleSpinBox(box);
-  adjust_angle_->setRange(-20, 20);
-  adjust_angle_->setSingleStep(0.5);
-  adjust_angle_->setSuffix("°");
-  adjust_shift_ = new QDoubleSpinBox(box);
-  adjust_shift_->setRange(-20, 20);
-  adjust_shift_->setSingleStep(0.5);
-  adjust_shift_->setSuffix(" mm");
-  auto* apply = button(tr("Apply"), "adjustPlane", box);
-  connect(apply, &QPushButton::clicked, this, [this] {
-    const Eigen::Vector3d axis =
-        adjust_axis_->currentIndex() == 0 ? Eigen::Vector3d::UnitZ() : Eigen::Vector3d::UnitY();
-    push(commands::adjust_plane(axis, adjust_angle_->value(), adjust_shift_->value()),
-         tr("Moving the plane"));
-  });
-  // Sliders beside the fields, in half-degree and half-millimetre steps.
-  auto linked_slider = [box](QDoubleSpinBox* field) {
-    auto* slider = new QSlider(Qt::Horizontal, box);
-    slider->setRange(-40, 40);
-    QObject::connect(slider, &QSlider::valueChanged, field,
-                     [field](int v) { field->setValue(0.5 * v); });
-    QObject::connect(field, &QDoubleSpinBox::valueChanged, slider, [slider](double v) {
-      const QSignalBlocker block(slider);
-      slider->setValue(static_cast<int>(std::lround(2.0 * v)));
-    });
-    return slider;
-  };
-  bl->addRow(tr("Turn about"), adjust_axis_);
-  bl->addRow(tr("Angle"), adjust_angle_);
-  bl->addRow(QString(), linked_slider(adjust_angle_));
-  bl->addRow(tr("Shift"), adjust_shift_);
-  bl->addRow(QString(), linked_slider(adjust_shift_));
-  bl->addRow(apply);
-  p.layout->addWidget(box);
-}
-
-// Step 3, mirror and register.
-void MainWindow::fill_mirror_page(const PageParts& p) {
-  auto* mirror = button(tr("Mirror skull"), "mirror", p.page);
-  connect(mirror, &QPushButton::clicked, this,
-          [this] { push(commands::mirror(), tr("Mirroring")); });
-  p.form->addRow(mirror);
-  roi_only_ = new QCheckBox(tr("Only around a point (click the skull)"), p.page);
-  roi_only_->setObjectName("roiOnly");
-  roi_radius_ = new QDoubleSpinBox(p.page);
-  roi_radius_->setRange(20, 200);
-  roi_radius_->setValue(70);
-  roi_radius_->setSuffix(" mm");
-  auto* reg = button(tr("Register"), "register", p.page);
-  connect(reg, &QPushButton::clicked, this, [this] {
-    RegisterParams p;
-    if (roi_only_->isChecked() && roi_center_) {
-      RegionOfInterest roi;
-      roi.center = *roi_center_;
-      roi.radius = roi_radius_->value();
-      p.roi = roi;
-    }
-    push(commands::register_mirror(p), tr("Registering"));
-  });
-  p.form->addRow(roi_only_);
-  p.form->addRow(tr("Region radius"), roi_radius_);
-  p.form->addRow(reg);
-  register_info_ = new QLabel(p.page);
-  register_info_->setWordWrap(true);
-  p.form->addRow(register_info_);
-  auto* box = new QGroupBox(tr("Nudge the mirror"), p.page);
-  auto* grid = new QHBoxLayout(box);
-  const std::pair<QString, Eigen::Vector3d> moves[] = {{"←", {-1, 0, 0}},     {"→", {1, 0, 0}},
-                                                       {"front", {0, -1, 0}}, {"back", {0, 1, 0}},
-                                                       {"↑", {0, 0, 1}},      {"↓", {0, 0, -1}}};
-  for (const auto& [label, delta] : moves) {
-    auto* b = new QPushButton(label, box);
-    b->setToolTip(tr("Move the mirrored skull 1 mm"));
-    connect(b, &QPushButton::clicked, this, [this, delta = delta] {
-      push(commands::move_mirrored(Eigen::Vector3d::UnitZ(), 0.0, Eigen::Vector3d::Zero(), delta),
-           tr("Moving the mirror"));
-    });
-    grid->addWidget(b);
-  }
-  p.layout->addWidget(box);
-  auto* opacity = new QSlider(Qt::Horizontal, p.page);
-  opacity->setRange(5, 100);
-  opacity->setValue(45);
-  connect(opacity, &QSlider::valueChanged, this,
-          [this](int v) { view_->set_mirror_opacity(v / 100.0); });
-  p.form->addRow(tr("Mirror opacity"), opacity);
-}
-
-// Step 4, clip and inspect.
-void MainWindow::fill_clip_page(const PageParts& p) {
-  clip_on_ = new QCheckBox(tr("Clip the skulls"), p.page);
-  clip_on_->setObjectName("clipOn");
-  clip_axis_ = new QComboBox(p.page);
-  clip_axis_->addItems({tr("Left–right"), tr("Front–back"), tr("Up–down")});
-  clip_position_ = new QSlider(Qt::Horizontal, p.page);
-  clip_position_->setObjectName("clipPosition");
-  clip_position_->setRange(-120, 120);
-  auto send = [this] { push(clip_command()); };
-  connect(clip_on_, &QCheckBox::toggled, this, send);
-  connect(clip_axis_, &QComboBox::currentIndexChanged, this, [this, send] {
-    if (clip_on_->isChecked()) send();
-  });
-  connect(clip_position_, &QSlider::sliderReleased, this, send);
-  connect(clip_position_, &QSlider::valueChanged, this, [this, send] {
-    if (!clip_position_->isSliderDown() && clip_on_->isChecked()) send();
-  });
-  p.form->addRow(clip_on_);
-  p.form->addRow(tr("Cut across"), clip_axis_);
-  p.form->addRow(tr("Position"), clip_position_);
-}
-
-// Steps 5 and 6, edge and surface markers.
-void MainWindow::fill_markers_page(const PageParts& p, int step) {
-  const bool edges = step == 5;
-  for (int t : edges ? std::vector<int>{0, 1} : std::vector<int>{2, 3}) {
-    const auto type = static_cast<MarkerType>(t);
-    auto* b = new QPushButton(
-        QStringLiteral("[%1] %2").arg(t).arg(q(to_string(type)).replace('_', ' ')), p.page);
-    b->setObjectName(QStringLiteral("markerType%1").arg(t));
-    b->setCheckable(true);
-    b->setAutoExclusive(true);
-    connect(b, &QPushButton::clicked, this, [this, type] { set_marker_type(type); });
-    p.form->addRow(b);
-  }
-  if (edges) {
-    auto* propose = button(tr("Propose markers automatically"), "propose", p.page);
-    connect(propose, &QPushButton::clicked, this, [this] {
-      // With several openings in the skull, the one where the user has put edge markers is
-      // meant (otherwise the largest).
-      ProposeParams params;
-      params.detect.near = edge_marker_centre(controller_->state().markers);
-      push(commands::propose_markers(params), tr("Finding the defect and proposing markers"));
-    });
-    auto* import = button(tr("Import markers…"), "importMarkers", p.page);
-    connect(import, &QPushButton::clicked, this, [this] {
-      const QString path = QFileDialog::getOpenFileName(this, tr("Markers"), QString(),
-                                                        tr("Markers (*.json *.csv)"));
-      if (path.isEmpty()) return;
-      try {
-        push(commands::import_markers(read_markers_file(path.toStdString()), path.toStdString(),
-                                      sha256_file(path.toStdString())));
-      } catch (const Error& e) {
-        show_message(QString::fromUtf8(e.what()), true);
-      }
-    });
-    auto* clear = button(tr("Clear markers"), "clearMarkers", p.page);
-    connect(clear, &QPushButton::clicked, this, [this] { push(commands::clear_markers()); });
-    p.form->addRow(propose);
-    p.form->addRow(import);
-    p.form->addRow(clear);
-  }
-  marker_counts_[edges ? 0 : 1] = new QLabel(p.page);
-  p.form->addRow(marker_counts_[edges ? 0 : 1]);
-  if (edges) {
-    // What the last proposal found stays in view while the markers are edited: where the
-    // rim was not seen, the outline between edge markers far apart needs a look.
-    proposal_note_ = new QLabel(p.page);
-    proposal_note_->setObjectName("proposalNote");
-    proposal_note_->setWordWrap(true);
-    p.form->addRow(proposal_note_);
-  }
-}
-
-// Step 7, build the implant.
-void MainWindow::fill_build_page(const PageParts& p) {
-  implant_method_ = new QComboBox(p.page);
-  implant_method_->setObjectName("implantMethod");
-  implant_method_->addItems({tr("Shell (fitted surfaces)"), tr("Delaunay 3D (the paper's)")});
-  implant_resolution_ = new QDoubleSpinBox(p.page);
-  implant_resolution_->setRange(0.3, 5);
-  implant_resolution_->setValue(1.0);
-  implant_resolution_->setSingleStep(0.1);
-  implant_resolution_->setSuffix(" mm");
-  implant_thickness_ = new QDoubleSpinBox(p.page);
-  implant_thickness_->setRange(0, 15);
-  implant_thickness_->setValue(0);
-  implant_thickness_->setSpecialValueText(tr("measured at the rim"));
-  implant_thickness_->setSuffix(" mm");
-  implant_fit_ = new QDoubleSpinBox(p.page);
-  implant_fit_->setObjectName("implantFit");
-  implant_fit_->setRange(0, 8);
-  implant_fit_->setSingleStep(0.5);
-  implant_fit_->setSpecialValueText(tr("off"));
-  implant_fit_->setSuffix(" mm");
-  implant_fit_->setToolTip(
-      tr("Build the shell this far over the bone and subtract the skull: the implant meets "
-         "the cut face all around and never enters the bone (about 1 s per rebuild)"));
-  auto* build = button(tr("Build implant"), "build", p.page);
-  connect(build, &QPushButton::clicked, this, [this] {
-    ImplantParams p;
-    p.method =
-        implant_method_->currentIndex() == 0 ? ImplantMethod::Shell : ImplantMethod::Delaunay3D;
-    p.resolution_mm = implant_resolution_->value();
-    if (implant_thickness_->value() > 0) p.thickness_mm = implant_thickness_->value();
-    p.surface_smoothing = 0.003;
-    p.fit_to_bone_mm = implant_fit_->value();
-    push(commands::build_implant(p), tr("Building the implant"));
-  });
-  p.form->addRow(tr("Method"), implant_method_);
-  p.form->addRow(tr("Resolution"), implant_resolution_);
-  p.form->addRow(tr("Thickness without inner markers"), implant_thickness_);
-  p.form->addRow(tr("Fit to the bone"), implant_fit_);
-  p.form->addRow(build);
-  implant_info_ = new QLabel(p.page);
-  implant_info_->setWordWrap(true);
-  p.form->addRow(implant_info_);
-}
-
-// Step 8, smooth and refine.
-void MainWindow::fill_smooth_page(const PageParts& p) {
-  smooth_radius_ = new QSlider(Qt::Horizontal, p.page);
-  smooth_radius_->setObjectName("smoothRadius");
-  smooth_radius_->setRange(2, 40);
-  smooth_radius_->setValue(10);
-  smooth_weight_ = new QSlider(Qt::Horizontal, p.page);
-  smooth_weight_->setObjectName("smoothWeight");
-  smooth_weight_->setRange(1, 10);
-  smooth_weight_->setValue(2);
-  smooth_iterations_ = new QSpinBox(p.page);
-  smooth_iterations_->setRange(1, 20);
-  smooth_project_ = new QCheckBox(tr("Put smoothed markers back on the mirror"), p.page);
-  smooth_project_->setChecked(true);
-  smooth_info_ = new QLabel(p.page);
-  smooth_info_->setWordWrap(true);
-  for (QSlider* s : {smooth_radius_, smooth_weight_})
-    connect(s, &QSlider::valueChanged, this, &MainWindow::preview_smoothing);
-  connect(smooth_iterations_, &QSpinBox::valueChanged, this, &MainWindow::preview_smoothing);
-  auto* apply = button(tr("Apply smoothing"), "applySmoothing", p.page);
-  connect(apply, &QPushButton::clicked, this, [this] {
-    push(commands::smooth_markers(
-             {static_cast<double>(smooth_radius_->value()),
-              static_cast<double>(smooth_weight_->value()), smooth_iterations_->value()},
-             smooth_project_->isChecked()),
-         tr("Smoothing"));
-  });
-  p.form->addRow(tr("Radius"), smooth_radius_);
-  p.form->addRow(tr("Edge-marker weight"), smooth_weight_);
-  p.form->addRow(tr("Iterations"), smooth_iterations_);
-  p.form->addRow(smooth_project_);
-  p.form->addRow(apply);
-  p.form->addRow(smooth_info_);
-}
-
-// Step 9, check and export.
-void MainWindow::fill_export_page(const PageParts& p) {
-  export_report_ = new QTextBrowser(p.page);
-  export_report_->setObjectName("exportReport");
-  p.layout->addWidget(export_report_, 1);
-  for (const char* ext : {"stl", "ply"}) {
-    auto* b = button(tr("Export %1…").arg(QString(ext).toUpper()),
-                     ext[0] == 's' ? "exportStl" : "exportPly", p.page);
-    connect(b, &QPushButton::clicked, this, [this, ext] {
-      const QString path = QFileDialog::getSaveFileName(
-          this, tr("Export the implant"), QStringLiteral("implant.%1").arg(ext),
-          QStringLiteral("%1 (*.%2)").arg(QString(ext).toUpper(), ext));
-      if (!path.isEmpty()) export_to(path);
-    });
-    p.layout->addWidget(b);
-  }
 }
 
 void MainWindow::build_plan_dock() {
@@ -758,7 +393,7 @@ void MainWindow::refresh() {
   refresh_steps();
   refresh_history();
   refresh_quality();
-  refresh_page();
+  for (StepPage* page : step_pages_) page->show_state(s);
   const Session& session = controller_->session();
   undo_->setText(session.can_undo() ? q(session.undo_text()) : tr("Undo"));
   redo_->setText(session.can_redo() ? q(session.redo_text()) : tr("Redo"));
@@ -807,43 +442,21 @@ void MainWindow::refresh_steps() {
   steps_->setCurrentRow(s.current_step - 1);
   shown_step_ = s.current_step;
   pages_->setCurrentIndex(s.current_step - 1);
-  const WizardStep& w = wizard_steps()[s.current_step - 1];
-  std::string missing;
-  const bool done = step_complete(s, s.current_step, &missing);
-  QString keys;
-  if (s.current_step == 5 || s.current_step == 6 || s.current_step == 8)
-    keys =
-        tr("<br><i>Keys: 0–3 marker type, Del delete, drag a marker to move it, Ctrl+Z "
-           "undo, Ctrl+Shift+Z redo.</i>");
-  else
-    keys =
-        tr("<br><i>Keys: Ctrl+Z undo, Ctrl+Shift+Z redo, F5–F9 standard views, M mirror "
-           "on/off.</i>");
-  instructions_->setText(QStringLiteral("<b>%1. %2</b><br>%3<br><br>%4%5")
-                             .arg(w.number)
-                             .arg(tr(w.title))
-                             .arg(tr(w.instructions).toHtmlEscaped())
-                             .arg(done ? tr("<span style='color:#070'>Done.</span>")
-                                       : tr("<span style='color:#a50'>To do: %1</span>")
-                                             .arg(q(missing).toHtmlEscaped()))
-                             .arg(keys));
+  StepPage* page = step_pages_[static_cast<size_t>(s.current_step - 1)];
+  instructions_->setText(page->instructions_html(s));
   done_button_->setEnabled(!controller_->read_only());
   done_button_->setText(s.current_step == 9 ? tr("Done") : tr("Done — next step"));
-  step_label_->setText(tr("Step %1 of 9: %2").arg(s.current_step).arg(tr(w.title)));
+  step_label_->setText(
+      tr("Step %1 of 9: %2").arg(s.current_step).arg(tr(wizard_steps()[s.current_step - 1].title)));
   if (timed_step_ != s.current_step) {
     timed_step_ = s.current_step;
     step_timer_.restart();
   }
 
-  // Clicks: landmarks in step 2, the region centre in step 3, markers in 5, 6 and 8.
-  const int st = s.current_step;
-  SkullView::PickTarget target = SkullView::PickTarget::None;
-  if (st == 2 || st == 3) target = SkullView::PickTarget::Original;
-  if (st == 5 || st == 6 || st == 8)
-    target =
-        is_edge(marker_type_) ? SkullView::PickTarget::Original : SkullView::PickTarget::Mirrored;
-  view_->set_pick_target(controller_->read_only() ? SkullView::PickTarget::None : target);
-  view_->set_markers_editable(!controller_->read_only() && (st == 5 || st == 6 || st == 8));
+  // What clicks and drags on the view do is the current page's.
+  const bool editable = !controller_->read_only();
+  view_->set_pick_target(editable ? page->pick_target() : SkullView::PickTarget::None);
+  view_->set_markers_editable(editable && page->markers_editable());
 }
 
 void MainWindow::refresh_history() {
@@ -862,14 +475,15 @@ void MainWindow::refresh_quality() {
   const PlanState& s = controller_->state();
   if (!s.implant) {
     quality_->setHtml(tr("<p>No implant yet.</p>"));
-    if (export_report_) export_report_->setHtml(tr("<p>Build the implant first (step 7).</p>"));
+    for (StepPage* page : step_pages_)
+      page->show_quality(tr("<p>Build the implant first (step 7).</p>"));
     return;
   }
   // The report (overlap on a fine grid, thickness, self-intersections) takes a few tenths of a
   // second on a real skull: while markers are dragged it is computed once the implant has
   // stopped changing, not for every rebuild.
   quality_->setHtml(tr("<p>Checking the implant…</p>"));
-  if (export_report_) export_report_->setHtml(tr("<p>Checking the implant…</p>"));
+  for (StepPage* page : step_pages_) page->show_quality(tr("<p>Checking the implant…</p>"));
   quality_timer_->start();
 }
 
@@ -878,85 +492,7 @@ void MainWindow::show_quality() {
   if (!s.implant) return;
   const QString html = quality_html(s.implant->quality());
   quality_->setHtml(html);
-  if (export_report_) export_report_->setHtml(html);
-}
-
-void MainWindow::refresh_page() {
-  const PlanState& s = controller_->state();
-  if (skull_info_) {
-    QString info = tr("No skull loaded.");
-    if (s.skull) {
-      const LoadedSkull& loaded = s.skull->surface->loaded;
-      info = tr("%1<br>%2 triangles")
-                 .arg(q(loaded.description).toHtmlEscaped())
-                 .arg(s.skull->surface->mesh.n_faces());
-      // What the reader changed or found (a skull turned outward, non-manifold edges).
-      for (const std::string& w : loaded.warnings)
-        info +=
-            QStringLiteral("<br><span style='color:#a05a00'>⚠ %1</span>").arg(q(w).toHtmlEscaped());
-    }
-    skull_info_->setText(info);
-  }
-  if (plane_info_) {
-    QString t;
-    if (s.plane_fit)
-      t = tr("Fit: symmetry RMS %1 mm, %2% inliers (%3 start)")
-              .arg(s.plane_fit->symmetry_rms_mm, 0, 'f', 2)
-              .arg(100.0 * s.plane_fit->inlier_fraction, 0, 'f', 0)
-              .arg(q(s.plane_fit->initial_method));
-    const int n = (s.landmarks.nasion ? 1 : 0) + (s.landmarks.orbit_left ? 1 : 0) +
-                  (s.landmarks.orbit_right ? 1 : 0);
-    plane_info_->setText(
-        tr("Landmarks: %1 of 3 set, %2 midline points.").arg(n).arg(s.landmarks.midline.size()) +
-        (t.isEmpty() ? QString() : "<br>" + t));
-  }
-  if (register_info_)
-    register_info_->setText(
-        s.registration ? (s.registration->usable()
-                              ? tr("Registered: RMS %1 mm, %2 iterations")
-                                    .arg(s.registration->rms_mm, 0, 'f', 2)
-                                    .arg(s.registration->iterations)
-                              : tr("Registration failed: %1").arg(q(s.registration->message)))
-                       : (s.mirrored ? tr("Mirrored, not registered.") : tr("Not mirrored yet.")));
-  int counts[4] = {0, 0, 0, 0};
-  for (const auto& m : s.markers) ++counts[static_cast<int>(m.type)];
-  if (marker_counts_[0])
-    marker_counts_[0]->setText(tr("Outer edge: %1, inner edge: %2").arg(counts[0]).arg(counts[1]));
-  if (marker_counts_[1])
-    marker_counts_[1]->setText(
-        tr("Outer surface: %1, inner surface: %2").arg(counts[2]).arg(counts[3]));
-  if (proposal_note_) {
-    QString note =
-        s.proposal_message.empty() ? QString() : tr("Last proposal: %1").arg(q(s.proposal_message));
-    if (!s.unseen_rim.empty())
-      note +=
-          tr(" The orange lines in the view run along the stretches of the rim no ray saw: "
-             "the outline there goes straight from one edge marker to the next.");
-    proposal_note_->setText(note);
-    proposal_note_->setVisible(!s.proposal_message.empty());
-  }
-  // The build controls show the parameters the plan's implant was built with (an automatic
-  // plan is fitted to the bone), so pressing Build again keeps them unless changed.
-  if (implant_fit_ && s.implant_params) {
-    const ImplantParams& p = *s.implant_params;
-    const QSignalBlocker b1(implant_method_), b2(implant_resolution_), b3(implant_thickness_),
-        b4(implant_fit_);
-    implant_method_->setCurrentIndex(p.method == ImplantMethod::Shell ? 0 : 1);
-    implant_resolution_->setValue(p.resolution_mm);
-    implant_thickness_->setValue(std::isnan(p.thickness_mm) ? 0.0 : p.thickness_mm);
-    implant_fit_->setValue(p.fit_to_bone_mm);
-  }
-  if (implant_info_)
-    implant_info_->setText(
-        s.implant
-            ? tr("Implant: %1 triangles, %2")
-                  .arg(s.implant->result().mesh.n_faces())
-                  .arg(s.implant->result().watertight ? tr("watertight") : tr("not watertight"))
-            : tr("No implant yet."));
-  if (clip_on_) {
-    const QSignalBlocker b1(clip_on_);
-    clip_on_->setChecked(s.clip_plane.has_value());
-  }
+  for (StepPage* page : step_pages_) page->show_quality(html);
 }
 
 void MainWindow::update_timers() {
@@ -994,60 +530,34 @@ void MainWindow::set_marker_type(MarkerType type) {
 }
 
 void MainWindow::on_surface_clicked(const Eigen::Vector3d& p) {
-  const int step = controller_->state().current_step;
-  if (step == 2) {
-    push(commands::set_landmark(kLandmarkNames[landmark_->currentIndex()], p));
-    if (landmark_->currentIndex() < 2) landmark_->setCurrentIndex(landmark_->currentIndex() + 1);
-  } else if (step == 3) {
-    roi_center_ = p;
-    roi_only_->setChecked(true);
-    show_message(tr("Registration region centred at the clicked point."), false);
-  } else if (step == 5 || step == 6 || step == 8) {
-    push(commands::add_marker(marker_type_, p));
-  }
+  step_pages_[static_cast<size_t>(controller_->state().current_step - 1)]->surface_clicked(p);
 }
 
 void MainWindow::on_marker_dragged(int id, const Eigen::Vector3d& p) {
   push(commands::move_marker(id, p));
 }
 
-Command MainWindow::clip_command() const {
-  if (!clip_on_->isChecked()) return commands::clear_clip_plane();
-  const PlanState& s = controller_->state();
-  const Eigen::Vector3d center = s.skull ? s.skull->centroid : Eigen::Vector3d::Zero();
-  Eigen::Vector3d n = Eigen::Vector3d::Unit(clip_axis_->currentIndex());
-  return commands::set_clip_plane(Plane::through(center + clip_position_->value() * n, n));
-}
-
-void MainWindow::preview_smoothing() {
-  if (!controller_->state().implant) return;
-  const Command c = commands::smooth_markers(
-      {static_cast<double>(smooth_radius_->value()), static_cast<double>(smooth_weight_->value()),
-       smooth_iterations_->value()},
-      smooth_project_->isChecked());
-  smooth_info_->setText(tr("Radius %1 mm, edge weight %2 — preview (Apply to keep it)")
-                            .arg(smooth_radius_->value())
-                            .arg(smooth_weight_->value()));
-  if (auto preview = controller_->preview(c)) view_->show_state(*preview);
+std::shared_ptr<const PlanState> MainWindow::preview(const Command& command) {
+  return controller_->preview(command);
 }
 
 void MainWindow::open_input(const QString& path, double threshold) {
   if (!confirm_discard()) return;
   ExtractBoneSurfaceParams import;
   const bool volume = is_volume_path(path.toStdString());
-  if (!volume) import.mesh_unit_mm = units_->currentData().toDouble();
+  if (!volume) import.mesh_unit_mm = load_page_->mesh_unit_mm();
   if (volume && QFileInfo(path).isDir() && !choose_dicom_series(path, import)) return;
   if (volume) {
-    import.threshold = std::isfinite(threshold) ? threshold : threshold_->value();
+    import.threshold = std::isfinite(threshold) ? threshold : load_page_->threshold();
     if (interactive_ && !std::isfinite(threshold)) {
       bool ok = false;
       const double v = QInputDialog::getDouble(
           this, tr("Bone threshold"),
           tr("Iso-value for the bone surface (CT: Hounsfield units, about 200–400; masks: 0.5):"),
-          threshold_->value(), -1000, 3000, 1, &ok);
+          load_page_->threshold(), -1000, 3000, 1, &ok);
       if (!ok) return;
       import.threshold = v;
-      threshold_->setValue(v);
+      load_page_->set_threshold(v);
     }
   }
   const QString case_id = QFileInfo(path).completeBaseName();
@@ -1100,12 +610,7 @@ bool MainWindow::choose_dicom_series(const QString& folder, ExtractBoneSurfacePa
   return true;
 }
 
-bool MainWindow::set_mesh_unit(const std::string& name) {
-  const std::optional<LengthUnit> unit = length_unit_named(name);
-  if (!unit) return false;
-  units_->setCurrentIndex(units_->findData(unit->mm));
-  return true;
-}
+bool MainWindow::set_mesh_unit(const std::string& name) { return load_page_->set_mesh_unit(name); }
 
 void MainWindow::open_sample() {
   const QString path = q(sample_case_path());

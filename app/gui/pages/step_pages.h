@@ -1,0 +1,170 @@
+#pragma once
+// The nine wizard pages. Each is built with its host and shows the state it is given; the
+// factory make_step_page (step_page.h) makes them in step order.
+#include <optional>
+
+#include "step_page.h"
+
+class QCheckBox;
+class QComboBox;
+class QDoubleSpinBox;
+class QLabel;
+class QSlider;
+class QSpinBox;
+class QTextBrowser;
+
+namespace cranioplan::gui {
+
+/// Step 1: open a mesh or a CT, its length unit and the bone threshold.
+class LoadPage : public StepPage {
+ public:
+  explicit LoadPage(PageHost& host);
+  void show_state(const PlanState& state) override;
+  /// Millimetres per unit of the mesh files read next.
+  double mesh_unit_mm() const;
+  /// Chooses the unit by name (mm, cm, m, in, um); false for another name.
+  bool set_mesh_unit(const std::string& name);
+  double threshold() const;
+  void set_threshold(double hu);
+
+ private:
+  QDoubleSpinBox* threshold_;
+  QComboBox* units_;
+  QLabel* skull_info_;
+};
+
+/// Step 2: landmarks by clicks, the plane's fit, and turning or shifting it by hand.
+class PlanePage : public StepPage {
+ public:
+  explicit PlanePage(PageHost& host);
+  void show_state(const PlanState& state) override;
+  void surface_clicked(const Eigen::Vector3d& point) override;
+  SkullView::PickTarget pick_target() const override { return SkullView::PickTarget::Original; }
+
+ private:
+  QWidget* make_adjust_box();
+
+  QComboBox* landmark_;
+  QLabel* plane_info_;
+  QComboBox* adjust_axis_ = nullptr;
+  QDoubleSpinBox* adjust_angle_ = nullptr;
+  QDoubleSpinBox* adjust_shift_ = nullptr;
+};
+
+/// Step 3: mirror, register (whole skull or a region around a clicked point), nudge.
+class MirrorPage : public StepPage {
+ public:
+  explicit MirrorPage(PageHost& host);
+  void show_state(const PlanState& state) override;
+  void surface_clicked(const Eigen::Vector3d& point) override;
+  SkullView::PickTarget pick_target() const override { return SkullView::PickTarget::Original; }
+
+ private:
+  QWidget* make_nudge_box();
+
+  QCheckBox* roi_only_;
+  QDoubleSpinBox* roi_radius_;
+  QLabel* register_info_;
+  std::optional<Eigen::Vector3d> roi_center_;
+};
+
+/// Step 4: a clip plane across one of the three axes.
+class ClipPage : public StepPage {
+ public:
+  explicit ClipPage(PageHost& host);
+  void show_state(const PlanState& state) override;
+
+ private:
+  Command clip_command() const;
+
+  QCheckBox* clip_on_;
+  QComboBox* clip_axis_;
+  QSlider* clip_position_;
+};
+
+/// Steps 5 and 6: buttons for the step's two marker types, clicks place them, drags move them.
+class MarkersPage : public StepPage {
+ public:
+  MarkersPage(int step, PageHost& host, MarkerType first, MarkerType second);
+  void show_state(const PlanState& state) override;
+  void surface_clicked(const Eigen::Vector3d& point) override;
+  SkullView::PickTarget pick_target() const override;
+  bool markers_editable() const override { return true; }
+
+ protected:
+  QString keys_hint() const override;
+  /// The row that counts the markers of the two types (each page puts it where it reads best).
+  void add_counts_row();
+
+ private:
+  MarkerType first_, second_;
+  QLabel* counts_ = nullptr;
+};
+
+/// Step 5: edge markers, proposed automatically or imported.
+class EdgeMarkersPage : public MarkersPage {
+ public:
+  explicit EdgeMarkersPage(PageHost& host);
+  void show_state(const PlanState& state) override;
+
+ private:
+  void import_markers();
+
+  QLabel* proposal_note_;  ///< what the last proposal found
+};
+
+/// Step 6: surface markers on the mirror.
+class SurfaceMarkersPage : public MarkersPage {
+ public:
+  explicit SurfaceMarkersPage(PageHost& host);
+};
+
+/// Step 7: the implant's method, resolution, thickness and fit to the bone.
+class BuildPage : public StepPage {
+ public:
+  explicit BuildPage(PageHost& host);
+  void show_state(const PlanState& state) override;
+
+ private:
+  ImplantParams params() const;
+
+  QComboBox* method_;
+  QDoubleSpinBox* resolution_;
+  QDoubleSpinBox* thickness_;
+  QDoubleSpinBox* fit_;
+  QLabel* info_;
+};
+
+/// Step 8: Laplacian smoothing of the markers, previewed live, and marker edits.
+class SmoothPage : public StepPage {
+ public:
+  explicit SmoothPage(PageHost& host);
+  void surface_clicked(const Eigen::Vector3d& point) override;
+  SkullView::PickTarget pick_target() const override;
+  bool markers_editable() const override { return true; }
+
+ protected:
+  QString keys_hint() const override;
+
+ private:
+  Command smooth_command() const;
+  void preview();
+
+  QSlider* radius_;
+  QSlider* weight_;
+  QSpinBox* iterations_;
+  QCheckBox* project_;
+  QLabel* info_;
+};
+
+/// Step 9: the quality report and export.
+class ExportPage : public StepPage {
+ public:
+  explicit ExportPage(PageHost& host);
+  void show_quality(const QString& html) override;
+
+ private:
+  QTextBrowser* report_;
+};
+
+}  // namespace cranioplan::gui

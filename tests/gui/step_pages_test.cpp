@@ -1,0 +1,220 @@
+// Each wizard page on its own, with a host that records what the page asks for: the commands
+// its controls push, how it reads clicks on the skull, what it shows of a state.
+#include "pages/step_pages.h"
+
+#include <gtest/gtest.h>
+
+#include <QCheckBox>
+#include <QComboBox>
+#include <QDoubleSpinBox>
+#include <QLabel>
+#include <QPushButton>
+#include <QSlider>
+#include <QTest>
+#include <QTextBrowser>
+
+namespace cranioplan::gui {
+namespace {
+
+class RecordingHost : public PageHost {
+ public:
+  const PlanState& plan() const override { return state; }
+  void push(Command command, const QString& what) override {
+    pushed.push_back(std::move(command));
+    announced.push_back(what);
+  }
+  void show_message(const QString& text, bool) override { messages.push_back(text); }
+  SkullView& view() override { return view_; }
+  MarkerType marker_type() const override { return type; }
+  void set_marker_type(MarkerType t) override { type = t; }
+  void open_skull(const QString& path) override { opened.push_back(path); }
+  void open_sample() override { opened.push_back("sample"); }
+  bool export_to(const QString& path) override {
+    opened.push_back(path);
+    return true;
+  }
+  std::shared_ptr<const PlanState> preview(const Command& command) override {
+    previewed.push_back(command);
+    return nullptr;
+  }
+
+  PlanState state;
+  MarkerType type = MarkerType::OuterEdge;
+  std::vector<Command> pushed, previewed;
+  std::vector<QString> announced, messages, opened;
+
+ private:
+  SkullView view_;
+};
+
+template <class T>
+T* child(QWidget& page, const char* name) {
+  T* c = page.findChild<T*>(name);
+  EXPECT_NE(c, nullptr) << "no " << name;
+  return c;
+}
+
+void click(QWidget& page, const char* name) {
+  QPushButton* b = child<QPushButton>(page, name);
+  ASSERT_TRUE(b);
+  QTest::mouseClick(b, Qt::LeftButton);
+}
+
+TEST(StepPages, EveryStepHasItsPageInOrder) {
+  RecordingHost host;
+  for (int step = 1; step <= 9; ++step) {
+    const std::unique_ptr<StepPage> page = make_step_page(step, host);
+    ASSERT_TRUE(page) << "step " << step;
+    EXPECT_EQ(page->step(), step);
+    // The instructions name the step and say what is left to do on an empty plan.
+    const QString html = page->instructions_html(host.state);
+    EXPECT_TRUE(html.contains(QString::fromLatin1(wizard_steps()[step - 1].title))) << step;
+    EXPECT_TRUE(html.contains("To do")) << step;
+  }
+  EXPECT_FALSE(make_step_page(0, host));
+  EXPECT_FALSE(make_step_page(10, host));
+}
+
+TEST(StepPages, ClicksPlaceTheThreeLandmarksInTurn) {
+  RecordingHost host;
+  PlanePage page(host);
+  EXPECT_EQ(page.pick_target(), SkullView::PickTarget::Original);
+  for (int i = 0; i < 4; ++i) page.surface_clicked(Eigen::Vector3d(i, 0, 0));
+  ASSERT_EQ(host.pushed.size(), 4u);
+  const char* expected[] = {"nasion", "orbit_left", "orbit_right", "orbit_right"};
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(host.pushed[i].type, CommandType::SetLandmark);
+    EXPECT_EQ(host.pushed[i].params.at("name"), expected[i]) << i;
+  }
+  click(page, "fitPlane");
+  EXPECT_EQ(host.pushed.back().type, CommandType::FitPlane);
+  EXPECT_FALSE(host.announced.back().isEmpty()) << "a long command is announced";
+  click(page, "clearLandmarks");
+  EXPECT_EQ(host.pushed.back().type, CommandType::ClearLandmark);
+}
+
+TEST(StepPages, ARegistrationAroundAClickedPointCarriesItsRegion) {
+  RecordingHost host;
+  MirrorPage page(host);
+  click(page, "register");
+  ASSERT_EQ(host.pushed.back().type, CommandType::Register);
+  const Json whole = host.pushed.back().params;
+  page.surface_clicked(Eigen::Vector3d(10, 20, 30));
+  EXPECT_TRUE(child<QCheckBox>(page, "roiOnly")->isChecked());
+  click(page, "register");
+  const Json around = host.pushed.back().params;
+  EXPECT_NE(whole, around);
+  EXPECT_NE(around.dump().find("30"), std::string::npos) << around.dump();
+}
+
+TEST(StepPages, TheClipPlaneIsACommandAndFollowsTheState) {
+  RecordingHost host;
+  ClipPage page(host);
+  auto* on = child<QCheckBox>(page, "clipOn");
+  on->setChecked(true);
+  ASSERT_EQ(host.pushed.size(), 1u);
+  EXPECT_EQ(host.pushed[0].type, CommandType::SetClipPlane);
+  on->setChecked(false);
+  EXPECT_EQ(host.pushed.back().type, CommandType::SetClipPlane);
+  // Showing a state sets the box without pushing anything.
+  host.state.clip_plane = Plane::through(Eigen::Vector3d::Zero(), Eigen::Vector3d::UnitX());
+  page.show_state(host.state);
+  EXPECT_TRUE(on->isChecked());
+  EXPECT_EQ(host.pushed.size(), 2u);
+}
+
+TEST(StepPages, MarkersGoOnTheSurfaceTheirTypeBelongsTo) {
+  RecordingHost host;
+  EdgeMarkersPage edges(host);
+  SurfaceMarkersPage surfaces(host);
+  EXPECT_TRUE(edges.markers_editable());
+  click(surfaces, "markerType3");
+  EXPECT_EQ(host.type, MarkerType::InnerSurface);
+  EXPECT_EQ(edges.pick_target(), SkullView::PickTarget::Mirrored);
+  click(edges, "markerType1");
+  EXPECT_EQ(host.type, MarkerType::InnerEdge);
+  EXPECT_EQ(surfaces.pick_target(), SkullView::PickTarget::Original);
+  surfaces.surface_clicked(Eigen::Vector3d(1, 2, 3));
+  ASSERT_EQ(host.pushed.back().type, CommandType::AddMarker);
+  EXPECT_EQ(host.pushed.back().params.at("type"), static_cast<int>(MarkerType::InnerEdge));
+  click(edges, "propose");
+  EXPECT_EQ(host.pushed.back().type, CommandType::ProposeMarkers);
+  click(edges, "clearMarkers");
+  EXPECT_EQ(host.pushed.back().type, CommandType::ClearMarkers);
+}
+
+TEST(StepPages, TheMarkerCountsAndTheProposalNoteShowTheState) {
+  RecordingHost host;
+  EdgeMarkersPage page(host);
+  for (int i = 0; i < 3; ++i) host.state.markers.push_back(Marker{i, MarkerType::OuterEdge, {}});
+  host.state.markers.push_back(Marker{3, MarkerType::OuterSurface, {}});
+  host.state.proposal_message = "12 markers proposed";
+  page.show_state(host.state);
+  bool counted = false;
+  for (QLabel* label : page.findChildren<QLabel*>())
+    counted |= label->text() == "Outer edge: 3, inner edge: 0";
+  EXPECT_TRUE(counted);
+  auto* note = child<QLabel>(page, "proposalNote");
+  EXPECT_TRUE(note->text().contains("12 markers proposed"));
+  host.state.proposal_message.clear();
+  page.show_state(host.state);
+  EXPECT_TRUE(note->isHidden());
+}
+
+TEST(StepPages, BuildPushesTheParametersTheControlsShow) {
+  RecordingHost host;
+  BuildPage page(host);
+  ImplantParams built;
+  built.method = ImplantMethod::Shell;
+  built.resolution_mm = 0.8;
+  built.thickness_mm = 3.5;
+  built.fit_to_bone_mm = 4.0;
+  host.state.implant_params = built;
+  page.show_state(host.state);
+  EXPECT_DOUBLE_EQ(child<QDoubleSpinBox>(page, "implantFit")->value(), 4.0);
+  click(page, "build");
+  ASSERT_EQ(host.pushed.back().type, CommandType::BuildImplant);
+  const Json& p = host.pushed.back().params.at("params");
+  EXPECT_DOUBLE_EQ(p.at("resolution_mm").get<double>(), 0.8);
+  EXPECT_DOUBLE_EQ(p.at("thickness_mm").get<double>(), 3.5);
+  EXPECT_DOUBLE_EQ(p.at("fit_to_bone_mm").get<double>(), 4.0);
+}
+
+TEST(StepPages, SmoothingIsPreviewedThenApplied) {
+  RecordingHost host;
+  SmoothPage page(host);
+  auto* radius = child<QSlider>(page, "smoothRadius");
+  radius->setValue(15);
+  EXPECT_TRUE(host.previewed.empty()) << "no preview without an implant";
+  host.state.implant = std::make_shared<ImplantData>(ImplantResult{}, nullptr);
+  radius->setValue(20);
+  ASSERT_EQ(host.previewed.size(), 1u);
+  EXPECT_EQ(host.previewed[0].type, CommandType::SmoothMarkers);
+  EXPECT_TRUE(host.pushed.empty()) << "a preview records nothing";
+  click(page, "applySmoothing");
+  ASSERT_EQ(host.pushed.size(), 1u);
+  EXPECT_EQ(host.pushed[0].params, host.previewed[0].params);
+}
+
+TEST(StepPages, TheExportPageShowsTheQualityReport) {
+  RecordingHost host;
+  ExportPage page(host);
+  page.show_quality("<p>Printable: yes</p>");
+  EXPECT_TRUE(child<QTextBrowser>(page, "exportReport")->toPlainText().contains("Printable"));
+}
+
+TEST(StepPages, TheLoadPageKnowsTheMeshUnits) {
+  RecordingHost host;
+  LoadPage page(host);
+  EXPECT_DOUBLE_EQ(page.mesh_unit_mm(), 1.0);
+  EXPECT_TRUE(page.set_mesh_unit("cm"));
+  EXPECT_DOUBLE_EQ(page.mesh_unit_mm(), 10.0);
+  EXPECT_FALSE(page.set_mesh_unit("furlong"));
+  EXPECT_DOUBLE_EQ(page.mesh_unit_mm(), 10.0);
+  click(page, "pageSample");
+  ASSERT_EQ(host.opened.size(), 1u);
+  EXPECT_EQ(host.opened[0], "sample");
+}
+
+}  // namespace
+}  // namespace cranioplan::gui
