@@ -4,6 +4,8 @@
 
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/algorithms/quality/inject_defect.h"
+#include "cranioplan/sessions/autoplan_session.h"
+#include "cranioplan/sessions/sha256.h"
 #include "support/synthetic.h"
 #include "support/test_files.h"
 
@@ -12,6 +14,21 @@ namespace cranioplan::test {
 std::string scratch_path(const std::string& name) {
   static TempDir dir;
   return dir.path(name);
+}
+
+const PlannedCase& planned_defect_case() {
+  static const PlannedCase c = [] {
+    PlannedCase p;
+    p.session_path = scratch_path("auto.json");
+    p.implant_path = scratch_path("auto_implant.stl");
+    AutoplanSession a = autoplan_session(defect_skull_stl(), Landmarks{}, AutoplanParams{},
+                                         p.implant_path, SessionInfo{"synthetic", "expert", ""});
+    EXPECT_TRUE(a.planned()) << a.message;
+    a.session.save(p.session_path);
+    p.implant_sha = sha256_file(p.implant_path);
+    return p;
+  }();
+  return c;
 }
 
 const std::string& small_skull_stl() {

@@ -14,6 +14,13 @@ const std::string& small_skull_stl();
 /// binary STL; and its ground-truth implant.
 const std::string& defect_skull_stl();
 const std::string& defect_implant_stl();
+/// The automatic plan of defect_skull_stl() (autoplan_session, user "expert"), saved as a
+/// session with its exported implant; made once per test program.
+struct PlannedCase {
+  std::string session_path, implant_path;
+  std::string implant_sha;  ///< SHA-256 of the exported implant file
+};
+const PlannedCase& planned_defect_case();
 /// A folder that lives as long as the test program.
 std::string scratch_path(const std::string& name);
 

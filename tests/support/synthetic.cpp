@@ -4,8 +4,10 @@
 #include <cmath>
 #include <map>
 
+#include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
+#include "cranioplan/algorithms/quality/inject_defect.h"
 
 namespace cranioplan::test {
 namespace {
@@ -205,6 +207,41 @@ std::vector<Marker> round_defect_markers(const Eigen::Vector3d& center, double r
     }
   }
   return markers;
+}
+
+Volume oblique_ball_volume(const Eigen::Vector3d& center) {
+  Volume v = make_ball_volume(Eigen::Vector3d::Zero(), 10.0, 32, 1.0, false);
+  const Eigen::Matrix3d rot =
+      Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 0.5).normalized()).toRotationMatrix();
+  v.directions = rot * Eigen::Vector3d(0.9, 1.0, 1.3).asDiagonal();
+  // The centre index (15.5, 15.5, 15.5) lands on `center`.
+  v.origin = center - v.directions * Eigen::Vector3d::Constant(15.5);
+  for (int k = 0; k < 32; ++k)
+    for (int j = 0; j < 32; ++j)
+      for (int i = 0; i < 32; ++i)
+        v.data[v.index(i, j, k)] = (v.world(Eigen::Vector3d(i, j, k)) - center).norm() <= 10.0;
+  return v;
+}
+
+Eigen::Vector3d vertex_centroid(const SkullMesh& mesh) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (auto vh : mesh.vertices()) c += to_eigen(mesh.point(vh));
+  return c / static_cast<double>(mesh.n_vertices());
+}
+
+const ThickHeadDefect& thick_head_defect() {
+  static const ThickHeadDefect c = [] {
+    ThickHeadDefect k;
+    k.intact = make_thick_head();
+    InjectDefectParams p;
+    p.center = head_surface_point(Eigen::Vector3d(0.7, 0.1, 0.7).normalized()) * 0.965;
+    p.size_mm = 55;
+    p.voxel_mm = 0.5;
+    k.defective = inject_defect(k.intact, p).defective;
+    k.defect = detect_defect(k.defective, SurfaceLocator(k.defective), Eigen::Vector3d::Zero());
+    return k;
+  }();
+  return c;
 }
 
 }  // namespace cranioplan::test

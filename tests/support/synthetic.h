@@ -1,5 +1,6 @@
 #pragma once
 // Shapes whose truth is known by construction, for known-answer tests.
+#include "cranioplan/algorithms/planning/detect_defect.h"
 #include "cranioplan/model/landmarks.h"
 #include "cranioplan/model/marker.h"
 #include "cranioplan/model/mesh.h"
@@ -39,6 +40,18 @@ Plane transformed(const Plane& p, const RigidTransform& t);
 /// A volume holding a solid ball (values 1 inside, 0 outside; or HU 1000 / -1000 as CT).
 Volume make_ball_volume(const Eigen::Vector3d& center_world, double radius, int n, double spacing,
                         bool as_ct);
+/// A mask of a ball of radius 10 mm centred on `center`, on an oblique 32³ grid (turned and
+/// sheared, spacings 0.9, 1.0 and 1.3 mm): a reader must put it where the directions say.
+Volume oblique_ball_volume(const Eigen::Vector3d& center);
+/// A head whose truth is known: the intact thick head, and the same with a 55 mm defect on the
+/// upper right, detected from the origin (inside the cranial cavity). Made once.
+struct ThickHeadDefect {
+  SkullMesh intact, defective;
+  DefectRegion defect;
+};
+const ThickHeadDefect& thick_head_defect();
+/// The mean of a mesh's vertices, mm.
+Eigen::Vector3d vertex_centroid(const SkullMesh& mesh);
 
 }  // namespace cranioplan::test
 

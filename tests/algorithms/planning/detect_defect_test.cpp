@@ -110,5 +110,29 @@ TEST(DetectDefect, ADefectThatReachesTheScansCutIsStillADefect) {
   EXPECT_LT(with.area_mm2, 0.5 * without.area_mm2);
 }
 
+// A point to choose the opening: one in its direction plans it without a note; one on intact
+// bone far from it still plans the only opening, and the message says no opening lies towards
+// the point (a cut that did not go through would otherwise plan another opening unsaid).
+TEST(DetectDefect, APointFarFromEveryOpeningIsSaidToMissIt) {
+  const test::ThickHeadDefect& c = test::thick_head_defect();
+  ASSERT_TRUE(c.defect.found()) << c.defect.message;
+  const SurfaceLocator bone(c.defective);
+  DetectDefectParams towards;
+  towards.near = c.defect.center + 80.0 * c.defect.axis;
+  const DefectRegion hit = detect_defect(c.defective, bone, c.defect.center, towards);
+  ASSERT_TRUE(hit.found());
+  EXPECT_LT(hit.near_miss_deg, 1.0);
+  EXPECT_EQ(hit.message.find("no opening lies towards"), std::string::npos) << hit.message;
+  DetectDefectParams away;
+  away.near = c.defect.center - 80.0 * c.defect.axis;
+  const DefectRegion miss = detect_defect(c.defective, bone, c.defect.center, away);
+  ASSERT_TRUE(miss.found());
+  EXPECT_GT(miss.near_miss_deg, 90.0);
+  EXPECT_NE(miss.message.find("no opening lies towards the point given: the nearest, planned, is"),
+            std::string::npos)
+      << miss.message;
+  EXPECT_EQ(miss.hole_directions.size(), hit.hole_directions.size()) << "the same opening";
+}
+
 }  // namespace
 }  // namespace cranioplan

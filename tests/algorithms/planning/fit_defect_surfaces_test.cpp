@@ -14,51 +14,8 @@
 namespace cranioplan {
 namespace {
 
-// A head whose truth is known: the intact thick head, and the same with a 55 mm defect on the
-// upper right, seen from the origin (inside the cranial cavity).
-struct Case {
-  SkullMesh intact, defective;
-  DefectRegion defect;
-};
-
-const Case& the_case() {
-  static const Case c = [] {
-    Case k;
-    k.intact = test::make_thick_head();
-    InjectDefectParams p;
-    p.center = test::head_surface_point(Eigen::Vector3d(0.7, 0.1, 0.7).normalized()) * 0.965;
-    p.size_mm = 55;
-    p.voxel_mm = 0.5;
-    k.defective = inject_defect(k.intact, p).defective;
-    k.defect = detect_defect(k.defective, SurfaceLocator(k.defective), Eigen::Vector3d::Zero());
-    return k;
-  }();
-  return c;
-}
-
-// A point to choose the opening: one in its direction plans it without a note; one on intact
-// bone far from it still plans the only opening, and the message says no opening lies towards
-// the point (a cut that did not go through would otherwise plan another opening unsaid).
-TEST(DetectDefect, APointFarFromEveryOpeningIsSaidToMissIt) {
-  const Case& c = the_case();
-  ASSERT_TRUE(c.defect.found()) << c.defect.message;
-  const SurfaceLocator bone(c.defective);
-  DetectDefectParams towards;
-  towards.near = c.defect.center + 80.0 * c.defect.axis;
-  const DefectRegion hit = detect_defect(c.defective, bone, c.defect.center, towards);
-  ASSERT_TRUE(hit.found());
-  EXPECT_LT(hit.near_miss_deg, 1.0);
-  EXPECT_EQ(hit.message.find("no opening lies towards"), std::string::npos) << hit.message;
-  DetectDefectParams away;
-  away.near = c.defect.center - 80.0 * c.defect.axis;
-  const DefectRegion miss = detect_defect(c.defective, bone, c.defect.center, away);
-  ASSERT_TRUE(miss.found());
-  EXPECT_GT(miss.near_miss_deg, 90.0);
-  EXPECT_NE(miss.message.find("no opening lies towards the point given: the nearest, planned, is"),
-            std::string::npos)
-      << miss.message;
-  EXPECT_EQ(miss.hole_directions.size(), hit.hole_directions.size()) << "the same opening";
-}
+using Case = test::ThickHeadDefect;
+const Case& the_case() { return test::thick_head_defect(); }
 
 struct Errors {
   double outer_median = 0, outer_max = 0, inner_median = 0, inner_max = 0;

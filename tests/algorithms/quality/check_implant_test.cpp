@@ -2,7 +2,6 @@
 
 #include <gtest/gtest.h>
 
-#include "cranioplan/algorithms/geometry/self_intersections.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
 #include "support/synthetic.h"
@@ -22,14 +21,6 @@ bool has_reason(const QualityReport& q, const std::string& part) {
 
 bool judged_thin(const QualityReport& q) {
   return has_reason(q, "thinner than") || has_reason(q, "nowhere is the implant");
-}
-
-TEST(SelfIntersections, CrossingTrianglesAreCountedAndAClosedSurfaceHasNone) {
-  TriangleSoup s;
-  s.vertices = {{0, 0, 0}, {4, 0, 0}, {0, 4, 0}, {1, 1, -1}, {1, 1, 1}, {3, 3, 0.5}};
-  s.triangles = {{0, 1, 2}, {3, 4, 5}};  // the second pierces the first
-  EXPECT_EQ(count_self_intersections(build_mesh(s)), 1);
-  EXPECT_EQ(count_self_intersections(test::make_symmetric_head(3)), 0);
 }
 
 TEST(CheckImplant, ThicknessVolumeAndReasonsOnKnownBoxes) {

@@ -1,0 +1,80 @@
+#include "cranioplan/algorithms/planning/propose_markers.h"
+
+#include <gtest/gtest.h>
+
+#include <map>
+
+#include "cranioplan/algorithms/geometry/surface_locator.h"
+#include "support/synthetic.h"
+
+namespace cranioplan {
+namespace {
+
+// The proposal for the synthetic defect with the intact head as a perfect mirror: the markers
+// stand on the bone the truth has there.
+TEST(ProposeMarkers, MarkersLieOnTheRimAndOnTheMissingBone) {
+  const test::ThickHeadDefect& c = test::thick_head_defect();
+  ASSERT_TRUE(c.defect.found()) << c.defect.message;
+  const SurfaceLocator bone(c.defective), truth(c.intact);
+  const MarkerProposal p = propose_markers_for_defect(c.defect, bone, truth, ProposeParams{}, 7);
+  ASSERT_TRUE(p.proposed()) << p.message;
+  EXPECT_EQ(p.method_used, PlanMethod::Mirror);
+  EXPECT_GT(p.mirror_coverage, 0.9);
+  std::map<MarkerType, int> count;
+  for (size_t i = 0; i < p.markers.size(); ++i) {
+    const Marker& m = p.markers[i];
+    EXPECT_EQ(m.id, 7 + static_cast<int>(i)) << "ids from first_id on, in order";
+    // Edge markers and the support markers beside the rim lie on the skull; surface markers
+    // over the opening on the mirror, here the intact head.
+    if (is_edge(m.type)) EXPECT_EQ(m.surface, MarkerSurface::Original);
+    ++count[m.type];
+    const SurfaceLocator& on = m.surface == MarkerSurface::Original ? bone : truth;
+    EXPECT_LT(on.closest(m.position).distance, 1.0) << to_string(m.type) << " " << m.id;
+  }
+  EXPECT_GE(count[MarkerType::OuterEdge], 10);
+  EXPECT_GE(count[MarkerType::OuterSurface], 10);
+  EXPECT_GE(count[MarkerType::InnerSurface], 10);
+}
+
+TEST(ProposeMarkers, RimOnlyFittingIsUsedWhenAsked) {
+  const test::ThickHeadDefect& c = test::thick_head_defect();
+  const SurfaceLocator bone(c.defective), truth(c.intact);
+  ProposeParams params;
+  params.method = PlanMethod::RimOnly;
+  const MarkerProposal p = propose_markers_for_defect(c.defect, bone, truth, params);
+  ASSERT_TRUE(p.proposed()) << p.message;
+  EXPECT_EQ(p.method_used, PlanMethod::RimOnly);
+  // Without the mirror every marker is on the skull's side, and the surface markers still
+  // follow the missing bone within 2 mm.
+  for (const Marker& m : p.markers) {
+    EXPECT_EQ(m.surface, MarkerSurface::Original);
+    if (m.type == MarkerType::OuterSurface) EXPECT_LT(truth.closest(m.position).distance, 2.0);
+  }
+}
+
+TEST(ProposeMarkers, AnIntactSkullHasNoDefectToPropose) {
+  const test::ThickHeadDefect& c = test::thick_head_defect();
+  const SurfaceLocator intact(c.intact);
+  const MarkerProposal p =
+      propose_markers(c.intact, intact, Plane::through({}, {1, 0, 0}), intact, ProposeParams{});
+  EXPECT_EQ(p.status, MarkerProposal::Status::NoDefect) << p.message;
+  EXPECT_TRUE(p.markers.empty());
+}
+
+TEST(ProposeMarkers, MethodsHaveNamesAndTheRegionReachesPastTheRim) {
+  for (PlanMethod m : {PlanMethod::Auto, PlanMethod::Mirror, PlanMethod::RimOnly}) {
+    PlanMethod back = PlanMethod::Auto;
+    ASSERT_TRUE(plan_method_from_string(to_string(m), back)) << to_string(m);
+    EXPECT_EQ(back, m);
+  }
+  PlanMethod unchanged = PlanMethod::Mirror;
+  EXPECT_FALSE(plan_method_from_string("mirrored", unchanged));
+  EXPECT_EQ(describe_method(PlanMethod::Mirror, 0.974),
+            "mirror-guided (mirror covers 97% of the opening)");
+  const DefectRegion& d = test::thick_head_defect().defect;
+  const RegionOfInterest roi = local_registration_region(d, 20.0);
+  for (const Eigen::Vector3d& p : d.outer_rim) EXPECT_LE((p - roi.center).norm(), roi.radius - 20);
+}
+
+}  // namespace
+}  // namespace cranioplan
