@@ -37,6 +37,9 @@
 #include "cranioplan/algorithms/io/read_volume.h"
 #include "cranioplan/model/error.h"
 #include "cranioplan/sessions/audit.h"
+#include "cranioplan/sessions/marker_files.h"
+#include "cranioplan/sessions/plan_files.h"
+#include "cranioplan/sessions/sha256.h"
 #include "pages/step_pages.h"
 
 namespace cranioplan::gui {
@@ -169,6 +172,8 @@ void MainWindow::build_menus() {
   recent_menu_ = file->addMenu(tr("Recent files"));
   refresh_recent_menu();
   file->addSeparator();
+  add_points_actions(file);
+  file->addSeparator();
   QAction* audit = file->addAction(tr("Audit a session (read-only)…"), this, [this] {
     const QString path = QFileDialog::getOpenFileName(this, tr("Audit a plan"), QString(),
                                                       tr("Cranioplan session (*.json)"));
@@ -183,6 +188,102 @@ void MainWindow::build_menus() {
 }
 
 // Edit (undo, redo, delete, notes) and View (standard views, the mirror and the plane).
+// Markers and landmarks in and out: JSON, CSV or 3D Slicer's markups.
+void MainWindow::add_points_actions(QMenu* file) {
+  const QString markers = tr("Markers (*.mrk.json *.json *.csv)");
+  const QString landmarks = tr("Landmarks (*.mrk.json *.json)");
+  file->addAction(tr("Import markers…"), this,
+                  [this, markers] {
+                    const QString path = QFileDialog::getOpenFileName(this, tr("Import markers"),
+                                                                      QString(), markers);
+                    if (!path.isEmpty()) import_markers(path);
+                  })
+      ->setObjectName("importMarkersMenu");
+  file->addAction(tr("Export markers…"), this,
+                  [this, markers] {
+                    const QString path = QFileDialog::getSaveFileName(
+                        this, tr("Export markers"), QStringLiteral("markers.mrk.json"), markers);
+                    if (!path.isEmpty()) export_markers(path);
+                  })
+      ->setObjectName("exportMarkers");
+  file->addAction(tr("Import landmarks…"), this,
+                  [this, landmarks] {
+                    const QString path = QFileDialog::getOpenFileName(this, tr("Import landmarks"),
+                                                                      QString(), landmarks);
+                    if (!path.isEmpty()) import_landmarks(path);
+                  })
+      ->setObjectName("importLandmarks");
+  file->addAction(tr("Export landmarks…"), this,
+                  [this, landmarks] {
+                    const QString path = QFileDialog::getSaveFileName(
+                        this, tr("Export landmarks"), QStringLiteral("landmarks.mrk.json"),
+                        landmarks);
+                    if (!path.isEmpty()) export_landmarks(path);
+                  })
+      ->setObjectName("exportLandmarks");
+}
+
+void MainWindow::import_markers(const QString& path) {
+  try {
+    const std::string file = path.toStdString();
+    push(commands::import_markers(read_markers_file(file), file, sha256_file(file)));
+  } catch (const Error& e) {
+    show_message(QString::fromUtf8(e.what()), true);
+  }
+}
+
+void MainWindow::import_landmarks(const QString& path) {
+  Landmarks lm;
+  try {
+    lm = read_landmarks_file(path.toStdString());
+  } catch (const Error& e) {
+    show_message(QString::fromUtf8(e.what()), true);
+    return;
+  }
+  // The file's landmarks replace the plan's, a command each (undo takes them back one by one);
+  // when one is refused (far from the skull: another frame) none is kept.
+  std::vector<Command> commands_to_push;
+  for (const char* name : {"nasion", "orbit_left", "orbit_right", "midline"})
+    commands_to_push.push_back(commands::clear_landmark(name));
+  const std::pair<const char*, const std::optional<Eigen::Vector3d>*> named[] = {
+      {"nasion", &lm.nasion}, {"orbit_left", &lm.orbit_left}, {"orbit_right", &lm.orbit_right}};
+  for (const auto& [name, p] : named)
+    if (*p) commands_to_push.push_back(commands::set_landmark(name, **p));
+  for (const Eigen::Vector3d& p : lm.midline)
+    commands_to_push.push_back(commands::set_landmark("midline", p));
+  const size_t before = controller_->session().index();
+  for (Command& c : commands_to_push)
+    if (!controller_->push(std::move(c))) {
+      while (controller_->session().index() > before) controller_->undo();
+      show_message(tr("%1: the landmarks were not imported.").arg(path), true);
+      return;
+    }
+  show_message(tr("Imported the landmarks of %1").arg(path), false);
+}
+
+bool MainWindow::export_markers(const QString& path) {
+  try {
+    write_markers_file(controller_->state().markers, path.toStdString());
+  } catch (const Error& e) {
+    show_message(QString::fromUtf8(e.what()), true);
+    return false;
+  }
+  show_message(tr("Wrote %1 markers to %2").arg(controller_->state().markers.size()).arg(path),
+               false);
+  return true;
+}
+
+bool MainWindow::export_landmarks(const QString& path) {
+  try {
+    write_landmarks_file(controller_->state().landmarks, path.toStdString());
+  } catch (const Error& e) {
+    show_message(QString::fromUtf8(e.what()), true);
+    return false;
+  }
+  show_message(tr("Wrote the landmarks to %1").arg(path), false);
+  return true;
+}
+
 void MainWindow::build_edit_view_menus() {
   QMenu* edit = menuBar()->addMenu(tr("&Edit"));
   undo_ = edit->addAction(tr("Undo"), controller_, &PlanController::undo);

@@ -57,6 +57,8 @@ class MainWindow : public QMainWindow, public PageHost {
   void set_marker_type(MarkerType type) override;
   void open_skull(const QString& path) override { open_input(path); }
   std::shared_ptr<const PlanState> preview(const Command& command) override;
+  /// Markers from a file (.mrk.json, .json, .csv) as one import command.
+  void import_markers(const QString& path) override;
 
   /// Without interaction, dialogs take their default answer (tests, --quit).
   void set_interactive(bool interactive) { interactive_ = interactive; }
@@ -74,6 +76,11 @@ class MainWindow : public QMainWindow, public PageHost {
   void replay_to_step(int step);
   bool save_session_to(const QString& path);
   bool export_to(const QString& path) override;
+  /// Landmarks from a file (.mrk.json, .json): they replace the plan's, a command each.
+  void import_landmarks(const QString& path);
+  /// The plan's markers or landmarks to a file (by extension: .mrk.json, .json, .csv).
+  bool export_markers(const QString& path);
+  bool export_landmarks(const QString& path);
   void open_audit(const QString& path);
   void start_training(const QString& reference_session);
   /// Unsaved plans of earlier runs that crashed; offers to recover the newest.
@@ -88,6 +95,7 @@ class MainWindow : public QMainWindow, public PageHost {
 
  private:
   void build_menus();  // File, then the others
+  void add_points_actions(class QMenu* file);
   void build_edit_view_menus();
   void build_training_help_menus();
   void build_steps_dock();

@@ -229,7 +229,7 @@ Subcommand add_smooth(CLI::App& app, const bool& json) {
   };
   auto o = std::make_shared<Opts>();
   auto* cmd = app.add_subcommand("smooth", "The paper's Laplacian smoother on surface markers");
-  cmd->add_option("MARKERS", o->markers, "markers (.json or .csv)")->required();
+  cmd->add_option("MARKERS", o->markers, "markers (.json, .csv or Slicer .mrk.json)")->required();
   cmd->add_option("--radius", o->params.radius_mm, "neighbourhood radius (mm)")
       ->required()
       ->check(CLI::PositiveNumber);
@@ -240,7 +240,7 @@ Subcommand add_smooth(CLI::App& app, const bool& json) {
       ->check(CLI::Range(1, 1000));
   cmd->add_option("--project-onto", o->mirrored,
                   "put smoothed surface markers back onto this mesh (the mirrored skull)");
-  cmd->add_option("-o,--output", o->output, "markers to write (.json or .csv)")->required();
+  cmd->add_option("-o,--output", o->output, "markers to write (.json, .csv or Slicer .mrk.json)")->required();
   return Subcommand{cmd, [o, &json] {
                       const auto markers = read_markers_file(o->markers);
                       std::unique_ptr<SurfaceLocator> surface;
@@ -273,7 +273,7 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
   cmd->add_option("--skull", o->skull, "the original (defective) skull")->required();
   cmd->add_option("--mirrored", o->mirrored,
                   "the registered mirrored skull (surface markers are snapped onto it)");
-  cmd->add_option("--markers", o->markers, "markers (.json or .csv)")->required();
+  cmd->add_option("--markers", o->markers, "markers (.json, .csv or Slicer .mrk.json)")->required();
   cmd->add_option("--method", o->method, "shell (default) or delaunay3d")
       ->check(CLI::IsMember({"shell", "delaunay3d"}));
   cmd->add_option("--resolution", o->params.resolution_mm, "shell edge length (mm)")
@@ -428,11 +428,11 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
   auto* cmd =
       app.add_subcommand("autoplan", "Plan an implant automatically from a defective skull");
   cmd->add_option("SKULL", o->skull, "defective skull (mesh or volume)")->required();
-  cmd->add_option("--landmarks", o->landmarks, "landmarks JSON for the midsagittal plane");
+  cmd->add_option("--landmarks", o->landmarks, "landmarks for the midsagittal plane (.json or Slicer .mrk.json)");
   cmd->add_option("--method", o->method, "auto, mirror or rim-only")
       ->check(CLI::IsMember({"auto", "mirror", "rim-only"}));
   cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
-  cmd->add_option("--markers-out", o->markers_out, "proposed markers to write (.json or .csv)");
+  cmd->add_option("--markers-out", o->markers_out, "proposed markers to write (.json, .csv or Slicer .mrk.json)");
   add_units_option(cmd, o->import.mesh_unit_mm);
   add_series_option(cmd, o->import.dicom_series);
   cmd->add_option("--near", o->near,

@@ -151,7 +151,7 @@ Subcommand add_plane(CLI::App& app, const bool& json) {
   auto* cmd = app.add_subcommand("plane", "Fit the midsagittal plane");
   cmd->add_option("MESH", o->mesh, "skull mesh or volume")->required();
   cmd->add_option("--landmarks", o->landmarks,
-                  "landmarks JSON (nasion, orbit_left, orbit_right, midline)");
+                  "landmarks (nasion, orbit_left, orbit_right, midline; .json or Slicer .mrk.json)");
   cmd->add_flag("--no-refine", o->no_refine,
                 "only the initial plane, without the Ceres refinement");
   cmd->add_option("-o,--output", o->output, "plane JSON to write");
@@ -262,7 +262,7 @@ Subcommand add_pipeline(CLI::App& app, const bool& json) {
       "pipeline", "Import, fit the plane, mirror and register; write the meshes to a folder");
   cmd->add_option("INPUT", o->input, "skull mesh or volume (default: the sample case)");
   cmd->add_flag("--sample", o->use_sample, "use the installed sample case (Cranium.inv3)");
-  cmd->add_option("--landmarks", o->landmarks, "landmarks JSON");
+  cmd->add_option("--landmarks", o->landmarks, "landmarks (.json or Slicer .mrk.json)");
   cmd->add_option("-o,--output", o->output, "output folder")->required();
   add_import_options(cmd, o->import);
   return {cmd, [o, &json] {

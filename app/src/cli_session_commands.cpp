@@ -6,6 +6,7 @@
 #include "cranioplan/algorithms/io/file_io.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/sessions/audit.h"
+#include "cranioplan/sessions/marker_files.h"
 #include "cranioplan/sessions/session.h"
 
 namespace cranioplan::cli {
@@ -64,6 +65,32 @@ std::vector<Subcommand> add_session_commands(CLI::App& app, const bool& json) {
                        }
                        write_mesh(s.state().implant->result().mesh, o->output);
                        j["output"] = o->output;
+                     }
+                     print_result(j, json);
+                     return kOk;
+                   }});
+  }
+  {  // points
+    struct Opts {
+      std::string session, markers, landmarks;
+    };
+    auto o = std::make_shared<Opts>();
+    auto* cmd = app.add_subcommand(
+        "points", "Write a plan's markers and landmarks (.json, .csv or Slicer .mrk.json)");
+    cmd->add_option("SESSION", o->session, "session (.json)")->required();
+    cmd->add_option("--markers", o->markers, "markers to write (.json, .csv or .mrk.json)");
+    cmd->add_option("--landmarks", o->landmarks, "landmarks to write (.json or .mrk.json)");
+    out.push_back({cmd, [o, &json] {
+                     const Session s = Session::open(o->session);
+                     const PlanState& state = s.state();
+                     Json j{{"markers", state.markers.size()}};
+                     if (!o->markers.empty()) {
+                       write_markers_file(state.markers, o->markers);
+                       j["markers_file"] = o->markers;
+                     }
+                     if (!o->landmarks.empty()) {
+                       write_landmarks_file(state.landmarks, o->landmarks);
+                       j["landmarks_file"] = o->landmarks;
                      }
                      print_result(j, json);
                      return kOk;

@@ -8,6 +8,7 @@
 
 #include "cranioplan/algorithms/io/file_io.h"
 #include "cranioplan/model/error.h"
+#include "cranioplan/sessions/slicer_markups.h"
 
 namespace cranioplan {
 namespace {
@@ -77,6 +78,7 @@ std::vector<Marker> markers_from_json(const Json& j, const std::string& source) 
 }
 
 std::vector<Marker> read_markers_file(const std::string& path) {
+  if (is_markups_path(path)) return markers_from_markups(read_json_file(path), path);
   const std::string name = lower(path);
   if (name.size() >= 4 && name.substr(name.size() - 4) == ".csv") {
     std::istringstream in(read_file_bytes(path));
@@ -111,6 +113,7 @@ std::vector<Marker> read_markers_file(const std::string& path) {
 }
 
 void write_markers_file(const std::vector<Marker>& markers, const std::string& path) {
+  if (is_markups_path(path)) return write_json_file(markers_to_markups(markers), path);
   const std::string name = lower(path);
   if (name.size() >= 4 && name.substr(name.size() - 4) == ".csv") {
     std::string text = "id,type,x,y,z,surface\n";

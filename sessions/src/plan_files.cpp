@@ -11,6 +11,7 @@
 
 #include "cranioplan/algorithms/io/file_io.h"
 #include "cranioplan/model/error.h"
+#include "cranioplan/sessions/slicer_markups.h"
 
 namespace cranioplan {
 
@@ -275,7 +276,13 @@ void write_json_file(const Json& j, const std::string& path) {
 }
 
 Landmarks read_landmarks_file(const std::string& path) {
-  return landmarks_from_json(read_json_file(path), path);
+  const Json j = read_json_file(path);
+  return is_markups_path(path) ? landmarks_from_markups(j, path) : landmarks_from_json(j, path);
+}
+
+void write_landmarks_file(const Landmarks& landmarks, const std::string& path) {
+  write_json_file(is_markups_path(path) ? landmarks_to_markups(landmarks) : to_json(landmarks),
+                  path);
 }
 
 Plane read_plane_file(const std::string& path) {

@@ -401,10 +401,25 @@ void apply_load(PlanState& s, const ParamReader& r, const ApplyContext& ctx, Jso
   s = std::move(fresh);
 }
 
+// A landmark is put on the skull's surface; one further from it than this is refused, mm.
+constexpr double kMaxLandmarkSnapMm = 10.0;
+
 void apply_landmark(PlanState& s, const ParamReader& r, bool set) {
   const std::string name = r.string("name");
   std::optional<Eigen::Vector3d> value;
-  if (set) value = s.skull->surface->locator.closest(r.vector3("position")).point;
+  if (set) {
+    // Clicked landmarks lie on the skull; one from a file far from it is in another frame.
+    const auto closest = s.skull->surface->locator.closest(r.vector3("position"));
+    if (closest.distance > kMaxLandmarkSnapMm) {
+      char buf[200];
+      std::snprintf(buf, sizeof(buf),
+                    "the %s landmark lies %.1f mm from the skull (at most %.0f mm): is it in the "
+                    "skull's frame?",
+                    name.c_str(), closest.distance, kMaxLandmarkSnapMm);
+      throw Refusal{buf};
+    }
+    value = closest.point;
+  }
   if (name == "nasion")
     s.landmarks.nasion = value;
   else if (name == "orbit_left")

@@ -33,6 +33,7 @@ class RecordingHost : public PageHost {
     opened.push_back(path);
     return true;
   }
+  void import_markers(const QString& path) override { opened.push_back(path); }
   std::shared_ptr<const PlanState> preview(const Command& command) override {
     previewed.push_back(command);
     return nullptr;

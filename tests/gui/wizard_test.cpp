@@ -19,9 +19,12 @@
 
 #include "cranioplan/algorithms/io/load_skull.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
+#include "cranioplan/sessions/marker_files.h"
+#include "cranioplan/sessions/plan_files.h"
 #include "cranioplan/sessions/session.h"
 #include "cranioplan/sessions/sha256.h"
 #include "main_window.h"
+#include "support/session_cases.h"
 #include "support/synthetic.h"
 #include "support/test_files.h"
 
@@ -346,6 +349,52 @@ TEST_F(Wizard, AllNineStepsOnTheSampleReplayToTheSameImplant) {
   EXPECT_EQ(slider->maximum(), static_cast<int>(replayed.stack().size()));
   slider->setValue(3);
   EXPECT_EQ(audit.controller().session().index(), replayed.index()) << "audit does not undo";
+}
+
+// Markers and landmarks through 3D Slicer's markups: File → Export markers writes the plan's
+// markers; File → Import landmarks sets the file's landmarks as commands, which undo takes back.
+TEST(WizardPoints, MarkersAndLandmarksGoOutAndComeInAsSlicerMarkups) {
+  test::TempDir tmp;
+  MainWindow w;
+  w.set_interactive(false);
+  ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
+  const std::vector<Marker> markers = w.plan().markers;
+  ASSERT_FALSE(markers.empty());
+  const QString out = QString::fromStdString(tmp.path("markers.mrk.json"));
+  ASSERT_TRUE(w.export_markers(out));
+  const std::vector<Marker> back = read_markers_file(out.toStdString());
+  ASSERT_EQ(back.size(), markers.size());
+  for (const Marker& m : back) {  // grouped by type in the file: matched by id
+    const Marker* was = w.plan().find_marker(m.id);
+    ASSERT_TRUE(was) << m.id;
+    EXPECT_EQ(m.position, was->position);
+    EXPECT_EQ(m.type, was->type);
+  }
+
+  // Points on the skull (edge markers lie on it) stand for the landmarks.
+  Landmarks lm;
+  lm.nasion = markers[0].position;
+  lm.orbit_left = markers[1].position;
+  lm.orbit_right = markers[2].position;
+  write_landmarks_file(lm, tmp.path("lm.mrk.json"));
+  const size_t before = w.controller().session().index();
+  w.import_landmarks(QString::fromStdString(tmp.path("lm.mrk.json")));
+  // Put on the skull's surface, within the rim markers' distance from it.
+  ASSERT_TRUE(w.plan().landmarks.has_required());
+  EXPECT_LT((*w.plan().landmarks.nasion - *lm.nasion).norm(), 0.5);
+  EXPECT_LT((*w.plan().landmarks.orbit_right - *lm.orbit_right).norm(), 0.5);
+  ASSERT_TRUE(w.export_landmarks(QString::fromStdString(tmp.path("again.json"))));
+  EXPECT_EQ(read_landmarks_file(tmp.path("again.json")).orbit_left, w.plan().landmarks.orbit_left);
+  const Eigen::Vector3d nasion = *w.plan().landmarks.nasion;
+  // A landmark far from the skull (a file in another frame) is refused, not snapped.
+  lm.nasion = *lm.nasion + Eigen::Vector3d(0, 0, 40);
+  write_landmarks_file(lm, tmp.path("far.mrk.json"));
+  const size_t done = w.controller().session().index();
+  w.import_landmarks(QString::fromStdString(tmp.path("far.mrk.json")));
+  EXPECT_EQ(w.plan().landmarks.nasion, nasion) << "the plan's stay";
+  EXPECT_EQ(w.controller().session().index(), done);
+  while (w.controller().session().index() > before) w.controller().undo();
+  EXPECT_FALSE(w.plan().landmarks.nasion) << "undo takes the imported landmarks back";
 }
 
 // A mesh in metres (STL carries no unit): refused with the unit named, then loaded once the

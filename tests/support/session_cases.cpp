@@ -111,13 +111,18 @@ void push_ok(Session& session, Command command) {
 }
 
 std::string validate_session_schema(const std::string& path) {
+  return validate_json_schema(path,
+                              std::string(CRANIOPLAN_SOURCE_DIR) + "/docs/session.schema.json");
+}
+
+std::string validate_json_schema(const std::string& path, const std::string& schema) {
   std::string out;
   if (run_command("python3 -c 'import jsonschema'") != 0) return "skip";
   const std::string cmd =
       "python3 -c 'import json,sys,jsonschema; "
       "jsonschema.validate(json.load(open(sys.argv[2])), "
       "json.load(open(sys.argv[1]))); print(\"valid\")' '" +
-      std::string(CRANIOPLAN_SOURCE_DIR) + "/docs/session.schema.json' '" + path + "' 2>&1";
+      schema + "' '" + path + "' 2>&1";
   run_command(cmd, &out);
   return out.find("valid") == 0 ? std::string() : out;
 }

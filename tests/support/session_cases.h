@@ -37,5 +37,7 @@ void push_ok(Session& session, Command command);
 /// an empty string when valid, the validator's message otherwise; "skip" when python3 or
 /// jsonschema is missing.
 std::string validate_session_schema(const std::string& path);
+/// The same against any JSON schema file.
+std::string validate_json_schema(const std::string& path, const std::string& schema);
 
 }  // namespace cranioplan::test

@@ -3,9 +3,6 @@
 #include <QLabel>
 #include <QPushButton>
 
-#include "cranioplan/model/error.h"
-#include "cranioplan/sessions/marker_files.h"
-#include "cranioplan/sessions/sha256.h"
 #include "step_pages.h"
 
 namespace cranioplan::gui {
@@ -85,15 +82,9 @@ EdgeMarkersPage::EdgeMarkersPage(PageHost& host)
 }
 
 void EdgeMarkersPage::import_markers() {
-  const QString path =
-      QFileDialog::getOpenFileName(this, tr("Markers"), QString(), tr("Markers (*.json *.csv)"));
-  if (path.isEmpty()) return;
-  try {
-    const std::string file = path.toStdString();
-    host_.push(commands::import_markers(read_markers_file(file), file, sha256_file(file)));
-  } catch (const Error& e) {
-    host_.show_message(QString::fromUtf8(e.what()), true);
-  }
+  const QString path = QFileDialog::getOpenFileName(this, tr("Markers"), QString(),
+                                                    tr("Markers (*.mrk.json *.json *.csv)"));
+  if (!path.isEmpty()) host_.import_markers(path);
 }
 
 void EdgeMarkersPage::show_state(const PlanState& s) {

@@ -44,7 +44,9 @@ Json read_json_file(const std::string& path);
 /// Writes pretty JSON atomically (temporary file, flush, rename).
 void write_json_file(const Json& j, const std::string& path);
 
+/// Landmarks as JSON (to_json's form) or 3D Slicer markups (.mrk.json). Throws InputError.
 Landmarks read_landmarks_file(const std::string& path);
+void write_landmarks_file(const Landmarks& landmarks, const std::string& path);
 Plane read_plane_file(const std::string& path);
 
 }  // namespace cranioplan
