@@ -1,5 +1,6 @@
 #include "cli_implant_commands.h"
 
+#include <Eigen/LU>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -16,6 +17,8 @@
 #include "cranioplan/algorithms/implant/smooth_markers.h"
 #include "cranioplan/algorithms/implant/snap_markers.h"
 #include "cranioplan/algorithms/io/load_skull.h"
+#include "cranioplan/algorithms/io/read_volume.h"
+#include "cranioplan/algorithms/io/write_labelmap.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/algorithms/planning/autoplan.h"
 #include "cranioplan/algorithms/planning/detect_defect.h"
@@ -240,7 +243,8 @@ Subcommand add_smooth(CLI::App& app, const bool& json) {
       ->check(CLI::Range(1, 1000));
   cmd->add_option("--project-onto", o->mirrored,
                   "put smoothed surface markers back onto this mesh (the mirrored skull)");
-  cmd->add_option("-o,--output", o->output, "markers to write (.json, .csv or Slicer .mrk.json)")->required();
+  cmd->add_option("-o,--output", o->output, "markers to write (.json, .csv or Slicer .mrk.json)")
+      ->required();
   return Subcommand{cmd, [o, &json] {
                       const auto markers = read_markers_file(o->markers);
                       std::unique_ptr<SurfaceLocator> surface;
@@ -347,6 +351,41 @@ Subcommand add_qa(CLI::App& app, const bool& json) {
                     }};
 }
 
+// labelmap
+Subcommand add_labelmap(CLI::App& app, const bool& json) {
+  struct Opts {
+    std::string implant, reference, output, series;
+    LabelSegment segment;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* cmd = app.add_subcommand(
+      "labelmap", "The implant as a labelmap on a CT's grid (.nrrd, or a Slicer .seg.nrrd)");
+  cmd->add_option("IMPLANT", o->implant, "implant mesh")->required();
+  cmd->add_option("--reference", o->reference, "the CT whose grid to use (any volume format)")
+      ->required();
+  cmd->add_option("-o,--output", o->output, "labelmap to write (.nrrd or .seg.nrrd)")->required();
+  cmd->add_option("--name", o->segment.name, "the segment's name in a .seg.nrrd");
+  add_series_option(cmd, o->series);
+  return Subcommand{cmd, [o, &json] {
+                      const SkullMesh implant = load_surface(o->implant).mesh;
+                      ReadVolumeParams read;
+                      read.dicom_series = o->series;
+                      const Volume grid = read_volume(o->reference, read);
+                      const std::vector<uint8_t> labels = labelmap_on_grid(implant, grid);
+                      write_labelmap_nrrd(labels, grid, o->output, o->segment);
+                      long long inside = 0;
+                      for (uint8_t l : labels) inside += l;
+                      const double voxel = std::abs(grid.directions.determinant());
+                      Json j{{"output", o->output},
+                             {"grid", {grid.dims[0], grid.dims[1], grid.dims[2]}},
+                             {"voxels", inside},
+                             {"volume_mm3", inside * voxel},
+                             {"mesh_volume_mm3", signed_volume(implant)}};
+                      print_result(j, json);
+                      return inside > 0 ? kOk : kUnusable;
+                    }};
+}
+
 // compare
 Subcommand add_compare(CLI::App& app, const bool& json) {
   struct Opts {
@@ -428,11 +467,13 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
   auto* cmd =
       app.add_subcommand("autoplan", "Plan an implant automatically from a defective skull");
   cmd->add_option("SKULL", o->skull, "defective skull (mesh or volume)")->required();
-  cmd->add_option("--landmarks", o->landmarks, "landmarks for the midsagittal plane (.json or Slicer .mrk.json)");
+  cmd->add_option("--landmarks", o->landmarks,
+                  "landmarks for the midsagittal plane (.json or Slicer .mrk.json)");
   cmd->add_option("--method", o->method, "auto, mirror or rim-only")
       ->check(CLI::IsMember({"auto", "mirror", "rim-only"}));
   cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
-  cmd->add_option("--markers-out", o->markers_out, "proposed markers to write (.json, .csv or Slicer .mrk.json)");
+  cmd->add_option("--markers-out", o->markers_out,
+                  "proposed markers to write (.json, .csv or Slicer .mrk.json)");
   add_units_option(cmd, o->import.mesh_unit_mm);
   add_series_option(cmd, o->import.dicom_series);
   cmd->add_option("--near", o->near,
@@ -694,9 +735,9 @@ Subcommand add_study(CLI::App& app, const bool& json) {
 }  // namespace
 
 std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
-  return {add_smooth(app, json),   add_implant(app, json),       add_qa(app, json),
-          add_compare(app, json),  add_inject_defect(app, json), add_autoplan(app, json),
-          add_evaluate(app, json), add_study(app, json)};
+  return {add_smooth(app, json),   add_implant(app, json),  add_qa(app, json),
+          add_labelmap(app, json), add_compare(app, json),  add_inject_defect(app, json),
+          add_autoplan(app, json), add_evaluate(app, json), add_study(app, json)};
 }
 
 }  // namespace cranioplan::cli

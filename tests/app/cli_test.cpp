@@ -51,6 +51,32 @@ TEST(Cli, InfoPlaneMirrorRegisterOnASyntheticHead) {
   EXPECT_LT(reg["rms_mm"].get<double>(), 0.1);
 }
 
+// An implant mesh as a Slicer segmentation on a volume's grid, read back as the same volume.
+TEST(Cli, LabelmapWritesTheImplantOnTheReferenceGrid) {
+  test::TempDir dir;
+  const Eigen::Vector3d c(-5, 12, 40);
+  test::write_nrrd(test::oblique_ball_volume(c), dir.path("ct.nrrd"), true);
+  TriangleSoup ball = to_soup(test::make_symmetric_head(4));
+  for (auto& p : ball.vertices) p = c + 7.0 * p.normalized();
+  write_mesh(build_mesh(ball), dir.path("implant.stl"));
+  std::string out;
+  ASSERT_EQ(test::run_command(kCli + " labelmap " + dir.path("implant.stl") + " --reference " +
+                                  dir.path("ct.nrrd") + " -o " + dir.path("implant.seg.nrrd") +
+                                  " --name plate --json",
+                              &out),
+            0)
+      << out;
+  const Json j = Json::parse(out);
+  EXPECT_NEAR(j["volume_mm3"].get<double>(), j["mesh_volume_mm3"].get<double>(),
+              0.1 * j["mesh_volume_mm3"].get<double>());
+  const Volume back = read_volume(dir.path("implant.seg.nrrd"));
+  EXPECT_EQ(back.dims, (std::array<int, 3>{32, 32, 32}));
+  EXPECT_NE(back.description.find("segment 'plate'"), std::string::npos) << back.description;
+  EXPECT_EQ(test::run_command(kCli + " labelmap " + dir.path("implant.stl") + " --reference " +
+                              dir.path("missing.nrrd") + " -o " + dir.path("x.nrrd")),
+            3);
+}
+
 TEST(Cli, ExitCodesForUsageAndBadInput) {
   test::TempDir dir;
   EXPECT_EQ(test::run_command(kCli), 2);

@@ -62,7 +62,7 @@ std::string gzip(const std::string& bytes) {
 }
 
 void write_nrrd(const Volume& v, const std::string& path, bool gzip_encoding,
-                const std::string& space) {
+                const std::string& space, const std::string& extra_fields) {
   std::ostringstream h;
   h.precision(17);
   h << "NRRD0004\ntype: int16\ndimension: 3\n";
@@ -80,7 +80,7 @@ void write_nrrd(const Volume& v, const std::string& path, bool gzip_encoding,
     h << "\nspace origin: (" << o.x() << "," << o.y() << "," << o.z() << ")\n";
   }
   h << "kinds: domain domain domain\nendian: little\n";
-  h << "encoding: " << (gzip_encoding ? "gzip" : "raw") << "\n\n";
+  h << "encoding: " << (gzip_encoding ? "gzip" : "raw") << "\n" << extra_fields << "\n";
   std::string data(v.size() * 2, '\0');
   for (size_t i = 0; i < v.size(); ++i) {
     const int16_t s = static_cast<int16_t>(v.data[i]);

@@ -23,9 +23,11 @@ std::string gzip(const std::string& bytes);
 
 /// Writes an int16 NRRD of the volume (LPS) with its directions and origin in `space`
 /// ("left-posterior-superior" or "right-anterior-superior"; empty: no space field and
-/// `spacings` only); gzip or raw.
+/// `spacings` only); gzip or raw. `extra_fields` (lines, each ending in a newline) go at the
+/// header's end, e.g. a segmentation's "Segment0_ID:=bone" fields.
 void write_nrrd(const Volume& v, const std::string& path, bool gzip_encoding,
-                const std::string& space = "left-posterior-superior");
+                const std::string& space = "left-posterior-superior",
+                const std::string& extra_fields = "");
 
 enum class NiftiForm { Sform, Qform };
 /// Writes a float32 NIfTI-1 of the volume (LPS) with its affine in NIfTI's RAS, as the sform,

@@ -2,6 +2,7 @@
 // oblique) and `space origin`; `spacings` when no directions are given.
 #include <algorithm>
 #include <cctype>
+#include <cmath>
 #include <cstdlib>
 #include <filesystem>
 #include <map>
@@ -102,12 +103,82 @@ void frame_from_space(const std::string& path, const std::string& space, bool pa
   }
 }
 
+// A segment of a 3D Slicer segmentation (.seg.nrrd): its fields SegmentN_*.
+struct Segment {
+  std::string id, name;
+  int label = 1;
+};
+
+std::vector<Segment> segments_of(const std::string& path,
+                                 const std::map<std::string, std::string>& custom) {
+  std::vector<Segment> out;
+  for (int n = 0;; ++n) {
+    const std::string prefix = "Segment" + std::to_string(n) + "_";
+    const auto id = custom.find(prefix + "ID");
+    if (id == custom.end()) break;
+    Segment s;
+    s.id = id->second;
+    const auto name = custom.find(prefix + "Name");
+    s.name = name == custom.end() ? s.id : name->second;
+    const auto label = custom.find(prefix + "LabelValue");
+    if (label != custom.end()) {
+      char* end = nullptr;
+      const long v = std::strtol(label->second.c_str(), &end, 10);
+      if (end == label->second.c_str() || v < 1)
+        throw InputError(
+            path, "segment '" + s.name + "' has no usable label value ('" + label->second + "')");
+      s.label = static_cast<int>(v);
+    }
+    out.push_back(s);
+  }
+  return out;
+}
+
+// A Slicer segmentation as the bone's mask: the segment named bone, skull or cranium (any
+// case), or the only segment; its label value's samples 1, the others 0.
+void keep_bone_segment(const std::string& path, const std::map<std::string, std::string>& custom,
+                       Volume& v) {
+  const std::vector<Segment> segments = segments_of(path, custom);
+  const Segment* bone = segments.size() == 1 ? &segments[0] : nullptr;
+  for (const Segment& s : segments) {
+    std::string n = s.name;
+    std::transform(n.begin(), n.end(), n.begin(),
+                   [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
+    if (!bone && (n.find("bone") != std::string::npos || n.find("skull") != std::string::npos ||
+                  n.find("cranium") != std::string::npos))
+      bone = &s;
+  }
+  if (!bone) {
+    std::string names;
+    for (const Segment& s : segments) names += (names.empty() ? "'" : ", '") + s.name + "'";
+    throw InputError(path, "the segmentation holds " + std::to_string(segments.size()) +
+                               " segments (" + names +
+                               ") and none is named bone, skull or cranium: rename the skull's "
+                               "segment in 3D Slicer");
+  }
+  long long kept = 0;
+  for (float& x : v.data) {
+    x = std::lround(x) == bone->label ? 1.0f : 0.0f;
+    kept += x > 0.0f;
+  }
+  if (kept == 0)
+    throw InputError(
+        path, "segment '" + bone->name + "' (label " + std::to_string(bone->label) + ") is empty");
+  v.kind = VolumeKind::Mask;
+  v.description = "3D Slicer segmentation, segment '" + bone->name + "' of " +
+                  std::to_string(segments.size()) + " (" + v.description + ")";
+  if (segments.size() > 1)
+    v.warnings.push_back(path + ": the segment '" + bone->name + "' is read as the skull; the " +
+                         std::to_string(segments.size() - 1) + " others are left out");
+}
+
 }  // namespace
 
 Volume read_nrrd(const std::string& path, bool patient_frame) {
   const std::string bytes = read_file_bytes(path);
   if (bytes.compare(0, 4, "NRRD") != 0) throw InputError(path, "not a NRRD file (no 'NRRD' magic)");
   std::map<std::string, std::string> fields;
+  std::map<std::string, std::string> custom;  // key:=value pairs (Slicer's segment fields)
   size_t pos = bytes.find('\n');
   if (pos == std::string::npos) throw InputError(path, "NRRD header is not terminated");
   ++pos;
@@ -123,8 +194,13 @@ Volume read_nrrd(const std::string& path, bool patient_frame) {
       break;
     }
     if (line[0] == '#') continue;
+    const size_t assign = line.find(":=");
+    if (assign != std::string::npos) {
+      custom[line.substr(0, assign)] = line.substr(assign + 2);
+      continue;
+    }
     const size_t colon = line.find(": ");
-    if (colon == std::string::npos) continue;  // key:=value pairs and unknown lines
+    if (colon == std::string::npos) continue;  // unknown lines
     std::string key = line.substr(0, colon);
     std::transform(key.begin(), key.end(), key.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
@@ -138,9 +214,14 @@ Volume read_nrrd(const std::string& path, bool patient_frame) {
       !field("data file").empty() ? field("data file") : field("datafile");
   if (!header_done && data_file.empty())
     throw InputError(path, "NRRD header does not end with a blank line before the data");
-  if (field("dimension") != "3")
+  if (field("dimension") != "3") {
+    if (custom.count("Segment0_ID"))
+      throw InputError(path,
+                       "a segmentation of overlapping segments (layers) is not read: in 3D Slicer, "
+                       "export the bone's segment alone, or save the segments without overlap");
     throw InputError(path, "only 3-dimensional NRRD volumes are supported (dimension: " +
                                field("dimension") + ")");
+  }
   if (field("type").empty() || field("sizes").empty() || field("encoding").empty())
     throw InputError(path, "NRRD header lacks type, sizes or encoding");
   const SampleType type = parse_type(path, field("type"));
@@ -210,7 +291,10 @@ Volume read_nrrd(const std::string& path, bool patient_frame) {
   std::ostringstream d;
   d << "NRRD " << v.dims[0] << "×" << v.dims[1] << "×" << v.dims[2] << " " << field("type");
   v.description = d.str();
-  classify_kind(v);
+  if (custom.count("Segment0_ID"))
+    keep_bone_segment(path, custom, v);
+  else
+    classify_kind(v);
   return v;
 }
 
