@@ -150,7 +150,7 @@ void MainWindow::build_menus() {
   file->addSeparator();
   QAction* open_plan = file->addAction(tr("Open session…"), this, [this] {
     const QString path = QFileDialog::getOpenFileName(this, tr("Open a plan"), QString(),
-                                                      tr("Cranioplan session (*.json)"));
+                                                      tr("Cranioplan plan (*.cranioplan.json *.json)"));
     if (!path.isEmpty()) open_session(path);
   });
   open_plan->setShortcut(QKeySequence::Open);
@@ -159,14 +159,14 @@ void MainWindow::build_menus() {
     QString path = session_path_;
     if (path.isEmpty())
       path = QFileDialog::getSaveFileName(this, tr("Save the plan"), QString(),
-                                          tr("Cranioplan session (*.json)"));
+                                          tr("Cranioplan plan (*.cranioplan.json *.json)"));
     if (!path.isEmpty()) save_session_to(path);
   });
   save->setShortcut(QKeySequence::Save);
   save->setObjectName("saveSession");
   file->addAction(tr("Save session as…"), this, [this] {
     const QString path = QFileDialog::getSaveFileName(this, tr("Save the plan"), QString(),
-                                                      tr("Cranioplan session (*.json)"));
+                                                      tr("Cranioplan plan (*.cranioplan.json *.json)"));
     if (!path.isEmpty()) save_session_to(path);
   });
   recent_menu_ = file->addMenu(tr("Recent files"));
@@ -176,7 +176,7 @@ void MainWindow::build_menus() {
   file->addSeparator();
   QAction* audit = file->addAction(tr("Audit a session (read-only)…"), this, [this] {
     const QString path = QFileDialog::getOpenFileName(this, tr("Audit a plan"), QString(),
-                                                      tr("Cranioplan session (*.json)"));
+                                                      tr("Cranioplan plan (*.cranioplan.json *.json)"));
     if (!path.isEmpty()) open_audit(path);
   });
   audit->setObjectName("audit");
@@ -338,7 +338,7 @@ void MainWindow::build_training_help_menus() {
   QMenu* training = menuBar()->addMenu(tr("&Training"));
   training->addAction(tr("Start training with a reference plan…"), this, [this] {
     const QString path = QFileDialog::getOpenFileName(this, tr("The expert's plan"), QString(),
-                                                      tr("Cranioplan session (*.json)"));
+                                                      tr("Cranioplan plan (*.cranioplan.json *.json)"));
     if (!path.isEmpty()) start_training(path);
   });
   training->addAction(tr("Show the training report"), this, [this] {
@@ -908,7 +908,7 @@ bool MainWindow::confirm_discard() {
     QString path = session_path_;
     if (path.isEmpty())
       path = QFileDialog::getSaveFileName(this, tr("Save the plan"), QString(),
-                                          tr("Cranioplan session (*.json)"));
+                                          tr("Cranioplan plan (*.cranioplan.json *.json)"));
     return !path.isEmpty() && save_session_to(path);
   }
   // Discarded on purpose: the unsaved plan's autosave is not a crash to recover from.

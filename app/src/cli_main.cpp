@@ -18,7 +18,7 @@ int run(int argc, char** argv) {
                " — patient-specific cranial implant planning without a window.\n"
                "Exit codes: 0 success, 1 no usable result, 2 usage error, 3 bad input file."};
   app.require_subcommand(1);
-  app.set_version_flag("--version", CRANIOPLAN_VERSION);
+  app.set_version_flag("--version", std::string("cranioplan-cli ") + CRANIOPLAN_VERSION);
   bool json = false;
   std::vector<Subcommand> subcommands = add_mesh_commands(app, json);
   for (auto* add : {&add_implant_commands, &add_session_commands})
