@@ -28,7 +28,9 @@ int main(int argc, char** argv) {
   const QCommandLineOption quit("quit", "quit when done (no dialogs)");
   const QCommandLineOption view("view", "front, back, left, right, top or markers", "VIEW");
   const QCommandLineOption units("units", "a mesh file's length unit: mm, cm, m, in or um", "U");
-  parser.addOptions({sample, units, step, screenshot, quit, view});
+  const QCommandLineOption layout("layout", "3d, both (3D and CT slices) or slices", "LAYOUT");
+  const QCommandLineOption window_preset("window", "CT window: bone, soft or brain", "W");
+  parser.addOptions({sample, units, step, screenshot, quit, view, layout, window_preset});
   parser.process(app);
 
   cranioplan::gui::MainWindow window;
@@ -76,6 +78,17 @@ int main(int argc, char** argv) {
                                       : v == "right" ? V::Right
                                       : v == "top"   ? V::Top
                                                      : V::Front);
+  }
+  if (parser.isSet(layout)) {
+    using L = cranioplan::gui::MainWindow::Layout;
+    const QString l = parser.value(layout).toLower();
+    window.set_layout(l == "slices" ? L::Slices : l == "both" ? L::ThreeDAndSlices : L::ThreeD);
+    window.slices().wait_loaded();
+  }
+  if (parser.isSet(window_preset)) {
+    using P = cranioplan::gui::SlicePanel::Preset;
+    const QString w = parser.value(window_preset).toLower();
+    window.slices().apply_preset(w == "brain" ? P::Brain : w == "soft" ? P::SoftTissue : P::Bone);
   }
   if (parser.isSet(screenshot)) {
     const QString out = parser.value(screenshot);

@@ -1,6 +1,7 @@
 #include "main_window.h"
 
 #include <QAction>
+#include <QActionGroup>
 #include <QApplication>
 #include <QCloseEvent>
 #include <QDateTime>
@@ -23,6 +24,7 @@
 #include <QSettings>
 #include <QShortcut>
 #include <QSlider>
+#include <QSplitter>
 #include <QStackedWidget>
 #include <QStandardPaths>
 #include <QStatusBar>
@@ -62,7 +64,15 @@ MainWindow::MainWindow(QWidget* parent)
     : QMainWindow(parent), controller_(new PlanController(this)), view_(new SkullView(this)) {
   setWindowTitle(tr("Cranioplan"));
   resize(1500, 950);
-  setCentralWidget(view_);
+  center_ = new QSplitter(Qt::Horizontal, this);
+  center_->setObjectName("center");
+  center_->addWidget(view_);
+  slices_ = new SlicePanel(center_);
+  center_->addWidget(slices_);
+  center_->setStretchFactor(0, 3);
+  center_->setStretchFactor(1, 1);
+  setCentralWidget(center_);
+  slices_->setVisible(false);
   build_steps_dock();
   build_plan_dock();
   build_menus();
@@ -111,6 +121,14 @@ MainWindow::MainWindow(QWidget* parent)
     pages_->setEnabled(!busy);
   });
   connect(view_, &SkullView::surfaceClicked, this, &MainWindow::on_surface_clicked);
+  // One cursor: a click on the skull moves the slices there, a click on a slice the 3D cursor.
+  connect(view_, &SkullView::pointed, this, [this](const Eigen::Vector3d& p) {
+    if (layout_ == Layout::ThreeD) return;
+    slices_->set_cursor(p);
+    view_->set_cursor(p);
+  });
+  connect(slices_, &SlicePanel::cursorMoved, view_,
+          [this](const Eigen::Vector3d& p) { view_->set_cursor(p); });
   connect(view_, &SkullView::markerDragged, this, &MainWindow::on_marker_dragged);
   connect(view_, &SkullView::markerClicked, this, [this](int id) {
     show_message(tr("Marker %1 selected (Del deletes it, drag moves it).").arg(id), false);
@@ -149,8 +167,8 @@ void MainWindow::build_menus() {
   sample->setObjectName("openSample");
   file->addSeparator();
   QAction* open_plan = file->addAction(tr("Open session…"), this, [this] {
-    const QString path = QFileDialog::getOpenFileName(this, tr("Open a plan"), QString(),
-                                                      tr("Cranioplan plan (*.cranioplan.json *.json)"));
+    const QString path = QFileDialog::getOpenFileName(
+        this, tr("Open a plan"), QString(), tr("Cranioplan plan (*.cranioplan.json *.json)"));
     if (!path.isEmpty()) open_session(path);
   });
   open_plan->setShortcut(QKeySequence::Open);
@@ -165,8 +183,8 @@ void MainWindow::build_menus() {
   save->setShortcut(QKeySequence::Save);
   save->setObjectName("saveSession");
   file->addAction(tr("Save session as…"), this, [this] {
-    const QString path = QFileDialog::getSaveFileName(this, tr("Save the plan"), QString(),
-                                                      tr("Cranioplan plan (*.cranioplan.json *.json)"));
+    const QString path = QFileDialog::getSaveFileName(
+        this, tr("Save the plan"), QString(), tr("Cranioplan plan (*.cranioplan.json *.json)"));
     if (!path.isEmpty()) save_session_to(path);
   });
   recent_menu_ = file->addMenu(tr("Recent files"));
@@ -175,8 +193,8 @@ void MainWindow::build_menus() {
   add_points_actions(file);
   file->addSeparator();
   QAction* audit = file->addAction(tr("Audit a session (read-only)…"), this, [this] {
-    const QString path = QFileDialog::getOpenFileName(this, tr("Audit a plan"), QString(),
-                                                      tr("Cranioplan plan (*.cranioplan.json *.json)"));
+    const QString path = QFileDialog::getOpenFileName(
+        this, tr("Audit a plan"), QString(), tr("Cranioplan plan (*.cranioplan.json *.json)"));
     if (!path.isEmpty()) open_audit(path);
   });
   audit->setObjectName("audit");
@@ -331,14 +349,72 @@ void MainWindow::build_edit_view_menus() {
   show_plane->setCheckable(true);
   show_plane->setChecked(true);
   connect(show_plane, &QAction::toggled, view_, &SkullView::set_plane_visible);
+  view->addSeparator();
+  add_slice_actions(view);
+}
+
+// The CT slices: the centre's layout, and window/level presets.
+void MainWindow::add_slice_actions(QMenu* view) {
+  QMenu* layout = view->addMenu(tr("Layout"));
+  auto* layouts = new QActionGroup(this);
+  const std::tuple<QString, Layout, const char*> modes[] = {
+      {tr("3D only"), Layout::ThreeD, "layout3d"},
+      {tr("3D and CT slices"), Layout::ThreeDAndSlices, "layoutBoth"},
+      {tr("CT slices only"), Layout::Slices, "layoutSlices"}};
+  for (const auto& [name, mode, object] : modes) {
+    QAction* a = layout->addAction(name, this, [this, mode = mode] { set_layout(mode); });
+    a->setObjectName(object);
+    a->setCheckable(true);
+    a->setChecked(mode == layout_);
+    layouts->addAction(a);
+  }
+  QAction* markers = view->addAction(tr("Markers on the CT slices"));
+  markers->setObjectName("slicesMarkers");
+  markers->setCheckable(true);
+  markers->setChecked(true);
+  connect(markers, &QAction::toggled, slices_, &SlicePanel::set_markers_shown);
+  QMenu* wl = view->addMenu(tr("CT window"));
+  const std::tuple<QString, SlicePanel::Preset, const char*> presets[] = {
+      {tr("Bone (W 1000, L 400)"), SlicePanel::Preset::Bone, "windowBone"},
+      {tr("Soft tissue (W 400, L 40)"), SlicePanel::Preset::SoftTissue, "windowSoftTissue"},
+      {tr("Brain (W 80, L 40)"), SlicePanel::Preset::Brain, "windowBrain"}};
+  for (const auto& [name, preset, object] : presets)
+    wl->addAction(name, this, [this, preset = preset] {
+        slices_->apply_preset(preset);
+      })->setObjectName(object);
+}
+
+void MainWindow::set_layout(Layout layout) {
+  layout_ = layout;
+  view_->setVisible(layout != Layout::Slices);
+  slices_->setVisible(layout != Layout::ThreeD);
+  slices_->set_column(layout == Layout::ThreeDAndSlices);
+  if (layout == Layout::ThreeDAndSlices) {
+    // The slices take three eighths of the width; set once the shown widgets are laid out
+    // (a splitter keeps a hidden widget's old size otherwise).
+    const auto widths = [this] {
+      const int w = std::max(600, center_->width());
+      center_->setSizes({w * 5 / 8, w * 3 / 8});
+    };
+    widths();
+    QTimer::singleShot(0, this, widths);
+  }
+  const char* names[] = {"layout3d", "layoutBoth", "layoutSlices"};
+  if (auto* a = findChild<QAction*>(names[static_cast<int>(layout)])) a->setChecked(true);
+  if (layout == Layout::ThreeD) {
+    view_->set_cursor(std::nullopt);
+    return;
+  }
+  slices_->show_state(controller_->state());
+  view_->set_cursor(slices_->cursor());
 }
 
 // Training (a reference plan and the report) and Help (About).
 void MainWindow::build_training_help_menus() {
   QMenu* training = menuBar()->addMenu(tr("&Training"));
   training->addAction(tr("Start training with a reference plan…"), this, [this] {
-    const QString path = QFileDialog::getOpenFileName(this, tr("The expert's plan"), QString(),
-                                                      tr("Cranioplan plan (*.cranioplan.json *.json)"));
+    const QString path = QFileDialog::getOpenFileName(
+        this, tr("The expert's plan"), QString(), tr("Cranioplan plan (*.cranioplan.json *.json)"));
     if (!path.isEmpty()) start_training(path);
   });
   training->addAction(tr("Show the training report"), this, [this] {
@@ -486,6 +562,7 @@ void MainWindow::build_plan_dock() {
 void MainWindow::refresh() {
   const PlanState& s = controller_->state();
   if (!controller_->read_only()) view_->show_state(s);
+  if (layout_ != Layout::ThreeD) slices_->show_state(s);
   // A new proposal: turn to the defect it found.
   if (s.proposal_message != last_proposal_) {
     last_proposal_ = s.proposal_message;

@@ -15,6 +15,7 @@
 #include "pages/step_page.h"
 #include "plan_controller.h"
 #include "skull_view.h"
+#include "slice_panel.h"
 
 class QAction;
 class QCheckBox;
@@ -33,6 +34,8 @@ class QTableWidget;
 class QTextBrowser;
 class QTabWidget;
 class QTimer;
+class QMenu;
+class QSplitter;
 
 namespace cranioplan::gui {
 
@@ -47,6 +50,13 @@ class MainWindow : public QMainWindow, public PageHost {
 
   PlanController& controller() { return *controller_; }
   SkullView& view() override { return *view_; }
+  SlicePanel& slices() { return *slices_; }
+  /// What the centre shows: the 3D view, the 3D view with the three CT slices beside it, or
+  /// the slices alone (View → Layout).
+  enum class Layout { ThreeD, ThreeDAndSlices, Slices };
+  void set_layout(Layout layout);
+  Layout layout() const { return layout_; }
+  void show_slices() override { set_layout(Layout::ThreeDAndSlices); }
 
   // The pages' host.
   const PlanState& plan() const override { return controller_->state(); }
@@ -95,7 +105,8 @@ class MainWindow : public QMainWindow, public PageHost {
 
  private:
   void build_menus();  // File, then the others
-  void add_points_actions(class QMenu* file);
+  void add_points_actions(QMenu* file);
+  void add_slice_actions(QMenu* view);
   void build_edit_view_menus();
   void build_training_help_menus();
   void build_steps_dock();
@@ -117,6 +128,9 @@ class MainWindow : public QMainWindow, public PageHost {
 
   PlanController* controller_;
   SkullView* view_;
+  QSplitter* center_;
+  SlicePanel* slices_;
+  Layout layout_ = Layout::ThreeD;
   bool interactive_ = true;
 
   // Left: steps, instructions, pages.

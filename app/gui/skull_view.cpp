@@ -254,7 +254,8 @@ struct SkullView::Impl {
   MeshLayer skull, mirror, implant;
   GlyphLayer outer_edge{sphere(1.6), kEdge}, inner_edge{cube(2.4), kEdge},
       outer_surface{sphere(1.6), kSurface}, inner_surface{cube(2.4), kSurface},
-      landmarks{sphere(2.6), {0.90, 0.15, 0.10}}, selected{sphere(2.8), {1.0, 0.95, 0.1}};
+      landmarks{sphere(2.6), {0.90, 0.15, 0.10}}, selected{sphere(2.8), {1.0, 0.95, 0.1}},
+      cursor{sphere(1.8), {0.0, 0.85, 1.0}};  // the slice views' shared cursor
   vtkNew<vtkPlaneSource> plane_source;
   vtkNew<vtkPolyDataMapper> plane_mapper;
   vtkNew<vtkActor> plane_actor;
@@ -298,7 +299,7 @@ void SkullView::set_default_surface_format() {
 }
 
 SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_unique<Impl>()) {
-  setMinimumSize(400, 300);
+  setMinimumSize(280, 280);
   setFocusPolicy(Qt::StrongFocus);
   Impl& d = *d_;
   d.window->AddRenderer(d.renderer);
@@ -348,7 +349,8 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
   for (vtkActor* a :
        {d.skull.actor.Get(), d.mirror.actor.Get(), d.implant.actor.Get(), d.outer_edge.actor.Get(),
         d.inner_edge.actor.Get(), d.outer_surface.actor.Get(), d.inner_surface.actor.Get(),
-        d.landmarks.actor.Get(), d.selected.actor.Get(), d.plane_actor.Get()}) {
+        d.landmarks.actor.Get(), d.selected.actor.Get(), d.cursor.actor.Get(),
+        d.plane_actor.Get()}) {
     a->SetVisibility(false);
     d.renderer->AddActor(a);
   }
@@ -566,6 +568,11 @@ void SkullView::set_selected_marker(int id) {
   update();
 }
 
+void SkullView::set_cursor(const std::optional<Eigen::Vector3d>& point) {
+  d_->cursor.set(point ? std::vector<Eigen::Vector3d>{*point} : std::vector<Eigen::Vector3d>{});
+  update();
+}
+
 int SkullView::unseen_rim_shown() const {
   return d_->unseen_actor->GetVisibility() ? static_cast<int>(d_->unseen_data->GetNumberOfLines())
                                            : 0;
@@ -715,8 +722,14 @@ void SkullView::mouseReleaseEvent(QMouseEvent* e) {
     emit markerClicked(id);
     return;
   }
-  if (d.target != PickTarget::None)
-    if (const auto p = pick(pos, d.target)) emit surfaceClicked(*p);
+  if (d.target != PickTarget::None) {
+    if (const auto p = pick(pos, d.target)) {
+      emit pointed(*p);
+      emit surfaceClicked(*p);
+    }
+  } else if (const auto p = pick(pos, PickTarget::Original)) {
+    emit pointed(*p);
+  }
 }
 
 void SkullView::wheelEvent(QWheelEvent* e) {

@@ -41,6 +41,8 @@ class SkullView : public QOpenGLWidget {
   /// Whether markers can be dragged (steps 5, 6 and 8).
   void set_markers_editable(bool editable);
   void set_selected_marker(int id);
+  /// The slice views' cursor, drawn as a small cyan ball (none: hidden).
+  void set_cursor(const std::optional<Eigen::Vector3d>& point);
   int selected_marker() const;
   /// How many stretches of the rim no ray saw are drawn (the last proposal's).
   int unseen_rim_shown() const;
@@ -52,6 +54,8 @@ class SkullView : public QOpenGLWidget {
 
  signals:
   void surfaceClicked(const Eigen::Vector3d& point);
+  /// A click (not a drag) on the skull, in any step: the slice views go there.
+  void pointed(const Eigen::Vector3d& point);
   void markerClicked(int id);
   void markerDragged(int id, const Eigen::Vector3d& point);
   void markerDragFinished(int id);

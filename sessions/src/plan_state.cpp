@@ -19,7 +19,8 @@
 namespace cranioplan {
 
 SharedSurface::SharedSurface(const std::string& path, const ExtractBoneSurfaceParams& import)
-    : loaded(load_skull(path, import)), mesh(loaded.mesh), locator(mesh) {}
+    : loaded(load_skull(path, import)), mesh(loaded.mesh), locator(mesh), path(path),
+      import(import) {}
 
 ImplantData::ImplantData(ImplantResult result, std::shared_ptr<const SkullInput> skull)
     : result_(std::move(result)),

@@ -34,6 +34,7 @@ class RecordingHost : public PageHost {
     return true;
   }
   void import_markers(const QString& path) override { opened.push_back(path); }
+  void show_slices() override { opened.push_back("slices"); }
   std::shared_ptr<const PlanState> preview(const Command& command) override {
     previewed.push_back(command);
     return nullptr;

@@ -15,10 +15,13 @@
 #include <QSlider>
 #include <QTest>
 #include <QTimer>
+#include <QWheelEvent>
 #include <filesystem>
 
+#include "cranioplan/algorithms/geometry/slices.h"
 #include "cranioplan/algorithms/io/load_skull.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
+#include "cranioplan/sessions/autoplan_session.h"
 #include "cranioplan/sessions/marker_files.h"
 #include "cranioplan/sessions/plan_files.h"
 #include "cranioplan/sessions/session.h"
@@ -395,6 +398,103 @@ TEST(WizardPoints, MarkersAndLandmarksGoOutAndComeInAsSlicerMarkups) {
   EXPECT_EQ(w.controller().session().index(), done);
   while (w.controller().session().index() > before) w.controller().undo();
   EXPECT_FALSE(w.plan().landmarks.nasion) << "undo takes the imported landmarks back";
+}
+
+// The CT slices beside the 3D view on the sample's automatic plan: the implant's outline where
+// the geometry puts it, window/level, the cursor shared by the slices and the 3D view, and a
+// picture of the layout against its baseline.
+TEST_F(Wizard, CtSlicesShowTheImplantWhereTheGeometrySays) {
+  test::TempDir tmp;
+  const std::string session = tmp.path("sample.json");
+  {
+    AutoplanSession a = autoplan_session(sample_case_path(), Landmarks{}, AutoplanParams{},
+                                         tmp.path("implant.stl"), SessionInfo{"sample", "", ""});
+    ASSERT_TRUE(a.planned()) << a.message;
+    a.session.save(session);
+  }
+  MainWindow w;
+  w.set_interactive(false);
+  w.resize(1500, 950);
+  w.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&w));
+  ASSERT_TRUE(w.open_session(QString::fromStdString(session)));
+  w.set_layout(MainWindow::Layout::Slices);
+  w.slices().wait_loaded();
+  ASSERT_TRUE(w.slices().has_ct());
+  QTest::qWait(50);
+
+  // Until pointed elsewhere, the slices go through the implant: each shows its outline, drawn
+  // in orange at the points where the implant's cut lies.
+  SliceView& axial = w.slices().view(SliceOrientation::Axial);
+  const SkullMesh& implant = w.plan().implant->result().mesh;
+  for (SliceOrientation o :
+       {SliceOrientation::Axial, SliceOrientation::Coronal, SliceOrientation::Sagittal})
+    EXPECT_GT(w.slices().view(o).implant_segments(), 10) << to_string(o);
+  const SliceGeometry& g = axial.geometry();
+  const std::vector<CutSegment> cut = cut_mesh(implant, g.normal, g.position_mm);
+  ASSERT_FALSE(cut.empty());
+  w.slices().set_markers_shown(false);  // markers near the slice would hide parts of it
+  const QImage picture = axial.grab().toImage();
+  int orange = 0, checked = 0;
+  for (size_t i = 0; i < cut.size(); i += std::max<size_t>(1, cut.size() / 40)) {
+    const QPointF at = axial.to_widget(0.5 * (cut[i][0] + cut[i][1]));
+    bool found = false;
+    for (int dy = -1; dy <= 1 && !found; ++dy)
+      for (int dx = -1; dx <= 1 && !found; ++dx) {
+        const QColor c = picture.pixelColor(at.toPoint() + QPoint(dx, dy));
+        found = c.red() > 200 && c.green() > 80 && c.green() < 190 && c.blue() < 90;
+      }
+    orange += found;
+    ++checked;
+  }
+  EXPECT_GE(checked, 5);
+  EXPECT_GE(orange, checked * 9 / 10) << "implant outline drawn where it is cut";
+  w.slices().set_markers_shown(true);
+
+  // Window/level: a preset changes the picture.
+  w.slices().apply_preset(SlicePanel::Preset::Brain);
+  EXPECT_DOUBLE_EQ(axial.window(), 80.0);
+  EXPECT_NE(axial.grab().toImage(), picture);
+  w.slices().apply_preset(SlicePanel::Preset::Bone);
+
+  // A click on a slice moves the cursor, and the other slices pass through it.
+  const QPoint at(axial.width() / 2 + 20, axial.height() / 2 - 15);
+  const Eigen::Vector3d expected = axial.to_patient(QPointF(at));
+  QTest::mouseClick(&axial, Qt::LeftButton, Qt::NoModifier, at);
+  EXPECT_LT((w.slices().cursor() - expected).norm(), 1e-9);
+  EXPECT_NEAR(w.slices().view(SliceOrientation::Coronal).geometry().position_mm, expected.y(),
+              1e-9);
+  EXPECT_NEAR(w.slices().view(SliceOrientation::Sagittal).geometry().position_mm, expected.x(),
+              1e-9);
+  // The wheel steps one slice.
+  const double z = g.position_mm;
+  QWheelEvent wheel(QPointF(at), axial.mapToGlobal(QPointF(at)), QPoint(), QPoint(0, 120),
+                    Qt::NoButton, Qt::NoModifier, Qt::NoScrollPhase, false);
+  QApplication::sendEvent(&axial, &wheel);
+  EXPECT_NEAR(axial.geometry().position_mm, z + axial.geometry().right.norm(), 1e-9);
+  // A click on the skull in the 3D view moves the slices there.
+  const Eigen::Vector3d bone = to_eigen(implant.point(*implant.vertices().begin()));
+  emit w.view().pointed(bone);
+  EXPECT_LT((w.slices().cursor() - bone).norm(), 1e-9);
+  EXPECT_NEAR(axial.geometry().position_mm, bone.z(), 1.0);
+
+  w.set_layout(MainWindow::Layout::ThreeDAndSlices);
+  w.slices().set_cursor(expected);
+  QTest::qWait(50);
+  expect_image_like_baseline(w.slices().grab().toImage(), "sample_slices", 0.02);
+}
+
+// A plan made from a mesh has no CT: the slices say so.
+TEST(WizardSlices, APlanFromAMeshHasNoCtToShow) {
+  MainWindow w;
+  w.set_interactive(false);
+  ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
+  w.set_layout(MainWindow::Layout::Slices);
+  w.slices().wait_loaded();
+  EXPECT_FALSE(w.slices().has_ct());
+  EXPECT_FALSE(w.view().isVisible());
+  w.set_layout(MainWindow::Layout::ThreeD);
+  EXPECT_FALSE(w.slices().isVisible());
 }
 
 // A mesh in metres (STL carries no unit): refused with the unit named, then loaded once the

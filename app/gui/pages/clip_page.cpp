@@ -1,6 +1,7 @@
 #include <QCheckBox>
 #include <QComboBox>
 #include <QFormLayout>
+#include <QPushButton>
 #include <QSlider>
 
 #include "step_pages.h"
@@ -28,6 +29,12 @@ ClipPage::ClipPage(PageHost& host) : StepPage(4, host) {
   form_->addRow(clip_on_);
   form_->addRow(tr("Cut across"), clip_axis_);
   form_->addRow(tr("Position"), clip_position_);
+  // The CT's slices show the inner edge and what lies under the defect where the bone is.
+  QPushButton* slices = add_button(tr("Show CT slices"), "showSlices");
+  slices->setToolTip(
+      tr("Axial, coronal and sagittal slices of the CT beside the 3D view "
+         "(View → Layout); a click on the skull moves them there"));
+  connect(slices, &QPushButton::clicked, this, [this] { host_.show_slices(); });
 }
 
 Command ClipPage::clip_command() const {

@@ -33,6 +33,8 @@ class PageHost {
   virtual void open_skull(const QString& path) = 0;
   virtual void open_sample() = 0;
   virtual bool export_to(const QString& path) = 0;
+  /// Shows the CT slices beside the 3D view.
+  virtual void show_slices() = 0;
   /// Markers from a file (.mrk.json, .json, .csv), as one command.
   virtual void import_markers(const QString& path) = 0;
   /// The state a command would give, without recording it.

@@ -35,6 +35,8 @@ struct SharedSurface {
   const LoadedSkull loaded;  ///< how it was read (description, warnings) and its mesh
   const SkullMesh& mesh;     ///< loaded.mesh
   SurfaceLocator locator;
+  const std::string path;                 ///< the file read (found where the plan says)
+  const ExtractBoneSurfaceParams import;  ///< how (a CT's threshold, series, ...)
 };
 
 /// The mirrored skull where the plan has put it: not a mesh of its own but the skull itself,

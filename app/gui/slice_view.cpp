@@ -1,0 +1,216 @@
+#include "slice_view.h"
+
+#include <QMouseEvent>
+#include <QPainter>
+#include <QWheelEvent>
+#include <cmath>
+
+namespace cranioplan::gui {
+
+namespace {
+
+// Markers this close to the slice (mm) are drawn on it.
+constexpr double kMarkerNearMm = 2.0;
+
+QColor marker_color(MarkerType t) {
+  return is_edge(t) ? QColor(40, 200, 70) : QColor(220, 60, 220);
+}
+
+}  // namespace
+
+SliceView::SliceView(SliceOrientation orientation, QWidget* parent)
+    : QWidget(parent), orientation_(orientation) {
+  setObjectName(QStringLiteral("slice_%1").arg(to_string(orientation)));
+  setMinimumSize(160, 160);
+  setMouseTracking(false);
+  setAttribute(Qt::WA_OpaquePaintEvent);
+}
+
+void SliceView::set_volume(std::shared_ptr<const Volume> volume, const QString& missing) {
+  volume_ = std::move(volume);
+  missing_ = missing;
+  if (volume_ && volume_->kind == VolumeKind::Mask) window_ = 1.0, level_ = 0.5;
+  reslice();
+}
+
+void SliceView::show_state(const PlanState& s) {
+  const std::shared_ptr<const SharedSurface> skull = s.skull ? s.skull->surface : nullptr;
+  const bool changed = skull != skull_ || s.implant != implant_;
+  skull_ = skull;
+  implant_ = s.implant;
+  markers_ = s.markers;
+  if (changed) recut();
+  update();
+}
+
+void SliceView::set_cursor(const Eigen::Vector3d& point) {
+  const double before = slice_.position_mm;
+  cursor_ = point;
+  if (!volume_) return;
+  const SliceGeometry next = slice_through(*volume_, orientation_, point);
+  if (next.position_mm != before || next.width != slice_.width || image_.isNull())
+    reslice();
+  else
+    update();
+}
+
+void SliceView::set_window_level(double window, double level) {
+  window_ = std::max(window, 1e-3);
+  level_ = level;
+  if (!volume_) return;
+  const std::vector<uint8_t> grey = window_level(values_, window_, level_);
+  image_ = QImage(slice_.width, slice_.height, QImage::Format_Grayscale8);
+  for (int r = 0; r < slice_.height; ++r)
+    std::copy_n(grey.data() + static_cast<size_t>(r) * slice_.width, slice_.width,
+                image_.scanLine(r));
+  update();
+}
+
+void SliceView::set_markers_shown(bool shown) {
+  markers_shown_ = shown;
+  update();
+}
+
+void SliceView::reslice() {
+  if (!volume_) {
+    image_ = QImage();
+    update();
+    return;
+  }
+  slice_ = slice_through(*volume_, orientation_, cursor_);
+  values_ = sample_slice(*volume_, slice_);
+  recut();
+  set_window_level(window_, level_);
+}
+
+void SliceView::recut() {
+  skull_cut_.clear();
+  implant_cut_.clear();
+  if (!volume_) return;
+  if (skull_) skull_cut_ = cut_mesh(skull_->mesh, slice_.normal, slice_.position_mm);
+  if (implant_) implant_cut_ = cut_mesh(implant_->result().mesh, slice_.normal, slice_.position_mm);
+}
+
+double SliceView::scale() const {
+  if (slice_.width == 0 || slice_.height == 0) return 1.0;
+  return std::min(width() / static_cast<double>(slice_.width),
+                  height() / static_cast<double>(slice_.height));
+}
+
+QPointF SliceView::offset() const {
+  const double s = scale();
+  return {(width() - s * slice_.width) / 2.0, (height() - s * slice_.height) / 2.0};
+}
+
+QPointF SliceView::to_widget(const Eigen::Vector3d& point) const {
+  // Pixel (c, r)'s sample is drawn at the centre of its square.
+  const Eigen::Vector2d px = slice_.pixel(point);
+  const double s = scale();
+  return offset() + QPointF((px.x() + 0.5) * s, (px.y() + 0.5) * s);
+}
+
+Eigen::Vector3d SliceView::to_patient(const QPointF& position) const {
+  const double s = scale();
+  const QPointF q = (position - offset()) / s - QPointF(0.5, 0.5);
+  return slice_.world(q.x(), q.y());
+}
+
+void SliceView::draw_outline(QPainter& p, const std::vector<CutSegment>& cut, const QColor& color,
+                             double width) const {
+  p.setPen(QPen(color, width));
+  for (const CutSegment& s : cut) p.drawLine(to_widget(s[0]), to_widget(s[1]));
+}
+
+void SliceView::paintEvent(QPaintEvent*) {
+  QPainter p(this);
+  p.fillRect(rect(), Qt::black);
+  p.setPen(QColor(200, 200, 200));
+  if (!volume_ || image_.isNull()) {
+    p.drawText(rect().adjusted(12, 12, -12, -12), Qt::AlignCenter | Qt::TextWordWrap,
+               missing_.isEmpty() ? tr("No CT") : missing_);
+    return;
+  }
+  const double s = scale();
+  const QPointF o = offset();
+  p.setRenderHint(QPainter::SmoothPixmapTransform, true);
+  p.drawImage(QRectF(o, QSizeF(s * slice_.width, s * slice_.height)), image_);
+  p.setRenderHint(QPainter::Antialiasing, true);
+  // The crosshair at the cursor, under the outlines it would hide.
+  const QPointF c = to_widget(cursor_);
+  p.setPen(QPen(QColor(0, 220, 255, 170), 1, Qt::DashLine));
+  p.drawLine(QPointF(o.x(), c.y()), QPointF(o.x() + s * slice_.width, c.y()));
+  p.drawLine(QPointF(c.x(), o.y()), QPointF(c.x(), o.y() + s * slice_.height));
+  draw_outline(p, skull_cut_, QColor(240, 220, 90), 1.0);
+  draw_outline(p, implant_cut_, QColor(255, 130, 0), 2.0);
+  for (const Marker& m : markers_) {
+    if (!markers_shown_) break;
+    const double d = slice_.distance(m.position);
+    if (std::abs(d) > kMarkerNearMm) continue;
+    p.setPen(QPen(Qt::black, 1));
+    p.setBrush(marker_color(m.type));
+    p.drawEllipse(to_widget(m.position), 3.5, 3.5);
+  }
+  // Orientation letters at the middle of the image's edges; the slice's position and the
+  // window and level in the widget's corners.
+  const QRectF image(o, QSizeF(s * slice_.width, s * slice_.height));
+  QFont f = font();
+  f.setBold(true);
+  p.setFont(f);
+  p.setPen(QColor(255, 230, 120));
+  const QRectF letters = image.adjusted(3, 1, -3, -1);
+  p.drawText(letters, Qt::AlignLeft | Qt::AlignVCenter, slice_.edge_labels[0]);
+  p.drawText(letters, Qt::AlignRight | Qt::AlignVCenter, slice_.edge_labels[1]);
+  p.drawText(letters, Qt::AlignHCenter | Qt::AlignTop, slice_.edge_labels[2]);
+  p.drawText(letters, Qt::AlignHCenter | Qt::AlignBottom, slice_.edge_labels[3]);
+  f.setBold(false);
+  f.setPointSizeF(f.pointSizeF() * 0.85);
+  p.setFont(f);
+  p.setPen(QColor(220, 220, 220));
+  static const char* const kAxis[] = {"z", "y", "x"};
+  const QRect corners = rect().adjusted(4, 2, -4, -2);
+  p.drawText(corners, Qt::AlignLeft | Qt::AlignTop,
+             tr("%1\n%2 = %3 mm")
+                 .arg(QString::fromLatin1(to_string(orientation_)))
+                 .arg(QString::fromLatin1(kAxis[static_cast<int>(orientation_)]))
+                 .arg(slice_.position_mm, 0, 'f', 1));
+  p.drawText(corners, Qt::AlignRight | Qt::AlignBottom,
+             tr("W %1\nL %2").arg(window_, 0, 'g', 4).arg(level_, 0, 'g', 4));
+}
+
+void SliceView::mousePressEvent(QMouseEvent* e) {
+  if (!volume_) return;
+  drag_start_ = e->position();
+  if (e->button() == Qt::LeftButton) {
+    drag_ = Drag::Cursor;
+    emit cursorMoved(to_patient(e->position()));
+  } else if (e->button() == Qt::RightButton) {
+    drag_ = Drag::WindowLevel;
+    window_start_ = window_;
+    level_start_ = level_;
+  }
+}
+
+void SliceView::mouseMoveEvent(QMouseEvent* e) {
+  if (drag_ == Drag::Cursor) {
+    emit cursorMoved(to_patient(e->position()));
+  } else if (drag_ == Drag::WindowLevel) {
+    // One widget width of drag doubles (or halves) the window; one height moves the level by
+    // the window.
+    const QPointF d = e->position() - drag_start_;
+    const double w = window_start_ * std::pow(2.0, d.x() / std::max(1, width()));
+    const double l = level_start_ - window_start_ * d.y() / std::max(1, height());
+    set_window_level(w, l);
+    emit windowLevelChanged(window_, level_);
+  }
+}
+
+void SliceView::mouseReleaseEvent(QMouseEvent*) { drag_ = Drag::None; }
+
+void SliceView::wheelEvent(QWheelEvent* e) {
+  if (!volume_ || e->angleDelta().y() == 0) return;
+  // One step: the slice's pixel size (the CT's finest spacing) along its normal.
+  const double step = slice_.right.norm() * (e->angleDelta().y() > 0 ? 1.0 : -1.0);
+  emit cursorMoved(cursor_ + step * slice_.normal);
+}
+
+}  // namespace cranioplan::gui
