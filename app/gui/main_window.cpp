@@ -206,8 +206,20 @@ void MainWindow::build_menus() {
 }
 
 // Edit (undo, redo, delete, notes) and View (standard views, the mirror and the plane).
-// Markers and landmarks in and out: JSON, CSV or 3D Slicer's markups.
+// Markers and landmarks in and out: JSON, CSV or 3D Slicer's markups; a mesh plan's CT.
 void MainWindow::add_points_actions(QMenu* file) {
+  file->addAction(tr("Attach CT…"), this,
+                  [this] {
+                    const QString path = QFileDialog::getOpenFileName(
+                        this, tr("The CT of this skull"), QString(),
+                        tr("CT (*.inv3 *.nrrd *.nhdr *.nii *.nii.gz);;All (*)"));
+                    if (!path.isEmpty()) attach_ct(path);
+                  })
+      ->setObjectName("attachCt");
+  file->addAction(tr("Attach CT from a DICOM folder…"), this, [this] {
+    const QString dir = QFileDialog::getExistingDirectory(this, tr("The CT of this skull"));
+    if (!dir.isEmpty()) attach_ct(dir);
+  });
   const QString markers = tr("Markers (*.mrk.json *.json *.csv)");
   const QString landmarks = tr("Landmarks (*.mrk.json *.json)");
   file->addAction(tr("Import markers…"), this,
@@ -239,6 +251,13 @@ void MainWindow::add_points_actions(QMenu* file) {
                     if (!path.isEmpty()) export_landmarks(path);
                   })
       ->setObjectName("exportLandmarks");
+}
+
+void MainWindow::attach_ct(const QString& path, double threshold) {
+  ExtractBoneSurfaceParams import;
+  if (QFileInfo(path).isDir() && !choose_dicom_series(path, import)) return;
+  import.threshold = threshold;
+  push(commands::attach_ct(path.toStdString(), import), tr("Checking the CT against the skull"));
 }
 
 void MainWindow::import_markers(const QString& path) {

@@ -86,6 +86,9 @@ class MainWindow : public QMainWindow, public PageHost {
   void replay_to_step(int step);
   bool save_session_to(const QString& path);
   bool export_to(const QString& path) override;
+  /// A CT for a plan made from a mesh (its bone surface at `threshold`, NaN: 300 HU or 0.5,
+  /// must lie on the skull), shown in the slice views.
+  void attach_ct(const QString& path, double threshold = std::numeric_limits<double>::quiet_NaN());
   /// Landmarks from a file (.mrk.json, .json): they replace the plan's, a command each.
   void import_landmarks(const QString& path);
   /// The plan's markers or landmarks to a file (by extension: .mrk.json, .json, .csv).

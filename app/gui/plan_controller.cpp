@@ -30,6 +30,7 @@ void PlanController::set_session(Session session) {
 bool PlanController::is_long(const Command& c) {
   switch (c.type) {
     case CommandType::LoadSkull:
+    case CommandType::AttachCt:
     case CommandType::FitPlane:
     case CommandType::AdjustPlane:
     case CommandType::Mirror:

@@ -60,12 +60,20 @@ void SlicePanel::show_state(const PlanState& s) {
     for (SliceView* v : views_) v->set_cursor(cursor_);
   }
   const SharedSurface* skull = s.skull ? s.skull->surface.get() : nullptr;
-  std::string key;
+  // The CT: the one attached to a mesh plan, or the volume the skull was imported from.
+  std::string key, path;
+  ExtractBoneSurfaceParams import;
   QString missing = tr("No CT: load a skull (step 1).");
-  if (skull && skull->loaded.source_kind == "volume")
-    key = skull->path + "\n" + skull->import.dicom_series;
-  else if (skull)
-    missing = tr("No CT: this plan was made from a mesh, which holds no slices.");
+  if (s.ct) {
+    path = s.ct->path;
+    import = s.ct->import;
+  } else if (skull && skull->loaded.source_kind == "volume") {
+    path = skull->path;
+    import = skull->import;
+  } else if (skull) {
+    missing = tr("No CT: this plan was made from a mesh. File → Attach CT… gives it its CT.");
+  }
+  if (!path.empty()) key = path + "\n" + import.dicom_series;
   if (key == key_) return;
   key_ = key;
   volume_.reset();
@@ -73,9 +81,8 @@ void SlicePanel::show_state(const PlanState& s) {
   if (key.empty()) return;
   if (watcher_) watcher_->waitForFinished();  // an earlier read, now of no use
   ReadVolumeParams read;
-  read.dicom_series = skull->import.dicom_series;
-  read.patient_frame = skull->import.patient_frame;
-  const std::string path = skull->path;
+  read.dicom_series = import.dicom_series;
+  read.patient_frame = import.patient_frame;
   delete watcher_;
   watcher_ = new QFutureWatcher<std::shared_ptr<Read>>(this);
   connect(watcher_, &QFutureWatcherBase::finished, this, &SlicePanel::loaded);

@@ -90,7 +90,7 @@ VerifyReport verify_session(const std::string& path) {
   VerifyCheck inputs{"inputs", true, ""};
   int n_inputs = 0;
   for (const auto& c : doc.commands) {
-    if (c.type != CommandType::LoadSkull) continue;
+    if (c.type != CommandType::LoadSkull && c.type != CommandType::AttachCt) continue;
     ++n_inputs;
     const std::string recorded = c.params.value("path", std::string());
     const std::string found = resolve(recorded, dir);

@@ -43,6 +43,7 @@ const std::vector<TypeInfo>& type_table() {
       {CommandType::GoToStep, "go_to_step", {"step"}},
       {CommandType::CompleteStep, "complete_step", {"step"}},
       {CommandType::Note, "note", {"text"}},
+      {CommandType::AttachCt, "attach_ct", {"path", "sha256", "import"}},
   };
   return table;
 }
@@ -556,6 +557,8 @@ std::string describe(const Command& c) {
       return "Complete step " + std::to_string(p.value("step", 0));
     case CommandType::Note:
       return "Note: " + p.value("text", std::string());
+    case CommandType::AttachCt:
+      return "Attach CT " + p.value("path", std::string());
   }
   return type_tag(c.type);
 }
@@ -564,6 +567,12 @@ std::string describe(const Command& c) {
 // Builders
 
 namespace commands {
+
+Command attach_ct(const std::string& path, const ExtractBoneSurfaceParams& import,
+                  const std::string& sha256) {
+  return make(CommandType::AttachCt,
+              {{"path", path}, {"sha256", sha256}, {"import", params_to_json(import)}}, 0);
+}
 
 Command load_skull(const std::string& path, const ExtractBoneSurfaceParams& import,
                    const std::string& sha256) {

@@ -10,8 +10,10 @@
 #include "cranioplan/algorithms/implant/snap_markers.h"
 #include "cranioplan/algorithms/io/file_io.h"
 #include "cranioplan/algorithms/io/load_skull.h"
+#include "cranioplan/algorithms/io/read_volume.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/algorithms/planning/propose_markers.h"
+#include "cranioplan/algorithms/quality/ct_agreement.h"
 #include "cranioplan/sessions/marker_files.h"
 #include "cranioplan/sessions/session_error.h"
 #include "cranioplan/sessions/sha256.h"
@@ -19,7 +21,10 @@
 namespace cranioplan {
 
 SharedSurface::SharedSurface(const std::string& path, const ExtractBoneSurfaceParams& import)
-    : loaded(load_skull(path, import)), mesh(loaded.mesh), locator(mesh), path(path),
+    : loaded(load_skull(path, import)),
+      mesh(loaded.mesh),
+      locator(mesh),
+      path(path),
       import(import) {}
 
 ImplantData::ImplantData(ImplantResult result, std::shared_ptr<const SkullInput> skull)
@@ -200,6 +205,7 @@ int command_step(const PlanState& s, const Command& c) {
     case CommandType::CompleteStep:
       return std::clamp(p.value("step", 1), 1, 9);
     case CommandType::Note:
+    case CommandType::AttachCt:
       return 0;
   }
   return 0;
@@ -324,7 +330,8 @@ bool snap(const PlanState& s, std::vector<Marker>& markers, std::string& why) {
   return true;
 }
 
-std::string resolve_input(const std::string& recorded, const ApplyContext& ctx) {
+std::string resolve_input(const std::string& recorded, const ApplyContext& ctx,
+                          const char* what = "skull file") {
   namespace fs = std::filesystem;
   std::error_code ec;
   if (fs::exists(recorded, ec)) return recorded;
@@ -333,7 +340,7 @@ std::string resolve_input(const std::string& recorded, const ApplyContext& ctx) 
                                       fs::path(ctx.session_dir) / fs::path(recorded).filename()})
       if (fs::exists(candidate, ec)) return candidate.string();
   }
-  throw InputError(recorded, "the skull file of this plan is missing");
+  throw InputError(recorded, std::string("the ") + what + " of this plan is missing");
 }
 
 struct Refusal {
@@ -404,6 +411,45 @@ void apply_load(PlanState& s, const ParamReader& r, const ApplyContext& ctx, Jso
 
 // A landmark is put on the skull's surface; one further from it than this is refused, mm.
 constexpr double kMaxLandmarkSnapMm = 10.0;
+
+// The CT of a plan made from a mesh: the file must be the one recorded, and its bone surface at
+// the threshold given must lie on the skull (ct_agreement), measured once and recorded.
+void apply_attach_ct(PlanState& s, const ParamReader& r, const ApplyContext& ctx, Json& record) {
+  if (!s.skull) throw Refusal{"load a skull before attaching its CT"};
+  const std::string recorded = r.string("path");
+  const std::string path = resolve_input(recorded, ctx, "CT");
+  const std::string sha = sha256_file(path);
+  if (sha != r.string("sha256"))
+    throw SessionError(
+        path, "the CT changed since it was attached (SHA-256 " + sha.substr(0, 12) + "… now)");
+  AttachedCt ct;
+  ct.path = path;
+  ct.recorded_path = recorded;
+  ct.sha256 = sha;
+  params_from_json(ParamReader(r.value("import"), r.where() + " import"), ct.import);
+  if (r.has("result")) {
+    const Json& j = r.value("result");
+    ct.median_mm = j.at("median_mm").get<double>();
+    ct.p90_mm = j.at("p90_mm").get<double>();
+    ct.message = j.at("message").get<std::string>();
+  } else {
+    ReadVolumeParams read;
+    read.dicom_series = ct.import.dicom_series;
+    read.patient_frame = ct.import.patient_frame;
+    const Volume volume = read_volume(path, read);
+    CtAgreementParams check;
+    check.surface = ct.import;
+    const CtAgreement a = ct_agreement(s.skull->surface->mesh, volume, check);
+    if (!a.agrees) throw Refusal{path + ": " + a.message};
+    ct.median_mm = a.median_mm;
+    ct.p90_mm = a.p90_mm;
+    ct.message = a.message;
+    record["result"] =
+        Json{{"median_mm", a.median_mm}, {"p90_mm", a.p90_mm}, {"message", a.message}};
+  }
+  s.message = "attached the CT " + recorded + ": " + ct.message;
+  s.ct = std::move(ct);
+}
 
 void apply_landmark(PlanState& s, const ParamReader& r, bool set) {
   const std::string name = r.string("name");
@@ -824,6 +870,9 @@ ApplyOutcome apply_command(const PlanState& before, const Command& command,
       case CommandType::Note:
         s.notes.push_back(r.string("text"));
         s.message = "note added";
+        break;
+      case CommandType::AttachCt:
+        apply_attach_ct(s, r, context, out.record);
         break;
     }
   } catch (const Refusal& refusal) {

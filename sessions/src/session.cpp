@@ -421,7 +421,7 @@ PreparedCommand Session::prepare(Command command) {
     return p;
   }
   // Live side effects: what replay checks rather than repeats.
-  if (command.type == CommandType::LoadSkull) {
+  if (command.type == CommandType::LoadSkull || command.type == CommandType::AttachCt) {
     const std::string path = command.params.value("path", std::string());
     std::error_code ec;
     const fs::path absolute = fs::absolute(path, ec);
@@ -592,8 +592,8 @@ Json Session::to_json() const {
   j["created"] = header_.info.created;
   Json inputs = Json::array();
   for (size_t i = 0; i < index_; ++i)
-    if (stack_[i].type == CommandType::LoadSkull)
-      inputs.push_back({{"role", "skull"},
+    if (stack_[i].type == CommandType::LoadSkull || stack_[i].type == CommandType::AttachCt)
+      inputs.push_back({{"role", stack_[i].type == CommandType::LoadSkull ? "skull" : "ct"},
                         {"path", stack_[i].params["path"]},
                         {"sha256", stack_[i].params["sha256"]}});
   j["inputs"] = inputs;

@@ -19,6 +19,7 @@
 #include <filesystem>
 
 #include "cranioplan/algorithms/geometry/slices.h"
+#include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/load_skull.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/sessions/autoplan_session.h"
@@ -484,8 +485,10 @@ TEST_F(Wizard, CtSlicesShowTheImplantWhereTheGeometrySays) {
   expect_image_like_baseline(w.slices().grab().toImage(), "sample_slices", 0.02);
 }
 
-// A plan made from a mesh has no CT: the slices say so.
-TEST(WizardSlices, APlanFromAMeshHasNoCtToShow) {
+// A plan made from a mesh has no CT: the slices say so, until File → Attach CT gives it one
+// whose bone lies on the skull.
+TEST(WizardSlices, APlanFromAMeshShowsTheCtAttachedToIt) {
+  test::TempDir tmp;
   MainWindow w;
   w.set_interactive(false);
   ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
@@ -493,6 +496,17 @@ TEST(WizardSlices, APlanFromAMeshHasNoCtToShow) {
   w.slices().wait_loaded();
   EXPECT_FALSE(w.slices().has_ct());
   EXPECT_FALSE(w.view().isVisible());
+  // The skull's own CT: its mask on a 1 mm grid.
+  const SkullMesh& skull = w.plan().skull->surface->mesh;
+  const auto [lo, hi] = mesh_bounds(skull);
+  const VoxelGrid grid = VoxelGrid::covering(lo, hi, 1.0);
+  test::write_nrrd(mask_volume(voxelize_mesh(skull, grid), grid), tmp.path("ct.nrrd"), true);
+  w.attach_ct(QString::fromStdString(tmp.path("ct.nrrd")));
+  w.controller().wait();
+  ASSERT_TRUE(w.plan().ct) << w.plan().message;
+  w.slices().wait_loaded();
+  EXPECT_TRUE(w.slices().has_ct());
+  EXPECT_GT(w.slices().view(SliceOrientation::Axial).skull_segments(), 10);
   w.set_layout(MainWindow::Layout::ThreeD);
   EXPECT_FALSE(w.slices().isVisible());
 }

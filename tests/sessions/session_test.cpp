@@ -6,11 +6,13 @@
 #include <filesystem>
 #include <random>
 
+#include "cranioplan/algorithms/io/extract_bone_surface.h"
 #include "cranioplan/algorithms/io/mesh_report.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/model/error.h"
 #include "cranioplan/sessions/audit.h"
 #include "cranioplan/sessions/marker_files.h"
+#include "cranioplan/sessions/plan_files.h"
 #include "cranioplan/sessions/session_error.h"
 #include "support/session_cases.h"
 #include "support/synthetic.h"
@@ -538,6 +540,51 @@ TEST(SessionFile, MissingOrChangedSkullIsNamed) {
   fs::remove(skull);
   const std::string missing = expect_session_error(path);
   EXPECT_NE(missing.find("the skull file of this plan is missing"), std::string::npos) << missing;
+}
+
+// A plan made from a mesh is given its CT: the CT's bone surface must lie on the skull. The
+// check is recorded, the CT is an input of the plan (verify checks its bytes), and a CT of
+// another frame is refused.
+TEST(SessionFile, ACtAttachedToAMeshPlanIsCheckedRecordedAndVerified) {
+  test::TempDir dir;
+  const Volume ct = test::make_ball_volume(Eigen::Vector3d(0, 0, 60), 70.0, 80, 2.0, true);
+  test::write_nrrd(ct, dir.path("ct.nrrd"), true);
+  write_mesh(extract_bone_surface(ct).mesh, dir.path("skull.stl"));
+  Volume moved = ct;
+  moved.origin.z() += 25.0;
+  test::write_nrrd(moved, dir.path("other.nrrd"), true);
+
+  Session s;
+  push_ok(s, commands::load_skull(dir.path("skull.stl")));
+  const PushResult wrong = s.push(commands::attach_ct(dir.path("other.nrrd")));
+  EXPECT_FALSE(wrong.accepted);
+  EXPECT_NE(wrong.message.find("not this skull's CT, or not in its frame"), std::string::npos)
+      << wrong.message;
+  EXPECT_FALSE(s.state().ct);
+  push_ok(s, commands::attach_ct(dir.path("ct.nrrd")));
+  ASSERT_TRUE(s.state().ct);
+  EXPECT_LT(s.state().ct->median_mm, 0.1);
+  EXPECT_EQ(s.state().current_step, 2) << "attaching a CT is no step of its own";
+  const Command attach = s.effective_commands().back();
+  EXPECT_TRUE(attach.params.contains("result")) << "the check is recorded";
+  EXPECT_EQ(attach.params["sha256"].get<std::string>().size(), 64u);
+
+  s.save(dir.path("plan.json"));
+  EXPECT_EQ(test::validate_session_schema(dir.path("plan.json")), "");
+  const Json saved = read_json_file(dir.path("plan.json"));
+  ASSERT_EQ(saved["inputs"].size(), 2u);
+  EXPECT_EQ(saved["inputs"][1]["role"], "ct");
+  const Session reopened = Session::open(dir.path("plan.json"));
+  ASSERT_TRUE(reopened.state().ct);
+  EXPECT_EQ(reopened.state().ct->message, s.state().ct->message);
+  EXPECT_TRUE(verify_session(dir.path("plan.json")).ok());
+  // A changed CT is caught.
+  test::write_nrrd(moved, dir.path("ct.nrrd"), true);
+  EXPECT_FALSE(verify_session(dir.path("plan.json")).ok());
+  // A new skull drops the CT of the old one.
+  Session t;
+  push_ok(t, commands::load_skull(dir.path("skull.stl")));
+  EXPECT_FALSE(t.state().ct);
 }
 
 TEST(SessionFile, AutosaveOffersRecoveryOfUnsavedCommands) {

@@ -23,6 +23,14 @@ std::string schema() {
   return std::string(CRANIOPLAN_SOURCE_DIR) + "/tests/support/slicer-markups.schema.json";
 }
 
+// Validates a file against the markups schema (skipped without python3-jsonschema).
+void expect_valid(const std::string& path) {
+  const std::string check = test::validate_json_schema(path, schema());
+  if (check != "skip") {
+    EXPECT_EQ(check, "") << path;
+  }
+}
+
 std::string error_of(const std::string& path) {
   try {
     read_markers_file(path);
@@ -37,8 +45,7 @@ TEST(SlicerMarkups, MarkersOutAndInAreTheSameMarkers) {
   TempDir dir;
   const std::string path = dir.path("plan.mrk.json");
   write_markers_file(kMarkers, path);
-  const std::string check = test::validate_json_schema(path, schema());
-  if (check != "skip") EXPECT_EQ(check, "");
+  expect_valid(path);
   const std::vector<Marker> back = read_markers_file(path);
   ASSERT_EQ(back.size(), kMarkers.size());
   for (size_t i = 0; i < back.size(); ++i) {
@@ -65,8 +72,7 @@ TEST(SlicerMarkups, LandmarksOutAndIn) {
   lm.midline = {{0, 0, 120}, {0.25, 60, 80}};
   const std::string path = dir.path("lm.mrk.json");
   write_landmarks_file(lm, path);
-  const std::string check = test::validate_json_schema(path, schema());
-  if (check != "skip") EXPECT_EQ(check, "");
+  expect_valid(path);
   const Landmarks back = read_landmarks_file(path);
   EXPECT_EQ(back.nasion, lm.nasion);
   EXPECT_EQ(back.orbit_left, lm.orbit_left);
@@ -90,8 +96,7 @@ TEST(SlicerMarkups, AListMadeInSlicerIsRead) {
      {"id": "3", "label": "F-3", "position": [0, 0, 0], "positionStatus": "undefined"},
      {"id": "vtkMRMLMarkupsFiducialNode1", "label": "inner surface", "description": "mirrored",
       "position": [-5000.0, 1000.0, 2000.0], "positionStatus": "defined"}]}]})");
-  const std::string check = test::validate_json_schema(path, schema());
-  if (check != "skip") EXPECT_EQ(check, "");
+  expect_valid(path);
   const std::vector<Marker> m = read_markers_file(path);
   ASSERT_EQ(m.size(), 3u) << "the undefined point is left out";
   EXPECT_EQ(m[0].type, MarkerType::OuterEdge);
@@ -143,8 +148,7 @@ TEST(SlicerMarkups, TheCliWritesAPlansPointsAsMarkups) {
                               "' --markers '" + markers + "' --landmarks '" + landmarks + "'"),
             0);
   EXPECT_GT(read_markers_file(markers).size(), 20u);
-  const std::string check = test::validate_json_schema(markers, schema());
-  if (check != "skip") EXPECT_EQ(check, "");
+  expect_valid(markers);
   EXPECT_TRUE(read_landmarks_file(landmarks).empty()) << "the automatic plan sets none";
 }
 

@@ -44,6 +44,7 @@ enum class CommandType {
   GoToStep,
   CompleteStep,
   Note,
+  AttachCt,
 };
 
 /// Every command type, in the order above.
@@ -149,6 +150,9 @@ Command export_implant(const std::string& path, const std::string& sha256 = "");
 Command go_to_step(int step);
 Command complete_step(int step);
 Command note(const std::string& text);
+/// The CT of a plan made from a mesh, for the slice views: checked to lie on the skull.
+Command attach_ct(const std::string& path, const ExtractBoneSurfaceParams& import = {},
+                  const std::string& sha256 = "");
 }  // namespace commands
 
 }  // namespace cranioplan

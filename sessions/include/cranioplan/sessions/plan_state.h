@@ -82,9 +82,20 @@ struct ExportRecord {
   std::string implant_sha256;   ///< the implant's STL hash at the time of the export
 };
 
+/// A CT attached to a plan made from a mesh (attach_ct), shown in the slice views.
+struct AttachedCt {
+  std::string path;           ///< the file read (found where the plan says)
+  std::string recorded_path;  ///< as the command records it
+  std::string sha256;
+  ExtractBoneSurfaceParams import;       ///< threshold, series; read with these
+  double median_mm = 0.0, p90_mm = 0.0;  ///< the skull's distance to its bone surface
+  std::string message;
+};
+
 struct PlanState {
   // Step 1
   std::shared_ptr<const SkullInput> skull;
+  std::optional<AttachedCt> ct;  ///< a mesh plan's CT (a CT plan's is its skull's file)
   // Step 2
   Landmarks landmarks;
   std::optional<Plane> plane;
