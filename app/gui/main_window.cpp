@@ -56,7 +56,9 @@ QPushButton* button(const QString& text, const char* name, QWidget* parent = nul
   return b;
 }
 
-QString quality_html(const QualityReport& r) { return q(quality_report_html(r)); }
+QString quality_html(const QualityReport& r, const SoftTissueCheck* tissue = nullptr) {
+  return q(quality_report_html(r, tissue));
+}
 
 }  // namespace
 
@@ -127,6 +129,7 @@ MainWindow::MainWindow(QWidget* parent)
     slices_->set_cursor(p);
     view_->set_cursor(p);
   });
+  connect(slices_, &SlicePanel::ctChanged, this, &MainWindow::show_quality);
   connect(slices_, &SlicePanel::cursorMoved, view_,
           [this](const Eigen::Vector3d& p) { view_->set_cursor(p); });
   connect(view_, &SkullView::markerDragged, this, &MainWindow::on_marker_dragged);
@@ -687,7 +690,13 @@ void MainWindow::refresh_quality() {
 void MainWindow::show_quality() {
   const PlanState& s = controller_->state();
   if (!s.implant) return;
-  const QString html = quality_html(s.implant->quality());
+  // With the plan's CT at hand, the soft tissue under the implant, marked on the slices.
+  SoftTissueCheck tissue;
+  if (const std::shared_ptr<const Volume> ct = slices_->ct(); ct && s.skull)
+    tissue = check_soft_tissue(s.implant->result().mesh, *ct,
+                               s.defect_center ? *s.defect_center : s.skull->centroid);
+  slices_->set_highlight(tissue.intrusion);
+  const QString html = quality_html(s.implant->quality(), tissue.checked ? &tissue : nullptr);
   quality_->setHtml(html);
   for (StepPage* page : step_pages_) page->show_quality(html);
 }

@@ -78,6 +78,8 @@ void SlicePanel::show_state(const PlanState& s) {
   key_ = key;
   volume_.reset();
   for (SliceView* v : views_) v->set_volume(nullptr, key.empty() ? missing : tr("Reading the CT…"));
+  set_highlight({});
+  emit ctChanged();
   if (key.empty()) return;
   if (watcher_) watcher_->waitForFinished();  // an earlier read, now of no use
   ReadVolumeParams read;
@@ -110,6 +112,7 @@ void SlicePanel::loaded() {
     v->set_cursor(cursor_);
     v->set_volume(volume_);
   }
+  emit ctChanged();
 }
 
 void SlicePanel::wait_loaded() {
@@ -127,6 +130,12 @@ void SlicePanel::set_cursor(const Eigen::Vector3d& point) {
 
 void SlicePanel::set_window_level(double window, double level) {
   for (SliceView* v : views_) v->set_window_level(window, level);
+}
+
+void SlicePanel::set_highlight(const std::vector<Eigen::Vector3d>& points) {
+  // A voxel's centre shows on the slices within half its size of it.
+  const double half = volume_ ? 0.5 * volume_->spacing().maxCoeff() : 0.5;
+  for (SliceView* v : views_) v->set_highlight(points, half);
 }
 
 void SlicePanel::set_markers_shown(bool shown) {

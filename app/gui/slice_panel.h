@@ -37,9 +37,15 @@ class SlicePanel : public QWidget {
   /// Waits (processing events) until the CT is read; for tests and the command line.
   void wait_loaded();
   bool has_ct() const { return volume_ != nullptr; }
+  /// The CT shown (null: none).
+  std::shared_ptr<const Volume> ct() const { return volume_; }
+  /// Marks points red on the slices they lie in (the implant's voxels in soft tissue).
+  void set_highlight(const std::vector<Eigen::Vector3d>& points);
 
  signals:
   void cursorMoved(const Eigen::Vector3d& point);
+  /// The plan's CT has been read (or is gone).
+  void ctChanged();
 
  private:
   void loaded();

@@ -66,6 +66,19 @@ void SliceView::set_window_level(double window, double level) {
   update();
 }
 
+void SliceView::set_highlight(std::vector<Eigen::Vector3d> points, double half_thickness_mm) {
+  highlight_ = std::move(points);
+  highlight_half_mm_ = half_thickness_mm;
+  update();
+}
+
+int SliceView::highlighted() const {
+  int n = 0;
+  for (const Eigen::Vector3d& p : highlight_)
+    n += std::abs(slice_.distance(p)) <= highlight_half_mm_;
+  return n;
+}
+
 void SliceView::set_markers_shown(bool shown) {
   markers_shown_ = shown;
   update();
@@ -142,6 +155,13 @@ void SliceView::paintEvent(QPaintEvent*) {
   p.drawLine(QPointF(c.x(), o.y()), QPointF(c.x(), o.y() + s * slice_.height));
   draw_outline(p, skull_cut_, QColor(240, 220, 90), 1.0);
   draw_outline(p, implant_cut_, QColor(255, 130, 0), 2.0);
+  // Where the implant lies in soft tissue: its voxels in this slice, red.
+  p.setPen(Qt::NoPen);
+  p.setBrush(QColor(255, 30, 30, 190));
+  const double dot = std::max(2.0, s * 0.9);
+  for (const Eigen::Vector3d& h : highlight_)
+    if (std::abs(slice_.distance(h)) <= highlight_half_mm_)
+      p.drawRect(QRectF(to_widget(h) - QPointF(dot / 2, dot / 2), QSizeF(dot, dot)));
   for (const Marker& m : markers_) {
     if (!markers_shown_) break;
     const double d = slice_.distance(m.position);

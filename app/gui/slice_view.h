@@ -29,6 +29,9 @@ class SliceView : public QWidget {
   /// Moves the slice through `point` and the crosshair onto it.
   void set_cursor(const Eigen::Vector3d& point);
   void set_window_level(double window, double level);
+  /// Points drawn red where they lie in the slice (the implant's voxels in soft tissue).
+  void set_highlight(std::vector<Eigen::Vector3d> points, double half_thickness_mm);
+  int highlighted() const;  ///< how many of them the current slice shows
   /// Whether the markers near the slice are drawn over it.
   void set_markers_shown(bool shown);
   double window() const { return window_; }
@@ -75,6 +78,8 @@ class SliceView : public QWidget {
   std::shared_ptr<const ImplantData> implant_;
   std::vector<Marker> markers_;
   bool markers_shown_ = true;
+  std::vector<Eigen::Vector3d> highlight_;
+  double highlight_half_mm_ = 0.5;
   std::vector<CutSegment> skull_cut_, implant_cut_;
   enum class Drag { None, Cursor, WindowLevel } drag_ = Drag::None;
   QPointF drag_start_;

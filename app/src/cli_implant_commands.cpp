@@ -13,6 +13,7 @@
 #include "cli_output.h"
 #include "cli_session_commands.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
+#include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/implant/build_implant.h"
 #include "cranioplan/algorithms/implant/smooth_markers.h"
 #include "cranioplan/algorithms/implant/snap_markers.h"
@@ -25,6 +26,7 @@
 #include "cranioplan/algorithms/quality/check_implant.h"
 #include "cranioplan/algorithms/quality/compare_implants.h"
 #include "cranioplan/algorithms/quality/inject_defect.h"
+#include "cranioplan/algorithms/quality/soft_tissue_check.h"
 #include "cranioplan/model/error.h"
 #include "cranioplan/sessions/autoplan_session.h"
 #include "cranioplan/sessions/marker_files.h"
@@ -327,13 +329,16 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
 // qa
 Subcommand add_qa(CLI::App& app, const bool& json) {
   struct Opts {
-    std::string implant, skull;
+    std::string implant, skull, ct, series;
     QualityParams params;
   };
   auto o = std::make_shared<Opts>();
   auto* cmd = app.add_subcommand("qa", "Quality report of an implant before printing");
   cmd->add_option("IMPLANT", o->implant, "implant mesh")->required();
   cmd->add_option("--skull", o->skull, "the (defective) skull it is made for");
+  cmd->add_option("--ct", o->ct,
+                  "the patient's CT: also the soft tissue under the implant (brain, dura)");
+  add_series_option(cmd, o->series);
   cmd->add_option("--min-thickness", o->params.min_thickness_mm, "thinnest printable (mm)");
   cmd->add_option("--max-taper", o->params.max_taper_mm,
                   "widest edge on the bone that may be thinner (mm)");
@@ -346,7 +351,21 @@ Subcommand add_qa(CLI::App& app, const bool& json) {
                       if (!o->skull.empty()) skull = load_skull(o->skull).mesh;
                       const QualityReport q =
                           check_implant(implant, o->skull.empty() ? nullptr : &skull, o->params);
-                      print_result(to_json(q), json);
+                      Json j = to_json(q);
+                      if (!o->ct.empty()) {
+                        ReadVolumeParams read;
+                        read.dicom_series = o->series;
+                        const Volume ct = read_volume(o->ct, read);
+                        // The cavity's side: the skull's centre, else the CT's.
+                        Eigen::Vector3d inside = ct.world(
+                            0.5 * Eigen::Vector3d(ct.dims[0] - 1, ct.dims[1] - 1, ct.dims[2] - 1));
+                        if (!o->skull.empty()) {
+                          const auto [lo, hi] = mesh_bounds(skull);
+                          inside = 0.5 * (lo + hi);
+                        }
+                        j["soft_tissue"] = to_json(check_soft_tissue(implant, ct, inside));
+                      }
+                      print_result(j, json);
                       return q.printable ? kOk : kUnusable;
                     }};
 }

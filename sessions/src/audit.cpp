@@ -371,7 +371,7 @@ std::string training_report_html(const TrainingReport& r) {
   return out.str();
 }
 
-std::string quality_report_html(const QualityReport& r) {
+std::string quality_report_html(const QualityReport& r, const SoftTissueCheck* tissue) {
   auto fixed = [](double v, int decimals) {
     char buf[64];
     std::snprintf(buf, sizeof(buf), "%.*f", decimals, v);
@@ -400,7 +400,15 @@ std::string quality_report_html(const QualityReport& r) {
                                             fixed(r.corner_reach_mm, 1) + " mm");
   if (r.rim_gap_mm >= 0) row("Gap to bone (rim)", fixed(r.rim_gap_mm, 2) + " mm");
   if (r.penetration_mm3 >= 0) row("Overlap with skull", fixed(r.penetration_mm3, 1) + " mm³");
+  if (tissue && tissue->checked) {
+    row("In soft tissue (CT)", fixed(tissue->intrusion_mm3, 0) + " mm³");
+    row("Soft tissue under it",
+        std::isfinite(tissue->closest_mm) ? fixed(tissue->closest_mm, 1) + " mm" : "none near");
+  }
   h += "</table>";
+  if (tissue && tissue->checked && tissue->intrusion_mm3 > 0)
+    h += "<p style='color:#a00'><b>Check on the CT slices:</b> " + html_escape(tissue->message) +
+         " (red on the slices).</p>";
   if (!r.reasons.empty()) {
     h += "<p><b>Problems:</b></p><ul>";
     for (const auto& reason : r.reasons) h += "<li>" + html_escape(reason) + "</li>";

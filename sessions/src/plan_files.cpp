@@ -118,6 +118,13 @@ Json to_json(const QualityReport& q) {
               {"reasons", q.reasons}};
 }
 
+Json to_json(const SoftTissueCheck& c) {
+  return Json{{"checked", c.checked},
+              {"intrusion_mm3", c.intrusion_mm3},
+              {"closest_mm", std::isfinite(c.closest_mm) ? Json(c.closest_mm) : Json(nullptr)},
+              {"message", c.message}};
+}
+
 Json to_json(const CompareResult& c) {
   Json j{{"dice", c.dice}};
   if (c.boundary_dice >= 0) j["boundary_dice"] = c.boundary_dice;

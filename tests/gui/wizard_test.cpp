@@ -452,6 +452,11 @@ TEST_F(Wizard, CtSlicesShowTheImplantWhereTheGeometrySays) {
   EXPECT_GE(orange, checked * 9 / 10) << "implant outline drawn where it is cut";
   w.slices().set_markers_shown(true);
 
+  // The soft tissue under the implant, from the CT: the voxels of the implant in it are red on
+  // the slices (the sample's scalp lies in the defect).
+  QTest::qWait(50);
+  EXPECT_GT(axial.highlighted(), 0);
+
   // Window/level: a preset changes the picture.
   w.slices().apply_preset(SlicePanel::Preset::Brain);
   EXPECT_DOUBLE_EQ(axial.window(), 80.0);

@@ -44,6 +44,7 @@ TEST(Commands, EveryTypeRoundTripsThroughJson) {
       commands::go_to_step(4),
       commands::complete_step(4),
       commands::note("checked with the surgeon"),
+      commands::attach_ct("ct.nrrd", {}, std::string(64, 'd')),
   };
   RegisterParams with_roi;
   with_roi.roi = RegionOfInterest{RegionOfInterest::Shape::Box, {1, 2, 3}, 10, {4, 5, 6}};

@@ -68,38 +68,45 @@ SliceGeometry slice_through(const Volume& volume, SliceOrientation orientation,
   return s;
 }
 
+namespace {
+
+// The volume at index-space position q (trilinear); NaN outside the samples.
+double at_index(const Volume& volume, const Eigen::Vector3d& q) {
+  for (int a = 0; a < 3; ++a)
+    if (!(q[a] >= 0.0) || q[a] > volume.dims[a] - 1)
+      return std::numeric_limits<double>::quiet_NaN();
+  // Samples on the last index along an axis interpolate within the last cell.
+  std::array<int, 3> i0{}, i1{};
+  Eigen::Vector3d t;
+  for (int a = 0; a < 3; ++a) {
+    i0[a] = volume.dims[a] > 1 ? std::min(static_cast<int>(q[a]), volume.dims[a] - 2) : 0;
+    i1[a] = std::min(i0[a] + 1, volume.dims[a] - 1);
+    t[a] = q[a] - i0[a];
+  }
+  auto at = [&](int x, int y, int z) { return static_cast<double>(volume.at(x, y, z)); };
+  const double c00 = at(i0[0], i0[1], i0[2]) * (1 - t.x()) + at(i1[0], i0[1], i0[2]) * t.x();
+  const double c10 = at(i0[0], i1[1], i0[2]) * (1 - t.x()) + at(i1[0], i1[1], i0[2]) * t.x();
+  const double c01 = at(i0[0], i0[1], i1[2]) * (1 - t.x()) + at(i1[0], i0[1], i1[2]) * t.x();
+  const double c11 = at(i0[0], i1[1], i1[2]) * (1 - t.x()) + at(i1[0], i1[1], i1[2]) * t.x();
+  return (c00 * (1 - t.y()) + c10 * t.y()) * (1 - t.z()) +
+         (c01 * (1 - t.y()) + c11 * t.y()) * t.z();
+}
+
+}  // namespace
+
+double sample_volume(const Volume& volume, const Eigen::Vector3d& point) {
+  return at_index(volume, volume.directions.inverse() * (point - volume.origin));
+}
+
 std::vector<float> sample_slice(const Volume& volume, const SliceGeometry& slice) {
-  std::vector<float> out(static_cast<size_t>(slice.width) * slice.height,
-                         std::numeric_limits<float>::quiet_NaN());
+  std::vector<float> out(static_cast<size_t>(slice.width) * slice.height);
   const Eigen::Matrix3d to_index = volume.directions.inverse();
   const Eigen::Vector3d step_c = to_index * slice.right, step_r = to_index * slice.down;
   const Eigen::Vector3d start = to_index * (slice.origin - volume.origin);
   for (int r = 0; r < slice.height; ++r)
-    for (int c = 0; c < slice.width; ++c) {
-      const Eigen::Vector3d q = start + c * step_c + r * step_r;
-      const Eigen::Vector3d f = q.array().floor();
-      const int i = static_cast<int>(f.x()), j = static_cast<int>(f.y()),
-                k = static_cast<int>(f.z());
-      // Samples on the volume's last index along an axis interpolate within it.
-      auto clamp_hi = [](int i0, int n) { return std::min(i0, n - 2); };
-      if (q.x() < 0 || q.y() < 0 || q.z() < 0 || q.x() > volume.dims[0] - 1 ||
-          q.y() > volume.dims[1] - 1 || q.z() > volume.dims[2] - 1)
-        continue;
-      const int i0 = volume.dims[0] > 1 ? clamp_hi(i, volume.dims[0]) : 0;
-      const int j0 = volume.dims[1] > 1 ? clamp_hi(j, volume.dims[1]) : 0;
-      const int k0 = volume.dims[2] > 1 ? clamp_hi(k, volume.dims[2]) : 0;
-      const int i1 = std::min(i0 + 1, volume.dims[0] - 1),
-                j1 = std::min(j0 + 1, volume.dims[1] - 1),
-                k1 = std::min(k0 + 1, volume.dims[2] - 1);
-      const double tx = q.x() - i0, ty = q.y() - j0, tz = q.z() - k0;
-      auto at = [&](int a, int b, int cc) { return static_cast<double>(volume.at(a, b, cc)); };
-      const double c00 = at(i0, j0, k0) * (1 - tx) + at(i1, j0, k0) * tx;
-      const double c10 = at(i0, j1, k0) * (1 - tx) + at(i1, j1, k0) * tx;
-      const double c01 = at(i0, j0, k1) * (1 - tx) + at(i1, j0, k1) * tx;
-      const double c11 = at(i0, j1, k1) * (1 - tx) + at(i1, j1, k1) * tx;
-      const double v = (c00 * (1 - ty) + c10 * ty) * (1 - tz) + (c01 * (1 - ty) + c11 * ty) * tz;
-      out[static_cast<size_t>(r) * slice.width + c] = static_cast<float>(v);
-    }
+    for (int c = 0; c < slice.width; ++c)
+      out[static_cast<size_t>(r) * slice.width + c] =
+          static_cast<float>(at_index(volume, start + c * step_c + r * step_r));
   return out;
 }
 

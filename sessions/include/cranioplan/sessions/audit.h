@@ -8,6 +8,7 @@
 
 #include "cranioplan/algorithms/quality/check_implant.h"
 #include "cranioplan/algorithms/quality/compare_implants.h"
+#include "cranioplan/algorithms/quality/soft_tissue_check.h"
 #include "cranioplan/sessions/session.h"
 
 namespace cranioplan {
@@ -70,6 +71,9 @@ std::string training_report_html(const TrainingReport& report);
 
 /// The quality report as an HTML table and its problems as a list (the wizard's Quality panel
 /// and its export check).
-std::string quality_report_html(const QualityReport& report);
+/// With `tissue` (the plan has a CT), also the soft tissue under the implant
+/// (check_soft_tissue), a warning when the implant lies in it.
+std::string quality_report_html(const QualityReport& report,
+                                const SoftTissueCheck* tissue = nullptr);
 
 }  // namespace cranioplan

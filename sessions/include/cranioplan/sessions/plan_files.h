@@ -11,6 +11,7 @@
 #include "cranioplan/algorithms/io/mesh_report.h"
 #include "cranioplan/algorithms/quality/check_implant.h"
 #include "cranioplan/algorithms/quality/compare_implants.h"
+#include "cranioplan/algorithms/quality/soft_tissue_check.h"
 #include "cranioplan/model/landmarks.h"
 #include "cranioplan/model/plane.h"
 #include "cranioplan/model/rigid_transform.h"
@@ -28,6 +29,7 @@ Json to_json(const PlaneFit& fit);
 Json to_json(const RegisterResult& r);
 Json to_json(const QualityReport& q);
 Json to_json(const CompareResult& c);
+Json to_json(const SoftTissueCheck& c);  ///< without the intruding voxels' positions
 
 /// Readers of the same forms; `source` names the file in error messages. Throw InputError.
 Eigen::Vector3d vector_from_json(const Json& j, const std::string& source, const std::string& what);

@@ -43,6 +43,9 @@ struct SliceGeometry {
 SliceGeometry slice_through(const Volume& volume, SliceOrientation orientation,
                             const Eigen::Vector3d& point, double pixel_mm = 0.0);
 
+/// The volume at a patient point (trilinear); NaN outside it.
+double sample_volume(const Volume& volume, const Eigen::Vector3d& point);
+
 /// The volume sampled at each pixel of the slice (trilinear), row by row; NaN outside it.
 std::vector<float> sample_slice(const Volume& volume, const SliceGeometry& slice);
 
