@@ -37,6 +37,7 @@
 
 #include "cranioplan/algorithms/io/load_skull.h"
 #include "cranioplan/algorithms/io/read_volume.h"
+#include "cranioplan/algorithms/io/write_labelmap.h"
 #include "cranioplan/model/error.h"
 #include "cranioplan/sessions/audit.h"
 #include "cranioplan/sessions/marker_files.h"
@@ -223,6 +224,15 @@ void MainWindow::add_points_actions(QMenu* file) {
     const QString dir = QFileDialog::getExistingDirectory(this, tr("The CT of this skull"));
     if (!dir.isEmpty()) attach_ct(dir);
   });
+  file->addAction(tr("Export implant over the CT…"), this,
+                  [this] {
+                    const QString path = QFileDialog::getSaveFileName(
+                        this, tr("The implant as a labelmap on the CT's grid"),
+                        QStringLiteral("implant.seg.nrrd"),
+                        tr("3D Slicer segmentation (*.seg.nrrd);;Labelmap (*.nrrd)"));
+                    if (!path.isEmpty()) export_labelmap(path);
+                  })
+      ->setObjectName("exportLabelmap");
   const QString markers = tr("Markers (*.mrk.json *.json *.csv)");
   const QString landmarks = tr("Landmarks (*.mrk.json *.json)");
   file->addAction(tr("Import markers…"), this,
@@ -261,6 +271,35 @@ void MainWindow::attach_ct(const QString& path, double threshold) {
   if (QFileInfo(path).isDir() && !choose_dicom_series(path, import)) return;
   import.threshold = threshold;
   push(commands::attach_ct(path.toStdString(), import), tr("Checking the CT against the skull"));
+}
+
+bool MainWindow::export_labelmap(const QString& path) {
+  const PlanState& s = controller_->state();
+  const std::optional<AttachedCt> source = plan_ct(s);
+  if (!s.implant || !source) {
+    show_message(s.implant ? tr("The plan has no CT: File → Attach CT… gives it one.")
+                           : tr("There is no implant to export: build it first (step 7)."),
+                 true);
+    return false;
+  }
+  try {
+    QApplication::setOverrideCursor(Qt::WaitCursor);
+    std::shared_ptr<const Volume> ct = slices_->ct();
+    if (!ct) {
+      ReadVolumeParams read;
+      read.dicom_series = source->import.dicom_series;
+      read.patient_frame = source->import.patient_frame;
+      ct = std::make_shared<const Volume>(read_volume(source->path, read));
+    }
+    write_labelmap_nrrd(labelmap_on_grid(s.implant->result().mesh, *ct), *ct, path.toStdString());
+    QApplication::restoreOverrideCursor();
+  } catch (const Error& e) {
+    QApplication::restoreOverrideCursor();
+    show_message(QString::fromUtf8(e.what()), true);
+    return false;
+  }
+  show_message(tr("Wrote the implant on the CT's grid to %1").arg(path), false);
+  return true;
 }
 
 void MainWindow::import_markers(const QString& path) {

@@ -91,6 +91,9 @@ class MainWindow : public QMainWindow, public PageHost {
   void attach_ct(const QString& path, double threshold = std::numeric_limits<double>::quiet_NaN());
   /// Landmarks from a file (.mrk.json, .json): they replace the plan's, a command each.
   void import_landmarks(const QString& path);
+  /// The implant as a labelmap (.nrrd) or 3D Slicer segmentation (.seg.nrrd) on the grid of
+  /// the plan's CT.
+  bool export_labelmap(const QString& path);
   /// The plan's markers or landmarks to a file (by extension: .mrk.json, .json, .csv).
   bool export_markers(const QString& path);
   bool export_landmarks(const QString& path);

@@ -61,19 +61,17 @@ void SlicePanel::show_state(const PlanState& s) {
   }
   const SharedSurface* skull = s.skull ? s.skull->surface.get() : nullptr;
   // The CT: the one attached to a mesh plan, or the volume the skull was imported from.
+  const std::optional<AttachedCt> ct = plan_ct(s);
   std::string key, path;
   ExtractBoneSurfaceParams import;
   QString missing = tr("No CT: load a skull (step 1).");
-  if (s.ct) {
-    path = s.ct->path;
-    import = s.ct->import;
-  } else if (skull && skull->loaded.source_kind == "volume") {
-    path = skull->path;
-    import = skull->import;
+  if (ct) {
+    path = ct->path;
+    import = ct->import;
+    key = path + "\n" + import.dicom_series;
   } else if (skull) {
     missing = tr("No CT: this plan was made from a mesh. File → Attach CT… gives it its CT.");
   }
-  if (!path.empty()) key = path + "\n" + import.dicom_series;
   if (key == key_) return;
   key_ = key;
   volume_.reset();

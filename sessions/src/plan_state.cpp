@@ -53,6 +53,18 @@ const Marker* PlanState::find_marker(int id) const {
   return nullptr;
 }
 
+std::optional<AttachedCt> plan_ct(const PlanState& s) {
+  if (s.ct) return s.ct;
+  if (!s.skull || s.skull->surface->loaded.source_kind != "volume") return std::nullopt;
+  AttachedCt ct;
+  ct.path = s.skull->surface->path;
+  ct.recorded_path = s.skull->path;
+  ct.sha256 = s.skull->sha256;
+  ct.import = s.skull->surface->import;
+  ct.message = "the CT the skull was imported from";
+  return ct;
+}
+
 const std::array<WizardStep, 9>& wizard_steps() {
   static const std::array<WizardStep, 9> steps = {{
       {1, "Load skull",

@@ -20,6 +20,7 @@
 
 #include "cranioplan/algorithms/geometry/slices.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
+#include "cranioplan/algorithms/io/read_volume.h"
 #include "cranioplan/algorithms/io/load_skull.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/sessions/autoplan_session.h"
@@ -501,6 +502,7 @@ TEST(WizardSlices, APlanFromAMeshShowsTheCtAttachedToIt) {
   w.slices().wait_loaded();
   EXPECT_FALSE(w.slices().has_ct());
   EXPECT_FALSE(w.view().isVisible());
+  EXPECT_FALSE(w.export_labelmap(QString::fromStdString(tmp.path("none.seg.nrrd"))));
   // The skull's own CT: its mask on a 1 mm grid.
   const SkullMesh& skull = w.plan().skull->surface->mesh;
   const auto [lo, hi] = mesh_bounds(skull);
@@ -512,6 +514,11 @@ TEST(WizardSlices, APlanFromAMeshShowsTheCtAttachedToIt) {
   w.slices().wait_loaded();
   EXPECT_TRUE(w.slices().has_ct());
   EXPECT_GT(w.slices().view(SliceOrientation::Axial).skull_segments(), 10);
+  // The implant over that CT, as a Slicer segmentation on its grid.
+  ASSERT_TRUE(w.export_labelmap(QString::fromStdString(tmp.path("implant.seg.nrrd"))));
+  const Volume labels = read_volume(tmp.path("implant.seg.nrrd"));
+  EXPECT_EQ(labels.dims, grid.dims);
+  EXPECT_GT(std::count(labels.data.begin(), labels.data.end(), 1.0f), 1000);
   w.set_layout(MainWindow::Layout::ThreeD);
   EXPECT_FALSE(w.slices().isVisible());
 }

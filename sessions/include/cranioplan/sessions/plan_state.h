@@ -137,6 +137,11 @@ struct WizardStep {
   const char* title;
   const char* instructions;
 };
+/// The plan's CT: the one attached to a plan made from a mesh, or the volume its skull was
+/// imported from (its `median_mm`, `p90_mm` then 0: the skull is its bone surface); none for a
+/// mesh plan without one.
+std::optional<AttachedCt> plan_ct(const PlanState& state);
+
 /// The nine steps of the wizard, 1..9.
 const std::array<WizardStep, 9>& wizard_steps();
 /// Whether step `step` (1..9) is done; when not, `missing` says what is missing.
