@@ -11,6 +11,7 @@
 #include <sstream>
 
 #include "cli_output.h"
+#include "cli_planning.h"
 #include "cli_session_commands.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
@@ -36,14 +37,6 @@ namespace {
 
 // Skulls are used where load_skull put them (`const LoadedSkull loaded = ...; loaded.mesh`), never
 // copied out: OpenMesh meshes have no move constructor, and a copy of a SkullFix skull is 300 MB.
-
-// Meshes, or label volumes (e.g. SkullFix NRRD masks) turned into surfaces with every piece kept.
-SkullMesh load_any(const std::string& path) {
-  ExtractBoneSurfaceParams p;
-  p.largest_piece_only = false;
-  p.min_piece_triangles = 1;
-  return load_surface(path, p).mesh;
-}
 
 Json implant_json(const ImplantResult& r) {
   static const char* names[] = {"built", "too_few_markers", "failed"};
@@ -97,18 +90,6 @@ Json autoplan_json(const AutoplanResult& r) {
   times["total"] = total;
   j["seconds"] = times;
   return j;
-}
-
-// --fit-to-bone MM: the automatic planner's implant built beyond the rim and trimmed by the bone.
-void add_fit_option(CLI::App* cmd, AutoplanParams& params) {
-  cmd->add_option("--fit-to-bone", params.implant.fit_to_bone_mm,
-                  "build the implant this far over the bone and subtract the skull (mm; 0: off)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 10.0));
-  cmd->add_option("--local-registration", params.local_registration_mm,
-                  "register the mirror again within this margin of the opening (mm; 0: off)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 200.0));
 }
 
 // The k-th of several outputs: the path itself for the first, else "name_k.ext" beside it.
@@ -198,32 +179,6 @@ Json write_autoplan(const AutoplanResult& r, const std::string& output,
     j["output"] = output;
   }
   return j;
-}
-
-// A scored plan's row (evaluate, study): the method it used and its agreement with the truth.
-void add_scores(Json& row, const AutoplanResult& r, const CompareResult& c) {
-  row["method"] = to_string(r.method_used);
-  row["dice"] = c.dice;
-  row["boundary_dice"] = c.boundary_dice;
-  row["hd95_mm"] = c.hd95_mm;
-  // Whether the plan could go to the printer as it stands (the quality report's verdict).
-  row["printable"] = r.quality.printable;
-  row["rim_gap_mm"] = r.quality.rim_gap_mm;
-  if (!r.quality.printable) row["not_printable_because"] = r.quality.reasons;
-}
-
-// The printable verdict of a scored row, for the text table.
-std::string printable_text(const Json& row) {
-  if (!row.contains("printable")) return "";
-  if (row["printable"].get<bool>()) return "printable  ";
-  const Json& why = row["not_printable_because"];
-  return "NOT printable (" + (why.empty() ? std::string("?") : why[0].get<std::string>()) + ")  ";
-}
-
-double median(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::sort(v.begin(), v.end());
-  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
 }
 
 // smooth
@@ -550,213 +505,12 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
       }};
 }
 
-// evaluate
-Subcommand add_evaluate(CLI::App& app, const bool& json) {
-  struct Opts {
-    std::string dir, implants_out;
-    AutoplanParams params;
-  };
-  auto o = std::make_shared<Opts>();
-  auto* cmd = app.add_subcommand(
-      "evaluate",
-      "Autoplan every NNN_defective_skull.* against its NNN_implant.* (exit 1 if a case could "
-      "not be planned, 3 if a case's file could not be read; every case is in the table)");
-  cmd->add_option("CASES_DIR", o->dir, "folder of cases (meshes or NRRD/NIfTI masks)")->required();
-  cmd->add_option("--implants-out", o->implants_out,
-                  "folder to write each planned implant to (NNN_planned_implant.stl)");
-  add_fit_option(cmd, o->params);
-  return Subcommand{
-      cmd, [o, &json] {
-        namespace fs = std::filesystem;
-        if (!fs::is_directory(o->dir)) throw InputError(o->dir, "is not a folder");
-        if (!o->implants_out.empty() && !fs::is_directory(o->implants_out))
-          throw InputError(o->implants_out, "is not a folder (--implants-out)");
-        std::map<std::string, std::pair<std::string, std::string>>
-            cases;  // id → (defective, implant)
-        for (const auto& e : fs::directory_iterator(o->dir)) {
-          const std::string name = e.path().filename().string();
-          const size_t us = name.find('_');
-          if (us == std::string::npos) continue;
-          const std::string id = name.substr(0, us), rest = name.substr(us + 1);
-          if (rest.rfind("defective_skull.", 0) == 0) cases[id].first = e.path().string();
-          if (rest.rfind("implant.", 0) == 0) cases[id].second = e.path().string();
-        }
-        Json rows = Json::array();
-        std::vector<double> dsc, bdsc, hd95, secs;
-        int failed = 0, unreadable = 0, printable = 0;
-        for (const auto& [id, files] : cases) {
-          if (files.first.empty() || files.second.empty()) continue;
-          double seconds = 0.0;
-          bool read = true;
-          Json row{{"case", id}};
-          // One case's unreadable file is that case's row, not the end of the run: the
-          // others are still planned and scored.
-          try {
-            // The truth is read first (to fail before planning) and not timed: the time is
-            // the plan's, from reading the skull to the implant.
-            const SkullMesh truth = load_any(files.second);
-            const auto t0 = std::chrono::steady_clock::now();
-            const LoadedSkull loaded = load_skull(files.first);
-            const SkullMesh& skull = loaded.mesh;
-            const AutoplanResult r = autoplan(skull, Landmarks{}, o->params);
-            seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-            row["status"] = r.planned() ? "planned" : "failed";
-            row["message"] = r.message;
-            if (r.planned()) {
-              const CompareResult c = compare_implants(r.implant.mesh, truth, &skull);
-              if (!o->implants_out.empty()) {
-                const std::string path =
-                    (fs::path(o->implants_out) / (id + "_planned_implant.stl")).string();
-                write_mesh(r.implant.mesh, path);
-                row["implant"] = path;
-              }
-              add_scores(row, r, c);
-              printable += r.quality.printable;
-              dsc.push_back(c.dice);
-              bdsc.push_back(c.boundary_dice);
-              hd95.push_back(c.hd95_mm);
-            } else {
-              // No implant overlaps nothing: a failed plan counts as Dice 0 in the medians
-              // (as a missing prediction does in the challenge); it has no distance.
-              ++failed;
-              dsc.push_back(0.0);
-              bdsc.push_back(0.0);
-            }
-          } catch (const Error& e) {
-            ++unreadable;
-            read = false;
-            row["status"] = "bad_input";
-            row["message"] = e.what();
-          }
-          row["seconds"] = read ? Json(seconds) : Json(nullptr);  // no plan, no time
-          if (read) secs.push_back(seconds);
-          if (!json) {
-            if (row["status"] == "planned")
-              std::cout << id << "  " << row["method"].get<std::string>() << "  DSC "
-                        << row["dice"].get<double>() << "  bDSC "
-                        << row["boundary_dice"].get<double>() << "  HD95 "
-                        << row["hd95_mm"].get<double>() << " mm  " << seconds << " s  "
-                        << printable_text(row) << row["message"].get<std::string>() << std::endl;
-            else
-              std::cout << id << "  " << row["status"].get<std::string>() << "  "
-                        << row["message"].get<std::string>() << std::endl;
-          }
-          rows.push_back(row);
-        }
-        if (rows.empty())
-          throw InputError(o->dir,
-                           "holds no NNN_defective_skull.* with an NNN_implant.* beside it");
-        // No figure where no case gave one (null, not 0).
-        auto median_of = [](const std::vector<double>& v) {
-          return v.empty() ? Json(nullptr) : Json(median(v));
-        };
-        const Json summary{{"cases", rows.size()},
-                           {"printable", printable},
-                           {"failed", failed},
-                           {"bad_input", unreadable},
-                           {"median_dice", median_of(dsc)},
-                           {"median_boundary_dice", median_of(bdsc)},
-                           {"median_hd95_mm", median_of(hd95)},
-                           {"median_seconds", median_of(secs)}};
-        if (json)
-          print_result(Json{{"cases", rows}, {"median", summary}}, true);
-        else
-          print_result(Json{{"median", summary}}, false);
-        // Every case is in the table; the exit code says whether all of them were planned.
-        if (unreadable > 0) return kBadInput;
-        if (failed > 0) return kUnusable;
-        return kOk;
-      }};
-}
-
-// study: inject one-sided defects into a healthy skull, plan them, score them
-Subcommand add_study(CLI::App& app, const bool& json) {
-  struct Opts {
-    std::string skull;
-    int count = 10;
-    double min_size = 30.0, max_size = 50.0;
-    AutoplanParams params;
-  };
-  auto o = std::make_shared<Opts>();
-  auto* cmd = app.add_subcommand(
-      "study", "Inject one-sided defects into a healthy skull, autoplan and score each");
-  cmd->add_option("SKULL", o->skull, "healthy skull (mesh or volume)")->required();
-  cmd->add_option("--count", o->count, "number of defects (default 10)")->check(CLI::Range(1, 100));
-  cmd->add_option("--min-size", o->min_size, "smallest sphere diameter (mm)")
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--max-size", o->max_size, "largest sphere diameter (mm)")
-      ->check(CLI::PositiveNumber);
-  add_fit_option(cmd, o->params);
-  return Subcommand{
-      cmd, [o, &json] {
-        const LoadedSkull loaded = load_skull(o->skull);
-        const SkullMesh& skull = loaded.mesh;
-        const SurfaceLocator bone(skull);
-        // Directions on the upper vault, alternately left and right, spread by the golden angle;
-        // each defect's centre is in the middle of the bone along that ray from the centroid.
-        Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-        for (auto vh : skull.vertices()) centroid += to_eigen(skull.point(vh));
-        centroid /= static_cast<double>(skull.n_vertices());
-        Json rows = Json::array();
-        std::vector<double> dsc, hd95;
-        int printable = 0;
-        for (int k = 0; k < o->count; ++k) {
-          const double side = k % 2 == 0 ? 1.0 : -1.0;
-          const double phi = 2.39996 * k, up = 0.25 + 0.5 * std::fmod(0.618034 * k, 1.0);
-          const Eigen::Vector3d dir =
-              Eigen::Vector3d(side * (0.55 + 0.25 * std::abs(std::cos(phi))), 0.6 * std::sin(phi),
-                              up)
-                  .normalized();
-          const auto out_hit = bone.first_hit(centroid + 400.0 * dir, centroid);
-          const auto in_hit = bone.first_hit(centroid, centroid + 400.0 * dir);
-          if (!out_hit || !in_hit) continue;
-          InjectDefectParams ip;
-          ip.center = 0.5 * (out_hit->point + in_hit->point);
-          ip.size_mm =
-              o->min_size + (o->max_size - o->min_size) * std::fmod(0.381966 * (k + 1), 1.0);
-          ip.voxel_mm = 0.5;
-          const InjectDefectResult d = inject_defect(skull, ip);
-          if (!d.usable()) continue;
-          // The skull may have a defect of its own (the sample has): the planner is told
-          // which opening is meant, as a user would point at it.
-          AutoplanParams params = o->params;
-          params.propose.detect.near = ip.center;
-          const AutoplanResult r = autoplan(d.defective, Landmarks{}, params);
-          Json row{{"center", to_json(ip.center)}, {"size_mm", ip.size_mm}, {"message", r.message}};
-          if (r.planned()) {
-            const CompareResult c = compare_implants(r.implant.mesh, d.implant, &d.defective);
-            add_scores(row, r, c);
-            printable += r.quality.printable;
-            dsc.push_back(c.dice);
-            hd95.push_back(c.hd95_mm);
-          } else {
-            dsc.push_back(0.0);
-          }
-          if (!json)
-            std::cout << k << "  size " << ip.size_mm << " mm  " << row.value("method", "-")
-                      << "  DSC " << row.value("dice", 0.0) << "  HD95 "
-                      << row.value("hd95_mm", 0.0) << " mm  " << printable_text(row) << r.message
-                      << std::endl;
-          rows.push_back(row);
-        }
-        const Json summary{{"defects", rows.size()},
-                           {"printable", printable},
-                           {"median_dice", median(dsc)},
-                           {"median_hd95_mm", median(hd95)}};
-        if (json)
-          print_result(Json{{"defects", rows}, {"median", summary}}, true);
-        else
-          print_result(Json{{"median", summary}}, false);
-        return kOk;
-      }};
-}
-
 }  // namespace
 
 std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
-  return {add_smooth(app, json),   add_implant(app, json),  add_qa(app, json),
-          add_labelmap(app, json), add_compare(app, json),  add_inject_defect(app, json),
-          add_autoplan(app, json), add_evaluate(app, json), add_study(app, json)};
+  return {add_smooth(app, json),   add_implant(app, json), add_qa(app, json),
+          add_labelmap(app, json), add_compare(app, json), add_inject_defect(app, json),
+          add_autoplan(app, json)};
 }
 
 }  // namespace cranioplan::cli

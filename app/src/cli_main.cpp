@@ -5,6 +5,7 @@
 #include <new>
 #include <vector>
 
+#include "cli_evaluation.h"
 #include "cli_implant_commands.h"
 #include "cli_mesh_commands.h"
 #include "cli_output.h"
@@ -21,7 +22,7 @@ int run(int argc, char** argv) {
   app.set_version_flag("--version", std::string("cranioplan-cli ") + CRANIOPLAN_VERSION);
   bool json = false;
   std::vector<Subcommand> subcommands = add_mesh_commands(app, json);
-  for (auto* add : {&add_implant_commands, &add_session_commands})
+  for (auto* add : {&add_implant_commands, &add_evaluation_commands, &add_session_commands})
     for (auto& c : (*add)(app, json)) subcommands.push_back(std::move(c));
 
   for (auto* sub : app.get_subcommands([](CLI::App*) { return true; }))

@@ -150,8 +150,9 @@ Subcommand add_plane(CLI::App& app, const bool& json) {
   auto o = std::make_shared<Opts>();
   auto* cmd = app.add_subcommand("plane", "Fit the midsagittal plane");
   cmd->add_option("MESH", o->mesh, "skull mesh or volume")->required();
-  cmd->add_option("--landmarks", o->landmarks,
-                  "landmarks (nasion, orbit_left, orbit_right, midline; .json or Slicer .mrk.json)");
+  cmd->add_option(
+      "--landmarks", o->landmarks,
+      "landmarks (nasion, orbit_left, orbit_right, midline; .json or Slicer .mrk.json)");
   cmd->add_flag("--no-refine", o->no_refine,
                 "only the initial plane, without the Ceres refinement");
   cmd->add_option("-o,--output", o->output, "plane JSON to write");

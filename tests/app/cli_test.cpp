@@ -197,6 +197,13 @@ TEST(Cli, StudyInjectsPlansAndScoresDefects) {
     printable += row["printable"].get<bool>();
   }
   EXPECT_EQ(j["median"]["printable"].get<int>(), printable);
+  // Its two shards, merged, are the same run.
+  for (const char* shard : {"1/2", "2/2"})
+    ASSERT_EQ(test::run_command(kCli + " study --count 2 " + dir.path("thick.stl") + " --shard " +
+                                shard + " --rows-out " + dir.path("rows")),
+              0);
+  ASSERT_EQ(test::run_command(kCli + " merge --json " + dir.path("rows"), &out), 0);
+  EXPECT_EQ(Json::parse(out), j);
 }
 
 // autoplan --all-openings: bilateral defects (mirror images of each other) get an implant each,
@@ -310,6 +317,25 @@ TEST(Cli, EvaluateScoresAFolderOfCasesAndWritesTheImplants) {
   EXPECT_EQ(both["median"]["bad_input"].get<int>(), 1);
   EXPECT_NEAR(both["median"]["median_dice"].get<double>(), j["cases"][0]["dice"].get<double>(),
               1e-9);
+  // The same run in two shards (each case in one), merged: the same table and medians (but
+  // for the times).
+  ASSERT_EQ(test::run_command(kCli + " evaluate " + dir.path("cases") + " --shard 1/2 --rows-out " +
+                              dir.path("rows1")),
+            0);
+  ASSERT_EQ(test::run_command(kCli + " evaluate " + dir.path("cases") + " --shard 2/2 --rows-out " +
+                              dir.path("rows2")),
+            3);
+  ASSERT_EQ(test::run_command(kCli + " merge --json " + dir.path("rows1") + " " + dir.path("rows2"),
+                              &out),
+            3);
+  Json merged = Json::parse(out), single = both;
+  for (Json* t : {&merged, &single}) {
+    for (Json& row : (*t)["cases"]) row.erase("seconds");
+    (*t)["median"].erase("median_seconds");
+  }
+  EXPECT_EQ(merged, single);
+  EXPECT_EQ(test::run_command(kCli + " evaluate " + dir.path("cases") + " --shard 3/2"), 2)
+      << "a shard past the count is a usage error";
   // A skull without a defect cannot be planned: its row says so, it counts as Dice 0 (as a
   // missing prediction does in the challenge), and the exit code is 1.
   std::filesystem::create_directories(dir.path("intact"));

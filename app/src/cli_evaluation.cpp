@@ -1,0 +1,391 @@
+#include "cli_evaluation.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <iostream>
+#include <map>
+#include <memory>
+
+#include "cli_output.h"
+#include "cli_planning.h"
+#include "cranioplan/algorithms/geometry/surface_locator.h"
+#include "cranioplan/algorithms/io/load_skull.h"
+#include "cranioplan/algorithms/io/write_mesh.h"
+#include "cranioplan/algorithms/quality/compare_implants.h"
+#include "cranioplan/algorithms/quality/inject_defect.h"
+#include "cranioplan/model/error.h"
+
+namespace cranioplan::cli {
+namespace {
+
+namespace fs = std::filesystem;
+
+// --shard I/N: the I-th (1-based) of N disjoint slices of the cases, item k going to slice
+// k mod N: every case in exactly one shard, the same shard on every machine and run.
+struct Shard {
+  int index = 1, count = 1;
+  bool takes(size_t k) const {
+    return static_cast<int>(k % static_cast<size_t>(count)) == index - 1;
+  }
+};
+
+void add_shard_options(CLI::App* cmd, Shard& shard, std::string& rows_out) {
+  cmd->add_option_function<std::string>(
+         "--shard",
+         [&shard](const std::string& text) {
+           int i = 0, n = 0;
+           char slash = 0, extra = 0;
+           if (std::sscanf(text.c_str(), "%d%c%d%c", &i, &slash, &n, &extra) != 3 || slash != '/' ||
+               n < 1 || i < 1 || i > n)
+             throw CLI::ValidationError("--shard",
+                                        "expected I/N with 1 <= I <= N, not '" + text + "'");
+           shard = {i, n};
+         },
+         "plan only the I-th of N disjoint slices of the cases (I/N, e.g. 2/8)")
+      ->type_name("I/N");
+  cmd->add_option("--rows-out", rows_out,
+                  "folder to write each case's row to as JSON, for `merge` (created if missing)");
+}
+
+// Each row as FOLDER/<kind>-<key>.json, {"kind": ..., "row": ...}.
+void write_row(const std::string& folder, const char* kind, const std::string& key,
+               const Json& row) {
+  if (folder.empty()) return;
+  write_json_file(Json{{"kind", kind}, {"row", row}},
+                  (fs::path(folder) / (std::string(kind) + "-" + key + ".json")).string());
+}
+
+void make_rows_folder(const std::string& folder) {
+  if (folder.empty()) return;
+  std::error_code ec;
+  fs::create_directories(folder, ec);
+  if (!fs::is_directory(folder)) throw InputError(folder, "cannot be made a folder (--rows-out)");
+}
+
+// A scored plan's row (evaluate, study): the method it used and its agreement with the truth.
+void add_scores(Json& row, const AutoplanResult& r, const CompareResult& c) {
+  row["method"] = to_string(r.method_used);
+  row["dice"] = c.dice;
+  row["boundary_dice"] = c.boundary_dice;
+  row["hd95_mm"] = c.hd95_mm;
+  // Whether the plan could go to the printer as it stands (the quality report's verdict).
+  row["printable"] = r.quality.printable;
+  row["rim_gap_mm"] = r.quality.rim_gap_mm;
+  if (!r.quality.printable) row["not_printable_because"] = r.quality.reasons;
+}
+
+// The printable verdict of a scored row, for the text table.
+std::string printable_text(const Json& row) {
+  if (!row.contains("printable")) return "";
+  if (row["printable"].get<bool>()) return "printable  ";
+  const Json& why = row["not_printable_because"];
+  return "NOT printable (" + (why.empty() ? std::string("?") : why[0].get<std::string>()) + ")  ";
+}
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  return v.size() % 2 ? v[v.size() / 2] : 0.5 * (v[v.size() / 2 - 1] + v[v.size() / 2]);
+}
+
+// No figure where no case gave one (null, not 0).
+Json median_or_null(const std::vector<double>& v) {
+  return v.empty() ? Json(nullptr) : Json(median(v));
+}
+
+// The table's medians, from its rows alone: one run and its merged shards give the same.
+Json evaluate_summary(const Json& rows) {
+  std::vector<double> dsc, bdsc, hd95, secs;
+  int failed = 0, unreadable = 0, printable = 0;
+  for (const Json& row : rows) {
+    const std::string status = row.at("status");
+    if (status == "planned") {
+      dsc.push_back(row.at("dice"));
+      bdsc.push_back(row.at("boundary_dice"));
+      hd95.push_back(row.at("hd95_mm"));
+      printable += row.at("printable").get<bool>();
+    } else if (status == "failed") {
+      // No implant overlaps nothing: a failed plan counts as Dice 0 in the medians (as a
+      // missing prediction does in the challenge); it has no distance.
+      ++failed;
+      dsc.push_back(0.0);
+      bdsc.push_back(0.0);
+    } else {
+      ++unreadable;
+    }
+    if (!row.at("seconds").is_null()) secs.push_back(row.at("seconds"));
+  }
+  return Json{{"cases", rows.size()},
+              {"printable", printable},
+              {"failed", failed},
+              {"bad_input", unreadable},
+              {"median_dice", median_or_null(dsc)},
+              {"median_boundary_dice", median_or_null(bdsc)},
+              {"median_hd95_mm", median_or_null(hd95)},
+              {"median_seconds", median_or_null(secs)}};
+}
+
+Json study_summary(const Json& rows) {
+  std::vector<double> dsc, hd95;
+  int printable = 0;
+  for (const Json& row : rows) {
+    if (row.contains("dice")) {
+      dsc.push_back(row.at("dice"));
+      hd95.push_back(row.at("hd95_mm"));
+      printable += row.at("printable").get<bool>();
+    } else {
+      dsc.push_back(0.0);
+    }
+  }
+  return Json{{"defects", rows.size()},
+              {"printable", printable},
+              {"median_dice", median(dsc)},
+              {"median_hd95_mm", median(hd95)}};
+}
+
+// Every case is in the table; the exit code says whether all of them were planned.
+int evaluate_exit(const Json& summary) {
+  if (summary.at("bad_input").get<int>() > 0) return kBadInput;
+  if (summary.at("failed").get<int>() > 0) return kUnusable;
+  return kOk;
+}
+
+// The cases of a SkullFix-like folder: id → (defective skull, implant), in id order.
+std::map<std::string, std::pair<std::string, std::string>> cases_in(const std::string& dir) {
+  if (!fs::is_directory(dir)) throw InputError(dir, "is not a folder");
+  std::map<std::string, std::pair<std::string, std::string>> cases;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    const size_t us = name.find('_');
+    if (us == std::string::npos) continue;
+    const std::string id = name.substr(0, us), rest = name.substr(us + 1);
+    if (rest.rfind("defective_skull.", 0) == 0) cases[id].first = e.path().string();
+    if (rest.rfind("implant.", 0) == 0) cases[id].second = e.path().string();
+  }
+  for (auto it = cases.begin(); it != cases.end();)
+    it = it->second.first.empty() || it->second.second.empty() ? cases.erase(it) : std::next(it);
+  if (cases.empty())
+    throw InputError(dir, "holds no NNN_defective_skull.* with an NNN_implant.* beside it");
+  return cases;
+}
+
+// One case of `evaluate`: planned and scored, or its unreadable file as its row.
+Json evaluate_case(const std::string& id, const std::string& defective,
+                   const std::string& truth_path, const AutoplanParams& params,
+                   const std::string& implants_out) {
+  Json row{{"case", id}};
+  try {
+    // The truth is read first (to fail before planning) and not timed: the time is the
+    // plan's, from reading the skull to the implant.
+    const SkullMesh truth = load_any(truth_path);
+    const auto t0 = std::chrono::steady_clock::now();
+    const LoadedSkull loaded = load_skull(defective);
+    const SkullMesh& skull = loaded.mesh;
+    const AutoplanResult r = autoplan(skull, Landmarks{}, params);
+    const double seconds =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    row["status"] = r.planned() ? "planned" : "failed";
+    row["message"] = r.message;
+    if (r.planned()) {
+      const CompareResult c = compare_implants(r.implant.mesh, truth, &skull);
+      if (!implants_out.empty()) {
+        const std::string path = (fs::path(implants_out) / (id + "_planned_implant.stl")).string();
+        write_mesh(r.implant.mesh, path);
+        row["implant"] = path;
+      }
+      add_scores(row, r, c);
+    }
+    row["seconds"] = seconds;
+  } catch (const Error& e) {
+    // One case's unreadable file is that case's row, not the end of the run.
+    row["status"] = "bad_input";
+    row["message"] = e.what();
+    row["seconds"] = nullptr;  // no plan, no time
+  }
+  return row;
+}
+
+void print_evaluate_row(const Json& row) {
+  if (row["status"] == "planned")
+    std::cout << row["case"].get<std::string>() << "  " << row["method"].get<std::string>()
+              << "  DSC " << row["dice"].get<double>() << "  bDSC "
+              << row["boundary_dice"].get<double>() << "  HD95 " << row["hd95_mm"].get<double>()
+              << " mm  " << row["seconds"].get<double>() << " s  " << printable_text(row)
+              << row["message"].get<std::string>() << std::endl;
+  else
+    std::cout << row["case"].get<std::string>() << "  " << row["status"].get<std::string>() << "  "
+              << row["message"].get<std::string>() << std::endl;
+}
+
+// evaluate
+Subcommand add_evaluate(CLI::App& app, const bool& json) {
+  struct Opts {
+    std::string dir, implants_out, rows_out;
+    AutoplanParams params;
+    Shard shard;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* cmd = app.add_subcommand(
+      "evaluate",
+      "Autoplan every NNN_defective_skull.* against its NNN_implant.* (exit 1 if a case could "
+      "not be planned, 3 if a case's file could not be read; every case is in the table)");
+  cmd->add_option("CASES_DIR", o->dir, "folder of cases (meshes or NRRD/NIfTI masks)")->required();
+  cmd->add_option("--implants-out", o->implants_out,
+                  "folder to write each planned implant to (NNN_planned_implant.stl)");
+  add_shard_options(cmd, o->shard, o->rows_out);
+  add_fit_option(cmd, o->params);
+  return Subcommand{cmd, [o, &json] {
+                      if (!o->implants_out.empty() && !fs::is_directory(o->implants_out))
+                        throw InputError(o->implants_out, "is not a folder (--implants-out)");
+                      const auto cases = cases_in(o->dir);
+                      make_rows_folder(o->rows_out);
+                      Json rows = Json::array();
+                      size_t k = 0;
+                      for (const auto& [id, files] : cases) {
+                        if (!o->shard.takes(k++)) continue;
+                        const Json row = evaluate_case(id, files.first, files.second, o->params,
+                                                       o->implants_out);
+                        if (!json) print_evaluate_row(row);
+                        write_row(o->rows_out, "evaluate", id, row);
+                        rows.push_back(row);
+                      }
+                      const Json summary = evaluate_summary(rows);
+                      if (json)
+                        print_result(Json{{"cases", rows}, {"median", summary}}, true);
+                      else
+                        print_result(Json{{"median", summary}}, false);
+                      return evaluate_exit(summary);
+                    }};
+}
+
+Subcommand add_study(CLI::App& app, const bool& json) {
+  struct Opts {
+    std::string skull;
+    int count = 10;
+    double min_size = 30.0, max_size = 50.0;
+    AutoplanParams params;
+    Shard shard;
+    std::string rows_out;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* cmd = app.add_subcommand(
+      "study", "Inject one-sided defects into a healthy skull, autoplan and score each");
+  cmd->add_option("SKULL", o->skull, "healthy skull (mesh or volume)")->required();
+  cmd->add_option("--count", o->count, "number of defects (default 10)")->check(CLI::Range(1, 100));
+  cmd->add_option("--min-size", o->min_size, "smallest sphere diameter (mm)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--max-size", o->max_size, "largest sphere diameter (mm)")
+      ->check(CLI::PositiveNumber);
+  add_shard_options(cmd, o->shard, o->rows_out);
+  add_fit_option(cmd, o->params);
+  return Subcommand{
+      cmd, [o, &json] {
+        const LoadedSkull loaded = load_skull(o->skull);
+        const SkullMesh& skull = loaded.mesh;
+        const SurfaceLocator bone(skull);
+        // Directions on the upper vault, alternately left and right, spread by the golden angle;
+        // each defect's centre is in the middle of the bone along that ray from the centroid.
+        Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
+        for (auto vh : skull.vertices()) centroid += to_eigen(skull.point(vh));
+        centroid /= static_cast<double>(skull.n_vertices());
+        make_rows_folder(o->rows_out);
+        Json rows = Json::array();
+        for (int k = 0; k < o->count; ++k) {
+          if (!o->shard.takes(static_cast<size_t>(k))) continue;
+          const double side = k % 2 == 0 ? 1.0 : -1.0;
+          const double phi = 2.39996 * k, up = 0.25 + 0.5 * std::fmod(0.618034 * k, 1.0);
+          const Eigen::Vector3d dir =
+              Eigen::Vector3d(side * (0.55 + 0.25 * std::abs(std::cos(phi))), 0.6 * std::sin(phi),
+                              up)
+                  .normalized();
+          const auto out_hit = bone.first_hit(centroid + 400.0 * dir, centroid);
+          const auto in_hit = bone.first_hit(centroid, centroid + 400.0 * dir);
+          if (!out_hit || !in_hit) continue;
+          InjectDefectParams ip;
+          ip.center = 0.5 * (out_hit->point + in_hit->point);
+          ip.size_mm =
+              o->min_size + (o->max_size - o->min_size) * std::fmod(0.381966 * (k + 1), 1.0);
+          ip.voxel_mm = 0.5;
+          const InjectDefectResult d = inject_defect(skull, ip);
+          if (!d.usable()) continue;
+          // The skull may have a defect of its own (the sample has): the planner is told
+          // which opening is meant, as a user would point at it.
+          AutoplanParams params = o->params;
+          params.propose.detect.near = ip.center;
+          const AutoplanResult r = autoplan(d.defective, Landmarks{}, params);
+          Json row{{"defect", k},
+                   {"center", to_json(ip.center)},
+                   {"size_mm", ip.size_mm},
+                   {"message", r.message}};
+          if (r.planned())
+            add_scores(row, r, compare_implants(r.implant.mesh, d.implant, &d.defective));
+          if (!json)
+            std::cout << k << "  size " << ip.size_mm << " mm  " << row.value("method", "-")
+                      << "  DSC " << row.value("dice", 0.0) << "  HD95 "
+                      << row.value("hd95_mm", 0.0) << " mm  " << printable_text(row) << r.message
+                      << std::endl;
+          write_row(o->rows_out, "study", std::to_string(k), row);
+          rows.push_back(row);
+        }
+        const Json summary = study_summary(rows);
+        if (json)
+          print_result(Json{{"defects", rows}, {"median", summary}}, true);
+        else
+          print_result(Json{{"median", summary}}, false);
+        return kOk;
+      }};
+}
+
+// merge
+Subcommand add_merge(CLI::App& app, const bool& json) {
+  auto folders = std::make_shared<std::vector<std::string>>();
+  auto* cmd = app.add_subcommand(
+      "merge", "The table and medians of evaluate or study shards (--rows-out folders) as one run");
+  cmd->add_option("FOLDERS", *folders, "folders the shards wrote their rows to")->required();
+  return Subcommand{
+      cmd, [folders, &json] {
+        std::string kind;
+        std::map<std::string, Json> evaluate_rows;
+        std::map<int, Json> study_rows;
+        for (const std::string& folder : *folders) {
+          if (!fs::is_directory(folder)) throw InputError(folder, "is not a folder");
+          for (const auto& e : fs::directory_iterator(folder)) {
+            if (e.path().extension() != ".json") continue;
+            const std::string path = e.path().string();
+            const Json j = read_json_file(path);
+            if (!j.is_object() || !j.contains("kind") || !j.contains("row"))
+              throw InputError(path, "is not a row of evaluate or study");
+            const std::string k = j["kind"].get<std::string>();
+            if (!kind.empty() && k != kind)
+              throw InputError(path, "is a row of " + k + ", the others of " + kind);
+            kind = k;
+            // A case in two shards (folders of two runs mixed up) is an error.
+            const bool fresh = k == "evaluate"
+                                   ? evaluate_rows.emplace(j["row"].at("case"), j["row"]).second
+                                   : study_rows.emplace(j["row"].at("defect"), j["row"]).second;
+            if (!fresh) throw InputError(path, "repeats a case another shard wrote");
+          }
+        }
+        if (kind.empty()) throw InputError(folders->front(), "holds no rows (evaluate --rows-out)");
+        Json rows = Json::array();
+        for (const auto& [key, row] : evaluate_rows) rows.push_back(row);
+        for (const auto& [key, row] : study_rows) rows.push_back(row);
+        const bool evaluate = kind == "evaluate";
+        const Json summary = evaluate ? evaluate_summary(rows) : study_summary(rows);
+        if (json)
+          print_result(Json{{evaluate ? "cases" : "defects", rows}, {"median", summary}}, true);
+        else
+          print_result(Json{{"median", summary}}, false);
+        return evaluate ? evaluate_exit(summary) : kOk;
+      }};
+}
+
+}  // namespace
+
+std::vector<Subcommand> add_evaluation_commands(CLI::App& app, const bool& json) {
+  return {add_evaluate(app, json), add_study(app, json), add_merge(app, json)};
+}
+
+}  // namespace cranioplan::cli
