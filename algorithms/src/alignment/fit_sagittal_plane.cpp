@@ -9,6 +9,7 @@
 #include <chrono>
 #include <cmath>
 
+#include "cranioplan/algorithms/geometry/parallel.h"
 #include "cranioplan/algorithms/geometry/point_index.h"
 #include "cranioplan/algorithms/geometry/surface_samples.h"
 
@@ -116,9 +117,14 @@ std::vector<Correspondence> find_correspondences(const SurfaceSamples& samples,
                                                  const Plane& plane, double max_dist) {
   std::vector<Correspondence> out;
   out.reserve(samples.points.size());
+  // Each sample's match on all threads; the correspondences in sample order.
+  std::vector<MirrorMatch> matches(samples.points.size());
+  parallel_for(samples.points.size(), [&](size_t first, size_t last) {
+    for (size_t i = first; i < last; ++i)
+      matches[i] = mirror_match(samples.points[i], samples.normals[i], plane, index, normals);
+  });
   for (size_t i = 0; i < samples.points.size(); ++i) {
-    const MirrorMatch mm =
-        mirror_match(samples.points[i], samples.normals[i], plane, index, normals);
+    const MirrorMatch& mm = matches[i];
     if (mm.d2 > max_dist * max_dist || !mm.facing) continue;
     out.push_back({samples.points[i], index.points()[mm.c], normals[mm.c]});
   }
@@ -140,10 +146,16 @@ SymmetryMeasure measure_symmetry(const SurfaceSamples& samples, const PointIndex
   dists.reserve(samples.points.size());
   double sum2 = 0.0;
   size_t inliers = 0;
+  std::vector<int> nearest(samples.points.size());
+  std::vector<double> nearest_d2(samples.points.size());
+  parallel_for(samples.points.size(), [&](size_t first, size_t last) {
+    for (size_t i = first; i < last; ++i)
+      nearest[i] = index.nearest(plane.reflect(samples.points[i]), &nearest_d2[i]);
+  });
   for (size_t i = 0; i < samples.points.size(); ++i) {
     const Eigen::Vector3d q = plane.reflect(samples.points[i]);
-    double d2;
-    const int c = index.nearest(q, &d2);
+    const double d2 = nearest_d2[i];
+    const int c = nearest[i];
     dists.push_back(std::sqrt(d2));
     if (d2 > max_dist * max_dist) continue;
     const double r = normals[c].dot(q - index.points()[c]);

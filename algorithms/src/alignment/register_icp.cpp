@@ -6,6 +6,7 @@
 #include <cmath>
 
 #include "cranioplan/algorithms/alignment/mirror_mesh.h"
+#include "cranioplan/algorithms/geometry/parallel.h"
 #include "cranioplan/algorithms/geometry/point_index.h"
 #include "cranioplan/algorithms/geometry/surface_samples.h"
 
@@ -76,10 +77,17 @@ RegisterResult register_icp(const SkullMesh& moving, const SkullMesh& fixed,
   const double trim = std::clamp(params.trim_fraction, 0.05, 1.0);
   for (int it = 0; it < std::clamp(params.max_iterations, 1, 500); ++it) {
     pairs.clear();
+    // The nearest fixed sample of each moving one, on all threads; the pairs in sample order.
+    std::vector<int> nearest(source.points.size());
+    std::vector<double> nearest_d2(source.points.size());
+    parallel_for(source.points.size(), [&](size_t first, size_t last) {
+      for (size_t i = first; i < last; ++i)
+        nearest[i] = index.nearest(T.apply(source.points[i]), &nearest_d2[i]);
+    });
     for (size_t i = 0; i < source.points.size(); ++i) {
       const Eigen::Vector3d p = T.apply(source.points[i]);
-      double d2;
-      const int c = index.nearest(p, &d2);
+      const double d2 = nearest_d2[i];
+      const int c = nearest[i];
       if (d2 > params.max_correspondence_mm * params.max_correspondence_mm) continue;
       const Eigen::Vector3d& n = fixed_samples.normals[c];
       if (n.dot(T.apply_direction(source.normals[i])) < 0.3) continue;  // outer vs inner table

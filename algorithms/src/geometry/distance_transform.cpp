@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "cranioplan/algorithms/geometry/parallel.h"
+
 namespace cranioplan {
 
 namespace {
@@ -48,20 +50,26 @@ std::vector<float> distance_to_mask(const std::vector<uint8_t>& mask, const Voxe
   std::vector<double> sq(mask.size());
   for (size_t c = 0; c < mask.size(); ++c) sq[c] = mask[c] ? 0.0 : kFar;
   const int longest = std::max({dims[0], dims[1], dims[2]});
-  std::vector<double> line(longest), out(longest);
-  std::vector<int> v(longest);
-  std::vector<double> z(longest + 1);
   const size_t stride[3] = {1, static_cast<size_t>(dims[0]),
                             static_cast<size_t>(dims[0]) * dims[1]};
   for (int axis = 0; axis < 3; ++axis) {
     const int a = (axis + 1) % 3, b = (axis + 2) % 3;
-    for (int j = 0; j < dims[b]; ++j)
-      for (int i = 0; i < dims[a]; ++i) {
-        const size_t base = i * stride[a] + j * stride[b];
-        for (int q = 0; q < dims[axis]; ++q) line[q] = sq[base + q * stride[axis]];
-        lower_envelope(line.data(), out.data(), dims[axis], v, z);
-        for (int q = 0; q < dims[axis]; ++q) sq[base + q * stride[axis]] = out[q];
-      }
+    // The lines along the axis are independent: each thread takes a range of them.
+    parallel_for(
+        static_cast<size_t>(dims[b]),
+        [&](size_t first, size_t last) {
+          std::vector<double> line(longest), out(longest);
+          std::vector<int> v(longest);
+          std::vector<double> z(longest + 1);
+          for (size_t j = first; j < last; ++j)
+            for (int i = 0; i < dims[a]; ++i) {
+              const size_t base = i * stride[a] + j * stride[b];
+              for (int q = 0; q < dims[axis]; ++q) line[q] = sq[base + q * stride[axis]];
+              lower_envelope(line.data(), out.data(), dims[axis], v, z);
+              for (int q = 0; q < dims[axis]; ++q) sq[base + q * stride[axis]] = out[q];
+            }
+        },
+        4);
   }
   std::vector<float> d(mask.size());
   for (size_t c = 0; c < mask.size(); ++c)

@@ -1,0 +1,54 @@
+#include "cranioplan/algorithms/geometry/parallel.h"
+
+#include <gtest/gtest.h>
+
+#include <atomic>
+
+#include "cranioplan/algorithms/io/write_mesh.h"
+#include "cranioplan/algorithms/planning/autoplan.h"
+#include "support/synthetic.h"
+
+namespace cranioplan {
+namespace {
+
+// Restores the default thread count when a test ends.
+struct ThreadCount {
+  explicit ThreadCount(int n) { set_thread_count(n); }
+  ~ThreadCount() { set_thread_count(0); }
+};
+
+TEST(Parallel, EveryItemIsVisitedOnceWhateverTheThreads) {
+  for (int threads : {1, 2, 3, 8}) {
+    const ThreadCount count(threads);
+    EXPECT_EQ(thread_count(), threads);
+    for (size_t n : {size_t{0}, size_t{1}, size_t{7}, size_t{1000}, size_t{100003}}) {
+      std::vector<std::atomic<int>> seen(n);
+      parallel_for(
+          n,
+          [&](size_t first, size_t last) {
+            for (size_t i = first; i < last; ++i) ++seen[i];
+          },
+          1);
+      for (size_t i = 0; i < n; ++i) ASSERT_EQ(seen[i].load(), 1) << n << " " << i;
+    }
+  }
+  set_thread_count(0);
+  EXPECT_GE(thread_count(), 1);
+}
+
+// The plan (plane, registrations, distance fields, the implant) is the same to the byte on one
+// thread and on two.
+TEST(Parallel, TheImplantIsTheSameOnOneThreadAndOnTwo) {
+  const SkullMesh& skull = test::thick_head_defect().defective;
+  std::string bytes[2];
+  for (int threads : {1, 2}) {
+    const ThreadCount count(threads);
+    const AutoplanResult r = autoplan(skull, Landmarks{});
+    ASSERT_TRUE(r.planned()) << r.message;
+    bytes[threads - 1] = encode_mesh(r.implant.mesh, MeshFormat::BinarySTL);
+  }
+  EXPECT_EQ(bytes[0], bytes[1]);
+}
+
+}  // namespace
+}  // namespace cranioplan
