@@ -2,9 +2,17 @@
 
 #include <sys/resource.h>
 #include <unistd.h>
+#include <vtkDataSetSurfaceFilter.h>
+#include <vtkDelaunay3D.h>
+#include <vtkIterativeClosestPointTransform.h>
+#include <vtkLandmarkTransform.h>
 #include <vtkNew.h>
+#include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkSTLReader.h>
+#include <vtkSmoothPolyDataFilter.h>
+#include <vtkTransform.h>
+#include <vtkTransformPolyDataFilter.h>
 
 #include <algorithm>
 #include <chrono>
@@ -33,6 +41,53 @@ double median_seconds(int runs, const std::function<void()>& step) {
   }
   std::sort(t.begin(), t.end());
   return t[t.size() / 2];
+}
+
+// The seed paper's steps written with plain VTK, as the reference the plan's speed is measured
+// against (it gives no usable implant): read the STL, mirror it across the plane, register the
+// mirror with VTK's ICP, triangulate the markers with Delaunay 3D and smooth the result.
+void vtk_reference_pipeline(const std::string& stl, const Plane& plane,
+                            const std::vector<Marker>& markers) {
+  vtkNew<vtkSTLReader> reader;
+  reader->SetFileName(stl.c_str());
+  reader->Update();
+  // The reflection x ↦ x − 2 (n·x − d) n as a 4×4 matrix.
+  const Eigen::Vector3d n = plane.normal;
+  vtkNew<vtkTransform> reflect;
+  double m[16] = {0};
+  for (int r = 0; r < 3; ++r) {
+    for (int c = 0; c < 3; ++c) m[4 * r + c] = (r == c ? 1.0 : 0.0) - 2.0 * n[r] * n[c];
+    m[4 * r + 3] = 2.0 * plane.offset * n[r];
+  }
+  m[15] = 1.0;
+  reflect->SetMatrix(m);
+  vtkNew<vtkTransformPolyDataFilter> mirror;
+  mirror->SetInputConnection(reader->GetOutputPort());
+  mirror->SetTransform(reflect);
+  mirror->Update();
+  vtkNew<vtkIterativeClosestPointTransform> icp;
+  icp->SetSource(mirror->GetOutput());
+  icp->SetTarget(reader->GetOutput());
+  icp->GetLandmarkTransform()->SetModeToRigidBody();
+  icp->SetMaximumNumberOfIterations(50);
+  icp->SetMaximumNumberOfLandmarks(2000);
+  icp->Update();
+  vtkNew<vtkTransformPolyDataFilter> registered;
+  registered->SetInputConnection(mirror->GetOutputPort());
+  registered->SetTransform(icp);
+  registered->Update();
+  vtkNew<vtkPoints> points;
+  for (const Marker& k : markers) points->InsertNextPoint(k.position.data());
+  vtkNew<vtkPolyData> cloud;
+  cloud->SetPoints(points);
+  vtkNew<vtkDelaunay3D> delaunay;
+  delaunay->SetInputData(cloud);
+  vtkNew<vtkDataSetSurfaceFilter> surface;
+  surface->SetInputConnection(delaunay->GetOutputPort());
+  vtkNew<vtkSmoothPolyDataFilter> smooth;
+  smooth->SetInputConnection(surface->GetOutputPort());
+  smooth->SetNumberOfIterations(20);
+  smooth->Update();
 }
 
 double peak_rss_mb() {
@@ -88,6 +143,15 @@ Json run_bench(const BenchOptions& options) {
   // with the skull's and the mirror's locators built once.
   AutoplanResult plan;
   out["autoplan_s"] = median_seconds(1, [&] { plan = autoplan(skull.mesh, Landmarks{}); });
+  // The paper's steps in plain VTK on the same skull, plane and markers, in the same run.
+  if (plan.planned()) {
+    write_mesh(skull.mesh, tmp.string(), MeshFormat::BinarySTL);
+    out["vtk_reference_s"] = median_seconds(
+        runs, [&] { vtk_reference_pipeline(tmp.string(), plan.plane.plane, plan.markers); });
+    std::filesystem::remove(tmp);
+    out["autoplan_over_vtk_reference"] =
+        out["autoplan_s"].get<double>() / out["vtk_reference_s"].get<double>();
+  }
   if (plan.planned()) {
     // At least 300 markers, as a dense manual plan has: re-plan with closer spacing if needed.
     AutoplanParams dense;

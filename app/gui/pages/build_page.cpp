@@ -31,7 +31,7 @@ BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
   fit_->setSuffix(" mm");
   fit_->setToolTip(
       tr("Build the shell this far over the bone and subtract the skull: the implant meets "
-         "the cut face all around and never enters the bone (about 1.4 s per rebuild)"));
+         "the cut face all around and never enters the bone (about 1 s per rebuild)"));
   form_->addRow(tr("Method"), method_);
   form_->addRow(tr("Resolution"), resolution_);
   form_->addRow(tr("Thickness without inner markers"), thickness_);
