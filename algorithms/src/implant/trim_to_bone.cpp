@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "cranioplan/algorithms/geometry/distance_transform.h"
+#include "cranioplan/algorithms/geometry/parallel.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
@@ -16,21 +17,24 @@ namespace {
 
 using Mask = std::vector<uint8_t>;
 
-// One step of 6-neighbour dilation.
+// One step of 6-neighbour dilation (slices on all threads; each voxel written once).
 Mask dilate(const Mask& in, const VoxelGrid& g) {
   Mask out(in.size(), 0);
   const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) {
-        const size_t c = g.index(i, j, k);
-        auto at = [&](int a, int b, int d) -> uint8_t {
-          if (a < 0 || b < 0 || d < 0 || a >= nx || b >= ny || d >= nz) return 0;
-          return in[g.index(a, b, d)];
-        };
-        out[c] = in[c] || at(i - 1, j, k) || at(i + 1, j, k) || at(i, j - 1, k) ||
-                 at(i, j + 1, k) || at(i, j, k - 1) || at(i, j, k + 1);
-      }
+  const size_t sy = static_cast<size_t>(nx), sz = static_cast<size_t>(nx) * ny;
+  parallel_for(
+      static_cast<size_t>(nz),
+      [&](size_t first, size_t last) {
+        for (size_t k = first; k < last; ++k)
+          for (int j = 0; j < ny; ++j)
+            for (int i = 0; i < nx; ++i) {
+              const size_t c = k * sz + j * sy + i;
+              out[c] = in[c] || (i > 0 && in[c - 1]) || (i + 1 < nx && in[c + 1]) ||
+                       (j > 0 && in[c - sy]) || (j + 1 < ny && in[c + sy]) ||
+                       (k > 0 && in[c - sz]) || (k + 1 < static_cast<size_t>(nz) && in[c + sz]);
+            }
+      },
+      2);
   return out;
 }
 
@@ -137,20 +141,26 @@ std::vector<float> blur(const Mask& in, const VoxelGrid& g, double sigma_voxels)
   const size_t stride[3] = {1, static_cast<size_t>(dims[0]),
                             static_cast<size_t>(dims[0]) * dims[1]};
   for (int axis = 0; axis < 3; ++axis) {
-    for (int k = 0; k < dims[2]; ++k)
-      for (int j = 0; j < dims[1]; ++j)
-        for (int i = 0; i < dims[0]; ++i) {
-          const int pos[3] = {i, j, k};
-          const size_t c = g.index(i, j, k);
-          float v = 0;
-          for (int t = -r; t <= r; ++t) {
-            const int q = pos[axis] + t;
-            if (q < 0 || q >= dims[axis]) continue;
-            v += w[t + r] *
-                 a[c + static_cast<std::ptrdiff_t>(t) * static_cast<std::ptrdiff_t>(stride[axis])];
-          }
-          b[c] = v;
-        }
+    // Slices on all threads: each voxel's sum, in the same order, written once.
+    parallel_for(
+        static_cast<size_t>(dims[2]),
+        [&](size_t first, size_t last) {
+          for (int k = static_cast<int>(first); k < static_cast<int>(last); ++k)
+            for (int j = 0; j < dims[1]; ++j)
+              for (int i = 0; i < dims[0]; ++i) {
+                const int pos[3] = {i, j, k};
+                const size_t c = g.index(i, j, k);
+                float v = 0;
+                for (int t = -r; t <= r; ++t) {
+                  const int q = pos[axis] + t;
+                  if (q < 0 || q >= dims[axis]) continue;
+                  v += w[t + r] * a[c + static_cast<std::ptrdiff_t>(t) *
+                                            static_cast<std::ptrdiff_t>(stride[axis])];
+                }
+                b[c] = v;
+              }
+        },
+        2);
     a.swap(b);
   }
   return a;
