@@ -79,11 +79,18 @@ void SlicePanel::show_state(const PlanState& s) {
   set_highlight({});
   emit ctChanged();
   if (key.empty()) return;
-  if (watcher_) watcher_->waitForFinished();  // an earlier read, now of no use
   ReadVolumeParams read;
   read.dicom_series = import.dicom_series;
   read.patient_frame = import.patient_frame;
-  delete watcher_;
+  // An earlier read still running is of no use now: it finishes on its own and is dropped
+  // (no waiting on the GUI thread).
+  if (watcher_) {
+    disconnect(watcher_, nullptr, this, nullptr);
+    if (watcher_->isRunning())
+      connect(watcher_, &QFutureWatcherBase::finished, watcher_, &QObject::deleteLater);
+    else
+      watcher_->deleteLater();
+  }
   watcher_ = new QFutureWatcher<std::shared_ptr<Read>>(this);
   connect(watcher_, &QFutureWatcherBase::finished, this, &SlicePanel::loaded);
   watcher_->setFuture(QtConcurrent::run([path, read, key] {

@@ -87,6 +87,22 @@ TEST(PlanState, ApplyingACommandLeavesTheStateBeforeItAsItWas) {
   EXPECT_EQ(command_step(loaded.state, commands::add_marker(MarkerType::OuterSurface, {})), 6);
   EXPECT_EQ(command_step(loaded.state, commands::note("x")), 0);
   EXPECT_EQ(command_step(loaded.state, commands::fit_plane()), 2);
+
+  // A landmark goes onto the skull; one far from it (another frame) is refused.
+  const Eigen::Vector3d top = loaded.state.skull->surface->locator.closest({0, 0, 500}).point;
+  const ApplyOutcome near = apply_command(
+      loaded.state, commands::set_landmark("nasion", top + Eigen::Vector3d(0, 0, 12)));
+  ASSERT_TRUE(near.accepted) << near.message;
+  EXPECT_LT(loaded.state.skull->surface->locator.closest(*near.state.landmarks.nasion).distance,
+            1e-9)
+      << "put on the surface";
+  const ApplyOutcome far = apply_command(
+      loaded.state, commands::set_landmark("nasion", top + Eigen::Vector3d(0, 0, 40)));
+  EXPECT_FALSE(far.accepted);
+  EXPECT_NE(far.message.find("the nasion landmark lies 4"), std::string::npos) << far.message;
+  EXPECT_NE(far.message.find("mm from the skull (at most 25 mm): is it in the skull's frame?"),
+            std::string::npos)
+      << far.message;
 }
 
 TEST(PlanState, TheMirrorIsMovedByTheRegistrationThenByHand) {
