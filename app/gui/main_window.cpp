@@ -180,15 +180,16 @@ void MainWindow::build_menus() {
   QAction* save = file->addAction(tr("Save session"), this, [this] {
     QString path = session_path_;
     if (path.isEmpty())
-      path = QFileDialog::getSaveFileName(this, tr("Save the plan"), QString(),
+      path = QFileDialog::getSaveFileName(this, tr("Save the plan"), default_plan_name(),
                                           tr("Cranioplan plan (*.cranioplan.json *.json)"));
     if (!path.isEmpty()) save_session_to(path);
   });
   save->setShortcut(QKeySequence::Save);
   save->setObjectName("saveSession");
   file->addAction(tr("Save session as…"), this, [this] {
-    const QString path = QFileDialog::getSaveFileName(
-        this, tr("Save the plan"), QString(), tr("Cranioplan plan (*.cranioplan.json *.json)"));
+    const QString path =
+        QFileDialog::getSaveFileName(this, tr("Save the plan"), default_plan_name(),
+                                     tr("Cranioplan plan (*.cranioplan.json *.json)"));
     if (!path.isEmpty()) save_session_to(path);
   });
   recent_menu_ = file->addMenu(tr("Recent files"));
@@ -1014,6 +1015,12 @@ void MainWindow::finish_training_if_done() {
   }
 }
 
+QString MainWindow::default_plan_name() const {
+  // The name the desktop knows as a plan (docs/INSTALL.md): CASE.cranioplan.json.
+  const std::string& id = controller_->session().header().info.case_id;
+  return (id.empty() ? tr("plan") : q(id)) + QStringLiteral(".cranioplan.json");
+}
+
 QString MainWindow::autosave_folder() const {
   return QStandardPaths::writableLocation(QStandardPaths::AppDataLocation) + "/autosave";
 }
@@ -1051,7 +1058,7 @@ bool MainWindow::confirm_discard() {
   if (answer == QMessageBox::Save) {
     QString path = session_path_;
     if (path.isEmpty())
-      path = QFileDialog::getSaveFileName(this, tr("Save the plan"), QString(),
+      path = QFileDialog::getSaveFileName(this, tr("Save the plan"), default_plan_name(),
                                           tr("Cranioplan plan (*.cranioplan.json *.json)"));
     return !path.isEmpty() && save_session_to(path);
   }

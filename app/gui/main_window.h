@@ -131,6 +131,7 @@ class MainWindow : public QMainWindow, public PageHost {
   void finish_training_if_done();
   void show_training_report();
   QString autosave_folder() const;
+  QString default_plan_name() const;
 
   PlanController* controller_;
   SkullView* view_;

@@ -93,7 +93,7 @@ void SlicePanel::show_state(const PlanState& s) {
   }
   watcher_ = new QFutureWatcher<std::shared_ptr<Read>>(this);
   connect(watcher_, &QFutureWatcherBase::finished, this, &SlicePanel::loaded);
-  watcher_->setFuture(QtConcurrent::run([path, read, key] {
+  watcher_->setFuture(QtConcurrent::run([path, read] {
     auto r = std::make_shared<Read>();
     try {
       r->volume = std::make_shared<const Volume>(read_volume(path, read));
