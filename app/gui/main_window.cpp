@@ -11,6 +11,7 @@
 #include <QDockWidget>
 #include <QFileDialog>
 #include <QFileInfo>
+#include <QFutureWatcher>
 #include <QHeaderView>
 #include <QInputDialog>
 #include <QKeySequence>
@@ -33,6 +34,7 @@
 #include <QTextBrowser>
 #include <QTimer>
 #include <QVBoxLayout>
+#include <QtConcurrent/QtConcurrent>
 #include <cmath>
 
 #include "cranioplan/algorithms/io/load_skull.h"
@@ -727,18 +729,57 @@ void MainWindow::refresh_quality() {
   quality_timer_->start();
 }
 
+// What the quality panel shows of an implant, computed off the GUI thread.
+struct MainWindow::QualityView {
+  std::shared_ptr<const ImplantData> implant;  ///< the implant it is of
+  QString html;
+  std::vector<Eigen::Vector3d> intrusion;  ///< the implant's voxels in soft tissue (CT plans)
+};
+
 void MainWindow::show_quality() {
   const PlanState& s = controller_->state();
   if (!s.implant) return;
-  // With the plan's CT at hand, the soft tissue under the implant, marked on the slices.
-  SoftTissueCheck tissue;
-  if (const std::shared_ptr<const Volume> ct = slices_->ct(); ct && s.skull)
-    tissue = check_soft_tissue(s.implant->result().mesh, *ct,
-                               s.defect_center ? *s.defect_center : s.skull->centroid);
-  slices_->set_highlight(tissue.intrusion);
-  const QString html = quality_html(s.implant->quality(), tissue.checked ? &tissue : nullptr);
-  quality_->setHtml(html);
-  for (StepPage* page : step_pages_) page->show_quality(html);
+  // The report (a few tenths of a second on a real skull) and, with the plan's CT at hand, the
+  // soft tissue under the implant are computed on a worker thread: the window stays live.
+  const std::shared_ptr<const ImplantData> implant = s.implant;
+  const std::shared_ptr<const Volume> ct = s.skull ? slices_->ct() : nullptr;
+  const Eigen::Vector3d inside =
+      s.defect_center ? *s.defect_center : (s.skull ? s.skull->centroid : Eigen::Vector3d::Zero());
+  if (quality_watcher_) {  // an earlier report, of no use now: dropped when done
+    disconnect(quality_watcher_, nullptr, this, nullptr);
+    if (quality_watcher_->isRunning())
+      connect(quality_watcher_, &QFutureWatcherBase::finished, quality_watcher_,
+              &QObject::deleteLater);
+    else
+      quality_watcher_->deleteLater();
+  }
+  quality_watcher_ = new QFutureWatcher<std::shared_ptr<QualityView>>(this);
+  connect(quality_watcher_, &QFutureWatcherBase::finished, this, [this] {
+    const std::shared_ptr<QualityView> v = quality_watcher_->result();
+    if (v->implant != controller_->state().implant) return;  // the plan moved on
+    slices_->set_highlight(v->intrusion);
+    quality_->setHtml(v->html);
+    for (StepPage* page : step_pages_) page->show_quality(v->html);
+  });
+  quality_watcher_->setFuture(QtConcurrent::run([implant, ct, inside] {
+    auto v = std::make_shared<QualityView>();
+    v->implant = implant;
+    SoftTissueCheck tissue;
+    if (ct) tissue = check_soft_tissue(implant->result().mesh, *ct, inside);
+    v->intrusion = std::move(tissue.intrusion);
+    v->html = quality_html(implant->quality(), tissue.checked ? &tissue : nullptr);
+    return v;
+  }));
+}
+
+void MainWindow::wait_quality() {
+  if (quality_timer_->isActive()) {
+    quality_timer_->stop();
+    show_quality();
+  }
+  while (quality_watcher_ && quality_watcher_->isRunning())
+    QApplication::processEvents(QEventLoop::AllEvents, 20);
+  QApplication::processEvents();
 }
 
 void MainWindow::update_timers() {
@@ -1091,10 +1132,7 @@ void MainWindow::refresh_recent_menu() {
 }
 
 QImage MainWindow::screenshot() {
-  if (quality_timer_->isActive()) {  // a picture shows the report, not "Checking…"
-    quality_timer_->stop();
-    show_quality();
-  }
+  wait_quality();  // a picture shows the report, not "Checking…"
   view_->update();
   QApplication::processEvents();
   return grab().toImage();

@@ -34,6 +34,8 @@ class QTableWidget;
 class QTextBrowser;
 class QTabWidget;
 class QTimer;
+template <typename T>
+class QFutureWatcher;
 class QMenu;
 class QSplitter;
 
@@ -103,6 +105,8 @@ class MainWindow : public QMainWindow, public PageHost {
   void offer_recovery();
   /// The training report as HTML (empty when not training or not finished).
   QString training_report_html() const { return training_html_; }
+  /// Waits (processing events) until the quality panel shows the current implant's report.
+  void wait_quality();
   /// A picture of the whole window.
   QImage screenshot();
 
@@ -169,6 +173,8 @@ class MainWindow : public QMainWindow, public PageHost {
   QPushButton* cancel_ = nullptr;
   QTimer* clock_ = nullptr;
   QTimer* quality_timer_ = nullptr;
+  struct QualityView;
+  QFutureWatcher<std::shared_ptr<QualityView>>* quality_watcher_ = nullptr;
   QElapsedTimer total_timer_, step_timer_;
   int timed_step_ = 0;
 

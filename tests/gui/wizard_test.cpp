@@ -20,8 +20,8 @@
 
 #include "cranioplan/algorithms/geometry/slices.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
-#include "cranioplan/algorithms/io/read_volume.h"
 #include "cranioplan/algorithms/io/load_skull.h"
+#include "cranioplan/algorithms/io/read_volume.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/sessions/autoplan_session.h"
 #include "cranioplan/sessions/marker_files.h"
@@ -455,7 +455,7 @@ TEST_F(Wizard, CtSlicesShowTheImplantWhereTheGeometrySays) {
 
   // The soft tissue under the implant, from the CT: the voxels of the implant in it are red on
   // the slices (the sample's scalp lies in the defect).
-  QTest::qWait(50);
+  w.wait_quality();
   EXPECT_GT(axial.highlighted(), 0);
 
   // Window/level: a preset changes the picture.
