@@ -69,12 +69,27 @@ void read(std::string_view data) {
     write(base + ".json", data);
     read_session_document(base + ".json");
   } else if (reader == "landmarks") {
+    // The same bytes as Cranioplan's JSON and as 3D Slicer's markups.
     write(base + ".json", data);
-    read_landmarks_file(base + ".json");
+    write(base + ".mrk.json", data);
+    try {
+      read_landmarks_file(base + ".json");
+    } catch (const cranioplan::Error&) {
+    }
+    read_landmarks_file(base + ".mrk.json");
   } else if (reader == "markers") {
-    // Markers come as JSON or CSV: the first byte chooses.
-    const std::string path = base + (!data.empty() && data[0] == '{' ? ".json" : ".csv");
+    // Markers come as JSON (Cranioplan's, and the same bytes as Slicer's markups) or CSV: the
+    // first byte chooses.
+    const bool json = !data.empty() && data[0] == '{';
+    const std::string path = base + (json ? ".json" : ".csv");
     write(path, data);
+    if (json) {
+      write(base + ".mrk.json", data);
+      try {
+        read_markers_file(base + ".mrk.json");
+      } catch (const cranioplan::Error&) {
+      }
+    }
     read_markers_file(path);
   }
 }
