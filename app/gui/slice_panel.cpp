@@ -46,10 +46,7 @@ void SlicePanel::show_state(const PlanState& s) {
   // Until the user points somewhere, the slices go through the implant (else the edge markers,
   // else the skull's middle).
   if (s.implant && s.implant->result().mesh.n_vertices() > 0) {
-    const SkullMesh& m = s.implant->result().mesh;
-    Eigen::Vector3d c = Eigen::Vector3d::Zero();
-    for (auto vh : m.vertices()) c += to_eigen(m.point(vh));
-    plan_centre_ = c / static_cast<double>(m.n_vertices());
+    plan_centre_ = vertex_centroid(s.implant->result().mesh);
   } else if (const auto edges = edge_marker_centre(s.markers)) {
     plan_centre_ = *edges;
   } else if (s.skull) {

@@ -287,9 +287,7 @@ Subcommand add_study(CLI::App& app, const bool& json) {
         const SurfaceLocator bone(skull);
         // Directions on the upper vault, alternately left and right, spread by the golden angle;
         // each defect's centre is in the middle of the bone along that ray from the centroid.
-        Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-        for (auto vh : skull.vertices()) centroid += to_eigen(skull.point(vh));
-        centroid /= static_cast<double>(skull.n_vertices());
+        const Eigen::Vector3d centroid = vertex_centroid(skull);
         make_rows_folder(o->rows_out);
         Json rows = Json::array();
         for (int k = 0; k < o->count; ++k) {

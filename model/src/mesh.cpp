@@ -281,6 +281,12 @@ Eigen::Matrix3Xd vertex_matrix(const SkullMesh& mesh) {
   return m;
 }
 
+Eigen::Vector3d vertex_centroid(const SkullMesh& mesh) {
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (auto vh : mesh.vertices()) c += to_eigen(mesh.point(vh));
+  return c / static_cast<double>(std::max<size_t>(1, mesh.n_vertices()));
+}
+
 double signed_volume(const SkullMesh& mesh) {
   double six_v = 0.0;
   for (auto fh : mesh.faces()) {

@@ -397,8 +397,7 @@ void apply_load(PlanState& s, const ParamReader& r, const ApplyContext& ctx, Jso
   input->path = recorded;
   input->sha256 = sha;
   const SkullMesh& mesh = input->surface->mesh;
-  for (auto vh : mesh.vertices()) input->centroid += to_eigen(mesh.point(vh));
-  input->centroid /= static_cast<double>(std::max<size_t>(1, mesh.n_vertices()));
+  input->centroid = vertex_centroid(mesh);
   PlanState fresh;
   fresh.notes = s.notes;
   fresh.skull = std::move(input);

@@ -223,12 +223,6 @@ Volume oblique_ball_volume(const Eigen::Vector3d& center) {
   return v;
 }
 
-Eigen::Vector3d vertex_centroid(const SkullMesh& mesh) {
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (auto vh : mesh.vertices()) c += to_eigen(mesh.point(vh));
-  return c / static_cast<double>(mesh.n_vertices());
-}
-
 const ThickHeadDefect& thick_head_defect() {
   static const ThickHeadDefect c = [] {
     ThickHeadDefect k;

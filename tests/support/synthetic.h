@@ -50,8 +50,6 @@ struct ThickHeadDefect {
   DefectRegion defect;
 };
 const ThickHeadDefect& thick_head_defect();
-/// The mean of a mesh's vertices, mm.
-Eigen::Vector3d vertex_centroid(const SkullMesh& mesh);
 
 }  // namespace cranioplan::test
 

@@ -68,10 +68,7 @@ std::vector<size_t> along(const std::vector<Eigen::Vector3d>& loop, double spaci
 
 DefectRegion detect_defect_near_plane(const SkullMesh& skull, const SurfaceLocator& bone,
                                       const Plane& plane, const DetectDefectParams& params) {
-  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
-  for (auto vh : skull.vertices()) centroid += to_eigen(skull.point(vh));
-  centroid /= static_cast<double>(std::max<size_t>(1, skull.n_vertices()));
-  const Eigen::Vector3d center = plane.project(centroid);
+  const Eigen::Vector3d center = plane.project(vertex_centroid(skull));
   DetectDefectParams framed = params;
   if (!framed.frame) framed.frame = skull_frame(skull, center, plane.normal);
   if (framed.scan_borders.empty() && has_boundary(skull))

@@ -242,9 +242,7 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
   }
 
   // Principal axes of the implant's vertices: the thinnest one is across the plate.
-  Eigen::Vector3d c = Eigen::Vector3d::Zero();
-  for (auto vh : implant.vertices()) c += to_eigen(implant.point(vh));
-  c /= static_cast<double>(implant.n_vertices());
+  const Eigen::Vector3d c = vertex_centroid(implant);
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
   for (auto vh : implant.vertices()) {
     const Eigen::Vector3d d = to_eigen(implant.point(vh)) - c;

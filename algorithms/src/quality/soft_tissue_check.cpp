@@ -80,10 +80,11 @@ SoftTissueCheck check_soft_tissue(const SkullMesh& implant, const Volume& ct,
   if (count > 0) out.closest_mm = 0.0;
   char buf[240];
   if (out.intrusion_mm3 > 0.0)
-    std::snprintf(buf, sizeof(buf),
-                  "%.0f mm³ of the implant lie where the CT shows soft tissue (brain, dura or scalp, "
-                  "%.0f–%.0f HU) under its inner surface",
-                  out.intrusion_mm3, params.soft_min_hu, params.soft_max_hu);
+    std::snprintf(
+        buf, sizeof(buf),
+        "%.0f mm³ of the implant lie where the CT shows soft tissue (brain, dura or scalp, "
+        "%.0f–%.0f HU) under its inner surface",
+        out.intrusion_mm3, params.soft_min_hu, params.soft_max_hu);
   else if (std::isfinite(out.closest_mm))
     std::snprintf(buf, sizeof(buf), "soft tissue lies %.1f mm under the implant's inner surface",
                   out.closest_mm);

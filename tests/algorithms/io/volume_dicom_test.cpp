@@ -14,7 +14,6 @@ namespace cranioplan {
 namespace {
 
 using test::oblique_ball_volume;
-using test::vertex_centroid;
 
 TEST(VolumeDicom, DicomSeriesFolderGivesWorldCoordinatesAndHounsfieldUnits) {
   test::TempDir dir;

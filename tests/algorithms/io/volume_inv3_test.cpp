@@ -14,7 +14,6 @@ namespace cranioplan {
 namespace {
 
 using test::oblique_ball_volume;
-using test::vertex_centroid;
 
 TEST(VolumeInv3, TheSampleProjectIsACtInHounsfieldUnits) {
   const std::string p = sample_case_path();

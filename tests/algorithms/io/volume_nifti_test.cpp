@@ -13,7 +13,6 @@ namespace cranioplan {
 namespace {
 
 using test::oblique_ball_volume;
-using test::vertex_centroid;
 
 TEST(VolumeNifti, NiftiSformGivesWorldCoordinates) {
   test::TempDir dir;

@@ -13,7 +13,6 @@ namespace cranioplan {
 namespace {
 
 using test::oblique_ball_volume;
-using test::vertex_centroid;
 
 TEST(VolumeNrrd, ObliqueNrrdRawAndGzipPlaceTheSurfaceInWorldCoordinates) {
   test::TempDir dir;

@@ -26,7 +26,9 @@ TEST(ProposeMarkers, MarkersLieOnTheRimAndOnTheMissingBone) {
     EXPECT_EQ(m.id, 7 + static_cast<int>(i)) << "ids from first_id on, in order";
     // Edge markers and the support markers beside the rim lie on the skull; surface markers
     // over the opening on the mirror, here the intact head.
-    if (is_edge(m.type)) EXPECT_EQ(m.surface, MarkerSurface::Original);
+    if (is_edge(m.type)) {
+      EXPECT_EQ(m.surface, MarkerSurface::Original);
+    }
     ++count[m.type];
     const SurfaceLocator& on = m.surface == MarkerSurface::Original ? bone : truth;
     EXPECT_LT(on.closest(m.position).distance, 1.0) << to_string(m.type) << " " << m.id;
@@ -48,7 +50,9 @@ TEST(ProposeMarkers, RimOnlyFittingIsUsedWhenAsked) {
   // follow the missing bone within 2 mm.
   for (const Marker& m : p.markers) {
     EXPECT_EQ(m.surface, MarkerSurface::Original);
-    if (m.type == MarkerType::OuterSurface) EXPECT_LT(truth.closest(m.position).distance, 2.0);
+    if (m.type == MarkerType::OuterSurface) {
+      EXPECT_LT(truth.closest(m.position).distance, 2.0);
+    }
   }
 }
 

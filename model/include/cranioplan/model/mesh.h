@@ -57,6 +57,8 @@ Eigen::Matrix3Xd vertex_matrix(const SkullMesh& mesh);
 /// Taken about `about` (the same for any point when the surface is closed; for a surface with
 /// holes, a point inside it keeps the open parts' share small).
 double signed_volume(const SkullMesh& mesh);
+/// The mean of the mesh's vertices, mm (zero for a mesh without vertices).
+Eigen::Vector3d vertex_centroid(const SkullMesh& mesh);
 double signed_volume(const TriangleSoup& soup,
                      const Eigen::Vector3d& about = Eigen::Vector3d::Zero());
 
