@@ -11,6 +11,7 @@
 #include <vtkCellArray.h>
 #include <vtkCoordinate.h>
 #include <vtkCubeSource.h>
+#include <vtkDoubleArray.h>
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkGenericRenderWindowInteractor.h>
 #include <vtkGlyph3DMapper.h>
@@ -255,7 +256,8 @@ struct SkullView::Impl {
   GlyphLayer outer_edge{sphere(1.6), kEdge}, inner_edge{cube(2.4), kEdge},
       outer_surface{sphere(1.6), kSurface}, inner_surface{cube(2.4), kSurface},
       landmarks{sphere(2.6), {0.90, 0.15, 0.10}}, selected{sphere(2.8), {1.0, 0.95, 0.1}},
-      cursor{sphere(1.8), {0.0, 0.85, 1.0}};  // the slice views' shared cursor
+      cursor{sphere(1.8), {0.0, 0.85, 1.0}},  // the slice views' shared cursor
+      zones{sphere(1.0), {1.0, 0.55, 0.0}};   // clearance zones, scaled to their radius
   vtkNew<vtkPlaneSource> plane_source;
   vtkNew<vtkPolyDataMapper> plane_mapper;
   vtkNew<vtkActor> plane_actor;
@@ -349,13 +351,17 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
   for (vtkActor* a :
        {d.skull.actor.Get(), d.mirror.actor.Get(), d.implant.actor.Get(), d.outer_edge.actor.Get(),
         d.inner_edge.actor.Get(), d.outer_surface.actor.Get(), d.inner_surface.actor.Get(),
-        d.landmarks.actor.Get(), d.selected.actor.Get(), d.cursor.actor.Get(),
+        d.landmarks.actor.Get(), d.selected.actor.Get(), d.cursor.actor.Get(), d.zones.actor.Get(),
         d.plane_actor.Get()}) {
     a->SetVisibility(false);
     d.renderer->AddActor(a);
   }
   d.unseen_actor->SetVisibility(false);
   d.overlay->AddActor(d.unseen_actor);
+  d.zones.mapper->ScalingOn();
+  d.zones.mapper->SetScaleArray("radius");
+  d.zones.mapper->SetScaleModeToScaleByMagnitude();
+  d.zones.actor->GetProperty()->SetOpacity(0.3);
   setup_orientation_marker(d.orientation, d.orientation_cube);
   d.window->AddRenderer(d.orientation);
 }
@@ -433,6 +439,17 @@ void SkullView::show_state(const PlanState& s) {
     if (*p) lm.push_back(**p);
   lm.insert(lm.end(), s.landmarks.midline.begin(), s.landmarks.midline.end());
   d.landmarks.set(lm);
+  // The implant's clearance zones: translucent balls of their radius on the rim.
+  std::vector<Eigen::Vector3d> zone_centres;
+  vtkNew<vtkDoubleArray> zone_radii;
+  zone_radii->SetName("radius");
+  if (s.implant_params)
+    for (const ClearanceZone& z : s.implant_params->clearance_zones) {
+      zone_centres.push_back(z.center);
+      zone_radii->InsertNextValue(z.radius_mm);
+    }
+  d.zones.set(zone_centres);
+  d.zones.points_data->GetPointData()->AddArray(zone_radii);
   set_selected_marker(s.find_marker(d.selected_id) ? d.selected_id : 0);
   {
     vtkNew<vtkPoints> points;

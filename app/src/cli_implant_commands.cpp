@@ -227,6 +227,7 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
   struct Opts {
     std::string skull, mirrored, markers, output, method = "shell";
     ImplantParams params;
+    MaterialOptions material;
     bool no_snap = false;
   };
   auto o = std::make_shared<Opts>();
@@ -247,6 +248,11 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
   cmd->add_option("--alpha", o->params.delaunay_alpha, "delaunay3d alpha (mm; 0 = convex hull)");
   cmd->add_option("--tolerance", o->params.delaunay_tolerance, "delaunay3d tolerance");
   cmd->add_option("--offset", o->params.delaunay_offset, "delaunay3d offset");
+  cmd->add_option("--fit-to-bone", o->params.fit_to_bone_mm,
+                  "build the shell this far over the bone and subtract the skull (mm; 0: off; "
+                  "a clearance or under-contour needs it)")
+      ->check(CLI::Range(0.0, 10.0));
+  add_material_options(cmd, o->material);
   cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
   return Subcommand{
       cmd, [o, &json] {
@@ -265,6 +271,8 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
           throw InputError(o->markers, snapped.message);
         o->params.method = o->method == "shell" ? ImplantMethod::Shell : ImplantMethod::Delaunay3D;
         o->params.snap_rim_to_skull = !o->no_snap;
+        o->params.material = material_from(o->material);
+        o->params.clearance_zones = zones_from(o->material);
         const ImplantResult r = build_implant(snapped.markers, &skull, o->params);
         Json j = implant_json(r);
         j["method"] = o->method;
@@ -275,7 +283,8 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
         }
         write_mesh(r.mesh, o->output);
         j["output"] = o->output;
-        j["quality"] = to_json(check_implant(r.mesh, &skull));
+        j["quality"] = to_json(check_implant(
+            r.mesh, &skull, quality_params_for(o->params.material, o->params.clearance_zones)));
         print_result(j, json);
         return kOk;
       }};
@@ -286,6 +295,8 @@ Subcommand add_qa(CLI::App& app, const bool& json) {
   struct Opts {
     std::string implant, skull, ct, series;
     QualityParams params;
+    std::optional<double> min_thickness;
+    MaterialOptions material;
   };
   auto o = std::make_shared<Opts>();
   auto* cmd = app.add_subcommand("qa", "Quality report of an implant before printing");
@@ -294,35 +305,45 @@ Subcommand add_qa(CLI::App& app, const bool& json) {
   cmd->add_option("--ct", o->ct,
                   "the patient's CT: also the soft tissue under the implant (brain, dura)");
   add_series_option(cmd, o->series);
-  cmd->add_option("--min-thickness", o->params.min_thickness_mm, "thinnest printable (mm)");
+  cmd->add_option("--min-thickness", o->min_thickness,
+                  "thinnest printable (mm; default the material's, else 1)");
+  add_material_options(cmd, o->material, true);
   cmd->add_option("--max-taper", o->params.max_taper_mm,
                   "widest edge on the bone that may be thinner (mm)");
   cmd->add_option("--max-rim-gap", o->params.max_rim_gap_mm, "largest acceptable rim gap (mm)");
   cmd->add_option("--max-penetration", o->params.max_penetration_mm3,
                   "largest acceptable overlap (mm³)");
-  return Subcommand{cmd, [o, &json] {
-                      const SkullMesh implant = load_surface(o->implant).mesh;
-                      SkullMesh skull;
-                      if (!o->skull.empty()) skull = load_skull(o->skull).mesh;
-                      const QualityReport q =
-                          check_implant(implant, o->skull.empty() ? nullptr : &skull, o->params);
-                      Json j = to_json(q);
-                      if (!o->ct.empty()) {
-                        ReadVolumeParams read;
-                        read.dicom_series = o->series;
-                        const Volume ct = read_volume(o->ct, read);
-                        // The cavity's side: the skull's centre, else the CT's.
-                        Eigen::Vector3d inside = ct.world(
-                            0.5 * Eigen::Vector3d(ct.dims[0] - 1, ct.dims[1] - 1, ct.dims[2] - 1));
-                        if (!o->skull.empty()) {
-                          const auto [lo, hi] = mesh_bounds(skull);
-                          inside = 0.5 * (lo + hi);
-                        }
-                        j["soft_tissue"] = to_json(check_soft_tissue(implant, ct, inside));
-                      }
-                      print_result(j, json);
-                      return q.printable ? kOk : kUnusable;
-                    }};
+  return Subcommand{
+      cmd, [o, &json] {
+        // The material's checks, then the limits given.
+        const QualityParams limits = o->params;
+        o->params = quality_params_for(material_from(o->material), zones_from(o->material));
+        o->params.max_taper_mm = limits.max_taper_mm;
+        o->params.max_rim_gap_mm = limits.max_rim_gap_mm;
+        o->params.max_penetration_mm3 = limits.max_penetration_mm3;
+        if (o->min_thickness) o->params.min_thickness_mm = *o->min_thickness;
+        const SkullMesh implant = load_surface(o->implant).mesh;
+        SkullMesh skull;
+        if (!o->skull.empty()) skull = load_skull(o->skull).mesh;
+        const QualityReport q =
+            check_implant(implant, o->skull.empty() ? nullptr : &skull, o->params);
+        Json j = to_json(q);
+        if (!o->ct.empty()) {
+          ReadVolumeParams read;
+          read.dicom_series = o->series;
+          const Volume ct = read_volume(o->ct, read);
+          // The cavity's side: the skull's centre, else the CT's.
+          Eigen::Vector3d inside =
+              ct.world(0.5 * Eigen::Vector3d(ct.dims[0] - 1, ct.dims[1] - 1, ct.dims[2] - 1));
+          if (!o->skull.empty()) {
+            const auto [lo, hi] = mesh_bounds(skull);
+            inside = 0.5 * (lo + hi);
+          }
+          j["soft_tissue"] = to_json(check_soft_tissue(implant, ct, inside));
+        }
+        print_result(j, json);
+        return q.printable ? kOk : kUnusable;
+      }};
 }
 
 // labelmap
@@ -435,6 +456,7 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
     std::vector<double> near;
     bool all_openings = false;
     AutoplanParams params;
+    MaterialOptions material;
     ExtractBoneSurfaceParams import;
   };
   auto o = std::make_shared<Opts>();
@@ -455,6 +477,7 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
                   "(default: the largest)")
       ->expected(3);
   add_fit_option(cmd, o->params);
+  add_material_options(cmd, o->material);
   cmd->add_option("--session", o->session,
                   "plan through session commands and save the session (.json): reopen, edit, "
                   "replay and audit it (with --all-openings, SESSION_2... for the others)");
@@ -468,6 +491,8 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
           o->params.propose.detect.near = Eigen::Vector3d(o->near[0], o->near[1], o->near[2]);
         const Landmarks lm = o->landmarks.empty() ? Landmarks{} : read_landmarks_file(o->landmarks);
         plan_method_from_string(o->method, o->params.propose.method);
+        o->params.implant.material = material_from(o->material);
+        o->params.implant.clearance_zones = zones_from(o->material);
         auto markers_path = [&](size_t k) {
           return o->markers_out.empty() ? std::string() : numbered_path(o->markers_out, k);
         };

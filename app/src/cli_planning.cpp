@@ -1,6 +1,7 @@
 #include "cli_planning.h"
 
 #include <CLI/CLI.hpp>
+#include <sstream>
 
 #include "cranioplan/algorithms/io/load_skull.h"
 
@@ -24,6 +25,74 @@ void add_fit_option(CLI::App* cmd, AutoplanParams& params) {
                   "register the mirror again within this margin of the opening (mm; 0: off)")
       ->capture_default_str()
       ->check(CLI::Range(0.0, 200.0));
+}
+
+void add_material_options(CLI::App* cmd, MaterialOptions& o, bool for_check) {
+  std::string presets;
+  for (const Material& m : material_presets()) presets += (presets.empty() ? "" : ", ") + m.id;
+  cmd->add_option("--material", o.material,
+                  "what the implant is made of: " + presets +
+                      " or custom (its thickness, minimum thickness, edge clearance, "
+                      "under-contour and density; the values below change them)");
+  cmd->add_option("--clearance", o.clearance, "gap between the implant's edge and the bone (mm)")
+      ->check(CLI::Range(0.0, 3.0));
+  if (!for_check) {
+    cmd->add_option("--under-contour", o.under_contour,
+                    "outer surface set this far below the skull's (mm)")
+        ->check(CLI::Range(0.0, 1.0));
+    cmd->add_option("--min-thickness", o.min_thickness, "the material's thinnest wall (mm)")
+        ->check(CLI::Range(0.3, 10.0));
+    cmd->add_option("--plate-thickness", o.plate_thickness,
+                    "a plate of this thickness instead of the bone's (mm)")
+        ->check(CLI::Range(0.3, 15.0));
+  }
+  cmd->add_option("--density", o.density, "for the mass (g/cm³)")->check(CLI::Range(0.1, 25.0));
+  cmd->add_option("--clearance-zone", o.zones,
+                  "X,Y,Z,RADIUS,MM: the rim within RADIUS mm of the point held MM off the bone "
+                  "(repeatable)");
+}
+
+std::optional<Material> material_from(const MaterialOptions& o) {
+  const bool changed =
+      o.clearance || o.under_contour || o.min_thickness || o.plate_thickness || o.density;
+  if (o.material.empty() && !changed) return std::nullopt;
+  Material m;
+  if (!o.material.empty() && o.material != "custom") {
+    const std::optional<Material> preset = material_preset(o.material);
+    if (!preset) {
+      std::string presets;
+      for (const Material& p : material_presets()) presets += " " + p.id;
+      throw CLI::ValidationError("--material", "unknown material '" + o.material +
+                                                   "' (presets:" + presets + ", or custom)");
+    }
+    m = *preset;
+  }
+  if (o.clearance) m.edge_clearance_mm = *o.clearance;
+  if (o.under_contour) m.under_contour_mm = *o.under_contour;
+  if (o.min_thickness) m.min_thickness_mm = *o.min_thickness;
+  if (o.plate_thickness) m.thickness_mm = *o.plate_thickness;
+  if (o.density) m.density_g_cm3 = *o.density;
+  if (const std::string problem = material_problem(m); !problem.empty())
+    throw CLI::ValidationError("--material", m.name + ": " + problem);
+  return m;
+}
+
+std::vector<ClearanceZone> zones_from(const MaterialOptions& o) {
+  std::vector<ClearanceZone> zones;
+  for (const std::string& text : o.zones) {
+    std::stringstream in(text);
+    ClearanceZone z;
+    char c[4] = {};
+    if (!(in >> z.center.x() >> c[0] >> z.center.y() >> c[1] >> z.center.z() >> c[2] >>
+          z.radius_mm >> c[3] >> z.clearance_mm) ||
+        c[0] != ',' || c[1] != ',' || c[2] != ',' || c[3] != ',')
+      throw CLI::ValidationError("--clearance-zone",
+                                 "expected X,Y,Z,RADIUS,MM in mm, got '" + text + "'");
+    if (const std::string problem = zone_problem(z); !problem.empty())
+      throw CLI::ValidationError("--clearance-zone", problem + " ('" + text + "')");
+    zones.push_back(z);
+  }
+  return zones;
 }
 
 }  // namespace cranioplan::cli

@@ -1,6 +1,8 @@
 #pragma once
 // Pieces the planning subcommands of cranioplan-cli share (implant, evaluation).
+#include <optional>
 #include <string>
+#include <vector>
 
 #include "cranioplan/algorithms/planning/autoplan.h"
 
@@ -16,5 +18,19 @@ SkullMesh load_any(const std::string& path);
 
 /// --fit-to-bone MM and --local-registration MM of the automatic planner.
 void add_fit_option(CLI::App* cmd, AutoplanParams& params);
+
+/// --material and the values that change a preset (--clearance, --under-contour,
+/// --min-thickness, --plate-thickness, --density), and --clearance-zone X,Y,Z,RADIUS,MM.
+struct MaterialOptions {
+  std::string material;  ///< preset id or name, or "custom"; empty: none
+  std::optional<double> clearance, under_contour, min_thickness, plate_thickness, density;
+  std::vector<std::string> zones;
+};
+/// `for_check`: only what a quality check uses (--material, --clearance, --density, zones).
+void add_material_options(CLI::App* cmd, MaterialOptions& o, bool for_check = false);
+/// The material and zones the options ask for (a CLI::ValidationError for a bad one); none
+/// when no option was given.
+std::optional<Material> material_from(const MaterialOptions& o);
+std::vector<ClearanceZone> zones_from(const MaterialOptions& o);
 
 }  // namespace cranioplan::cli

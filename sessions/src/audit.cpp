@@ -383,6 +383,7 @@ std::string quality_report_html(const QualityReport& r, const SoftTissueCheck* t
     h += "<tr><td>" + k + "</td><td><b>" + v + "</b></td></tr>";
   };
   row("Printable", r.printable ? "yes" : "NO");
+  if (!r.material_name.empty()) row("Material", html_escape(r.material_name));
   row("Watertight", yes(r.watertight));
   row("Manifold", yes(r.manifold));
   row("Outward normals", yes(r.outward));
@@ -390,6 +391,7 @@ std::string quality_report_html(const QualityReport& r, const SoftTissueCheck* t
   row("Pieces", std::to_string(r.pieces));
   row("Volume", fixed(r.volume_mm3, 0) + " mm³");
   row("Area", fixed(r.area_mm2, 0) + " mm²");
+  if (r.mass_g > 0) row("Mass", fixed(r.mass_g, 1) + " g");
   row("Thickness min / median / max", fixed(r.thickness_min_mm, 1) + " / " +
                                           fixed(r.thickness_median_mm, 1) + " / " +
                                           fixed(r.thickness_max_mm, 1) + " mm");
@@ -399,6 +401,11 @@ std::string quality_report_html(const QualityReport& r, const SoftTissueCheck* t
                                             fixed(r.taper_reach_mm, 1) + " mm wide, elsewhere " +
                                             fixed(r.corner_reach_mm, 1) + " mm");
   if (r.rim_gap_mm >= 0) row("Gap to bone (rim)", fixed(r.rim_gap_mm, 2) + " mm");
+  if (r.clearance_asked && r.rim_gap_mm >= 0) {
+    auto signed_mm = [&](double v) { return (v >= 0 ? "+" : "−") + fixed(std::abs(v), 2); };
+    row("Edge gap per 5° arc, less the clearance asked",
+        signed_mm(r.clearance_low_mm) + " to " + signed_mm(r.clearance_high_mm) + " mm");
+  }
   if (r.penetration_mm3 >= 0) row("Overlap with skull", fixed(r.penetration_mm3, 1) + " mm³");
   if (tissue && tissue->checked) {
     row("In soft tissue (CT)", fixed(tissue->intrusion_mm3, 0) + " mm³");

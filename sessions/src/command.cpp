@@ -223,7 +223,10 @@ int current_version(CommandType type) {
   // surface and removes thin fills ("thin_fills_removed"); version 3 is read without either.
   // build_implant 5: the skull's inside decided by votes where its surface is open
   // ("trim.vote_through_holes"); version 4 is read with parity along z.
-  if (type == CommandType::BuildImplant) return 5;
+  // build_implant 6: what the implant is made of ("material": thickness, minimum thickness,
+  // edge clearance, under-contour, density, onlay) and stretches of the rim with their own
+  // clearance ("clearance_zones"); version 5 is read without either.
+  if (type == CommandType::BuildImplant) return 6;
   if (type == CommandType::ProposeMarkers) return 3;
   // load_skull 4: volumes in the patient's frame ("import.patient_frame"), a DICOM folder's
   // series ("import.dicom_series"), a mesh's far pieces dropped ("import.drop_far_pieces");
@@ -337,7 +340,51 @@ Json params_to_json(const ImplantParams& p) {
   j["trim"]["thin_fills_removed"] = p.trim.thin_fills_removed;
   j["trim"]["clearance_mm"] = p.trim.clearance_mm ? Json(*p.trim.clearance_mm) : Json(nullptr);
   j["trim"]["vote_through_holes"] = p.trim.vote_through_holes;
+  j["material"] = p.material ? to_json(*p.material) : Json(nullptr);
+  j["clearance_zones"] = Json::array();
+  for (const ClearanceZone& z : p.clearance_zones) j["clearance_zones"].push_back(to_json(z));
   return j;
+}
+
+Json to_json(const Material& m) {
+  return Json{{"id", m.id},
+              {"name", m.name},
+              {"thickness_mm", std::isnan(m.thickness_mm) ? Json(nullptr) : Json(m.thickness_mm)},
+              {"min_thickness_mm", m.min_thickness_mm},
+              {"edge_clearance_mm", m.edge_clearance_mm},
+              {"under_contour_mm", m.under_contour_mm},
+              {"density_g_cm3", m.density_g_cm3},
+              {"onlay_mm", m.onlay_mm}};
+}
+
+Json to_json(const ClearanceZone& z) {
+  return Json{
+      {"center", to_json(z.center)}, {"radius_mm", z.radius_mm}, {"clearance_mm", z.clearance_mm}};
+}
+
+Material material_from_json(const ParamReader& r) {
+  Material m;
+  m.id = r.string("id");
+  m.name = r.string("name");
+  m.thickness_mm = r.number("thickness_mm");  // null: follows the bone
+  m.min_thickness_mm = r.number("min_thickness_mm");
+  m.edge_clearance_mm = r.number("edge_clearance_mm");
+  m.under_contour_mm = r.number("under_contour_mm");
+  m.density_g_cm3 = r.number("density_g_cm3");
+  m.onlay_mm = r.number("onlay_mm");
+  if (const std::string problem = material_problem(m); !problem.empty())
+    throw SessionError(r.where(), "material " + m.name + ": " + problem);
+  return m;
+}
+
+ClearanceZone clearance_zone_from_json(const ParamReader& r) {
+  ClearanceZone z;
+  z.center = r.vector3("center");
+  z.radius_mm = r.number("radius_mm");
+  z.clearance_mm = r.number("clearance_mm");
+  if (const std::string problem = zone_problem(z); !problem.empty())
+    throw SessionError(r.where(), problem);
+  return z;
 }
 
 void params_from_json(const ParamReader& r, ExtractBoneSurfaceParams& p) {
@@ -452,6 +499,18 @@ void params_from_json(const ParamReader& r, ImplantParams& p) {
     p.trim.clearance_mm.reset();
     p.trim.min_feature_mm = 1.25;
     p.trim.bridge_mm = 1.0;
+  }
+  // build_implant 5 and before have no material and no clearance zones.
+  p.material.reset();
+  if (r.has("material") && !r.value("material").is_null())
+    p.material = material_from_json(ParamReader(r.value("material"), r.where() + " material"));
+  p.clearance_zones.clear();
+  if (r.has("clearance_zones")) {
+    const Json& zones = r.value("clearance_zones");
+    if (!zones.is_array()) throw SessionError(r.where(), "clearance_zones must be a list");
+    for (size_t k = 0; k < zones.size(); ++k)
+      p.clearance_zones.push_back(clearance_zone_from_json(
+          ParamReader(zones[k], r.where() + " clearance zone " + std::to_string(k + 1))));
   }
 }
 

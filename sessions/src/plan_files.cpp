@@ -98,24 +98,33 @@ Json to_json(const RegisterResult& r) {
 }
 
 Json to_json(const QualityReport& q) {
-  return Json{{"watertight", q.watertight},
-              {"manifold", q.manifold},
-              {"outward", q.outward},
-              {"self_intersections", q.self_intersections},
-              {"pieces", q.pieces},
-              {"volume_mm3", q.volume_mm3},
-              {"area_mm2", q.area_mm2},
-              {"thickness_min_mm", q.thickness_min_mm},
-              {"thickness_median_mm", q.thickness_median_mm},
-              {"thickness_max_mm", q.thickness_max_mm},
-              {"thin_volume_mm3", q.thin_volume_mm3},
-              {"thin_off_bone_mm3", q.thin_off_bone_mm3},
-              {"taper_reach_mm", q.taper_reach_mm},
-              {"corner_reach_mm", q.corner_reach_mm},
-              {"rim_gap_mm", q.rim_gap_mm},
-              {"penetration_mm3", q.penetration_mm3},
-              {"printable", q.printable},
-              {"reasons", q.reasons}};
+  Json j{{"watertight", q.watertight},
+         {"manifold", q.manifold},
+         {"outward", q.outward},
+         {"self_intersections", q.self_intersections},
+         {"pieces", q.pieces},
+         {"volume_mm3", q.volume_mm3},
+         {"area_mm2", q.area_mm2},
+         {"thickness_min_mm", q.thickness_min_mm},
+         {"thickness_median_mm", q.thickness_median_mm},
+         {"thickness_max_mm", q.thickness_max_mm},
+         {"thin_volume_mm3", q.thin_volume_mm3},
+         {"thin_off_bone_mm3", q.thin_off_bone_mm3},
+         {"taper_reach_mm", q.taper_reach_mm},
+         {"corner_reach_mm", q.corner_reach_mm},
+         {"rim_gap_mm", q.rim_gap_mm},
+         {"penetration_mm3", q.penetration_mm3},
+         {"printable", q.printable},
+         {"reasons", q.reasons}};
+  // With a material and a clearance asked (build_implant 6) only, so that older reports read
+  // as they did.
+  if (!q.material_name.empty()) j["material"] = q.material_name;
+  if (q.mass_g > 0.0) j["mass_g"] = q.mass_g;
+  if (q.clearance_asked) {
+    j["clearance_low_mm"] = q.clearance_low_mm;
+    j["clearance_high_mm"] = q.clearance_high_mm;
+  }
+  return j;
 }
 
 Json to_json(const SoftTissueCheck& c) {

@@ -27,16 +27,18 @@ SharedSurface::SharedSurface(const std::string& path, const ExtractBoneSurfacePa
       path(path),
       import(import) {}
 
-ImplantData::ImplantData(ImplantResult result, std::shared_ptr<const SkullInput> skull)
+ImplantData::ImplantData(ImplantResult result, std::shared_ptr<const SkullInput> skull,
+                         QualityParams quality_params)
     : result_(std::move(result)),
       stl_sha256_(sha256_hex(encode_mesh(result_.mesh, MeshFormat::BinarySTL))),
-      skull_(std::move(skull)) {}
+      skull_(std::move(skull)),
+      quality_params_(std::move(quality_params)) {}
 
 const QualityReport& ImplantData::quality() const {
   std::call_once(quality_once_, [this] {
     quality_ = skull_ ? check_implant(result_.mesh, &skull_->surface->mesh,
-                                      &skull_->surface->locator, QualityParams{})
-                      : check_implant(result_.mesh, nullptr);
+                                      &skull_->surface->locator, quality_params_)
+                      : check_implant(result_.mesh, nullptr, quality_params_);
   });
   return quality_;
 }
@@ -292,7 +294,8 @@ void rebuild_implant(PlanState& s) {
                   format_count(static_cast<long long>(r.mesh.n_faces())).c_str(),
                   r.watertight ? "watertight" : "not watertight");
     s.message = buf;
-    s.implant = std::make_shared<const ImplantData>(std::move(r), s.skull);
+    s.implant = std::make_shared<const ImplantData>(
+        std::move(r), s.skull, quality_params_for(p.material, p.clearance_zones));
   } else {
     s.message = "implant not built: " + r.message;
     s.implant.reset();

@@ -179,6 +179,45 @@ TEST(Cli, ImplantSubcommandsAndTheirErrors) {
   EXPECT_EQ(test::run_command(kCli + " evaluate " + dir.path("")), 3);  // no cases in it
 }
 
+// A material on the command line: autoplan builds with it (its clearance kept on every arc, its
+// mass), qa checks an implant against it, and a material or value out of range is a usage
+// error that names it.
+TEST(Cli, AutoplanAndQaWithAMaterial) {
+  test::TempDir dir;
+  write_mesh(test::thick_head_defect().defective, dir.path("skull.stl"));
+  std::string out;
+  ASSERT_EQ(test::run_command(kCli + " autoplan --json " + dir.path("skull.stl") +
+                                  " --material pmma --clearance 1.5 -o " + dir.path("i.stl"),
+                              &out),
+            0)
+      << out;
+  const Json q = Json::parse(out)["quality"];
+  EXPECT_EQ(q["material"], "PMMA");
+  EXPECT_GE(q["clearance_low_mm"].get<double>(), -0.2);
+  EXPECT_LE(q["clearance_high_mm"].get<double>(), 0.2);
+  EXPECT_NEAR(q["mass_g"].get<double>(), q["volume_mm3"].get<double>() * 1.18e-3, 1e-6);
+  ASSERT_EQ(test::run_command(kCli + " qa --json " + dir.path("i.stl") + " --skull " +
+                                  dir.path("skull.stl") + " --material pmma --clearance 1.5",
+                              &out),
+            0)
+      << out;
+  EXPECT_NEAR(Json::parse(out)["rim_gap_mm"].get<double>(), 1.5, 0.2);
+  // Checked against a 3 mm clearance it would not go in.
+  ASSERT_EQ(test::run_command(kCli + " qa --json " + dir.path("i.stl") + " --skull " +
+                                  dir.path("skull.stl") + " --material pmma --clearance 3",
+                              &out),
+            1);
+  EXPECT_NE(out.find("nearer the bone than the clearance asked"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(kCli + " autoplan " + dir.path("skull.stl") +
+                                  " --material bone-cement -o " + dir.path("x.stl"),
+                              &out),
+            2);
+  EXPECT_EQ(test::run_command(kCli + " autoplan " + dir.path("skull.stl") +
+                                  " --material titanium --clearance 1 -o " + dir.path("x.stl"),
+                              &out),
+            2);
+}
+
 TEST(Cli, StudyInjectsPlansAndScoresDefects) {
   test::TempDir dir;
   write_mesh(test::make_thick_head(), dir.path("thick.stl"));

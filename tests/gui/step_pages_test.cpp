@@ -182,6 +182,51 @@ TEST(StepPages, BuildPushesTheParametersTheControlsShow) {
   EXPECT_DOUBLE_EQ(p.at("fit_to_bone_mm").get<double>(), 4.0);
 }
 
+// A material chosen fills its values and is built with them (the fit to the bone turned on for
+// its clearance); with "mark a wider clearance" on, a click on the rim adds a clearance zone
+// and builds again; the zone is removed the same way. A plan built with a material shows it.
+TEST(StepPages, TheMaterialAndClearanceZonesAreBuilt) {
+  RecordingHost host;
+  BuildPage page(host);
+  host.state.implant_params = ImplantParams{};
+  page.show_state(host.state);
+  EXPECT_FALSE(child<QDoubleSpinBox>(page, "materialClearance")->isEnabled());
+  child<QComboBox>(page, "implantMaterial")->setCurrentIndex(2);  // PMMA
+  EXPECT_DOUBLE_EQ(child<QDoubleSpinBox>(page, "materialUnderContour")->value(), 0.5);
+  EXPECT_DOUBLE_EQ(child<QDoubleSpinBox>(page, "implantFit")->value(), 4.0);
+  child<QDoubleSpinBox>(page, "materialClearance")->setValue(1.5);
+  click(page, "build");
+  ASSERT_EQ(host.pushed.size(), 1u);
+  const Json& built = host.pushed.back().params.at("params");
+  EXPECT_EQ(built.at("material").at("name"), "PMMA");
+  EXPECT_DOUBLE_EQ(built.at("material").at("edge_clearance_mm").get<double>(), 1.5);
+  EXPECT_TRUE(built.at("clearance_zones").empty());
+
+  EXPECT_EQ(page.pick_target(), SkullView::PickTarget::None) << "clicks do nothing until asked";
+  page.surface_clicked(Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(host.pushed.size(), 1u);
+  child<QPushButton>(page, "markZone")->setChecked(true);
+  EXPECT_EQ(page.pick_target(), SkullView::PickTarget::Original);
+  child<QDoubleSpinBox>(page, "zoneClearance")->setValue(2.5);
+  page.surface_clicked(Eigen::Vector3d(1, 2, 3));
+  ASSERT_EQ(host.pushed.size(), 2u);
+  const Json& zoned = host.pushed.back().params.at("params");
+  ASSERT_EQ(zoned.at("clearance_zones").size(), 1u);
+  EXPECT_DOUBLE_EQ(zoned.at("clearance_zones")[0].at("clearance_mm").get<double>(), 2.5);
+  EXPECT_DOUBLE_EQ(zoned.at("clearance_zones")[0].at("radius_mm").get<double>(), 15.0);
+
+  // The plan as it now stands (the zone built), shown; then the zone removed.
+  ImplantParams now;
+  params_from_json(ParamReader(zoned, "test"), now);
+  host.state.implant_params = now;
+  page.show_state(host.state);
+  EXPECT_EQ(child<QComboBox>(page, "implantMaterial")->currentText(), "PMMA");
+  EXPECT_DOUBLE_EQ(child<QDoubleSpinBox>(page, "materialClearance")->value(), 1.5);
+  click(page, "removeZone");
+  ASSERT_EQ(host.pushed.size(), 3u);
+  EXPECT_TRUE(host.pushed.back().params.at("params").at("clearance_zones").empty());
+}
+
 TEST(StepPages, SmoothingIsPreviewedThenApplied) {
   RecordingHost host;
   SmoothPage page(host);

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 
 #include "cranioplan/algorithms/io/mesh_report.h"
@@ -156,6 +157,51 @@ TEST(Commands, PlansSavedBeforeVotingThroughHolesFitTheBoneAsThen) {
   params_from_json(ParamReader(v4, "test"), back);
   EXPECT_FALSE(back.trim.vote_through_holes);
   EXPECT_TRUE(back.trim.thin_fills_removed) << "the rest of version 4 as recorded";
+}
+
+// build_implant 6 records the material and the clearance zones in full (a replay uses the
+// values of the day, not the presets of a later version); version 5 reads with neither. A
+// material out of its ranges in a file is refused with the value named.
+TEST(Commands, TheBuildRecordsItsMaterialAndClearanceZones) {
+  ImplantParams p;
+  p.fit_to_bone_mm = 4.0;
+  p.material = *material_preset("pmma");
+  p.material->edge_clearance_mm = 1.5;
+  p.clearance_zones = {{Eigen::Vector3d(1, 2, 3), 12.0, 2.5}};
+  const Json build = to_json(commands::build_implant(p));
+  EXPECT_EQ(build["version"], 6);
+  const Json& recorded = build["params"]["params"];
+  EXPECT_EQ(recorded["material"]["name"], "PMMA");
+  EXPECT_TRUE(recorded["material"]["thickness_mm"].is_null()) << "follows the bone";
+  ImplantParams back;
+  params_from_json(ParamReader(recorded, "test"), back);
+  ASSERT_TRUE(back.material);
+  EXPECT_EQ(back.material->id, "pmma");
+  EXPECT_EQ(back.material->edge_clearance_mm, 1.5);
+  EXPECT_EQ(back.material->under_contour_mm, 0.5);
+  EXPECT_TRUE(std::isnan(back.material->thickness_mm));
+  EXPECT_EQ(back.material->density_g_cm3, 1.18);
+  ASSERT_EQ(back.clearance_zones.size(), 1u);
+  EXPECT_EQ(back.clearance_zones[0].center, Eigen::Vector3d(1, 2, 3));
+  EXPECT_EQ(back.clearance_zones[0].clearance_mm, 2.5);
+
+  Json v5 = recorded;
+  v5.erase("material");
+  v5.erase("clearance_zones");
+  params_from_json(ParamReader(v5, "test"), back);
+  EXPECT_FALSE(back.material);
+  EXPECT_TRUE(back.clearance_zones.empty());
+
+  Json bad = recorded;
+  bad["material"]["edge_clearance_mm"] = 7.0;
+  try {
+    params_from_json(ParamReader(bad, "plan.json"), back);
+    ADD_FAILURE() << "a clearance of 7 mm was read";
+  } catch (const SessionError& e) {
+    EXPECT_NE(std::string(e.what()).find("edge clearance must be 0 to 3 mm (7 given)"),
+              std::string::npos)
+        << e.what();
+  }
 }
 
 // A mesh's length unit is part of the load: recorded, replayed, and read as millimetres from

@@ -36,6 +36,8 @@ namespace {
 constexpr double kTwoPi = 2.0 * M_PI;
 // Markers closer than this (mm, in the parametrisation) to an earlier one are not fitted.
 constexpr double kMinMarkerSeparation = 1.0;
+// A plate laid on the bone follows the bone's outer surface up to this far above the fitted one.
+constexpr double kOnlaySearchMm = 20.0;
 // Fitting to the bone seeks the bone to meet up to this many times the margin beyond the rim.
 constexpr double kFitReach = 3.0;
 
@@ -435,7 +437,17 @@ class ShellBuilder {
     return tps.fit(uv, h, smoothing, kMinMarkerSeparation, edges);
   }
   // Depths are kept between 0.3 mm and 20 mm: the inner surface never crosses the outer one.
-  double depth(const Eigen::Vector2d& q) const { return std::clamp(thickness_tps_(q), 0.3, 20.0); }
+  double depth(const Eigen::Vector2d& q) const {
+    return std::clamp(thickness_tps_(q), min_depth(), std::max(20.0, min_depth()));
+  }
+  // How far the inner surface lies at least below the fitted outer one: 0.3 mm, or a material's
+  // minimum thickness below the outer surface it is given (set below the fitted one by the
+  // under-contour, unless the inner surface follows it down).
+  double min_depth() const {
+    if (!params_.material) return 0.3;
+    const bool plate = !std::isnan(params_.material->thickness_mm);
+    return params_.material->min_thickness_mm + (plate ? 0.0 : under_contour());
+  }
   // Outward normal of the outer surface: from the spline's gradient (planar), or the ray
   // direction (radial; the surfaces of a skull are nearly perpendicular to rays from inside).
   Eigen::Vector3d outer_normal(const Eigen::Vector2d& q) const {
@@ -444,7 +456,9 @@ class ShellBuilder {
     return Eigen::Vector3d(f_.n - g.x() * f_.e1 - g.y() * f_.e2).normalized();
   }
   double offset(const Eigen::Vector2d& q) const {
-    return thickness_from_markers_ ? depth(q) : result_.thickness_used_mm;
+    if (thickness_from_markers_) return depth(q);
+    return params_.material ? std::max(result_.thickness_used_mm, min_depth())
+                            : result_.thickness_used_mm;
   }
   PolarPolygon polygon(const std::vector<Eigen::Vector3d>& edges) const {
     PolarPolygon poly{center_, {}, {}, {}};
@@ -467,7 +481,7 @@ class ShellBuilder {
     auto lift_rim = [&](const Eigen::Vector2d& q) {
       if (tps) return f_.lift(q, (*tps)(q));
       // No inner markers: the outer rim offset inwards along the surface normal.
-      return Eigen::Vector3d(f_.lift(q, outer_tps_(q)) - offset(q) * outer_normal(q));
+      return Eigen::Vector3d(f_.lift(q, offset_base(q)) - offset(q) * outer_normal(q));
     };
     for (size_t k = 0; k < n_rim; ++k) {
       const Eigen::Vector2d q = poly.at(angles_[k]).first;
@@ -477,7 +491,11 @@ class ShellBuilder {
       // cut face is oblique, the surface beyond the rim first passes over the missing wedge:
       // the bone is sought further out, up to kFitReach times the margin.
       bool extended = false;
-      if (fit_margin > 0.0 && (q - center_).norm() > 1e-9) {
+      if (fit_margin > 0.0 && onlay() > 0.0 && (q - center_).norm() > 1e-9) {
+        // A plate laid on the bone reaches its overlap beyond the rim, over the outer table.
+        pts[k] = lift_rim(q + onlay() * (q - center_).normalized());
+        extended = true;
+      } else if (fit_margin > 0.0 && (q - center_).norm() > 1e-9) {
         const Eigen::Vector2d out = (q - center_).normalized();
         for (double d = fit_margin; d <= kFitReach * fit_margin + 1e-9; d += 1.0) {
           const Eigen::Vector3d beyond = lift_rim(q + d * out);
@@ -533,12 +551,12 @@ class ShellBuilder {
     // inner surface set in from the outer one, that is the outer height less the offset (not
     // the outer height, which counted the offset twice at the rim).
     const Height offset_height = [&](const Eigen::Vector2d& q) {
-      return f_.h(Eigen::Vector3d(f_.lift(q, outer_tps_(q)) - offset(q) * outer_normal(q)));
+      return f_.h(Eigen::Vector3d(f_.lift(q, offset_base(q)) - offset(q) * outer_normal(q)));
     };
     const PolarPolygon poly = rim_polygon(rim, offset_from_outer ? &offset_height : tps);
     auto surface_point = [&](const Eigen::Vector2d& q, double correction) {
       if (!offset_from_outer) return f_.lift(q, (*tps)(q) + correction);
-      return Eigen::Vector3d(f_.lift(q, outer_tps_(q) + correction) - offset(q) * outer_normal(q));
+      return Eigen::Vector3d(f_.lift(q, offset_base(q) + correction) - offset(q) * outer_normal(q));
     };
     const size_t n_rim = angles_.size();
     std::vector<Eigen::Vector3i> tris;
@@ -600,7 +618,34 @@ class ShellBuilder {
   Frame f_;
   ThinPlateSpline outer_tps_, thickness_tps_;
   bool thickness_from_markers_ = false;
-  const Height outer_height_ = [this](const Eigen::Vector2d& q) { return outer_tps_(q); };
+  // The outer surface is set `under_contour` below the fitted one. An inner surface set in from
+  // it by a thickness of the material's follows it down (the plate keeps its thickness); one
+  // set in by the bone's thickness, or fitted to inner markers, stays at the inner table.
+  double under_contour() const {
+    return params_.material ? std::max(0.0, params_.material->under_contour_mm) : 0.0;
+  }
+  // A plate laid on the bone is raised by its thickness: its inner surface is the fitted outer
+  // one.
+  double onlay() const { return params_.material ? params_.material->onlay_mm : 0.0; }
+  double raise() const { return onlay() > 0.0 ? params_.material->thickness_mm : 0.0; }
+  // Where the plate lies: the fitted outer surface, or the bone's outer surface where that
+  // stands higher (a brow ridge the fitted surface passes under): the first bone met coming in
+  // from 20 mm outside along the surface's normal line.
+  double onlay_base(const Eigen::Vector2d& q) const {
+    const double fitted = outer_tps_(q);
+    if (!bone_) return fitted;
+    const auto hit =
+        bone_->first_hit(f_.lift(q, fitted + kOnlaySearchMm), f_.lift(q, fitted - kOnlaySearchMm));
+    return hit ? std::max(fitted, f_.h(hit->point)) : fitted;
+  }
+  double offset_base(const Eigen::Vector2d& q) const {
+    if (onlay() > 0.0) return onlay_base(q) + raise();
+    const bool plate = params_.material && !std::isnan(params_.material->thickness_mm);
+    return outer_tps_(q) - (plate ? under_contour() : 0.0);
+  }
+  const Height outer_height_ = [this](const Eigen::Vector2d& q) {
+    return onlay() > 0.0 ? onlay_base(q) + raise() : outer_tps_(q) - under_contour();
+  };
   const Height inner_height_ = [this](const Eigen::Vector2d& q) {
     return outer_tps_(q) - depth(q);
   };
@@ -684,12 +729,63 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
   return build_implant(markers, skull, nullptr, params);
 }
 
+namespace {
+
+// Why the material or the clearance zones cannot be applied, or empty.
+std::string finishing_problem(const ImplantParams& params, const SkullMesh* skull) {
+  if (params.material) {
+    const std::string problem = material_problem(*params.material);
+    if (!problem.empty()) return params.material->name + ": " + problem;
+  }
+  for (size_t k = 0; k < params.clearance_zones.size(); ++k) {
+    const std::string problem = zone_problem(params.clearance_zones[k]);
+    if (!problem.empty()) return "clearance zone " + std::to_string(k + 1) + ": " + problem;
+  }
+  const bool finished = !params.clearance_zones.empty() ||
+                        (params.material && (params.material->edge_clearance_mm > 0.0 ||
+                                             params.material->under_contour_mm > 0.0 ||
+                                             params.material->onlay_mm > 0.0));
+  if (finished && params.method != ImplantMethod::Shell)
+    return "an edge clearance, under-contour or onlay needs the shell method";
+  if (finished && (params.fit_to_bone_mm <= 0.0 || !skull || skull->n_faces() == 0))
+    return "an edge clearance, under-contour or onlay is made by fitting the implant to the "
+           "bone: set fit to bone (4 mm) with the skull";
+  return {};
+}
+
+}  // namespace
+
 ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh* skull,
-                            const SurfaceLocator* skull_locator, const ImplantParams& params) {
+                            const SurfaceLocator* skull_locator, const ImplantParams& given) {
   const auto t0 = std::chrono::steady_clock::now();
+  if (const std::string problem = finishing_problem(given, skull); !problem.empty()) {
+    ImplantResult r;
+    r.message = problem;
+    return r;
+  }
+  // The material's thickness replaces the plan's inner surface; its clearance is the fit's.
+  ImplantParams params = given;
+  std::vector<Marker> outer_only;
+  const bool plate = given.material && !std::isnan(given.material->thickness_mm);
+  if (plate) {
+    params.thickness_mm = given.material->thickness_mm;
+    for (const Marker& m : markers)
+      if (is_outer(m.type)) outer_only.push_back(m);
+  }
+  // The fit to the bone leaves nothing thinner than the material's minimum (and keeps a plate
+  // of the material's thickness, which the default feature size would take away).
+  if (given.material) params.trim.min_feature_mm = given.material->min_thickness_mm;
+  if (given.material && given.material->edge_clearance_mm > 0.0)
+    params.trim.clearance_mm =
+        std::max(params.trim.clearance_mm.value_or(0.0), given.material->edge_clearance_mm);
+  if (!given.clearance_zones.empty()) {
+    if (!params.trim.clearance_mm) params.trim.clearance_mm = 0.0;
+    params.trim.zones = given.clearance_zones;
+  }
+  const std::vector<Marker>& used = plate ? outer_only : markers;
   ImplantResult r = params.method == ImplantMethod::Shell
-                        ? build_shell(markers, skull, skull_locator, params)
-                        : build_delaunay(markers, params);
+                        ? build_shell(used, skull, skull_locator, params)
+                        : build_delaunay(used, params);
   if (r.usable() && params.method == ImplantMethod::Shell && params.fit_to_bone_mm > 0.0 && skull &&
       skull->n_faces() > 0) {
     TrimToBoneResult t = trim_to_bone(r.mesh, *skull, params.trim);

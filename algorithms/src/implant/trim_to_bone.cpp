@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 #include <vector>
 
 #include "cranioplan/algorithms/geometry/distance_transform.h"
@@ -193,40 +194,50 @@ SkullMesh faces_in_box(const SkullMesh& mesh, const Eigen::Vector3d& lo,
   return build_mesh(soup);
 }
 
-// The implant's smooth field, held `clearance` mm off the skull's surface to a fraction of the
+// The implant's smooth field, held the clearance off the skull's surface to a fraction of the
 // grid: the mask is blurred together with the bone it touches (so the blur does not pull the
-// surface back from the bone), then capped by a field that crosses ½ exactly `clearance` mm
+// surface back from the bone), then capped by a field that crosses ½ exactly the clearance
 // outside the skull's surface, from the distance to its triangles. The surface then follows the
-// bone's own surface rather than its voxels.
+// bone's own surface rather than its voxels. The clearance is `clearance` mm, or a zone's where
+// the nearest bone lies in one. `locator`: the skull's triangles near the grid (none: no
+// surface there).
 std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const VoxelGrid& g,
-                                    const SkullMesh& skull, double sigma_voxels, double clearance) {
+                                    const SurfaceLocator* locator, double sigma_voxels,
+                                    double clearance, const std::vector<ClearanceZone>& zones) {
   const double h = g.spacing;
+  double widest = clearance;
+  for (const ClearanceZone& z : zones) widest = std::max(widest, z.clearance_mm);
   // Bone within two voxels of the implant joins the blur.
   const Mask near_implant = dilate(dilate(mask, g), g);
   Mask joined = mask;
   for (size_t c = 0; c < joined.size(); ++c) joined[c] = mask[c] || (bone[c] && near_implant[c]);
   std::vector<float> field = blur(joined, g, sigma_voxels);
   Mask().swap(joined);
-  // The skull's triangles near the grid suffice for distances up to a few voxels.
-  const double reach = 3.0 * h + clearance;
-  const Eigen::Vector3d lo = g.origin - Eigen::Vector3d::Constant(reach);
-  const Eigen::Vector3d hi =
-      g.center(g.dims[0] - 1, g.dims[1] - 1, g.dims[2] - 1) + Eigen::Vector3d::Constant(reach);
-  const SkullMesh local = faces_in_box(skull, lo, hi);
-  if (local.n_faces() == 0) {  // no surface near the grid: its bone voxels stay empty
+  if (!locator) {  // no surface near the grid: its bone voxels stay empty
     for (size_t c = 0; c < field.size(); ++c)
       if (bone[c]) field[c] = 0.0f;
     return field;
   }
-  const SurfaceLocator locator(local);
-  const Mask near_bone = dilate(dilate(bone, g), g);
+  // The cap is below 1 up to a voxel beyond the clearance: the bone grown by two voxels holds
+  // that band while the clearance is at most a voxel; a wider one takes the distance to it.
+  Mask near_bone;
+  if (widest <= h) {
+    near_bone = dilate(dilate(bone, g), g);
+  } else {
+    const std::vector<float> to_bone = distance_to_mask(bone, g);
+    near_bone.resize(to_bone.size());
+    const float band = static_cast<float>(widest + 2.0 * h);
+    for (size_t c = 0; c < to_bone.size(); ++c) near_bone[c] = to_bone[c] <= band;
+  }
   for (int k = 0; k < g.dims[2]; ++k)
     for (int j = 0; j < g.dims[1]; ++j)
       for (int i = 0; i < g.dims[0]; ++i) {
         const size_t c = g.index(i, j, k);
         if (field[c] <= 0.0f || !near_bone[c]) continue;
-        const double d = locator.closest(g.center(i, j, k)).distance * (bone[c] ? -1.0 : 1.0);
-        const double cap = std::clamp(0.5 + (d - clearance) / h, 0.0, 1.0);
+        const auto near = locator->closest(g.center(i, j, k));
+        const double d = near.distance * (bone[c] ? -1.0 : 1.0);
+        const double want = zones.empty() ? clearance : clearance_at(near.point, clearance, zones);
+        const double cap = std::clamp(0.5 + (d - want) / h, 0.0, 1.0);
         field[c] = std::min(field[c], static_cast<float>(cap));
       }
   // Every bone voxel is in the band, and half a voxel or more inside the surface its cap is 0
@@ -252,6 +263,36 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
   for (size_t c = 0; c < mask.size(); ++c) {
     before += mask[c];
     mask[c] = mask[c] && !bone[c];
+  }
+  // The skull's triangles near the grid suffice for distances up to a few voxels beyond the
+  // widest clearance.
+  double widest = params.clearance_mm.value_or(0.0);
+  for (const ClearanceZone& z : params.zones) widest = std::max(widest, z.clearance_mm);
+  std::unique_ptr<SurfaceLocator> locator;
+  SkullMesh local;
+  if (params.clearance_mm) {
+    const double reach = 3.0 * h + widest;
+    local = faces_in_box(skull, grid.origin - Eigen::Vector3d::Constant(reach),
+                         grid.center(grid.dims[0] - 1, grid.dims[1] - 1, grid.dims[2] - 1) +
+                             Eigen::Vector3d::Constant(reach));
+    if (local.n_faces() > 0) locator = std::make_unique<SurfaceLocator>(local);
+  }
+  // A clearance wider than a voxel is cut first (to the voxels' resolution; the surface is held
+  // at it exactly below), so that the opening also takes what it leaves thin: a tongue of the
+  // implant reaching between two pieces of bone narrows by the clearance from both sides.
+  if (locator && widest > h) {
+    const std::vector<float> to_bone = distance_to_mask(bone, grid);
+    for (int k = 0; k < grid.dims[2]; ++k)
+      for (int j = 0; j < grid.dims[1]; ++j)
+        for (int i = 0; i < grid.dims[0]; ++i) {
+          const size_t c = grid.index(i, j, k);
+          if (!mask[c] || to_bone[c] >= widest) continue;
+          const double want = params.zones.empty()
+                                  ? *params.clearance_mm
+                                  : clearance_at(locator->closest(grid.center(i, j, k)).point,
+                                                 *params.clearance_mm, params.zones);
+          if (to_bone[c] < want) mask[c] = 0;
+        }
   }
   // Opening by a ball: slivers thinner than the feature size (left on top of intact bone, and
   // the thin lip where the shell's outer surface grazes the bone's) disappear, so the implant
@@ -299,8 +340,8 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
   }
   std::vector<float> smooth;
   if (params.clearance_mm) {
-    smooth = fit_against_bone(mask, bone, grid, skull, params.smoothing_mm / h,
-                              std::max(0.0, *params.clearance_mm));
+    smooth = fit_against_bone(mask, bone, grid, locator.get(), params.smoothing_mm / h,
+                              std::max(0.0, *params.clearance_mm), params.zones);
     Mask().swap(mask);
   } else {
     // Without a clearance (build_implant commands before version 4): neither the grid nor the

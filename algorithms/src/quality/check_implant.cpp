@@ -29,8 +29,8 @@ std::string fmt1(const char* f, double a) {
 }
 // Material thinner than the minimum: the solid minus its opening by a ball of that diameter
 // (the union of the balls that fit inside). Where it lies within its own thinness of the bone
-// it is the tapered edge of an implant resting on the bone; how far it reaches from the thick
-// part is the width of that taper.
+// (and the clearance asked) it is the tapered edge of an implant resting on the bone; how far
+// it reaches from the thick part is the width of that taper.
 void measure_thin_material(const std::vector<uint8_t>& solid, const std::vector<float>& depth,
                            const VoxelGrid& grid, const std::vector<float>& bone_distance,
                            const QualityParams& params, QualityReport& q) {
@@ -41,12 +41,17 @@ void measure_thin_material(const std::vector<uint8_t>& solid, const std::vector<
     return;
   }
   const std::vector<float> to_core = distance_to_mask(centres, grid);
+  // An edge held a clearance off the bone tapers that much further from it.
+  double clearance = params.edge_clearance_mm;
+  for (const ClearanceZone& z : params.clearance_zones)
+    clearance = std::max(clearance, z.clearance_mm);
+  const double on_bone = params.min_thickness_mm + 1.5 * h + std::max(0.0, clearance);
   size_t thin = 0, off_bone = 0;
   for (size_t c = 0; c < solid.size(); ++c) {
     if (!solid[c] || to_core[c] <= r + h) continue;  // within a ball that fits (one voxel slack)
     ++thin;
     const double reach = static_cast<double>(to_core[c]) - r;
-    if (!bone_distance.empty() && bone_distance[c] <= params.min_thickness_mm + 1.5 * h) {
+    if (!bone_distance.empty() && bone_distance[c] <= on_bone) {
       q.taper_reach_mm = std::max(q.taper_reach_mm, reach);
     } else {
       ++off_bone;
@@ -160,19 +165,34 @@ std::vector<float> measure_against_bone(const SkullMesh& implant, const SkullMes
                                         const SurfaceLocator& bone, const Eigen::Vector3d& c,
                                         const Eigen::Vector3d& axis, std::vector<int> wall_vertices,
                                         const std::vector<uint8_t>& solid, const VoxelGrid& grid,
-                                        QualityReport& q) {
+                                        const QualityParams& params, QualityReport& q) {
   std::sort(wall_vertices.begin(), wall_vertices.end());
   wall_vertices.erase(std::unique(wall_vertices.begin(), wall_vertices.end()), wall_vertices.end());
   const Eigen::Vector3d e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
   std::vector<double> angle, distance;
+  std::vector<Eigen::Vector3d> nearest;  // the bone point each wall vertex faces
   angle.reserve(wall_vertices.size());
   distance.reserve(wall_vertices.size());
+  nearest.reserve(wall_vertices.size());
   for (int v : wall_vertices) {
     const Eigen::Vector3d p = to_eigen(implant.point(SkullMesh::VertexHandle(v)));
     angle.push_back(std::atan2((p - c).dot(e2), (p - c).dot(e1)));
-    distance.push_back(bone.closest(p).distance);
+    const auto near = bone.closest(p);
+    distance.push_back(near.distance);
+    nearest.push_back(near.point);
   }
   q.rim_gap_mm = worst_arc_gap(angle, distance, M_PI / 36);
+  if (params.edge_clearance_mm > 0.0 || !params.clearance_zones.empty()) {
+    // The excess of each wall vertex's gap over the clearance asked at the bone it faces: the
+    // worst arc's (its nearest vertex to the bone) and the smallest of all.
+    std::vector<double> excess(distance.size());
+    for (size_t i = 0; i < distance.size(); ++i)
+      excess[i] =
+          distance[i] - clearance_at(nearest[i], params.edge_clearance_mm, params.clearance_zones);
+    q.clearance_asked = true;
+    q.clearance_high_mm = worst_arc_gap(angle, excess, M_PI / 36);
+    q.clearance_low_mm = excess.empty() ? 0.0 : *std::min_element(excess.begin(), excess.end());
+  }
   const std::vector<uint8_t> b = voxelize_mesh(skull, grid);
   long long both = 0;
   for (size_t i = 0; i < solid.size(); ++i) both += solid[i] && b[i];
@@ -210,15 +230,37 @@ void add_reasons(const MeshReport& rep, const QualityParams& params, bool with_b
                             params.min_thickness_mm, q.taper_reach_mm) +
                         " (a tapered edge on the bone may be " + fmt1("%.1f", params.max_taper_mm) +
                         " mm wide)");
-  if (q.rim_gap_mm > params.max_rim_gap_mm)
+  if (!q.clearance_asked && q.rim_gap_mm > params.max_rim_gap_mm)
     q.reasons.push_back(fmt("gap of %.2f mm between the rim and the bone (limit %.2f mm)",
                             q.rim_gap_mm, params.max_rim_gap_mm));
+  if (q.clearance_asked && q.clearance_high_mm > params.max_rim_gap_mm)
+    q.reasons.push_back(
+        fmt("a gap %.2f mm wider than the clearance asked between the rim and "
+            "the bone (limit %.2f mm)",
+            q.clearance_high_mm, params.max_rim_gap_mm));
+  if (q.clearance_asked && q.clearance_low_mm < -params.clearance_tolerance_mm)
+    q.reasons.push_back(
+        fmt("the edge comes %.2f mm nearer the bone than the clearance asked "
+            "(tolerance %.2f mm): it would not go in",
+            -q.clearance_low_mm, params.clearance_tolerance_mm));
   if (q.penetration_mm3 > params.max_penetration_mm3)
     q.reasons.push_back(fmt("%.1f mm³ overlap the skull (limit %.1f mm³)", q.penetration_mm3,
                             params.max_penetration_mm3));
 }
 
 }  // namespace
+
+QualityParams quality_params_for(const std::optional<Material>& material,
+                                 const std::vector<ClearanceZone>& zones) {
+  QualityParams q;
+  q.clearance_zones = zones;
+  if (!material) return q;
+  q.min_thickness_mm = material->min_thickness_mm;
+  q.edge_clearance_mm = material->edge_clearance_mm;
+  q.density_g_cm3 = material->density_g_cm3;
+  q.material_name = material->name;
+  return q;
+}
 
 QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
                             const QualityParams& params) {
@@ -236,6 +278,8 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
   q.outward = rep.volume_mm3 > 0;
   q.pieces = rep.pieces;
   q.self_intersections = count_self_intersections(implant);
+  q.material_name = params.material_name;
+  if (params.density_g_cm3 > 0.0) q.mass_g = rep.volume_mm3 * 1e-3 * params.density_g_cm3;
   if (implant.n_faces() == 0) {
     q.reasons.push_back("the implant has no triangles");
     return q;
@@ -274,7 +318,7 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
     if (!skull_locator) own = std::make_unique<SurfaceLocator>(*skull);
     const SurfaceLocator& bone = skull_locator ? *skull_locator : *own;
     bone_distance = measure_against_bone(implant, *skull, bone, c, axis, std::move(wall_vertices),
-                                         solid, grid, q);
+                                         solid, grid, params, q);
   }
   measure_thin_material(solid, depth, grid, bone_distance, params, q);
   add_reasons(rep, params, !bone_distance.empty(), q);

@@ -36,12 +36,105 @@ BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
   form_->addRow(tr("Resolution"), resolution_);
   form_->addRow(tr("Thickness without inner markers"), thickness_);
   form_->addRow(tr("Fit to the bone"), fit_);
+
+  // The material: a preset fills its values, which may then be changed.
+  material_ = new QComboBox(this);
+  material_->setObjectName("implantMaterial");
+  material_->addItem(tr("None (the plan's surfaces)"));
+  for (const Material& m : material_presets()) material_->addItem(QString::fromStdString(m.name));
+  material_->addItem(tr("Custom"));
+  auto spin = [this](const char* name, double lo, double hi, double step, const QString& suffix) {
+    auto* b = new QDoubleSpinBox(this);
+    b->setObjectName(name);
+    b->setRange(lo, hi);
+    b->setSingleStep(step);
+    b->setSuffix(suffix);
+    return b;
+  };
+  clearance_ = spin("materialClearance", 0, 3, 0.1, " mm");
+  clearance_->setToolTip(tr("Gap left between the implant's edge and the bone's cut edge"));
+  under_contour_ = spin("materialUnderContour", 0, 1, 0.1, " mm");
+  under_contour_->setToolTip(tr("The outer surface set this far below the skull's"));
+  min_thickness_ = spin("materialMinThickness", 0.3, 10, 0.1, " mm");
+  plate_ = spin("materialPlate", 0, 15, 0.1, " mm");
+  plate_->setSpecialValueText(tr("follows the bone"));
+  density_ = spin("materialDensity", 0.1, 25, 0.01, " g/cm³");
+  form_->addRow(tr("Material"), material_);
+  form_->addRow(tr("Edge clearance"), clearance_);
+  form_->addRow(tr("Under-contour"), under_contour_);
+  form_->addRow(tr("Minimum thickness"), min_thickness_);
+  form_->addRow(tr("Plate thickness"), plate_);
+  form_->addRow(tr("Density"), density_);
+  connect(material_, &QComboBox::currentIndexChanged, this, [this](int i) {
+    show_material(i);
+    // Clearance and under-contour are made by the fit to the bone.
+    if (i > 0 && fit_->value() == 0) fit_->setValue(4.0);
+  });
+
+  // Clearance zones: a wider gap along stretches of the rim the user marks.
+  mark_zone_ = make_button(tr("Mark a wider clearance on the rim"), "markZone");
+  mark_zone_->setCheckable(true);
+  mark_zone_->setToolTip(
+      tr("Then click the rim: the stretch within the radius keeps the zone's "
+         "clearance (e.g. 3 mm under the temporalis muscle)"));
+  connect(mark_zone_, &QPushButton::toggled, this,
+          [this](bool) { host_.view().set_pick_target(pick_target()); });
+  zone_radius_ = spin("zoneRadius", 1, 100, 1, " mm");
+  zone_radius_->setValue(15);
+  zone_clearance_ = spin("zoneClearance", 0, 3, 0.1, " mm");
+  zone_clearance_->setValue(3);
+  remove_zone_ = make_button(tr("Remove the last zone"), "removeZone");
+  connect(remove_zone_, &QPushButton::clicked, this, [this] {
+    if (zones_.empty()) return;
+    zones_.pop_back();
+    rebuild();
+  });
+  form_->addRow(mark_zone_);
+  form_->addRow(tr("Zone radius"), zone_radius_);
+  form_->addRow(tr("Zone clearance"), zone_clearance_);
+  form_->addRow(remove_zone_);
+  show_material(0);
+
   QPushButton* build = add_button(tr("Build implant"), "build");
   connect(build, &QPushButton::clicked, this,
           [this] { host_.push(commands::build_implant(params()), tr("Building the implant")); });
   info_ = new QLabel(this);
   info_->setWordWrap(true);
   form_->addRow(info_);
+}
+
+void BuildPage::show_material(int index) {
+  const auto& presets = material_presets();
+  const bool none = index <= 0;
+  for (QDoubleSpinBox* b : {clearance_, under_contour_, min_thickness_, plate_, density_})
+    b->setEnabled(!none);
+  if (none || index > static_cast<int>(presets.size())) return;  // none, or custom: as they are
+  const Material& m = presets[static_cast<size_t>(index - 1)];
+  clearance_->setValue(m.edge_clearance_mm);
+  under_contour_->setValue(m.under_contour_mm);
+  min_thickness_->setValue(m.min_thickness_mm);
+  plate_->setValue(std::isnan(m.thickness_mm) ? 0.0 : m.thickness_mm);
+  density_->setValue(m.density_g_cm3);
+}
+
+void BuildPage::rebuild() {
+  if (!host_.plan().implant_params) return;
+  host_.push(commands::build_implant(params()), tr("Building the implant"));
+}
+
+SkullView::PickTarget BuildPage::pick_target() const {
+  return mark_zone_->isChecked() ? SkullView::PickTarget::Original : SkullView::PickTarget::None;
+}
+
+void BuildPage::surface_clicked(const Eigen::Vector3d& point) {
+  if (!mark_zone_->isChecked()) return;
+  zones_.push_back({point, zone_radius_->value(), zone_clearance_->value()});
+  if (!host_.plan().implant_params) {
+    host_.show_message(tr("Zone marked: it applies when the implant is built (fit to the bone)."),
+                       false);
+    return;
+  }
+  rebuild();
 }
 
 ImplantParams BuildPage::params() const {
@@ -51,6 +144,19 @@ ImplantParams BuildPage::params() const {
   if (thickness_->value() > 0) p.thickness_mm = thickness_->value();
   p.surface_smoothing = 0.003;
   p.fit_to_bone_mm = fit_->value();
+  const int index = material_->currentIndex();
+  if (index > 0) {
+    const auto& presets = material_presets();
+    Material m;  // custom
+    if (index <= static_cast<int>(presets.size())) m = presets[static_cast<size_t>(index - 1)];
+    m.edge_clearance_mm = clearance_->value();
+    m.under_contour_mm = under_contour_->value();
+    m.min_thickness_mm = min_thickness_->value();
+    m.thickness_mm = plate_->value() > 0 ? plate_->value() : std::nan("");
+    m.density_g_cm3 = density_->value();
+    p.material = m;
+  }
+  p.clearance_zones = zones_;
   return p;
 }
 
@@ -59,17 +165,43 @@ void BuildPage::show_state(const PlanState& s) {
   // fitted to the bone), so pressing Build again keeps them unless changed.
   if (s.implant_params) {
     const ImplantParams& p = *s.implant_params;
-    const QSignalBlocker b1(method_), b2(resolution_), b3(thickness_), b4(fit_);
+    const QSignalBlocker b1(method_), b2(resolution_), b3(thickness_), b4(fit_), b5(material_);
     method_->setCurrentIndex(p.method == ImplantMethod::Shell ? 0 : 1);
     resolution_->setValue(p.resolution_mm);
     thickness_->setValue(std::isnan(p.thickness_mm) ? 0.0 : p.thickness_mm);
     fit_->setValue(p.fit_to_bone_mm);
+    int index = 0;
+    if (p.material) {
+      const auto& presets = material_presets();
+      index = static_cast<int>(presets.size()) + 1;  // custom
+      for (size_t k = 0; k < presets.size(); ++k)
+        if (presets[k].id == p.material->id) index = static_cast<int>(k) + 1;
+    }
+    material_->setCurrentIndex(index);
+    for (QDoubleSpinBox* b : {clearance_, under_contour_, min_thickness_, plate_, density_})
+      b->setEnabled(p.material.has_value());
+    if (p.material) {
+      clearance_->setValue(p.material->edge_clearance_mm);
+      under_contour_->setValue(p.material->under_contour_mm);
+      min_thickness_->setValue(p.material->min_thickness_mm);
+      plate_->setValue(std::isnan(p.material->thickness_mm) ? 0.0 : p.material->thickness_mm);
+      density_->setValue(p.material->density_g_cm3);
+    }
+    zones_ = p.clearance_zones;
   }
-  info_->setText(
+  remove_zone_->setEnabled(!zones_.empty());
+  QString text =
       s.implant ? tr("Implant: %1 triangles, %2")
                       .arg(s.implant->result().mesh.n_faces())
                       .arg(s.implant->result().watertight ? tr("watertight") : tr("not watertight"))
-                : tr("No implant yet."));
+                : tr("No implant yet.");
+  if (s.implant_params && s.implant_params->material)
+    text += "<br>" + QString::fromStdString(describe(*s.implant_params->material));
+  if (!zones_.empty())
+    text += "<br>" + (zones_.size() == 1
+                          ? tr("1 clearance zone on the rim (orange).")
+                          : tr("%1 clearance zones on the rim (orange).").arg(zones_.size()));
+  info_->setText(text);
 }
 
 }  // namespace cranioplan::gui

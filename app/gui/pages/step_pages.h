@@ -124,14 +124,27 @@ class BuildPage : public StepPage {
  public:
   explicit BuildPage(PageHost& host);
   void show_state(const PlanState& state) override;
+  /// With "Mark a wider clearance" on, a click on the rim adds a clearance zone there.
+  void surface_clicked(const Eigen::Vector3d& point) override;
+  SkullView::PickTarget pick_target() const override;
 
  private:
   ImplantParams params() const;
+  /// The chosen preset's values into the fields (none: the fields off).
+  void show_material(int index);
+  /// Builds again with the page's parameters, when there is an implant to rebuild.
+  void rebuild();
 
   QComboBox* method_;
   QDoubleSpinBox* resolution_;
   QDoubleSpinBox* thickness_;
   QDoubleSpinBox* fit_;
+  QComboBox* material_;
+  QDoubleSpinBox *clearance_, *under_contour_, *min_thickness_, *plate_, *density_;
+  QPushButton* mark_zone_;
+  QDoubleSpinBox *zone_radius_, *zone_clearance_;
+  QPushButton* remove_zone_;
+  std::vector<ClearanceZone> zones_;
   QLabel* info_;
 };
 

@@ -2,9 +2,12 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
+
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/implant/snap_markers.h"
 #include "cranioplan/algorithms/io/mesh_report.h"
+#include "cranioplan/algorithms/planning/detect_defect.h"
 #include "cranioplan/algorithms/quality/check_implant.h"
 #include "cranioplan/algorithms/quality/compare_implants.h"
 #include "cranioplan/algorithms/quality/inject_defect.h"
@@ -124,6 +127,145 @@ TEST(BuildImplant, AMarkerOnTheFarSideIsRefusedNotStretched) {
   const ImplantResult r = build_implant(markers, &head, p);
   EXPECT_EQ(r.status, ImplantResult::Status::Failed);
   EXPECT_NE(r.message.find("far side"), std::string::npos) << r.message;
+}
+
+// The right parietal case fitted to the bone, with `material` and `zones`.
+ImplantResult finished(const std::optional<Material>& material,
+                       const std::vector<ClearanceZone>& zones = {}) {
+  const DefectCase& c = right_parietal_case();
+  ImplantParams p;
+  p.fit_to_bone_mm = 4.0;
+  p.material = material;
+  p.clearance_zones = zones;
+  return build_implant(c.markers, &c.defective, p);
+}
+
+Material peek_with(double clearance, double under_contour) {
+  Material m = *material_preset("peek");
+  m.edge_clearance_mm = clearance;
+  m.under_contour_mm = under_contour;
+  return m;
+}
+
+// A material's edge clearance: over every 5° arc of the rim, the gap to the bone is the
+// clearance to 0.2 mm (the measure), and the quality report says so; mass is volume
+// times density.
+TEST(BuildImplant, AMaterialsClearanceHoldsTheEdgeOffTheBoneOnEveryArc) {
+  const DefectCase& c = right_parietal_case();
+  for (double clearance : {0.5, 1.5, 3.0}) {
+    SCOPED_TRACE(clearance);
+    const Material m = peek_with(clearance, 0.0);
+    const ImplantResult r = finished(m);
+    ASSERT_TRUE(r.usable()) << r.message;
+    const QualityReport q = check_implant(r.mesh, &c.defective, quality_params_for(m));
+    ASSERT_TRUE(q.clearance_asked);
+    EXPECT_GE(q.clearance_low_mm, -0.2);
+    EXPECT_LE(q.clearance_high_mm, 0.2);
+    EXPECT_NEAR(q.rim_gap_mm, clearance, 0.2);
+    EXPECT_TRUE(q.printable) << (q.reasons.empty() ? "" : q.reasons[0]);
+    EXPECT_NEAR(q.mass_g, q.volume_mm3 * 1.30e-3, 1e-9);
+    EXPECT_EQ(q.material_name, "PEEK");
+  }
+}
+
+// The radii along rays from the head's centre through the middle of the opening: outer and
+// inner surface of `implant`.
+std::vector<std::pair<double, double>> radii(const SkullMesh& implant) {
+  const SurfaceLocator loc(implant);
+  const Eigen::Vector3d axis = Eigen::Vector3d(0.7, 0.1, 0.7).normalized();
+  const Eigen::Vector3d e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
+  std::vector<std::pair<double, double>> out;
+  for (int i = -3; i <= 3; ++i)
+    for (int j = -3; j <= 3; ++j) {
+      const Eigen::Vector3d d = (axis + 0.04 * (i * e1 + j * e2)).normalized();
+      const RayThroughBone h = [&] {
+        RayThroughBone t;
+        const auto in = loc.first_hit(Eigen::Vector3d::Zero(), 400.0 * d);
+        const auto o = loc.first_hit(400.0 * d, Eigen::Vector3d::Zero());
+        if (in) t.inner = in->point;
+        if (o) t.outer = o->point;
+        return t;
+      }();
+      if (h.inner && h.outer) out.emplace_back(h.outer->norm(), h.inner->norm());
+    }
+  return out;
+}
+
+// Under-contour: the outer surface is set that far below the one fitted to the markers, across
+// the opening; the inner surface (the bone's thickness below) stays where it was (to 0.15 mm:
+// the fit to the bone meshes both again from a 0.25 mm grid).
+TEST(BuildImplant, UnderContourLowersTheOuterSurfaceOnly) {
+  const ImplantResult flush = finished(peek_with(1.0, 0.0));
+  const ImplantResult lowered = finished(peek_with(1.0, 0.8));
+  ASSERT_TRUE(flush.usable() && lowered.usable()) << lowered.message;
+  const auto a = radii(flush.mesh), b = radii(lowered.mesh);
+  ASSERT_EQ(a.size(), 49u);
+  ASSERT_EQ(b.size(), 49u);
+  for (size_t k = 0; k < a.size(); ++k) {
+    EXPECT_NEAR(a[k].first - b[k].first, 0.8, 0.15) << "outer, ray " << k;
+    EXPECT_NEAR(a[k].second - b[k].second, 0.0, 0.15) << "inner, ray " << k;
+  }
+}
+
+// A clearance zone over one side of the rim: the edge there keeps its 3 mm, the rest the
+// material's 1 mm, every arc within 0.2 mm of what is asked where it lies.
+TEST(BuildImplant, AClearanceZoneWidensTheGapAlongItsStretch) {
+  const DefectCase& c = right_parietal_case();
+  // The outer edge marker farthest along y: the zone is centred there.
+  Eigen::Vector3d side = Eigen::Vector3d::Zero();
+  for (const Marker& m : c.markers)
+    if (m.type == MarkerType::OuterEdge && (side.isZero() || m.position.y() > side.y()))
+      side = m.position;
+  const std::vector<ClearanceZone> zones = {{side, 15.0, 3.0}};
+  const Material m = peek_with(1.0, 0.0);
+  const ImplantResult r = finished(m, zones);
+  ASSERT_TRUE(r.usable()) << r.message;
+  const QualityReport q = check_implant(r.mesh, &c.defective, quality_params_for(m, zones));
+  EXPECT_GE(q.clearance_low_mm, -0.2);
+  EXPECT_LE(q.clearance_high_mm, 0.2);
+  EXPECT_NEAR(q.rim_gap_mm, 3.0, 0.2) << "the widest gap is the zone's";
+  EXPECT_TRUE(q.printable) << (q.reasons.empty() ? "" : q.reasons[0]);
+}
+
+// A titanium plate laid on the bone: 1 mm thick over the opening, its underside the fitted outer
+// surface, and over the rim onto the outer table.
+TEST(BuildImplant, ATitaniumPlateLiesOnTheBoneOverTheOpening) {
+  const DefectCase& c = right_parietal_case();
+  const Material ti = *material_preset("titanium");
+  const ImplantResult r = finished(ti);
+  ASSERT_TRUE(r.usable()) << r.message;
+  const QualityReport q = check_implant(r.mesh, &c.defective, quality_params_for(ti));
+  EXPECT_TRUE(q.printable) << (q.reasons.empty() ? "" : q.reasons[0]);
+  EXPECT_NEAR(q.thickness_median_mm, 1.0, 0.15);
+  EXPECT_LT(q.penetration_mm3, 0.1) << "on the bone, not in it";
+  EXPECT_NEAR(q.mass_g, q.volume_mm3 * 4.43e-3, 1e-9);
+  // Across the opening it is the plate's thickness; its underside is the outer surface fitted
+  // to the markers, the implant's without a material.
+  const auto plate_radii = radii(r.mesh), flush = radii(finished(std::nullopt).mesh);
+  ASSERT_EQ(plate_radii.size(), flush.size());
+  for (size_t k = 0; k < flush.size(); ++k) {
+    EXPECT_NEAR(plate_radii[k].first - plate_radii[k].second, 1.0, 0.2) << k;
+    EXPECT_NEAR(plate_radii[k].second, flush[k].first, 0.3) << k;
+  }
+  // It covers the rim: every outer edge marker (on the outer table) lies under it.
+  const SurfaceLocator plate(r.mesh);
+  for (const Marker& m : c.markers)
+    if (m.type == MarkerType::OuterEdge) {
+      EXPECT_LT(plate.closest(m.position).distance, 0.5) << m.id;
+    }
+}
+
+TEST(BuildImplant, FinishingWithoutTheFitToTheBoneIsRefused) {
+  const DefectCase& c = right_parietal_case();
+  ImplantParams p;
+  p.material = peek_with(1.0, 0.0);
+  const ImplantResult r = build_implant(c.markers, &c.defective, p);
+  EXPECT_FALSE(r.usable());
+  EXPECT_NE(r.message.find("fit to bone"), std::string::npos) << r.message;
+  p.material->edge_clearance_mm = 5.0;
+  p.fit_to_bone_mm = 4.0;
+  EXPECT_NE(build_implant(c.markers, &c.defective, p).message.find("edge clearance must be"),
+            std::string::npos);
 }
 
 }  // namespace

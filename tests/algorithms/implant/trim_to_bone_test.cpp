@@ -162,6 +162,38 @@ TEST(TrimToBone, ARodOfFillToAFragmentGoes) {
   EXPECT_LE(q.corner_reach_mm, 0.8);
 }
 
+// Plates 20 mm apart with an edge clearance of 2 mm (a material's), and 3 mm along the left cut
+// face (a clearance zone, blending into the 2 mm beyond its radius): each wall lies its
+// clearance off its cut face, to 0.2 mm, on the coarse grid.
+TEST(TrimToBone, HoldsAWideClearanceAndAZoneOffObliqueCutFaces) {
+  const Eigen::Matrix3d r =
+      (Eigen::AngleAxisd(0.5, Eigen::Vector3d(1, 2, 3).normalized())).toRotationMatrix();
+  const SkullMesh bone =
+      turned(merge(box({0, 0, 0}, {20, 20, 5}), box({40, 0, 0}, {60, 20, 5})), r);
+  const SkullMesh implant = turned(build_mesh(box({17, 2, 0}, {43, 18, 5.3})), r);
+  TrimToBoneParams p;
+  p.max_voxels = 1e5;
+  p.clearance_mm = 2.0;
+  p.zones = {{r * Eigen::Vector3d(20, 10, 2.5), 6.5, 3.0}};  // the left cut face
+  const TrimToBoneResult t = trim_to_bone(implant, bone, p);
+  ASSERT_TRUE(t.usable()) << t.message;
+  const SurfaceLocator locator(bone);
+  std::vector<double> left, right;
+  for (auto vh : t.mesh.vertices()) {
+    const Eigen::Vector3d q = r.transpose() * to_eigen(t.mesh.point(vh));
+    if (q.z() < 1 || q.z() > 4 || q.y() < 4 || q.y() > 16) continue;
+    const double d = locator.closest(r * q).distance;
+    if (std::abs(q.x() - 23) < 0.5) left.push_back(d);
+    if (std::abs(q.x() - 38) < 0.5) right.push_back(d);
+  }
+  ASSERT_GT(left.size(), 30u);
+  ASSERT_GT(right.size(), 30u);
+  for (double d : left) EXPECT_NEAR(d, 3.0, 0.2) << "the zone's clearance";
+  for (double d : right) EXPECT_NEAR(d, 2.0, 0.2) << "the clearance";
+  EXPECT_EQ(check_implant(t.mesh, &bone).penetration_mm3, 0.0);
+  EXPECT_TRUE(report_mesh(t.mesh).watertight);
+}
+
 // A large box on a fine grid is coarsened to the voxel budget; a small one keeps the spacing.
 TEST(VoxelGrid, CoveringAtMostKeepsToTheVoxelBudget) {
   const Eigen::Vector3d lo(0, 0, 0), big(110, 90, 60), small(10, 10, 10);

@@ -173,5 +173,44 @@ TEST(CheckImplant, TheRimGapIsTheWorstArcWhereverItLies) {
   EXPECT_DOUBLE_EQ(worst_arc_gap({2.0}, {0.7}, 5 * deg), 0.7);
 }
 
+// A clearance asked and not kept, on a constructed case: bone plates with a 10 mm gap, an
+// implant 0.3 mm off the left cut face and 2.5 mm off the right. Asked 1 mm, the left edge
+// would not go in and the right leaves a gap 1.5 mm too wide: not printable, for both reasons.
+// Asked nothing, only the 2.5 mm gap is judged, as before. Its mass is volume × density.
+TEST(CheckImplant, AClearanceAskedButNotKeptIsNotPrintable) {
+  TriangleSoup plates = test::box_soup({0, 0, 0}, {20, 20, 5});
+  const TriangleSoup right = test::box_soup({30, 0, 0}, {50, 20, 5});
+  const int n = static_cast<int>(plates.vertices.size());
+  plates.vertices.insert(plates.vertices.end(), right.vertices.begin(), right.vertices.end());
+  for (auto t : right.triangles) plates.triangles.push_back({t[0] + n, t[1] + n, t[2] + n});
+  const SkullMesh bone = build_mesh(plates);
+  const SkullMesh implant = box({20.3, 0, 0}, {27.5, 20, 5});
+  QualityParams asked;
+  asked.edge_clearance_mm = 1.0;
+  asked.density_g_cm3 = 1.3;
+  const QualityReport q = check_implant(implant, &bone, asked);
+  EXPECT_TRUE(q.clearance_asked);
+  EXPECT_NEAR(q.clearance_low_mm, -0.7, 0.05);
+  EXPECT_NEAR(q.clearance_high_mm, 1.5, 0.05);
+  EXPECT_FALSE(q.printable);
+  EXPECT_TRUE(has_reason(q, "nearer the bone than the clearance asked"));
+  EXPECT_TRUE(has_reason(q, "wider than the clearance asked"));
+  EXPECT_NEAR(q.mass_g, 7.2 * 20 * 5 * 1.3e-3, 1e-6);
+
+  const QualityReport plain = check_implant(implant, &bone);
+  EXPECT_FALSE(plain.clearance_asked);
+  EXPECT_NEAR(plain.rim_gap_mm, 2.5, 0.05);
+  EXPECT_TRUE(has_reason(plain, "gap of 2.50 mm between the rim and the bone"));
+  EXPECT_FALSE(has_reason(plain, "clearance"));
+  EXPECT_EQ(plain.mass_g, 0.0);
+
+  // A zone over the right cut face asking 2.5 mm there: that side is now as asked.
+  asked.clearance_zones = {{Eigen::Vector3d(35, 10, 2.5), 12.0, 2.5}};
+  const QualityReport zoned = check_implant(implant, &bone, asked);
+  EXPECT_LE(zoned.clearance_high_mm, 0.2);
+  EXPECT_FALSE(has_reason(zoned, "wider than the clearance asked"));
+  EXPECT_TRUE(has_reason(zoned, "nearer the bone than the clearance asked"));
+}
+
 }  // namespace
 }  // namespace cranioplan

@@ -114,6 +114,12 @@ void params_from_json(const ParamReader& r, RegisterParams& p);
 void params_from_json(const ParamReader& r, SmoothParams& p);
 void params_from_json(const ParamReader& r, ProposeParams& p);
 void params_from_json(const ParamReader& r, ImplantParams& p);
+/// A build's material and clearance zones as build_implant records them; read back with their
+/// ranges checked (a SessionError names the problem).
+Json to_json(const Material& m);
+Json to_json(const ClearanceZone& z);
+Material material_from_json(const ParamReader& r);
+ClearanceZone clearance_zone_from_json(const ParamReader& r);
 
 /// Builders: the only way the wizard and the CLI make commands.
 namespace commands {

@@ -57,10 +57,13 @@ struct SkullInput {
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< of the vertices, mm
 };
 
-/// The implant and what is derived from it; the quality report is computed on first use.
+/// The implant and what is derived from it; the quality report (with the checks the build's
+/// material and clearance zones ask for) is computed on first use.
 class ImplantData {
  public:
-  ImplantData(ImplantResult result, std::shared_ptr<const SkullInput> skull);
+  ImplantData(ImplantResult result, std::shared_ptr<const SkullInput> skull,
+              QualityParams quality_params = {});
+  const QualityParams& quality_params() const { return quality_params_; }
   const ImplantResult& result() const { return result_; }
   /// SHA-256 of the binary STL bytes of the implant (what an .stl export writes).
   const std::string& stl_sha256() const { return stl_sha256_; }
@@ -70,6 +73,7 @@ class ImplantData {
   ImplantResult result_;
   std::string stl_sha256_;
   std::shared_ptr<const SkullInput> skull_;
+  QualityParams quality_params_;
   mutable std::once_flag quality_once_;
   mutable QualityReport quality_;
 };

@@ -7,6 +7,7 @@
 
 #include "cranioplan/algorithms/implant/trim_to_bone.h"
 #include "cranioplan/model/marker.h"
+#include "cranioplan/model/material.h"
 #include "cranioplan/model/mesh.h"
 
 namespace cranioplan {
@@ -38,6 +39,14 @@ struct ImplantParams {
   /// through the edge markers).
   double fit_to_bone_mm = 0.0;
   TrimToBoneParams trim;  ///< how the shell is fitted to the bone (when fit_to_bone_mm > 0)
+  /// What the implant is made of (none: the plan's surfaces as they are). A thickness of the
+  /// material's replaces the inner surface (inner markers are not used); its under-contour sets
+  /// the outer surface below the fitted one; its edge clearance is the fit to the bone's
+  /// (`trim.clearance_mm`, when larger). A clearance or under-contour needs the fit to the bone.
+  std::optional<Material> material;
+  /// Stretches of the rim held further off the bone than the material's clearance (needs the
+  /// fit to the bone).
+  std::vector<ClearanceZone> clearance_zones;
   /// Radial needs a skull (its centroid is the centre) or `radial_center`; otherwise planar.
   ImplantFrame frame = ImplantFrame::Radial;
   std::optional<Eigen::Vector3d> radial_center;  ///< centre of the rays (inside the skull)

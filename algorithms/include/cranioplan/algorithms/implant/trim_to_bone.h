@@ -6,6 +6,7 @@
 #include <optional>
 #include <string>
 
+#include "cranioplan/model/material.h"
 #include "cranioplan/model/mesh.h"
 
 namespace cranioplan {
@@ -38,6 +39,9 @@ struct TrimToBoneParams {
   /// 0.5-1.5 voxels off the bone (up to 0.7 mm on a large implant's 0.45 mm grid), which left
   /// a layer of the defect unfilled along its cut face.
   std::optional<double> clearance_mm = 0.1;
+  /// Stretches of the edge held further off (the largest of `clearance_mm` and the zones that
+  /// hold a point applies there); used only with a clearance set.
+  std::vector<ClearanceZone> zones;
   /// The skull's inside where its surface is open (the cut where the scan ends): decided by
   /// parity-count voting along three axes (VoxelizeParams::vote_through_holes). false: parity
   /// along z, as plans saved before version 0.2 fitted their implants (a skull open at the

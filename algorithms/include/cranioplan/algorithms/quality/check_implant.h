@@ -1,8 +1,10 @@
 #pragma once
 // The quality report before printing.
+#include <optional>
 #include <string>
 #include <vector>
 
+#include "cranioplan/model/material.h"
 #include "cranioplan/model/mesh.h"
 
 namespace cranioplan {
@@ -21,7 +23,21 @@ struct QualityParams {
   double overlap_voxel_mm = 0.25;    ///< voxel size of the overlap measurement, mm
   /// A large implant's overlap grid is coarsened to at most this many voxels.
   double overlap_max_voxels = 8e6;
+  /// The gap asked between the implant's edge and the bone, mm (0: none asked); with zones,
+  /// the largest that holds a point of the edge (ClearanceZone). The rim gap is then judged as
+  /// its excess over the clearance, and an edge nearer the bone than the clearance less
+  /// `clearance_tolerance_mm` is not printable (it would not go in).
+  double edge_clearance_mm = 0.0;
+  std::vector<ClearanceZone> clearance_zones;
+  double clearance_tolerance_mm = 0.2;  ///< mm
+  double density_g_cm3 = 0.0;           ///< for the mass, g/cm³ (0: no mass)
+  std::string material_name;            ///< as the report names it (empty: none)
 };
+
+/// The quality check a build with a material asks for: its minimum thickness, clearance,
+/// clearance zones and density; the defaults without one.
+QualityParams quality_params_for(const std::optional<Material>& material,
+                                 const std::vector<ClearanceZone>& zones = {});
 
 struct QualityReport {
   bool watertight = false;
@@ -37,7 +53,14 @@ struct QualityReport {
   /// How far thin material reaches from the thick part: on the bone (the tapered edge) and
   /// away from it (corners); −1 when no part is thick.
   double taper_reach_mm = 0.0, corner_reach_mm = 0.0;
-  double rim_gap_mm = -1.0;       ///< −1 without a skull
+  double rim_gap_mm = -1.0;  ///< −1 without a skull
+  /// With a clearance asked: over every 5° arc of the rim, the arc's gap less the clearance
+  /// asked there; the smallest and the largest over the arcs (0 and 0: every arc exactly as
+  /// asked). Both 0 without a skull or without a clearance asked.
+  double clearance_low_mm = 0.0, clearance_high_mm = 0.0;
+  bool clearance_asked = false;  ///< a clearance (or zone) was asked
+  double mass_g = 0.0;           ///< volume × density (0 without a density)
+  std::string material_name;
   double penetration_mm3 = -1.0;  ///< −1 without a skull
   bool printable = false;
   std::vector<std::string> reasons;  ///< why not printable, one sentence each
