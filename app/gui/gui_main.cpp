@@ -30,7 +30,10 @@ int main(int argc, char** argv) {
   const QCommandLineOption units("units", "a mesh file's length unit: mm, cm, m, in or um", "U");
   const QCommandLineOption layout("layout", "3d, both (3D and CT slices) or slices", "LAYOUT");
   const QCommandLineOption window_preset("window", "CT window: bone, soft or brain", "W");
-  parser.addOptions({sample, units, step, screenshot, quit, view, layout, window_preset});
+  const QCommandLineOption thickness("thickness-map",
+                                     "colour the implant by its thickness (View → Thickness map)");
+  parser.addOptions(
+      {sample, units, step, screenshot, quit, view, layout, window_preset, thickness});
   parser.process(app);
 
   cranioplan::gui::MainWindow window;
@@ -85,6 +88,7 @@ int main(int argc, char** argv) {
     window.set_layout(l == "slices" ? L::Slices : l == "both" ? L::ThreeDAndSlices : L::ThreeD);
     window.slices().wait_loaded();
   }
+  if (parser.isSet(thickness)) window.set_thickness_map_shown(true);
   if (parser.isSet(window_preset)) {
     using P = cranioplan::gui::SlicePanel::Preset;
     const QString w = parser.value(window_preset).toLower();

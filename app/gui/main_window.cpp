@@ -409,6 +409,14 @@ void MainWindow::build_edit_view_menus() {
   show_mirror_->setChecked(true);
   show_mirror_->setShortcut(QKeySequence(Qt::Key_M));
   connect(show_mirror_, &QAction::toggled, view_, &SkullView::set_mirror_visible);
+  show_thickness_ = view->addAction(tr("Thickness map"));
+  show_thickness_->setObjectName("thicknessMap");
+  show_thickness_->setCheckable(true);
+  show_thickness_->setShortcut(QKeySequence(Qt::Key_T));
+  show_thickness_->setToolTip(
+      tr("The implant coloured by its thickness, the skull around it by "
+         "its gap to the implant"));
+  connect(show_thickness_, &QAction::toggled, view_, &SkullView::set_thickness_visible);
   QAction* show_plane = view->addAction(tr("Show midsagittal plane"));
   show_plane->setCheckable(true);
   show_plane->setChecked(true);
@@ -734,6 +742,7 @@ struct MainWindow::QualityView {
   std::shared_ptr<const ImplantData> implant;  ///< the implant it is of
   QString html;
   std::vector<Eigen::Vector3d> intrusion;  ///< the implant's voxels in soft tissue (CT plans)
+  std::shared_ptr<const ThicknessMap> thickness;  ///< the implant's, and the skull's gap to it
 };
 
 void MainWindow::show_quality() {
@@ -758,12 +767,16 @@ void MainWindow::show_quality() {
     const std::shared_ptr<QualityView> v = quality_watcher_->result();
     if (v->implant != controller_->state().implant) return;  // the plan moved on
     slices_->set_highlight(v->intrusion);
+    view_->set_thickness_map(&v->implant->result().mesh, v->thickness);
     quality_->setHtml(v->html);
     for (StepPage* page : step_pages_) page->show_quality(v->html);
   });
-  quality_watcher_->setFuture(QtConcurrent::run([implant, ct, inside] {
+  const std::shared_ptr<const SkullInput> skull = s.skull;
+  quality_watcher_->setFuture(QtConcurrent::run([implant, ct, inside, skull] {
     auto v = std::make_shared<QualityView>();
     v->implant = implant;
+    v->thickness = std::make_shared<const ThicknessMap>(
+        thickness_map(implant->result().mesh, skull ? &skull->surface->mesh : nullptr));
     SoftTissueCheck tissue;
     if (ct) tissue = check_soft_tissue(implant->result().mesh, *ct, inside);
     v->intrusion = std::move(tissue.intrusion);
@@ -771,6 +784,8 @@ void MainWindow::show_quality() {
     return v;
   }));
 }
+
+void MainWindow::set_thickness_map_shown(bool shown) { show_thickness_->setChecked(shown); }
 
 void MainWindow::wait_quality() {
   if (quality_timer_->isActive()) {

@@ -57,6 +57,8 @@ class MainWindow : public QMainWindow, public PageHost {
   /// the slices alone (View → Layout).
   enum class Layout { ThreeD, ThreeDAndSlices, Slices };
   void set_layout(Layout layout);
+  /// View → Thickness map on or off.
+  void set_thickness_map_shown(bool shown);
   Layout layout() const { return layout_; }
   void show_slices() override { set_layout(Layout::ThreeDAndSlices); }
 
@@ -181,6 +183,7 @@ class MainWindow : public QMainWindow, public PageHost {
   QAction* undo_ = nullptr;
   QAction* redo_ = nullptr;
   QAction* show_mirror_ = nullptr;
+  QAction* show_thickness_ = nullptr;
   class QMenu* recent_menu_ = nullptr;
 
   QString session_path_;

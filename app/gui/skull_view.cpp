@@ -12,10 +12,12 @@
 #include <vtkCoordinate.h>
 #include <vtkCubeSource.h>
 #include <vtkDoubleArray.h>
+#include <vtkFloatArray.h>
 #include <vtkGenericOpenGLRenderWindow.h>
 #include <vtkGenericRenderWindowInteractor.h>
 #include <vtkGlyph3DMapper.h>
 #include <vtkInteractorStyleTrackballCamera.h>
+#include <vtkLookupTable.h>
 #include <vtkMatrix4x4.h>
 #include <vtkNew.h>
 #include <vtkPlane.h>
@@ -28,8 +30,10 @@
 #include <vtkPolyDataNormals.h>
 #include <vtkProperty.h>
 #include <vtkRenderer.h>
+#include <vtkScalarBarActor.h>
 #include <vtkSmartPointer.h>
 #include <vtkSphereSource.h>
+#include <vtkTextProperty.h>
 
 #include <Eigen/Geometry>
 #include <QMouseEvent>
@@ -271,6 +275,12 @@ struct SkullView::Impl {
   // The patient's directions in the lower-left corner: a cube labelled L/R, A/P, S/I in the
   // frame meshes are in (LPS: +x is the patient's left, +y posterior, +z superior), turned with
   // the camera, so a skull that came in reflected or upside down shows at a glance.
+  // The thickness map: the implant by its thickness, the skull near it by its gap to it.
+  std::shared_ptr<const ThicknessMap> thickness;
+  const void* thickness_of = nullptr;  // the implant mesh the map is of
+  bool thickness_wanted = false;
+  vtkNew<vtkLookupTable> thickness_colors, gap_colors;
+  vtkNew<vtkScalarBarActor> thickness_bar, gap_bar;
   vtkNew<vtkRenderer> orientation;
   vtkNew<vtkAnnotatedCubeActor> orientation_cube;
 
@@ -358,6 +368,40 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
   }
   d.unseen_actor->SetVisibility(false);
   d.overlay->AddActor(d.unseen_actor);
+  // Thickness 0 (red) to 6 mm (blue); the bone's gap to the implant 0 (white) to 3 mm (dark
+  // violet), the bone's colour beyond the map's reach. Both in mm.
+  d.thickness_colors->SetRange(0.0, 6.0);
+  d.thickness_colors->SetHueRange(0.0, 0.66);
+  d.thickness_colors->Build();
+  d.gap_colors->SetRange(0.0, 3.0);
+  d.gap_colors->SetHueRange(0.8, 0.8);
+  d.gap_colors->SetSaturationRange(0.0, 0.9);
+  d.gap_colors->SetValueRange(1.0, 0.45);
+  d.gap_colors->SetNanColor(kBone[0], kBone[1], kBone[2], 1.0);
+  d.gap_colors->Build();
+  auto legend = [&](vtkScalarBarActor* bar, vtkLookupTable* lut, const char* title, double x) {
+    bar->SetLookupTable(lut);
+    bar->SetTitle(title);
+    bar->SetNumberOfLabels(4);
+    bar->SetLabelFormat("%.1f");
+    bar->SetOrientationToVertical();
+    bar->SetPosition(x, 0.06);
+    bar->SetWidth(0.11);
+    bar->SetHeight(0.4);
+    bar->SetBarRatio(0.3);           // room for the labels beside the colours
+    bar->UnconstrainedFontSizeOn();  // sizes in pixels, not scaled to the bar
+    bar->GetTitleTextProperty()->SetFontSize(14);
+    bar->GetTitleTextProperty()->BoldOff();
+    bar->GetTitleTextProperty()->ItalicOff();
+    bar->GetTitleTextProperty()->ShadowOff();
+    bar->GetLabelTextProperty()->SetFontSize(13);
+    bar->GetLabelTextProperty()->ItalicOff();
+    bar->GetLabelTextProperty()->ShadowOff();
+    bar->SetVisibility(false);
+    d.overlay->AddActor2D(bar);
+  };
+  legend(d.thickness_bar, d.thickness_colors, "Thickness", 0.88);
+  legend(d.gap_bar, d.gap_colors, "Bone gap", 0.75);
   d.zones.mapper->ScalingOn();
   d.zones.mapper->SetScaleArray("radius");
   d.zones.mapper->SetScaleModeToScaleByMagnitude();
@@ -414,6 +458,7 @@ void SkullView::show_state(const PlanState& s) {
   if (s.mirrored) d.mirror.set_motion(s.mirrored->placement);
   d.mirror.actor->SetVisibility(d.mirror.shown && d.mirror_wanted);
   d.implant.show(s.implant ? &s.implant->result().mesh : nullptr, s.implant);
+  if (d.thickness_wanted) set_thickness_visible(true);  // off until the new implant's map
 
   // Clip plane: keep the side the normal points away from.
   d.skull.mapper->RemoveAllClippingPlanes();
@@ -584,6 +629,52 @@ void SkullView::set_selected_marker(int id) {
   d.selected.set(p);
   update();
 }
+
+namespace {
+
+// `values` as the named point array of the layer's polydata, coloured through `lut` (none:
+// the layer's own colour).
+void colour_by(MeshLayer& layer, const char* name, const std::vector<float>* values,
+               vtkLookupTable* lut) {
+  vtkPolyData* poly = vtkPolyData::SafeDownCast(layer.mapper->GetInput());
+  if (!values || !poly || static_cast<size_t>(poly->GetNumberOfPoints()) != values->size()) {
+    layer.mapper->ScalarVisibilityOff();
+    return;
+  }
+  vtkNew<vtkFloatArray> a;
+  a->SetName(name);
+  a->SetNumberOfValues(static_cast<vtkIdType>(values->size()));
+  for (size_t i = 0; i < values->size(); ++i) a->SetValue(static_cast<vtkIdType>(i), (*values)[i]);
+  poly->GetPointData()->AddArray(a);
+  layer.mapper->SetLookupTable(lut);
+  layer.mapper->UseLookupTableScalarRangeOn();
+  layer.mapper->SetScalarModeToUsePointFieldData();
+  layer.mapper->SelectColorArray(name);
+  layer.mapper->ScalarVisibilityOn();
+}
+
+}  // namespace
+
+void SkullView::set_thickness_map(const SkullMesh* implant,
+                                  std::shared_ptr<const ThicknessMap> map) {
+  d_->thickness = std::move(map);
+  d_->thickness_of = implant;
+  set_thickness_visible(d_->thickness_wanted);
+}
+
+void SkullView::set_thickness_visible(bool visible) {
+  Impl& d = *d_;
+  d.thickness_wanted = visible;
+  const bool on = visible && d.thickness && d.implant.shown && d.implant.shown == d.thickness_of;
+  colour_by(d.implant, "thickness", on ? &d.thickness->implant_mm : nullptr, d.thickness_colors);
+  const bool gap = on && !d.thickness->skull_gap_mm.empty();
+  colour_by(d.skull, "gap", gap ? &d.thickness->skull_gap_mm : nullptr, d.gap_colors);
+  d.thickness_bar->SetVisibility(on);
+  d.gap_bar->SetVisibility(gap);
+  update();
+}
+
+bool SkullView::thickness_shown() const { return d_->thickness_bar->GetVisibility(); }
 
 void SkullView::set_cursor(const std::optional<Eigen::Vector3d>& point) {
   d_->cursor.set(point ? std::vector<Eigen::Vector3d>{*point} : std::vector<Eigen::Vector3d>{});

@@ -7,6 +7,7 @@
 #include <memory>
 #include <optional>
 
+#include "cranioplan/algorithms/quality/thickness_map.h"
 #include "cranioplan/model/marker.h"
 #include "cranioplan/sessions/plan_state.h"
 
@@ -43,6 +44,13 @@ class SkullView : public QOpenGLWidget {
   void set_selected_marker(int id);
   /// The slice views' cursor, drawn as a small cyan ball (none: hidden).
   void set_cursor(const std::optional<Eigen::Vector3d>& point);
+  /// The thickness map of `implant` (computed off the GUI thread): shown, when it is on and
+  /// `implant` is the implant shown, as the implant coloured by its thickness and the skull
+  /// near it by its gap to the implant, each with a legend.
+  void set_thickness_map(const SkullMesh* implant, std::shared_ptr<const ThicknessMap> map);
+  void set_thickness_visible(bool visible);
+  /// Whether the thickness map is drawn now.
+  bool thickness_shown() const;
   int selected_marker() const;
   /// How many stretches of the rim no ray saw are drawn (the last proposal's).
   int unseen_rim_shown() const;

@@ -623,6 +623,40 @@ TEST(WizardOrientation, TheCubeShowsTheFaceTheCameraLooksAt) {
   }
 }
 
+// View → Thickness map: once the implant's report is in, the implant is coloured by its
+// thickness and the skull around it by its gap, with legends; off again, the plain colours.
+TEST(WizardThickness, TheThicknessMapColoursTheImplantAndTheBoneAroundIt) {
+  MainWindow w;
+  w.set_interactive(false);
+  w.resize(1280, 800);
+  w.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&w));
+  ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
+  w.controller().wait();
+  ASSERT_TRUE(w.plan().implant);
+  w.view().look_at_markers();
+  w.wait_quality();
+  auto coloured = [&] {  // pixels far from grey, white and the bone's and implant's colours
+    QTest::qWait(50);
+    const QImage image = w.view().grabFramebuffer().convertToFormat(QImage::Format_RGB32);
+    int n = 0;
+    for (int y = 0; y < image.height(); y += 2)
+      for (int x = 0; x < image.width(); x += 2) {
+        const QRgb p = image.pixel(x, y);
+        n += qBlue(p) > qRed(p) + 60 && qBlue(p) > qGreen(p) + 20;  // the thick part's blue
+      }
+    return n;
+  };
+  const int before = coloured();
+  EXPECT_FALSE(w.view().thickness_shown());
+  w.set_thickness_map_shown(true);
+  w.wait_quality();
+  EXPECT_TRUE(w.view().thickness_shown());
+  EXPECT_GT(coloured(), before + 500) << "the implant in the map's colours";
+  w.set_thickness_map_shown(false);
+  EXPECT_FALSE(w.view().thickness_shown());
+}
+
 TEST_F(Wizard, CommandLineScreenshotOfASessionAtAStep) {
   test::TempDir tmp;
   const std::string session = tmp.path("auto.json"), implant = tmp.path("auto.stl");

@@ -80,7 +80,7 @@ TEST(Commands, EveryTypeRoundTripsThroughJson) {
 // read as recorded, built without the fit.
 TEST(Commands, BuildImplantVersionOneIsReadByItsOwnRules) {
   Json v1 = to_json(commands::build_implant());
-  EXPECT_EQ(v1["version"], 5);
+  EXPECT_EQ(v1["version"], 6);
   v1["version"] = 1;
   v1["params"]["params"].erase("trim");
   v1["params"]["params"].erase("fit_to_bone_mm");
@@ -127,7 +127,7 @@ TEST(Commands, OlderPlansReadTheSkullAndFitTheBoneAsTheyWereMade) {
   p.trim.min_feature_mm = 1.7;
   p.trim.bridge_mm = 0.8;
   const Json build = to_json(commands::build_implant(p));
-  EXPECT_EQ(build["version"], 5);
+  EXPECT_EQ(build["version"], 6);
   ImplantParams back;
   params_from_json(ParamReader(build["params"]["params"], "test"), back);
   EXPECT_EQ(back.trim.min_feature_mm, 1.7);

@@ -13,6 +13,7 @@
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/mesh_report.h"
+#include "cranioplan/algorithms/quality/thickness_map.h"
 #include "cranioplan/model/plane.h"
 
 namespace cranioplan {
@@ -102,22 +103,6 @@ double worst_arc_gap(const std::vector<double>& angle, const std::vector<double>
 
 namespace {
 
-// The deepest voxel along the segment from `a` to `b` (sampled every half voxel), in mm.
-double deepest_along(const std::vector<float>& depth, const VoxelGrid& grid,
-                     const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-  const int steps = 1 + static_cast<int>((b - a).norm() / (0.5 * grid.spacing));
-  double deepest = 0.0;
-  for (int t = 0; t <= steps; ++t) {
-    const Eigen::Vector3d v = (a + (b - a) * (double(t) / steps) - grid.origin) / grid.spacing;
-    const int i = static_cast<int>(std::lround(v.x())), j = static_cast<int>(std::lround(v.y())),
-              k = static_cast<int>(std::lround(v.z()));
-    if (i < 0 || j < 0 || k < 0 || i >= grid.dims[0] || j >= grid.dims[1] || k >= grid.dims[2])
-      continue;
-    deepest = std::max(deepest, static_cast<double>(depth[grid.index(i, j, k)]));
-  }
-  return deepest;
-}
-
 // Thickness across the plate from at most 60,000 faces spread evenly over the implant (one ray
 // each along the inward normal, for faces within 45° of `axis`): a mesh trimmed on a fine grid
 // has hundreds of thousands of faces, and a thin region spans many. The other faces' vertices
@@ -141,16 +126,11 @@ std::vector<double> thickness_samples(const SkullMesh& implant, const Eigen::Vec
     n.normalize();
     if (std::abs(n.dot(axis)) >= std::cos(M_PI / 4)) {
       if (!measure) continue;
-      const Eigen::Vector3d centre = (p[0] + p[1] + p[2]) / 3.0;
-      const auto hit = self.first_hit(centre - 1e-4 * n, centre - 200.0 * n);
-      if (!hit) continue;
       // Where the plate curves, a normal can leave it at a grazing angle and run along it (on
       // the sample's frontal implant up to 27 mm through a plate 8 mm at its thickest): the
-      // thickness there is at most the diameter of the deepest ball the ray passes, twice the
-      // deepest voxel's depth plus a voxel for the sampling.
-      const double along = hit->distance + 1e-4;
-      const double ball = 2.0 * deepest_along(depth, grid, centre, hit->point) + grid.spacing;
-      thickness.push_back(std::min(along, ball));
+      // thickness there is at most the diameter of the deepest ball the ray passes.
+      const double t = thickness_through(self, (p[0] + p[1] + p[2]) / 3.0, n, depth, grid);
+      if (t > 0.0) thickness.push_back(t);
     } else {
       wall_vertices.insert(wall_vertices.end(), ids, ids + 3);
     }
