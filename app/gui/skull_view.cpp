@@ -276,6 +276,9 @@ struct SkullView::Impl {
   // frame meshes are in (LPS: +x is the patient's left, +y posterior, +z superior), turned with
   // the camera, so a skull that came in reflected or upside down shows at a glance.
   // The thickness map: the implant by its thickness, the skull near it by its gap to it.
+  // The implant's locator for clicks on it (holes), made when first needed.
+  std::unique_ptr<SurfaceLocator> implant_locator;
+  const void* implant_locator_of = nullptr;
   std::shared_ptr<const ThicknessMap> thickness;
   const void* thickness_of = nullptr;  // the implant mesh the map is of
   bool thickness_wanted = false;
@@ -459,6 +462,10 @@ void SkullView::show_state(const PlanState& s) {
   d.mirror.actor->SetVisibility(d.mirror.shown && d.mirror_wanted);
   d.implant.show(s.implant ? &s.implant->result().mesh : nullptr, s.implant);
   if (d.thickness_wanted) set_thickness_visible(true);  // off until the new implant's map
+  if (d.implant.shown != d.implant_locator_of) {        // made again for the next click on it
+    d.implant_locator.reset();
+    d.implant_locator_of = nullptr;
+  }
 
   // Clip plane: keep the side the normal points away from.
   d.skull.mapper->RemoveAllClippingPlanes();
@@ -701,8 +708,17 @@ std::optional<QPoint> SkullView::project(const Eigen::Vector3d& world) {
 
 std::optional<Eigen::Vector3d> SkullView::pick(const QPoint& position, PickTarget target) {
   Impl& d = *d_;
-  MeshLayer* layer = target == PickTarget::Mirrored && d.mirror.shown ? &d.mirror : &d.skull;
-  if (target == PickTarget::None || !layer->shown || !layer->locator) return std::nullopt;
+  MeshLayer* layer = target == PickTarget::Mirrored && d.mirror.shown ? &d.mirror
+                     : target == PickTarget::Implant                  ? &d.implant
+                                                                      : &d.skull;
+  if (target == PickTarget::Implant && layer->shown && d.implant_locator_of != layer->shown) {
+    d.implant_locator =
+        std::make_unique<SurfaceLocator>(*static_cast<const SkullMesh*>(layer->shown));
+    d.implant_locator_of = layer->shown;
+  }
+  const SurfaceLocator* locator =
+      target == PickTarget::Implant ? d.implant_locator.get() : layer->locator;
+  if (target == PickTarget::None || !layer->shown || !locator) return std::nullopt;
   // The ray under the cursor, from the near to the far end of the view (a hidden mirror can
   // still take markers).
   const double x = d.display_x(position), y = d.display_y(position);
@@ -727,7 +743,7 @@ std::optional<Eigen::Vector3d> SkullView::pick(const QPoint& position, PickTarge
     if (fa < 0) from = crossing;
     if (fb < 0) to = crossing;
   }
-  const auto hit = layer->locator->first_hit(from, to);
+  const auto hit = locator->first_hit(from, to);
   if (!hit) return std::nullopt;
   return hit->point;
 }

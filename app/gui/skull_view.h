@@ -37,7 +37,7 @@ class SkullView : public QOpenGLWidget {
   void look_at_markers();
 
   /// Which surface a click places on (None: clicks only select markers).
-  enum class PickTarget { None, Original, Mirrored };
+  enum class PickTarget { None, Original, Mirrored, Implant };
   void set_pick_target(PickTarget target);
   /// Whether markers can be dragged (steps 5, 6 and 8).
   void set_markers_editable(bool editable);

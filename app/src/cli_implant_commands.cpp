@@ -40,7 +40,11 @@ namespace {
 
 Json implant_json(const ImplantResult& r) {
   static const char* names[] = {"built", "too_few_markers", "failed"};
+  Json holes = Json::array();
+  for (const Hole& h : r.holes)
+    holes.push_back(Json{{"center", to_json(h.center)}, {"axis", to_json(h.axis)}});
   return Json{{"status", names[static_cast<int>(r.status)]},
+              {"holes", holes},
               {"message", r.message},
               {"watertight", r.watertight},
               {"triangles", r.mesh.n_faces()},
@@ -228,6 +232,7 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
     std::string skull, mirrored, markers, output, method = "shell";
     ImplantParams params;
     MaterialOptions material;
+    HoleOptions holes;
     bool no_snap = false;
   };
   auto o = std::make_shared<Opts>();
@@ -253,6 +258,7 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
                   "a clearance or under-contour needs it)")
       ->check(CLI::Range(0.0, 10.0));
   add_material_options(cmd, o->material);
+  add_hole_options(cmd, o->holes);
   cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
   return Subcommand{
       cmd, [o, &json] {
@@ -273,6 +279,7 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
         o->params.snap_rim_to_skull = !o->no_snap;
         o->params.material = material_from(o->material);
         o->params.clearance_zones = zones_from(o->material);
+        o->params.perforations = perforations_from(o->holes);
         const ImplantResult r = build_implant(snapped.markers, &skull, o->params);
         Json j = implant_json(r);
         j["method"] = o->method;
@@ -283,8 +290,9 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
         }
         write_mesh(r.mesh, o->output);
         j["output"] = o->output;
-        j["quality"] = to_json(check_implant(
-            r.mesh, &skull, quality_params_for(o->params.material, o->params.clearance_zones)));
+        QualityParams checks = quality_params_for(o->params.material, o->params.clearance_zones);
+        checks.holes = r.holes;
+        j["quality"] = to_json(check_implant(r.mesh, &skull, checks));
         print_result(j, json);
         return kOk;
       }};
@@ -457,6 +465,7 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
     bool all_openings = false;
     AutoplanParams params;
     MaterialOptions material;
+    HoleOptions holes;
     ExtractBoneSurfaceParams import;
   };
   auto o = std::make_shared<Opts>();
@@ -478,6 +487,7 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
       ->expected(3);
   add_fit_option(cmd, o->params);
   add_material_options(cmd, o->material);
+  add_hole_options(cmd, o->holes);
   cmd->add_option("--session", o->session,
                   "plan through session commands and save the session (.json): reopen, edit, "
                   "replay and audit it (with --all-openings, SESSION_2... for the others)");
@@ -493,6 +503,7 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
         plan_method_from_string(o->method, o->params.propose.method);
         o->params.implant.material = material_from(o->material);
         o->params.implant.clearance_zones = zones_from(o->material);
+        o->params.implant.perforations = perforations_from(o->holes);
         auto markers_path = [&](size_t k) {
           return o->markers_out.empty() ? std::string() : numbered_path(o->markers_out, k);
         };

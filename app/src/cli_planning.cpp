@@ -3,6 +3,7 @@
 #include <CLI/CLI.hpp>
 #include <sstream>
 
+#include "cli_output.h"
 #include "cranioplan/algorithms/io/load_skull.h"
 
 namespace cranioplan::cli {
@@ -93,6 +94,34 @@ std::vector<ClearanceZone> zones_from(const MaterialOptions& o) {
     zones.push_back(z);
   }
   return zones;
+}
+
+void add_hole_options(CLI::App* cmd, HoleOptions& o) {
+  cmd->add_flag("--perforate", o.params.pattern,
+                "drill holes on a hexagonal pattern through the implant (drainage, dura "
+                "suspension)");
+  cmd->add_option("--hole-diameter", o.params.diameter_mm, "diameter of the holes (mm)")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 6.0));
+  cmd->add_option("--hole-spacing", o.params.spacing_mm, "between the pattern's holes (mm)")
+      ->capture_default_str()
+      ->check(CLI::Range(4.0, 40.0));
+  cmd->add_option("--hole-edge-distance", o.params.edge_distance_mm,
+                  "the pattern's holes at least this far from the implant's edge (mm)")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 20.0));
+  cmd->add_option("--hole", o.added, "X,Y,Z: a single hole there (repeatable)");
+  cmd->add_option("--no-hole", o.removed,
+                  "X,Y,Z: leave out the pattern's hole nearest there (repeatable)");
+}
+
+PerforationParams perforations_from(const HoleOptions& o) {
+  PerforationParams p = o.params;
+  for (const std::string& t : o.added) p.added.push_back(parse_point(t, "--hole"));
+  for (const std::string& t : o.removed) p.removed.push_back(parse_point(t, "--no-hole"));
+  if (const std::string problem = perforation_problem(p); !problem.empty())
+    throw CLI::ValidationError("--perforate", problem);
+  return p;
 }
 
 }  // namespace cranioplan::cli

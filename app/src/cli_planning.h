@@ -28,6 +28,16 @@ struct MaterialOptions {
 };
 /// `for_check`: only what a quality check uses (--material, --clearance, --density, zones).
 void add_material_options(CLI::App* cmd, MaterialOptions& o, bool for_check = false);
+
+/// --perforate (the pattern), --hole-diameter, --hole-spacing, --hole-edge-distance,
+/// --hole X,Y,Z (repeatable), --no-hole X,Y,Z (repeatable).
+struct HoleOptions {
+  PerforationParams params;
+  std::vector<std::string> added, removed;
+};
+void add_hole_options(CLI::App* cmd, HoleOptions& o);
+/// The perforations the options ask for (a CLI::ValidationError for a bad one).
+PerforationParams perforations_from(const HoleOptions& o);
 /// The material and zones the options ask for (a CLI::ValidationError for a bad one); none
 /// when no option was given.
 std::optional<Material> material_from(const MaterialOptions& o);

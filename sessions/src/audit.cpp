@@ -407,6 +407,11 @@ std::string quality_report_html(const QualityReport& r, const SoftTissueCheck* t
         signed_mm(r.clearance_low_mm) + " to " + signed_mm(r.clearance_high_mm) + " mm");
   }
   if (r.penetration_mm3 >= 0) row("Overlap with skull", fixed(r.penetration_mm3, 1) + " mm³");
+  if (r.holes > 0)
+    row("Perforations",
+        std::to_string(r.holes) +
+            (r.holes_blocked == 0 ? std::string(", all through")
+                                  : ", " + std::to_string(r.holes_blocked) + " <b>blocked</b>"));
   if (tissue && tissue->checked) {
     row("In soft tissue (CT)", fixed(tissue->intrusion_mm3, 0) + " mm³");
     row("Soft tissue under it",

@@ -224,8 +224,9 @@ int current_version(CommandType type) {
   // build_implant 5: the skull's inside decided by votes where its surface is open
   // ("trim.vote_through_holes"); version 4 is read with parity along z.
   // build_implant 6: what the implant is made of ("material": thickness, minimum thickness,
-  // edge clearance, under-contour, density, onlay) and stretches of the rim with their own
-  // clearance ("clearance_zones"); version 5 is read without either.
+  // edge clearance, under-contour, density, onlay), stretches of the rim with their own
+  // clearance ("clearance_zones") and the holes drilled ("perforations"); version 5 is read
+  // without them.
   if (type == CommandType::BuildImplant) return 6;
   if (type == CommandType::ProposeMarkers) return 3;
   // load_skull 4: volumes in the patient's frame ("import.patient_frame"), a DICOM folder's
@@ -343,7 +344,44 @@ Json params_to_json(const ImplantParams& p) {
   j["material"] = p.material ? to_json(*p.material) : Json(nullptr);
   j["clearance_zones"] = Json::array();
   for (const ClearanceZone& z : p.clearance_zones) j["clearance_zones"].push_back(to_json(z));
+  j["perforations"] = to_json(p.perforations);
   return j;
+}
+
+Json to_json(const PerforationParams& p) {
+  Json added = Json::array(), removed = Json::array();
+  for (const auto& v : p.added) added.push_back(to_json(v));
+  for (const auto& v : p.removed) removed.push_back(to_json(v));
+  return Json{{"pattern", p.pattern},
+              {"diameter_mm", p.diameter_mm},
+              {"spacing_mm", p.spacing_mm},
+              {"edge_distance_mm", p.edge_distance_mm},
+              {"min_thickness_mm", p.min_thickness_mm},
+              {"voxel_mm", p.voxel_mm},
+              {"max_voxels", p.max_voxels},
+              {"added", added},
+              {"removed", removed}};
+}
+
+PerforationParams perforations_from_json(const ParamReader& r) {
+  PerforationParams p;
+  p.pattern = r.boolean("pattern");
+  p.diameter_mm = r.number("diameter_mm");
+  p.spacing_mm = r.number("spacing_mm");
+  p.edge_distance_mm = r.number("edge_distance_mm");
+  p.min_thickness_mm = r.number("min_thickness_mm");
+  p.voxel_mm = r.number("voxel_mm");
+  p.max_voxels = r.number("max_voxels");
+  for (const char* list : {"added", "removed"}) {
+    const Json& points = r.value(list);
+    if (!points.is_array()) throw SessionError(r.where(), std::string(list) + " must be a list");
+    for (const Json& v : points)
+      (list[0] == 'a' ? p.added : p.removed)
+          .push_back(vector_from_json(v, r.where(), std::string("a hole in ") + list));
+  }
+  if (const std::string problem = perforation_problem(p); !problem.empty())
+    throw SessionError(r.where(), problem);
+  return p;
 }
 
 Json to_json(const Material& m) {
@@ -504,6 +542,10 @@ void params_from_json(const ParamReader& r, ImplantParams& p) {
   p.material.reset();
   if (r.has("material") && !r.value("material").is_null())
     p.material = material_from_json(ParamReader(r.value("material"), r.where() + " material"));
+  p.perforations = PerforationParams{};
+  if (r.has("perforations"))
+    p.perforations =
+        perforations_from_json(ParamReader(r.value("perforations"), r.where() + " perforations"));
   p.clearance_zones.clear();
   if (r.has("clearance_zones")) {
     const Json& zones = r.value("clearance_zones");

@@ -120,6 +120,10 @@ Json to_json(const QualityReport& q) {
   // as they did.
   if (!q.material_name.empty()) j["material"] = q.material_name;
   if (q.mass_g > 0.0) j["mass_g"] = q.mass_g;
+  if (q.holes > 0) {
+    j["holes"] = q.holes;
+    j["holes_blocked"] = q.holes_blocked;
+  }
   if (q.clearance_asked) {
     j["clearance_low_mm"] = q.clearance_low_mm;
     j["clearance_high_mm"] = q.clearance_high_mm;

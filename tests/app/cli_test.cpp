@@ -179,23 +179,27 @@ TEST(Cli, ImplantSubcommandsAndTheirErrors) {
   EXPECT_EQ(test::run_command(kCli + " evaluate " + dir.path("")), 3);  // no cases in it
 }
 
-// A material on the command line: autoplan builds with it (its clearance kept on every arc, its
-// mass), qa checks an implant against it, and a material or value out of range is a usage
-// error that names it.
+// A material and perforations on the command line: autoplan builds with them (the clearance
+// kept on every arc, the mass, holes that go through), qa checks an implant against them, and a
+// material or value out of range is a usage error that names it.
 TEST(Cli, AutoplanAndQaWithAMaterial) {
   test::TempDir dir;
   write_mesh(test::thick_head_defect().defective, dir.path("skull.stl"));
   std::string out;
-  ASSERT_EQ(test::run_command(kCli + " autoplan --json " + dir.path("skull.stl") +
-                                  " --material pmma --clearance 1.5 -o " + dir.path("i.stl"),
-                              &out),
-            0)
+  ASSERT_EQ(
+      test::run_command(kCli + " autoplan --json " + dir.path("skull.stl") +
+                            " --material pmma --clearance 1.5 --perforate -o " + dir.path("i.stl"),
+                        &out),
+      0)
       << out;
   const Json q = Json::parse(out)["quality"];
   EXPECT_EQ(q["material"], "PMMA");
   EXPECT_GE(q["clearance_low_mm"].get<double>(), -0.2);
   EXPECT_LE(q["clearance_high_mm"].get<double>(), 0.2);
   EXPECT_NEAR(q["mass_g"].get<double>(), q["volume_mm3"].get<double>() * 1.18e-3, 1e-6);
+  EXPECT_GE(q["holes"].get<int>(), 3) << "the pattern's holes";
+  EXPECT_EQ(q["holes_blocked"].get<int>(), 0);
+  EXPECT_TRUE(q["printable"].get<bool>()) << q.dump();
   ASSERT_EQ(test::run_command(kCli + " qa --json " + dir.path("i.stl") + " --skull " +
                                   dir.path("skull.stl") + " --material pmma --clearance 1.5",
                               &out),

@@ -7,6 +7,7 @@
 #include <QCheckBox>
 #include <QComboBox>
 #include <QDir>
+#include <QDoubleSpinBox>
 #include <QLabel>
 #include <QListWidget>
 #include <QMessageBox>
@@ -655,6 +656,62 @@ TEST(WizardThickness, TheThicknessMapColoursTheImplantAndTheBoneAroundIt) {
   EXPECT_GT(coloured(), before + 500) << "the implant in the map's colours";
   w.set_thickness_map_shown(false);
   EXPECT_FALSE(w.view().thickness_shown());
+}
+
+// Step 7's perforations in the whole wizard: a pattern built, a hole added by a click on the
+// implant, another taken away, each a build that undo takes back and redo does again.
+TEST(WizardHoles, HolesAreAddedAndRemovedByClicksWithUndo) {
+  MainWindow w;
+  w.set_interactive(false);
+  ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
+  PlanController& plan = w.controller();
+  plan.push(commands::go_to_step(7));
+  plan.wait();
+  ASSERT_EQ(plan.state().current_step, 7);
+  child<QCheckBox>(w, "perforate")->setChecked(true);
+  child<QDoubleSpinBox>(w, "holeSpacing")->setValue(12);
+  click(w, "build");
+  plan.wait();
+  ASSERT_TRUE(plan.state().implant) << plan.state().message;
+  const std::vector<Hole> pattern = plan.state().implant->result().holes;
+  ASSERT_GE(pattern.size(), 3u) << plan.state().message;
+  EXPECT_EQ(plan.state().implant->quality().holes_blocked, 0);
+  EXPECT_TRUE(plan.state().implant->quality().watertight);
+
+  // Added between two of the pattern's holes (which give way to it): a hole where clicked.
+  child<QPushButton>(w, "addHole")->setChecked(true);
+  const Eigen::Vector3d between = 0.5 * (pattern[0].center + pattern[1].center);
+  emit w.view().surfaceClicked(between);
+  plan.wait();
+  const std::vector<Hole> added = plan.state().implant->result().holes;
+  const auto near = [](const std::vector<Hole>& holes, const Eigen::Vector3d& p) {
+    return std::count_if(holes.begin(), holes.end(),
+                         [&](const Hole& h) { return (h.center - p).norm() < 1.5; });
+  };
+  EXPECT_EQ(near(added, between), 1) << plan.state().message;
+  // Removed: the pattern's hole farthest from the added one.
+  const Hole far =
+      *std::max_element(pattern.begin(), pattern.end(), [&](const Hole& a, const Hole& b) {
+        return (a.center - between).norm() < (b.center - between).norm();
+      });
+  child<QPushButton>(w, "removeHole")->setChecked(true);
+  EXPECT_FALSE(child<QPushButton>(w, "addHole")->isChecked()) << "one click mode at a time";
+  emit w.view().surfaceClicked(far.center);
+  plan.wait();
+  const std::vector<Hole> removed = plan.state().implant->result().holes;
+  EXPECT_EQ(removed.size(), added.size() - 1);
+  EXPECT_EQ(near(removed, far.center), 0);
+  EXPECT_EQ(plan.state().implant->quality().holes_blocked, 0);
+  // Undo twice: the pattern as built; redo: the added hole back.
+  plan.undo();
+  plan.wait();
+  EXPECT_EQ(plan.state().implant->result().holes.size(), added.size());
+  plan.undo();
+  plan.wait();
+  EXPECT_EQ(plan.state().implant->result().holes.size(), pattern.size());
+  plan.redo();
+  plan.wait();
+  EXPECT_EQ(near(plan.state().implant->result().holes, between), 1);
 }
 
 TEST_F(Wizard, CommandLineScreenshotOfASessionAtAStep) {

@@ -159,8 +159,8 @@ TEST(Commands, PlansSavedBeforeVotingThroughHolesFitTheBoneAsThen) {
   EXPECT_TRUE(back.trim.thin_fills_removed) << "the rest of version 4 as recorded";
 }
 
-// build_implant 6 records the material and the clearance zones in full (a replay uses the
-// values of the day, not the presets of a later version); version 5 reads with neither. A
+// build_implant 6 records the material, the clearance zones and the perforations in full (a replay
+// uses the values of the day, not the presets of a later version); version 5 reads with neither. A
 // material out of its ranges in a file is refused with the value named.
 TEST(Commands, TheBuildRecordsItsMaterialAndClearanceZones) {
   ImplantParams p;
@@ -168,6 +168,10 @@ TEST(Commands, TheBuildRecordsItsMaterialAndClearanceZones) {
   p.material = *material_preset("pmma");
   p.material->edge_clearance_mm = 1.5;
   p.clearance_zones = {{Eigen::Vector3d(1, 2, 3), 12.0, 2.5}};
+  p.perforations.pattern = true;
+  p.perforations.spacing_mm = 12.0;
+  p.perforations.added = {Eigen::Vector3d(4, 5, 6)};
+  p.perforations.removed = {Eigen::Vector3d(7, 8, 9)};
   const Json build = to_json(commands::build_implant(p));
   EXPECT_EQ(build["version"], 6);
   const Json& recorded = build["params"]["params"];
@@ -184,12 +188,19 @@ TEST(Commands, TheBuildRecordsItsMaterialAndClearanceZones) {
   ASSERT_EQ(back.clearance_zones.size(), 1u);
   EXPECT_EQ(back.clearance_zones[0].center, Eigen::Vector3d(1, 2, 3));
   EXPECT_EQ(back.clearance_zones[0].clearance_mm, 2.5);
+  EXPECT_TRUE(back.perforations.pattern);
+  EXPECT_EQ(back.perforations.spacing_mm, 12.0);
+  ASSERT_EQ(back.perforations.added.size(), 1u);
+  EXPECT_EQ(back.perforations.added[0], Eigen::Vector3d(4, 5, 6));
+  ASSERT_EQ(back.perforations.removed.size(), 1u);
 
   Json v5 = recorded;
   v5.erase("material");
   v5.erase("clearance_zones");
+  v5.erase("perforations");
   params_from_json(ParamReader(v5, "test"), back);
   EXPECT_FALSE(back.material);
+  EXPECT_FALSE(back.perforations.any());
   EXPECT_TRUE(back.clearance_zones.empty());
 
   Json bad = recorded;

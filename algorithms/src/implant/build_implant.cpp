@@ -737,6 +737,11 @@ std::string finishing_problem(const ImplantParams& params, const SkullMesh* skul
     const std::string problem = material_problem(*params.material);
     if (!problem.empty()) return params.material->name + ": " + problem;
   }
+  if (params.perforations.any()) {
+    if (params.method != ImplantMethod::Shell) return "perforations need the shell method";
+    const std::string problem = perforation_problem(params.perforations);
+    if (!problem.empty()) return problem;
+  }
   for (size_t k = 0; k < params.clearance_zones.size(); ++k) {
     const std::string problem = zone_problem(params.clearance_zones[k]);
     if (!problem.empty()) return "clearance zone " + std::to_string(k + 1) + ": " + problem;
@@ -795,6 +800,23 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
     } else {
       r.status = ImplantResult::Status::Failed;
       r.message = "fitting to the bone: " + t.message;
+    }
+  }
+  if (r.usable() && params.perforations.any()) {
+    // The holes' outer side faces away from the rays' centre (or the skull's centre).
+    Eigen::Vector3d inside = params.radial_center.value_or(Eigen::Vector3d::Zero());
+    if (!params.radial_center && skull && skull->n_vertices() > 0) inside = vertex_centroid(*skull);
+    PerforationParams holes = params.perforations;
+    if (params.material) holes.min_thickness_mm = params.material->min_thickness_mm;
+    PerforateResult p = perforate(r.mesh, inside, holes);
+    if (p.usable()) {
+      r.mesh = std::move(p.mesh);
+      r.holes = std::move(p.holes);
+      r.watertight = report_mesh(r.mesh).watertight;
+      r.message += "; " + p.message;
+    } else {
+      r.status = ImplantResult::Status::Failed;
+      r.message = "perforations: " + p.message;
     }
   }
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

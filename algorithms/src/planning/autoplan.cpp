@@ -69,9 +69,10 @@ void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const Auto
     r.message = "implant: " + r.implant.message;
     return;
   }
-  r.quality =
-      check_implant(r.implant.mesh, &skull, &bone,
-                    quality_params_for(params.implant.material, params.implant.clearance_zones));
+  QualityParams checks =
+      quality_params_for(params.implant.material, params.implant.clearance_zones);
+  checks.holes = r.implant.holes;
+  r.quality = check_implant(r.implant.mesh, &skull, &bone, checks);
   timer.stage("quality");
   r.status = AutoplanResult::Status::Planned;
   r.message = r.defect.message + "; " + describe_method(r.method_used, r.mirror_coverage) + "; " +

@@ -223,6 +223,9 @@ void add_reasons(const MeshReport& rep, const QualityParams& params, bool with_b
         fmt("the edge comes %.2f mm nearer the bone than the clearance asked "
             "(tolerance %.2f mm): it would not go in",
             -q.clearance_low_mm, params.clearance_tolerance_mm));
+  if (q.holes_blocked > 0)
+    q.reasons.push_back(std::to_string(q.holes_blocked) + " of " + std::to_string(q.holes) +
+                        " holes do not go through");
   if (q.penetration_mm3 > params.max_penetration_mm3)
     q.reasons.push_back(fmt("%.1f mm³ overlap the skull (limit %.1f mm³)", q.penetration_mm3,
                             params.max_penetration_mm3));
@@ -259,6 +262,11 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
   q.pieces = rep.pieces;
   q.self_intersections = count_self_intersections(implant);
   q.material_name = params.material_name;
+  if (!params.holes.empty()) {
+    const SurfaceLocator self(implant);
+    q.holes = static_cast<int>(params.holes.size());
+    for (const Hole& h : params.holes) q.holes_blocked += !hole_goes_through(self, h);
+  }
   if (params.density_g_cm3 > 0.0) q.mass_g = rep.volume_mm3 * 1e-3 * params.density_g_cm3;
   if (implant.n_faces() == 0) {
     q.reasons.push_back("the implant has no triangles");

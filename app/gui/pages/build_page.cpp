@@ -1,8 +1,11 @@
+#include <QCheckBox>
 #include <QComboBox>
 #include <QDoubleSpinBox>
 #include <QFormLayout>
+#include <QHBoxLayout>
 #include <QLabel>
 #include <QPushButton>
+#include <algorithm>
 #include <cmath>
 
 #include "step_pages.h"
@@ -77,8 +80,6 @@ BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
   mark_zone_->setToolTip(
       tr("Then click the rim: the stretch within the radius keeps the zone's "
          "clearance (e.g. 3 mm under the temporalis muscle)"));
-  connect(mark_zone_, &QPushButton::toggled, this,
-          [this](bool) { host_.view().set_pick_target(pick_target()); });
   zone_radius_ = spin("zoneRadius", 1, 100, 1, " mm");
   zone_radius_->setValue(15);
   zone_clearance_ = spin("zoneClearance", 0, 3, 0.1, " mm");
@@ -94,6 +95,36 @@ BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
   form_->addRow(tr("Zone clearance"), zone_clearance_);
   form_->addRow(remove_zone_);
   show_material(0);
+
+  // Perforations: a pattern, and single holes added or taken away by clicks on the implant.
+  perforate_ = new QCheckBox(tr("Perforations on a pattern"), this);
+  perforate_->setObjectName("perforate");
+  perforate_->setToolTip(tr("Holes through the implant for drainage and dura suspension"));
+  hole_diameter_ = spin("holeDiameter", 1, 6, 0.5, " mm");
+  hole_diameter_->setValue(2.0);
+  hole_spacing_ = spin("holeSpacing", 4, 40, 1, " mm");
+  hole_spacing_->setValue(10.0);
+  hole_edge_ = spin("holeEdge", 1, 20, 0.5, " mm");
+  hole_edge_->setValue(5.0);
+  add_hole_ = make_button(tr("Add a hole"), "addHole");
+  remove_hole_ = make_button(tr("Remove a hole"), "removeHole");
+  for (QPushButton* b : {add_hole_, remove_hole_}) {
+    b->setCheckable(true);
+    b->setToolTip(tr("Then click the implant"));
+  }
+  for (QPushButton* b : {mark_zone_, add_hole_, remove_hole_})
+    connect(b, &QPushButton::toggled, this, [this, b](bool on) {
+      if (on) click_mode(b);
+      host_.view().set_pick_target(pick_target());
+    });
+  form_->addRow(perforate_);
+  form_->addRow(tr("Hole diameter"), hole_diameter_);
+  form_->addRow(tr("Hole spacing"), hole_spacing_);
+  form_->addRow(tr("Distance from the edge"), hole_edge_);
+  auto* hole_buttons = new QHBoxLayout;
+  hole_buttons->addWidget(add_hole_);
+  hole_buttons->addWidget(remove_hole_);
+  form_->addRow(hole_buttons);
 
   QPushButton* build = add_button(tr("Build implant"), "build");
   connect(build, &QPushButton::clicked, this,
@@ -122,11 +153,51 @@ void BuildPage::rebuild() {
   host_.push(commands::build_implant(params()), tr("Building the implant"));
 }
 
+void BuildPage::click_mode(QPushButton* on) {
+  for (QPushButton* b : {mark_zone_, add_hole_, remove_hole_})
+    if (b != on && b->isChecked()) {
+      const QSignalBlocker block(b);
+      b->setChecked(false);
+    }
+}
+
 SkullView::PickTarget BuildPage::pick_target() const {
-  return mark_zone_->isChecked() ? SkullView::PickTarget::Original : SkullView::PickTarget::None;
+  if (mark_zone_->isChecked()) return SkullView::PickTarget::Original;
+  if (add_hole_->isChecked() || remove_hole_->isChecked()) return SkullView::PickTarget::Implant;
+  return SkullView::PickTarget::None;
 }
 
 void BuildPage::surface_clicked(const Eigen::Vector3d& point) {
+  if (add_hole_->isChecked()) {
+    added_holes_.push_back(point);
+    rebuild();
+    return;
+  }
+  if (remove_hole_->isChecked()) {
+    // The nearest hole of the implant shown: one the user added goes from that list, one of
+    // the pattern's is left out from now on.
+    const PlanState& s = host_.plan();
+    if (!s.implant || s.implant->result().holes.empty()) return;
+    const Hole* nearest = nullptr;
+    for (const Hole& h : s.implant->result().holes)
+      if (!nearest || (h.center - point).norm() < (nearest->center - point).norm()) nearest = &h;
+    if ((nearest->center - point).norm() > 5.0) {
+      host_.show_message(tr("No hole within 5 mm of the click."), true);
+      return;
+    }
+    if (nearest->added) {
+      auto closest =
+          std::min_element(added_holes_.begin(), added_holes_.end(),
+                           [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+                             return (a - nearest->center).norm() < (b - nearest->center).norm();
+                           });
+      if (closest != added_holes_.end()) added_holes_.erase(closest);
+    } else {
+      removed_holes_.push_back(nearest->center);
+    }
+    rebuild();
+    return;
+  }
   if (!mark_zone_->isChecked()) return;
   zones_.push_back({point, zone_radius_->value(), zone_clearance_->value()});
   if (!host_.plan().implant_params) {
@@ -157,6 +228,12 @@ ImplantParams BuildPage::params() const {
     p.material = m;
   }
   p.clearance_zones = zones_;
+  p.perforations.pattern = perforate_->isChecked();
+  p.perforations.diameter_mm = hole_diameter_->value();
+  p.perforations.spacing_mm = hole_spacing_->value();
+  p.perforations.edge_distance_mm = hole_edge_->value();
+  p.perforations.added = added_holes_;
+  p.perforations.removed = removed_holes_;
   return p;
 }
 
@@ -188,6 +265,13 @@ void BuildPage::show_state(const PlanState& s) {
       density_->setValue(p.material->density_g_cm3);
     }
     zones_ = p.clearance_zones;
+    const QSignalBlocker b6(perforate_);
+    perforate_->setChecked(p.perforations.pattern);
+    hole_diameter_->setValue(p.perforations.diameter_mm);
+    hole_spacing_->setValue(p.perforations.spacing_mm);
+    hole_edge_->setValue(p.perforations.edge_distance_mm);
+    added_holes_ = p.perforations.added;
+    removed_holes_ = p.perforations.removed;
   }
   remove_zone_->setEnabled(!zones_.empty());
   QString text =
@@ -197,6 +281,10 @@ void BuildPage::show_state(const PlanState& s) {
                 : tr("No implant yet.");
   if (s.implant_params && s.implant_params->material)
     text += "<br>" + QString::fromStdString(describe(*s.implant_params->material));
+  if (s.implant && !s.implant->result().holes.empty())
+    text += "<br>" + tr("%1 holes of %2 mm.")
+                         .arg(s.implant->result().holes.size())
+                         .arg(hole_diameter_->value(), 0, 'f', 1);
   if (!zones_.empty())
     text += "<br>" + (zones_.size() == 1
                           ? tr("1 clearance zone on the rim (orange).")

@@ -145,6 +145,12 @@ class BuildPage : public StepPage {
   QDoubleSpinBox *zone_radius_, *zone_clearance_;
   QPushButton* remove_zone_;
   std::vector<ClearanceZone> zones_;
+  QCheckBox* perforate_;
+  QDoubleSpinBox *hole_diameter_, *hole_spacing_, *hole_edge_;
+  QPushButton *add_hole_, *remove_hole_;
+  std::vector<Eigen::Vector3d> added_holes_, removed_holes_;
+  /// Turns the other click modes off when one is turned on.
+  void click_mode(QPushButton* on);
   QLabel* info_;
 };
 

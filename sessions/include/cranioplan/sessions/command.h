@@ -118,7 +118,9 @@ void params_from_json(const ParamReader& r, ImplantParams& p);
 /// ranges checked (a SessionError names the problem).
 Json to_json(const Material& m);
 Json to_json(const ClearanceZone& z);
+Json to_json(const PerforationParams& p);
 Material material_from_json(const ParamReader& r);
+PerforationParams perforations_from_json(const ParamReader& r);
 ClearanceZone clearance_zone_from_json(const ParamReader& r);
 
 /// Builders: the only way the wizard and the CLI make commands.

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "cranioplan/algorithms/implant/perforate.h"
 #include "cranioplan/algorithms/implant/trim_to_bone.h"
 #include "cranioplan/model/marker.h"
 #include "cranioplan/model/material.h"
@@ -47,6 +48,8 @@ struct ImplantParams {
   /// Stretches of the rim held further off the bone than the material's clearance (needs the
   /// fit to the bone).
   std::vector<ClearanceZone> clearance_zones;
+  /// Holes drilled through the finished implant (perforate.h; the shell method only).
+  PerforationParams perforations;
   /// Radial needs a skull (its centroid is the centre) or `radial_center`; otherwise planar.
   ImplantFrame frame = ImplantFrame::Radial;
   std::optional<Eigen::Vector3d> radial_center;  ///< centre of the rays (inside the skull)
@@ -65,6 +68,7 @@ struct ImplantResult {
   double thickness_used_mm = 0.0;    ///< shell without inner markers: the offset applied
   double rim_marker_error_mm = 0.0;  ///< largest distance from an edge marker to its rim
   int rim_points = 0;                ///< samples along each rim
+  std::vector<Hole> holes;           ///< the perforations drilled
   double seconds = 0.0;
   bool usable() const { return status == Status::Built; }
 };

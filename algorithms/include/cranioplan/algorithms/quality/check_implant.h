@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "cranioplan/algorithms/implant/perforate.h"
 #include "cranioplan/model/material.h"
 #include "cranioplan/model/mesh.h"
 
@@ -32,6 +33,8 @@ struct QualityParams {
   double clearance_tolerance_mm = 0.2;  ///< mm
   double density_g_cm3 = 0.0;           ///< for the mass, g/cm³ (0: no mass)
   std::string material_name;            ///< as the report names it (empty: none)
+  /// The perforations drilled (ImplantResult::holes): each must go through.
+  std::vector<Hole> holes;
 };
 
 /// The quality check a build with a material asks for: its minimum thickness, clearance,
@@ -58,8 +61,9 @@ struct QualityReport {
   /// asked there; the smallest and the largest over the arcs (0 and 0: every arc exactly as
   /// asked). Both 0 without a skull or without a clearance asked.
   double clearance_low_mm = 0.0, clearance_high_mm = 0.0;
-  bool clearance_asked = false;  ///< a clearance (or zone) was asked
-  double mass_g = 0.0;           ///< volume × density (0 without a density)
+  bool clearance_asked = false;      ///< a clearance (or zone) was asked
+  double mass_g = 0.0;               ///< volume × density (0 without a density)
+  int holes = 0, holes_blocked = 0;  ///< perforations, and those that do not go through
   std::string material_name;
   double penetration_mm3 = -1.0;  ///< −1 without a skull
   bool printable = false;

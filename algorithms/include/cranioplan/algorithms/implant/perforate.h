@@ -1,0 +1,63 @@
+#pragma once
+// Perforations: holes through the implant for drainage and dura suspension, on a pattern of
+// given spacing kept off the implant's edge, and single holes the user adds or takes away.
+// Each is drilled along the implant's surface normal at its centre; the implant is meshed again
+// from a field on a fine grid (the implant's signed distance, less the holes' cylinders), so it
+// stays one closed, manifold surface.
+#include <Eigen/Core>
+#include <string>
+#include <vector>
+
+#include "cranioplan/model/mesh.h"
+
+namespace cranioplan {
+
+struct PerforationParams {
+  bool pattern = false;      ///< holes on a hexagonal pattern over the implant
+  double diameter_mm = 2.0;  ///< of every hole, mm (1..6)
+  double spacing_mm = 10.0;  ///< between the pattern's holes, mm (4..40)
+  double edge_distance_mm =
+      5.0;  ///< pattern holes' centres at least this far from the edge, mm (1..20)
+  /// Pattern holes only where the implant is at least this thick plus 1 mm, mm (0.3..10; the
+  /// material's minimum thickness when built with one): the rim of a hole through thinner
+  /// material is thinner still where the surface curves.
+  double min_thickness_mm = 1.0;
+  /// Single holes at these points (each moved onto the implant's surface); a pattern hole
+  /// within half the spacing of one gives way to it.
+  std::vector<Eigen::Vector3d> added;
+  /// Pattern holes within half the spacing of these points are left out.
+  std::vector<Eigen::Vector3d> removed;
+  double voxel_mm = 0.2;      ///< grid of the drilling, mm (0.05..1; at most a quarter diameter)
+  double max_voxels = 1.2e7;  ///< a large implant's grid is coarsened to this many voxels
+  bool any() const { return pattern || !added.empty(); }
+};
+/// Why the parameters cannot be used (a value out of its range), or empty.
+std::string perforation_problem(const PerforationParams& p);
+
+/// A hole: its centre on the outer surface and the direction it is drilled (outward, unit).
+struct Hole {
+  Eigen::Vector3d center = Eigen::Vector3d::Zero();
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  bool added = false;  ///< one of PerforationParams::added (else the pattern's)
+};
+
+struct PerforateResult {
+  enum class Status { Drilled, Failed };
+  Status status = Status::Failed;
+  std::string message;
+  SkullMesh mesh;  ///< the implant with its holes (the input, untouched, when Failed)
+  std::vector<Hole> holes;
+  double seconds = 0.0;
+  bool usable() const { return status == Status::Drilled; }
+};
+
+/// Drills the holes into `implant` (closed, outward-oriented). `inside`: a point inside the
+/// skull, which tells the implant's outer surface (facing away from it) from its inner one.
+PerforateResult perforate(const SkullMesh& implant, const Eigen::Vector3d& inside,
+                          const PerforationParams& params);
+
+/// Whether a hole goes through `implant` (located by `locator`): its axis line, 15 mm to either
+/// side of its centre, meets no surface (a plate is at most 15 mm thick).
+bool hole_goes_through(const class SurfaceLocator& locator, const Hole& hole);
+
+}  // namespace cranioplan

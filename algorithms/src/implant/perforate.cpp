@@ -1,0 +1,289 @@
+#include "cranioplan/algorithms/implant/perforate.h"
+
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+
+#include "cranioplan/algorithms/geometry/parallel.h"
+#include "cranioplan/algorithms/geometry/point_index.h"
+#include "cranioplan/algorithms/geometry/surface_locator.h"
+#include "cranioplan/algorithms/geometry/voxelize_mesh.h"
+#include "cranioplan/algorithms/io/extract_bone_surface.h"
+
+namespace cranioplan {
+
+namespace {
+
+bool within(double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; }
+
+// The holes' rims are rounded over this radius, mm: a sharp rim is a thin edge, and
+// deburring one is the first thing a workshop does.
+constexpr double kRimRoundMm = 1.0;
+
+// The smooth minimum of two signed distances (positive inside): their intersection, its edge
+// rounded over `k`.
+double smooth_min(double a, double b, double k) {
+  const double w = std::max(k - std::abs(a - b), 0.0) / k;
+  return std::min(a, b) - 0.25 * w * w * k;
+}
+
+std::string range_problem(const char* what, double v, double lo, double hi) {
+  char buf[160];
+  std::snprintf(buf, sizeof(buf), "the holes' %s must be %g to %g mm (%g given)", what, lo, hi, v);
+  return buf;
+}
+
+// The implant's faces by the side they face: away from the inside point (outer), towards it
+// (inner), or across (the side wall).
+struct Faces {
+  std::vector<Eigen::Vector3d> outer_centres, outer_normals;
+  std::vector<double> outer_areas;
+  std::vector<Eigen::Vector3d> wall_points;  // the side wall's face centres: the edge
+};
+
+Faces classify(const SkullMesh& implant, const Eigen::Vector3d& inside) {
+  Faces f;
+  for (auto fh : implant.faces()) {
+    Eigen::Vector3d p[3];
+    int k = 0;
+    for (auto vh : implant.fv_range(fh)) p[k++] = to_eigen(implant.point(vh));
+    const Eigen::Vector3d cross = (p[1] - p[0]).cross(p[2] - p[0]);
+    if (cross.norm() == 0) continue;
+    const Eigen::Vector3d c = (p[0] + p[1] + p[2]) / 3.0, n = cross.normalized();
+    const double facing = n.dot((c - inside).normalized());
+    if (facing > 0.7) {
+      f.outer_centres.push_back(c);
+      f.outer_normals.push_back(n);
+      f.outer_areas.push_back(0.5 * cross.norm());
+    } else if (facing > -0.7) {
+      f.wall_points.push_back(c);
+    }
+  }
+  return f;
+}
+
+// The outer surface's normal around `at`: the mean of its faces' within 1.5 mm.
+Eigen::Vector3d normal_near(const Faces& f, const PointIndex& outer, const Eigen::Vector3d& at,
+                            const Eigen::Vector3d& inside) {
+  Eigen::Vector3d n = Eigen::Vector3d::Zero();
+  for (int i : outer.within_radius(at, 1.5)) n += f.outer_areas[i] * f.outer_normals[i];
+  if (n.norm() == 0) n = at - inside;
+  return n.normalized();
+}
+
+// The pattern: a hexagonal lattice over the plane across the outer surface's mean normal,
+// centred at its area-weighted centroid, each point carried along that normal onto the outer
+// surface; kept where it lies far enough from the edge and the implant is thick enough there.
+std::vector<Eigen::Vector3d> pattern_centres(const Faces& f, const SurfaceLocator& self,
+                                             const PointIndex& wall, const PerforationParams& p) {
+  Eigen::Vector3d axis = Eigen::Vector3d::Zero(), centroid = Eigen::Vector3d::Zero();
+  double area = 0.0;
+  for (size_t i = 0; i < f.outer_centres.size(); ++i) {
+    axis += f.outer_areas[i] * f.outer_normals[i];
+    centroid += f.outer_areas[i] * f.outer_centres[i];
+    area += f.outer_areas[i];
+  }
+  if (area == 0 || axis.norm() == 0) return {};
+  axis.normalize();
+  centroid /= area;
+  const Eigen::Vector3d e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
+  double reach = 0.0;
+  for (const auto& c : f.outer_centres) reach = std::max(reach, (c - centroid).norm());
+  const double s = p.spacing_mm, row = s * std::sqrt(3.0) / 2.0;
+  const int rows = static_cast<int>(reach / row) + 1, cols = static_cast<int>(reach / s) + 1;
+  std::vector<Eigen::Vector3d> out;
+  for (int j = -rows; j <= rows; ++j)
+    for (int i = -cols; i <= cols; ++i) {
+      const double u = (i + ((j & 1) ? 0.5 : 0.0)) * s, v = j * row;
+      const Eigen::Vector3d q = centroid + u * e1 + v * e2;
+      const auto hit = self.first_hit(q + (reach + 50.0) * axis, q - (reach + 50.0) * axis);
+      if (!hit || self.face_normal(hit->face).dot(axis) <= 0.0) continue;
+      double d2 = 0.0;
+      if (!f.wall_points.empty()) wall.nearest(hit->point, &d2);
+      if (!f.wall_points.empty() && std::sqrt(d2) < p.edge_distance_mm) continue;
+      const auto back = self.first_hit(hit->point - 1e-3 * axis, hit->point - 50.0 * axis);
+      if (back && back->distance >= p.min_thickness_mm + 2.0) out.push_back(hit->point);
+    }
+  return out;
+}
+
+}  // namespace
+
+std::string perforation_problem(const PerforationParams& p) {
+  if (!within(p.diameter_mm, 1.0, 6.0)) return range_problem("diameter", p.diameter_mm, 1, 6);
+  if (!within(p.spacing_mm, 4.0, 40.0)) return range_problem("spacing", p.spacing_mm, 4, 40);
+  if (p.spacing_mm < p.diameter_mm + 2.0)
+    return range_problem("spacing", p.spacing_mm, p.diameter_mm + 2.0, 40);
+  if (!within(p.min_thickness_mm, 0.3, 10.0))
+    return range_problem("minimum thickness around them", p.min_thickness_mm, 0.3, 10);
+  if (!within(p.edge_distance_mm, 1.0, 20.0))
+    return range_problem("distance from the edge", p.edge_distance_mm, 1, 20);
+  for (const auto& v : p.added)
+    if (!v.allFinite()) return "a hole's position is not a point";
+  for (const auto& v : p.removed)
+    if (!v.allFinite()) return "a hole's position is not a point";
+  return {};
+}
+
+bool hole_goes_through(const SurfaceLocator& locator, const Hole& hole) {
+  return !locator.first_hit(hole.center + 15.0 * hole.axis, hole.center - 15.0 * hole.axis);
+}
+
+PerforateResult perforate(const SkullMesh& implant, const Eigen::Vector3d& inside,
+                          const PerforationParams& p) {
+  const auto t0 = std::chrono::steady_clock::now();
+  PerforateResult r;
+  auto done = [&](PerforateResult& out) {
+    out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return out;
+  };
+  if (const std::string problem = perforation_problem(p); !problem.empty()) {
+    r.message = problem;
+    r.mesh = implant;
+    return done(r);
+  }
+  const Faces faces = classify(implant, inside);
+  if (faces.outer_centres.empty()) {
+    r.message = "the implant has no outer surface facing away from the skull's inside";
+    r.mesh = implant;
+    return done(r);
+  }
+  const SurfaceLocator self(implant);
+  const PointIndex outer(faces.outer_centres);
+  const PointIndex wall(faces.wall_points.empty() ? std::vector<Eigen::Vector3d>{inside}
+                                                  : faces.wall_points);
+  // The holes: the user's, then the pattern's that keep clear of them and of the removed.
+  const double radius = 0.5 * p.diameter_mm;
+  for (const Eigen::Vector3d& a : p.added) {
+    const Eigen::Vector3d at = self.closest(a).point;
+    r.holes.push_back({at, normal_near(faces, outer, at, inside), true});
+  }
+  for (size_t i = 0; i < r.holes.size(); ++i)
+    for (size_t j = i + 1; j < r.holes.size(); ++j)
+      if ((r.holes[i].center - r.holes[j].center).norm() < p.diameter_mm + 1.0) {
+        r.message = "holes " + std::to_string(i + 1) + " and " + std::to_string(j + 1) +
+                    " are less than 1 mm apart: move or remove one";
+        r.mesh = implant;
+        r.holes.clear();
+        return done(r);
+      }
+  if (p.pattern)
+    for (const Eigen::Vector3d& c : pattern_centres(faces, self, wall, p)) {
+      bool keep = true;
+      for (const Eigen::Vector3d& x : p.removed) keep = keep && (x - c).norm() > 0.5 * p.spacing_mm;
+      for (const Eigen::Vector3d& x : p.added) keep = keep && (x - c).norm() > 0.5 * p.spacing_mm;
+      if (keep) r.holes.push_back({c, normal_near(faces, outer, c, inside), false});
+    }
+  if (r.holes.empty()) {  // nothing to drill: the implant as it is
+    r.mesh = implant;
+    r.status = PerforateResult::Status::Drilled;
+    r.message = "no hole fits: the implant is smaller than the pattern's distance from its edge";
+    return done(r);
+  }
+
+  // The implant as a field on a fine grid: its signed distance near its surface, less each
+  // hole's cylinder (their smooth minimum, so the rims come out rounded).
+  const auto [lo, hi] = mesh_bounds(implant);
+  const double h0 = std::clamp(std::min(p.voxel_mm, p.diameter_mm / 4.0), 0.05, 1.0);
+  const VoxelGrid g = VoxelGrid::covering_at_most(lo, hi, h0, std::max(1e5, p.max_voxels), 3);
+  const double h = g.spacing;
+  const std::vector<uint8_t> solid = voxelize_mesh(implant, g);
+  // The implant's signed distance (mm, positive inside): exact near its surface, ±10 mm (no
+  // more than needed) elsewhere.
+  std::vector<float> field(solid.size());
+  for (size_t c = 0; c < solid.size(); ++c) field[c] = solid[c] ? 10.0f : -10.0f;
+  const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
+  // Near the surface: within two voxels (along each axis in turn) of a voxel whose neighbour
+  // along an axis is on the other side.
+  std::vector<uint8_t> band(solid.size(), 0);
+  for (int k = 0; k < nz; ++k)
+    for (int j = 0; j < ny; ++j)
+      for (int i = 0; i < nx; ++i) {
+        const size_t c = g.index(i, j, k);
+        band[c] = (i + 1 < nx && solid[g.index(i + 1, j, k)] != solid[c]) ||
+                  (j + 1 < ny && solid[g.index(i, j + 1, k)] != solid[c]) ||
+                  (k + 1 < nz && solid[g.index(i, j, k + 1)] != solid[c]);
+      }
+  const size_t step[3] = {1, static_cast<size_t>(nx), static_cast<size_t>(nx) * ny};
+  for (int axis = 0; axis < 3; ++axis) {
+    std::vector<uint8_t> grown = band;
+    for (int k = 0; k < nz; ++k)
+      for (int j = 0; j < ny; ++j)
+        for (int i = 0; i < nx; ++i) {
+          const size_t c = g.index(i, j, k);
+          if (!band[c]) continue;
+          const int at = axis == 0 ? i : axis == 1 ? j : k, n = g.dims[axis];
+          for (int d = -2; d <= 3; ++d)  // the pair (c, c+1) straddles: both sides' reach
+            if (at + d >= 0 && at + d < n)
+              grown[static_cast<size_t>(static_cast<long long>(c) +
+                                        d * static_cast<long long>(step[axis]))] = 1;
+        }
+    band = std::move(grown);
+  }
+  parallel_for(solid.size(), [&](size_t begin, size_t end) {
+    for (size_t c = begin; c < end; ++c) {
+      if (!band[c]) continue;
+      const int i = static_cast<int>(c % nx), j = static_cast<int>((c / nx) % ny),
+                k = static_cast<int>(c / (static_cast<size_t>(nx) * ny));
+      field[c] =
+          static_cast<float>(self.closest(g.center(i, j, k)).distance * (solid[c] ? 1.0 : -1.0));
+    }
+  });
+  for (const Hole& hole : r.holes) {
+    // The drill goes from above the outer surface to below the inner one at the centre, not
+    // on into another part of a curved implant.
+    const auto under =
+        self.first_hit(hole.center - 1e-3 * hole.axis, hole.center - 16.0 * hole.axis);
+    const double depth = (under ? under->distance : 15.0) + 1.0 + 2.0 * h, above = 1.0 + 2.0 * h;
+    const Eigen::Vector3d reach = Eigen::Vector3d::Constant(radius + 2.0 * h + 16.0);
+    const Eigen::Vector3d a = ((hole.center - reach) - g.origin) / h,
+                          b = ((hole.center + reach) - g.origin) / h;
+    for (int k = std::max(0, static_cast<int>(a.z()));
+         k <= std::min(nz - 1, static_cast<int>(b.z()) + 1); ++k)
+      for (int j = std::max(0, static_cast<int>(a.y()));
+           j <= std::min(ny - 1, static_cast<int>(b.y()) + 1); ++j)
+        for (int i = std::max(0, static_cast<int>(a.x()));
+             i <= std::min(nx - 1, static_cast<int>(b.x()) + 1); ++i) {
+          const Eigen::Vector3d q = g.center(i, j, k) - hole.center;
+          const double t = q.dot(hole.axis);
+          if (t > above || t < -depth) continue;
+          const double off_axis = (q - t * hole.axis).norm();
+          float& v = field[g.index(i, j, k)];
+          v = static_cast<float>(smooth_min(v, off_axis - radius, kRimRoundMm));
+        }
+  }
+  // As a field from 0 (outside) to 1 (inside), ½ on the surface. A value exactly at the
+  // iso-level puts a vertex on a grid point, shared by triangles that then have no area: nudged
+  // off it.
+  for (float& v : field) {
+    v = static_cast<float>(std::clamp(0.5 + v / h, 0.0, 1.0));
+    if (v == 0.5f) v = 0.5f + 1e-4f;
+  }
+  Volume volume = mask_volume({}, g);
+  volume.data = std::move(field);
+  ExtractBoneSurfaceParams surface;
+  surface.threshold = 0.5;
+  surface.largest_piece_only = true;
+  surface.canonical = false;
+  ExtractBoneSurfaceResult s = extract_bone_surface(volume, surface);
+  if (!s.usable()) {
+    r.message = "drilling the holes: " + s.message;
+    r.mesh = implant;
+    r.holes.clear();
+    return done(r);
+  }
+  r.mesh = std::move(s.mesh);
+  const SurfaceLocator drilled(r.mesh);
+  int blocked = 0;
+  for (const Hole& hole : r.holes) blocked += !hole_goes_through(drilled, hole);
+  r.status = PerforateResult::Status::Drilled;
+  char buf[160];
+  std::snprintf(buf, sizeof(buf), "%zu holes of %.1f mm drilled (%d do not go through)",
+                r.holes.size(), p.diameter_mm, blocked);
+  r.message = blocked == 0 ? std::string(buf).substr(0, std::string(buf).find(" (")) : buf;
+  return done(r);
+}
+
+}  // namespace cranioplan

@@ -1,0 +1,128 @@
+#include "cranioplan/algorithms/implant/perforate.h"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "cranioplan/algorithms/geometry/self_intersections.h"
+#include "cranioplan/algorithms/geometry/surface_locator.h"
+#include "cranioplan/algorithms/geometry/voxelize_mesh.h"
+#include "cranioplan/algorithms/io/extract_bone_surface.h"
+#include "cranioplan/algorithms/io/mesh_report.h"
+#include "cranioplan/algorithms/quality/check_implant.h"
+#include "support/synthetic.h"
+
+namespace cranioplan {
+namespace {
+
+// A 40 × 40 × 4 mm plate (z 7 to 11) meshed from a mask, as an implant is: the inside of the
+// skull lies below it.
+SkullMesh plate() {
+  const SkullMesh box = build_mesh(test::box_soup({0, 0, 7}, {40, 40, 11}));
+  const VoxelGrid g = VoxelGrid::covering({-2.25, -2.25, 4.75}, {42.25, 42.25, 13.25}, 0.5);
+  ExtractBoneSurfaceParams mask;
+  mask.threshold = 0.5;
+  return extract_bone_surface(mask_volume(voxelize_mesh(box, g), g), mask).mesh;
+}
+const Eigen::Vector3d kInside(20, 20, -60);
+
+// Euler characteristic V − E + F of a closed surface: 2 − 2·genus, one genus per hole through.
+long long genus(const SkullMesh& m) {
+  const long long chi = static_cast<long long>(m.n_vertices()) -
+                        static_cast<long long>(m.n_edges()) + static_cast<long long>(m.n_faces());
+  return (2 - chi) / 2;
+}
+
+// The pattern on a plate: holes on a hexagonal lattice 10 mm apart, none within 6 mm of the
+// edge, each drilled straight down and through; the plate stays one closed, manifold surface
+// with exactly as many tunnels as holes, and the quality report finds them all open.
+TEST(Perforate, APatternOnAPlateGoesThroughEveryHole) {
+  const SkullMesh p = plate();
+  PerforationParams params;
+  params.pattern = true;
+  params.spacing_mm = 10.0;
+  params.edge_distance_mm = 6.0;
+  const PerforateResult r = perforate(p, kInside, params);
+  ASSERT_TRUE(r.usable()) << r.message;
+  ASSERT_GE(r.holes.size(), 6u);
+  for (size_t i = 0; i < r.holes.size(); ++i) {
+    const Hole& h = r.holes[i];
+    EXPECT_NEAR(h.center.z(), 11.0, 0.05) << "on the outer surface";
+    EXPECT_NEAR(h.axis.z(), 1.0, 1e-3) << "along its normal";
+    EXPECT_GE(std::min({h.center.x(), h.center.y(), 40 - h.center.x(), 40 - h.center.y()}),
+              6.0 - 0.3);
+    for (size_t j = 0; j < i; ++j) EXPECT_GT((h.center - r.holes[j].center).norm(), 9.9);
+  }
+  const MeshReport rep = report_mesh(r.mesh);
+  EXPECT_TRUE(rep.watertight);
+  EXPECT_EQ(rep.nonmanifold_edges, 0);
+  EXPECT_EQ(rep.pieces, 1);
+  EXPECT_EQ(genus(r.mesh), static_cast<long long>(r.holes.size())) << "one tunnel per hole";
+  // Each hole's volume is gone: π r² × 4 mm, its rims rounded a little more.
+  const double hole = M_PI * 1.0 * 4.0;
+  EXPECT_NEAR(report_mesh(p).volume_mm3 - rep.volume_mm3, r.holes.size() * hole,
+              r.holes.size() * 0.35 * hole);
+  QualityParams q;
+  q.holes = r.holes;
+  const QualityReport report = check_implant(r.mesh, nullptr, q);
+  EXPECT_EQ(report.holes, static_cast<int>(r.holes.size()));
+  EXPECT_EQ(report.holes_blocked, 0);
+  EXPECT_TRUE(report.printable) << (report.reasons.empty() ? "" : report.reasons[0]);
+  EXPECT_EQ(count_self_intersections(r.mesh), 0);
+}
+
+// A single hole added where the user clicks (moved onto the surface), the pattern's holes near
+// it giving way; a pattern hole taken away; two added holes that would merge are refused.
+TEST(Perforate, HolesAreAddedAndTakenAway) {
+  const SkullMesh p = plate();
+  PerforationParams params;
+  params.pattern = true;
+  const size_t full = perforate(p, kInside, params).holes.size();
+  params.added = {Eigen::Vector3d(20, 20, 12)};
+  const PerforateResult r = perforate(p, kInside, params);
+  ASSERT_TRUE(r.usable()) << r.message;
+  ASSERT_TRUE(r.holes.front().added);
+  EXPECT_NEAR((r.holes.front().center - Eigen::Vector3d(20, 20, 11)).norm(), 0.0, 0.05);
+  for (size_t k = 1; k < r.holes.size(); ++k)
+    EXPECT_GT((r.holes[k].center - r.holes[0].center).norm(), 0.5 * params.spacing_mm);
+  EXPECT_EQ(genus(r.mesh), static_cast<long long>(r.holes.size()));
+
+  params.added.clear();
+  params.removed = {perforate(p, kInside, params).holes.front().center};
+  EXPECT_EQ(perforate(p, kInside, params).holes.size(), full - 1);
+
+  params.added = {Eigen::Vector3d(20, 20, 11), Eigen::Vector3d(21.5, 20, 11)};
+  const PerforateResult merged = perforate(p, kInside, params);
+  EXPECT_FALSE(merged.usable());
+  EXPECT_NE(merged.message.find("less than 1 mm apart"), std::string::npos) << merged.message;
+}
+
+// A hole blocked (the report is given one where there is none): the quality report says so.
+TEST(Perforate, TheQualityReportFindsABlockedHole) {
+  QualityParams q;
+  q.holes = {Hole{Eigen::Vector3d(20, 20, 11), Eigen::Vector3d::UnitZ(), true}};
+  const QualityReport report = check_implant(plate(), nullptr, q);
+  EXPECT_EQ(report.holes_blocked, 1);
+  EXPECT_FALSE(report.printable);
+  bool said = false;
+  for (const auto& reason : report.reasons)
+    said = said || reason == "1 of 1 holes do not go through";
+  EXPECT_TRUE(said);
+}
+
+TEST(Perforate, ValuesOutOfRangeAreNamed) {
+  PerforationParams p;
+  p.pattern = true;
+  p.diameter_mm = 8;
+  EXPECT_NE(perforation_problem(p).find("diameter must be 1 to 6 mm (8 given)"), std::string::npos);
+  p.diameter_mm = 3;
+  p.spacing_mm = 4;
+  EXPECT_NE(perforation_problem(p).find("spacing"), std::string::npos);
+  const PerforateResult r = perforate(plate(), kInside, p);
+  EXPECT_FALSE(r.usable());
+  EXPECT_EQ(r.mesh.n_faces(), plate().n_faces()) << "the input, untouched";
+}
+
+}  // namespace
+}  // namespace cranioplan
