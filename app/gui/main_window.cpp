@@ -22,6 +22,8 @@
 #include <QMessageBox>
 #include <QProgressBar>
 #include <QPushButton>
+#include <QScrollArea>
+#include <QScrollBar>
 #include <QSettings>
 #include <QShortcut>
 #include <QSlider>
@@ -546,6 +548,7 @@ void MainWindow::build_steps_dock() {
   for (const auto& s : wizard_steps())
     steps_->addItem(QStringLiteral("%1  %2").arg(s.number).arg(tr(s.title)));
   steps_->setMaximumHeight(9 * 24 + 8);
+  steps_->setMinimumHeight(9 * 24 + 8);  // every step in sight, however long the page
   connect(steps_, &QListWidget::itemClicked, this, [this](QListWidgetItem* item) {
     const int step = steps_->row(item) + 1;
     if (step == controller_->state().current_step) return;
@@ -567,7 +570,16 @@ void MainWindow::build_steps_dock() {
     step_pages_.push_back(page);
   }
   load_page_ = static_cast<LoadPage*>(step_pages_[0]);
-  layout->addWidget(pages_, 1);
+  // A long page (step 7's material, zones and holes) scrolls rather than squeezing the steps.
+  auto* scroll = new QScrollArea(panel);
+  scroll->setObjectName("pageScroll");
+  scroll->setWidgetResizable(true);
+  scroll->setFrameShape(QFrame::NoFrame);
+  scroll->setHorizontalScrollBarPolicy(Qt::ScrollBarAlwaysOff);
+  scroll->setWidget(pages_);
+  scroll->setMinimumWidth(pages_->minimumSizeHint().width() +
+                          scroll->verticalScrollBar()->sizeHint().width());
+  layout->addWidget(scroll, 1);
   done_button_ = button(tr("Done — next step"), "done", panel);
   connect(done_button_, &QPushButton::clicked, this,
           [this] { push(commands::complete_step(controller_->state().current_step)); });
@@ -691,7 +703,16 @@ void MainWindow::refresh_steps() {
   }
   steps_->setCurrentRow(s.current_step - 1);
   shown_step_ = s.current_step;
-  pages_->setCurrentIndex(s.current_step - 1);
+  if (pages_->currentIndex() != s.current_step - 1) {
+    pages_->setCurrentIndex(s.current_step - 1);
+    // The stack takes the current page's height (not the longest page's), so only a long
+    // page scrolls.
+    for (int i = 0; i < pages_->count(); ++i)
+      pages_->widget(i)->setSizePolicy(
+          i == s.current_step - 1 ? QSizePolicy::Preferred : QSizePolicy::Ignored,
+          i == s.current_step - 1 ? QSizePolicy::Preferred : QSizePolicy::Ignored);
+    pages_->adjustSize();
+  }
   StepPage* page = step_pages_[static_cast<size_t>(s.current_step - 1)];
   instructions_->setText(page->instructions_html(s));
   done_button_->setEnabled(!controller_->read_only());
