@@ -703,16 +703,7 @@ void MainWindow::refresh_steps() {
   }
   steps_->setCurrentRow(s.current_step - 1);
   shown_step_ = s.current_step;
-  if (pages_->currentIndex() != s.current_step - 1) {
-    pages_->setCurrentIndex(s.current_step - 1);
-    // The stack takes the current page's height (not the longest page's), so only a long
-    // page scrolls.
-    for (int i = 0; i < pages_->count(); ++i)
-      pages_->widget(i)->setSizePolicy(
-          i == s.current_step - 1 ? QSizePolicy::Preferred : QSizePolicy::Ignored,
-          i == s.current_step - 1 ? QSizePolicy::Preferred : QSizePolicy::Ignored);
-    pages_->adjustSize();
-  }
+  pages_->setCurrentIndex(s.current_step - 1);
   StepPage* page = step_pages_[static_cast<size_t>(s.current_step - 1)];
   instructions_->setText(page->instructions_html(s));
   done_button_->setEnabled(!controller_->read_only());

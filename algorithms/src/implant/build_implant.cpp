@@ -36,6 +36,8 @@ namespace {
 constexpr double kTwoPi = 2.0 * M_PI;
 // Markers closer than this (mm, in the parametrisation) to an earlier one are not fitted.
 constexpr double kMinMarkerSeparation = 1.0;
+// More clearance zones than a rim has stretches (each voxel of the fit weighs every zone).
+constexpr size_t kMaxClearanceZones = 100;
 // A plate laid on the bone follows the bone's outer surface up to this far above the fitted one.
 constexpr double kOnlaySearchMm = 20.0;
 // Fitting to the bone seeks the bone to meet up to this many times the margin beyond the rim.
@@ -742,6 +744,8 @@ std::string finishing_problem(const ImplantParams& params, const SkullMesh* skul
     const std::string problem = perforation_problem(params.perforations);
     if (!problem.empty()) return problem;
   }
+  if (params.clearance_zones.size() > kMaxClearanceZones)
+    return "at most " + std::to_string(kMaxClearanceZones) + " clearance zones";
   for (size_t k = 0; k < params.clearance_zones.size(); ++k) {
     const std::string problem = zone_problem(params.clearance_zones[k]);
     if (!problem.empty()) return "clearance zone " + std::to_string(k + 1) + ": " + problem;

@@ -18,6 +18,9 @@ namespace {
 
 bool within(double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; }
 
+// Holes added or taken away one by one: far more than a plate can hold.
+constexpr size_t kMaxHoles = 1000;
+
 // The holes' rims are rounded over this radius, mm: a sharp rim is a thin edge, and
 // deburring one is the first thing a workshop does.
 constexpr double kRimRoundMm = 1.0;
@@ -120,6 +123,11 @@ std::string perforation_problem(const PerforationParams& p) {
     return range_problem("minimum thickness around them", p.min_thickness_mm, 0.3, 10);
   if (!within(p.edge_distance_mm, 1.0, 20.0))
     return range_problem("distance from the edge", p.edge_distance_mm, 1, 20);
+  if (!within(p.voxel_mm, 0.05, 1.0)) return range_problem("grid", p.voxel_mm, 0.05, 1.0);
+  if (!(p.max_voxels >= 1e5 && p.max_voxels <= 5e7))
+    return "the holes' grid must have 100,000 to 50,000,000 voxels";
+  if (p.added.size() > kMaxHoles || p.removed.size() > kMaxHoles)
+    return "at most " + std::to_string(kMaxHoles) + " holes may be added or taken away";
   for (const auto& v : p.added)
     if (!v.allFinite()) return "a hole's position is not a point";
   for (const auto& v : p.removed)
