@@ -269,13 +269,7 @@ PerforateResult perforate(const SkullMesh& implant, const Eigen::Vector3d& insid
     v = static_cast<float>(std::clamp(0.5 + v / h, 0.0, 1.0));
     if (v == 0.5f) v = 0.5f + 1e-4f;
   }
-  Volume volume = mask_volume({}, g);
-  volume.data = std::move(field);
-  ExtractBoneSurfaceParams surface;
-  surface.threshold = 0.5;
-  surface.largest_piece_only = true;
-  surface.canonical = false;
-  ExtractBoneSurfaceResult s = extract_bone_surface(volume, surface);
+  ExtractBoneSurfaceResult s = surface_of_field(std::move(field), g);
   if (!s.usable()) {
     r.message = "drilling the holes: " + s.message;
     r.mesh = implant;
@@ -288,9 +282,9 @@ PerforateResult perforate(const SkullMesh& implant, const Eigen::Vector3d& insid
   for (const Hole& hole : r.holes) blocked += !hole_goes_through(drilled, hole);
   r.status = PerforateResult::Status::Drilled;
   char buf[160];
-  std::snprintf(buf, sizeof(buf), "%zu holes of %.1f mm drilled (%d do not go through)",
-                r.holes.size(), p.diameter_mm, blocked);
-  r.message = blocked == 0 ? std::string(buf).substr(0, std::string(buf).find(" (")) : buf;
+  std::snprintf(buf, sizeof(buf), "%zu holes of %.1f mm drilled", r.holes.size(), p.diameter_mm);
+  r.message = buf;
+  if (blocked > 0) r.message += " (" + std::to_string(blocked) + " do not go through)";
   return done(r);
 }
 

@@ -200,10 +200,11 @@ SkullMesh faces_in_box(const SkullMesh& mesh, const Eigen::Vector3d& lo,
 // outside the skull's surface, from the distance to its triangles. The surface then follows the
 // bone's own surface rather than its voxels. The clearance is `clearance` mm, or a zone's where
 // the nearest bone lies in one. `locator`: the skull's triangles near the grid (none: no
-// surface there).
+// surface there). `to_bone`: distance_to_mask(bone), needed for a clearance wider than a voxel.
 std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const VoxelGrid& g,
                                     const SurfaceLocator* locator, double sigma_voxels,
-                                    double clearance, const std::vector<ClearanceZone>& zones) {
+                                    double clearance, const std::vector<ClearanceZone>& zones,
+                                    const std::vector<float>& to_bone) {
   const double h = g.spacing;
   double widest = clearance;
   for (const ClearanceZone& z : zones) widest = std::max(widest, z.clearance_mm);
@@ -224,7 +225,6 @@ std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const Vo
   if (widest <= h) {
     near_bone = dilate(dilate(bone, g), g);
   } else {
-    const std::vector<float> to_bone = distance_to_mask(bone, g);
     near_bone.resize(to_bone.size());
     const float band = static_cast<float>(widest + 2.0 * h);
     for (size_t c = 0; c < to_bone.size(); ++c) near_bone[c] = to_bone[c] <= band;
@@ -280,8 +280,9 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
   // A clearance wider than a voxel is cut first (to the voxels' resolution; the surface is held
   // at it exactly below), so that the opening also takes what it leaves thin: a tongue of the
   // implant reaching between two pieces of bone narrows by the clearance from both sides.
+  std::vector<float> to_bone;  // the distance to the bone's voxels, when a clearance needs it
   if (locator && widest > h) {
-    const std::vector<float> to_bone = distance_to_mask(bone, grid);
+    to_bone = distance_to_mask(bone, grid);
     for (int k = 0; k < grid.dims[2]; ++k)
       for (int j = 0; j < grid.dims[1]; ++j)
         for (int i = 0; i < grid.dims[0]; ++i) {
@@ -312,8 +313,10 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
     // between the implant's edge and a fragment; a wall between the implant and a cut face is
     // thick along the cut): what lies within a millimetre of the bone is the fill's contact.
     if (params.thin_fills_removed && params.min_feature_mm > 0) {
-      const std::vector<float> to_bone = distance_to_mask(bone, grid);
-      auto far_fill = [&](size_t c) { return bridged[c] && !mask[c] && to_bone[c] > 1.0f; };
+      const std::vector<float> computed =
+          to_bone.empty() ? distance_to_mask(bone, grid) : std::vector<float>();
+      const std::vector<float>& distance = to_bone.empty() ? computed : to_bone;
+      auto far_fill = [&](size_t c) { return bridged[c] && !mask[c] && distance[c] > 1.0f; };
       bool any = false;
       for (size_t c = 0; c < bridged.size() && !any; ++c) any = far_fill(c);
       if (any) {  // the opening costs two distance transforms: only when there is a far fill
@@ -341,8 +344,9 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
   std::vector<float> smooth;
   if (params.clearance_mm) {
     smooth = fit_against_bone(mask, bone, grid, locator.get(), params.smoothing_mm / h,
-                              std::max(0.0, *params.clearance_mm), params.zones);
+                              std::max(0.0, *params.clearance_mm), params.zones, to_bone);
     Mask().swap(mask);
+    std::vector<float>().swap(to_bone);
   } else {
     // Without a clearance (build_implant commands before version 4): neither the grid nor the
     // smoothing may carry the surface into the
@@ -355,15 +359,9 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
       if (keep_out[c]) smooth[c] = 0.0f;
   }
   Mask().swap(bone);
-  Volume volume = mask_volume({}, grid);
-  volume.data = std::move(smooth);
-  ExtractBoneSurfaceParams surface;
-  surface.threshold = 0.5;
-  surface.largest_piece_only = true;
-  // The implant as the meshing gives it: its order follows from the (canonical) skull and the
-  // markers already, and plans saved before meshes were made canonical replay to their bytes.
-  surface.canonical = false;
-  ExtractBoneSurfaceResult s = extract_bone_surface(volume, surface);
+  // The implant as the meshing gives it: plans saved before meshes were made canonical replay
+  // to their bytes.
+  ExtractBoneSurfaceResult s = surface_of_field(std::move(smooth), grid);
   if (!s.usable()) {
     result.message = s.message;
     result.mesh = implant;

@@ -13,6 +13,7 @@
 #include <cmath>
 
 #include "cranioplan/algorithms/geometry/mesh_components.h"
+#include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "soup_building.h"
 
 namespace cranioplan {
@@ -98,6 +99,16 @@ ExtractBoneSurfaceResult extract_bone_surface(const Volume& volume,
   result.mesh = build_mesh(soup);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return result;
+}
+
+ExtractBoneSurfaceResult surface_of_field(std::vector<float> field, const VoxelGrid& grid) {
+  Volume volume = mask_volume({}, grid);
+  volume.data = std::move(field);
+  ExtractBoneSurfaceParams surface;
+  surface.threshold = 0.5;
+  surface.largest_piece_only = true;
+  surface.canonical = false;
+  return extract_bone_surface(volume, surface);
 }
 
 }  // namespace cranioplan

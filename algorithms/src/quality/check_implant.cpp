@@ -107,10 +107,9 @@ namespace {
 // each along the inward normal, for faces within 45° of `axis`): a mesh trimmed on a fine grid
 // has hundreds of thousands of faces, and a thin region spans many. The other faces' vertices
 // are the side wall's, returned in `wall_vertices`.
-std::vector<double> thickness_samples(const SkullMesh& implant, const Eigen::Vector3d& axis,
-                                      const std::vector<float>& depth, const VoxelGrid& grid,
-                                      std::vector<int>& wall_vertices) {
-  const SurfaceLocator self(implant);
+std::vector<double> thickness_samples(const SkullMesh& implant, const SurfaceLocator& self,
+                                      const Eigen::Vector3d& axis, const std::vector<float>& depth,
+                                      const VoxelGrid& grid, std::vector<int>& wall_vertices) {
   std::vector<double> thickness;
   const size_t stride = std::max<size_t>(1, (implant.n_faces() + 59999) / 60000);
   for (auto fh : implant.faces()) {
@@ -262,11 +261,6 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
   q.pieces = rep.pieces;
   q.self_intersections = count_self_intersections(implant);
   q.material_name = params.material_name;
-  if (!params.holes.empty()) {
-    const SurfaceLocator self(implant);
-    q.holes = static_cast<int>(params.holes.size());
-    for (const Hole& h : params.holes) q.holes_blocked += !hole_goes_through(self, h);
-  }
   if (params.density_g_cm3 > 0.0) q.mass_g = rep.volume_mm3 * 1e-3 * params.density_g_cm3;
   if (implant.n_faces() == 0) {
     q.reasons.push_back("the implant has no triangles");
@@ -292,8 +286,12 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
   const std::vector<uint8_t> solid = voxelize_mesh(implant, grid);
   const std::vector<float> depth = depth_in_mask(solid, grid);
 
+  const SurfaceLocator self(implant);
+  q.holes = static_cast<int>(params.holes.size());
+  for (const Hole& h : params.holes) q.holes_blocked += !hole_goes_through(self, h);
   std::vector<int> wall_vertices;
-  std::vector<double> thickness = thickness_samples(implant, axis, depth, grid, wall_vertices);
+  std::vector<double> thickness =
+      thickness_samples(implant, self, axis, depth, grid, wall_vertices);
   if (!thickness.empty()) {
     std::sort(thickness.begin(), thickness.end());
     q.thickness_min_mm = thickness.front();

@@ -75,7 +75,7 @@ TEST(ThicknessMap, APlateIsItsThicknessAndTheBoneItsGap) {
   EXPECT_GT(none, 0);
 }
 
-// On the thick synthetic skull's plan the map agrees with the quality report's measure.
+// A curved shell (the thick synthetic head, outer and inner wall): the map reads its wall.
 TEST(ThicknessMap, ACurvedShellReadsTheBonesThickness) {
   const SkullMesh head = test::make_thick_head(0.93, 1.0);
   const ThicknessMap m = thickness_map(head, nullptr);

@@ -2,6 +2,7 @@
 // From a CT or label volume to a bone surface mesh.
 #include <limits>
 #include <string>
+#include <vector>
 
 #include "cranioplan/model/mesh.h"
 #include "cranioplan/model/volume.h"
@@ -63,5 +64,11 @@ struct ExtractBoneSurfaceResult {
 
 ExtractBoneSurfaceResult extract_bone_surface(const Volume& volume,
                                               const ExtractBoneSurfaceParams& params = {});
+
+struct VoxelGrid;
+/// A solid given as a field on a grid (0 outside, 1 inside, ½ on its surface) meshed at ½: its
+/// largest piece, in the order the meshing gives (not canonical: an implant fitted to the bone
+/// or drilled follows from the canonical skull and the markers already).
+ExtractBoneSurfaceResult surface_of_field(std::vector<float> field, const VoxelGrid& grid);
 
 }  // namespace cranioplan
