@@ -43,8 +43,21 @@ Json implant_json(const ImplantResult& r) {
   Json holes = Json::array();
   for (const Hole& h : r.holes)
     holes.push_back(Json{{"center", to_json(h.center)}, {"axis", to_json(h.axis)}});
+  Json tabs = Json::array();
+  for (const Tab& t : r.tabs) {
+    Json screws = Json::array();
+    for (const Hole& h : t.screws)
+      screws.push_back(Json{{"center", to_json(h.center)}, {"axis", to_json(h.axis)}});
+    tabs.push_back(Json{{"rim", to_json(t.rim)},
+                        {"outward", to_json(t.outward)},
+                        {"normal", to_json(t.normal)},
+                        {"screws", screws},
+                        {"bone_mm", t.bone_mm},
+                        {"midline_mm", std::isnan(t.midline_mm) ? Json() : Json(t.midline_mm)}});
+  }
   return Json{{"status", names[static_cast<int>(r.status)]},
               {"holes", holes},
+              {"tabs", tabs},
               {"message", r.message},
               {"watertight", r.watertight},
               {"triangles", r.mesh.n_faces()},
@@ -233,6 +246,7 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
     ImplantParams params;
     MaterialOptions material;
     HoleOptions holes;
+    TabOptions tabs;
     bool no_snap = false;
   };
   auto o = std::make_shared<Opts>();
@@ -259,6 +273,7 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
       ->check(CLI::Range(0.0, 10.0));
   add_material_options(cmd, o->material);
   add_hole_options(cmd, o->holes);
+  add_tab_options(cmd, o->tabs);
   cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
   return Subcommand{
       cmd, [o, &json] {
@@ -280,6 +295,7 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
         o->params.material = material_from(o->material);
         o->params.clearance_zones = zones_from(o->material);
         o->params.perforations = perforations_from(o->holes);
+        o->params.tabs = tabs_from(o->tabs, std::nullopt);
         const ImplantResult r = build_implant(snapped.markers, &skull, o->params);
         Json j = implant_json(r);
         j["method"] = o->method;
@@ -290,9 +306,7 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
         }
         write_mesh(r.mesh, o->output);
         j["output"] = o->output;
-        QualityParams checks = quality_params_for(o->params.material, o->params.clearance_zones);
-        checks.holes = r.holes;
-        j["quality"] = to_json(check_implant(r.mesh, &skull, checks));
+        j["quality"] = to_json(check_implant(r.mesh, &skull, quality_params_for(o->params, r)));
         print_result(j, json);
         return kOk;
       }};
@@ -466,6 +480,7 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
     AutoplanParams params;
     MaterialOptions material;
     HoleOptions holes;
+    TabOptions tabs;
     ExtractBoneSurfaceParams import;
   };
   auto o = std::make_shared<Opts>();
@@ -488,6 +503,7 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
   add_fit_option(cmd, o->params);
   add_material_options(cmd, o->material);
   add_hole_options(cmd, o->holes);
+  add_tab_options(cmd, o->tabs);
   cmd->add_option("--session", o->session,
                   "plan through session commands and save the session (.json): reopen, edit, "
                   "replay and audit it (with --all-openings, SESSION_2... for the others)");
@@ -504,6 +520,7 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
         o->params.implant.material = material_from(o->material);
         o->params.implant.clearance_zones = zones_from(o->material);
         o->params.implant.perforations = perforations_from(o->holes);
+        o->params.implant.tabs = tabs_from(o->tabs, std::nullopt);  // the plan's plane, later
         auto markers_path = [&](size_t k) {
           return o->markers_out.empty() ? std::string() : numbered_path(o->markers_out, k);
         };

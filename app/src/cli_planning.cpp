@@ -124,4 +124,54 @@ PerforationParams perforations_from(const HoleOptions& o) {
   return p;
 }
 
+void add_tab_options(CLI::App* cmd, TabOptions& o) {
+  cmd->add_flag("--tabs", o.params.automatic,
+                "fixation tabs onto the outer table, evenly along the rim (away from thin bone "
+                "and the midline)");
+  cmd->add_option("--tab-count", o.params.count, "how many tabs (0: one per 40 mm of rim)")
+      ->capture_default_str()
+      ->check(CLI::Range(0, 12));
+  cmd->add_option("--tab-length", o.params.length_mm, "beyond the implant's edge (mm)")
+      ->capture_default_str()
+      ->check(CLI::Range(4.0, 25.0));
+  cmd->add_option("--tab-width", o.params.width_mm,
+                  "of the tabs (mm; default: the countersink with a ring of the material's "
+                  "minimum thickness + 0.5 mm, at least 6)")
+      ->check(CLI::Range(3.0, 15.0));
+  cmd->add_option("--tab-thickness", o.params.thickness_mm,
+                  "of the tabs (mm; default: the material's minimum under the countersink "
+                  "+ 0.4 mm, at least 1.5)")
+      ->check(CLI::Range(0.5, 5.0));
+  cmd->add_option("--tab-screws", o.params.screws, "screws per tab (1 or 2, along the tab)")
+      ->capture_default_str()
+      ->check(CLI::Range(1, 2));
+  cmd->add_option("--screw-diameter", o.params.screw_diameter_mm, "the screw holes' (mm)")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 3.0));
+  cmd->add_option("--countersink", o.params.countersink_diameter_mm,
+                  "the countersinks' diameter at the tab's top (mm, 90°; 0: none)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 8.0));
+  cmd->add_option("--tab-midline-distance", o.params.midline_distance_mm,
+                  "tabs at least this far from the midsagittal plane (mm; the sagittal sinus)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 40.0));
+  cmd->add_option("--tab-min-bone", o.params.min_bone_mm,
+                  "screws only into bone at least this thick (mm)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 10.0));
+  cmd->add_option("--tab", o.at,
+                  "X,Y,Z: a tab at the rim point nearest there (repeatable; instead of --tabs' "
+                  "even placement)");
+}
+
+TabParams tabs_from(const TabOptions& o, const std::optional<Plane>& midline) {
+  TabParams p = o.params;
+  for (const std::string& t : o.at) p.positions.push_back(parse_point(t, "--tab"));
+  if (p.any()) p.midline = midline;
+  if (const std::string problem = tab_problem(p); !problem.empty())
+    throw CLI::ValidationError("--tabs", problem);
+  return p;
+}
+
 }  // namespace cranioplan::cli

@@ -38,6 +38,17 @@ struct HoleOptions {
 void add_hole_options(CLI::App* cmd, HoleOptions& o);
 /// The perforations the options ask for (a CLI::ValidationError for a bad one).
 PerforationParams perforations_from(const HoleOptions& o);
+/// --tabs (evenly along the rim), --tab-count, --tab-length, --tab-width, --tab-thickness,
+/// --tab-screws, --screw-diameter, --countersink, --tab-midline-distance, --tab-min-bone,
+/// --tab X,Y,Z (repeatable: the user's tabs, instead of the even placement).
+struct TabOptions {
+  TabParams params;
+  std::vector<std::string> at;
+};
+void add_tab_options(CLI::App* cmd, TabOptions& o);
+/// The tabs the options ask for (a CLI::ValidationError for a bad one), with `midline` (the
+/// plan's plane) when the plan has one.
+TabParams tabs_from(const TabOptions& o, const std::optional<Plane>& midline);
 /// The material and zones the options ask for (a CLI::ValidationError for a bad one); none
 /// when no option was given.
 std::optional<Material> material_from(const MaterialOptions& o);

@@ -412,6 +412,16 @@ std::string quality_report_html(const QualityReport& r, const SoftTissueCheck* t
         std::to_string(r.holes) +
             (r.holes_blocked == 0 ? std::string(", all through")
                                   : ", " + std::to_string(r.holes_blocked) + " <b>blocked</b>"));
+  if (r.tabs > 0) {
+    row("Fixation tabs", std::to_string(r.tabs) + ", underside up to " + fixed(r.tab_gap_mm, 2) +
+                             " mm off the bone" +
+                             (r.screws_blocked == 0 ? std::string(", screw holes through")
+                                                    : ", " + std::to_string(r.screws_blocked) +
+                                                          " screw holes <b>blocked</b>"));
+    row("Bone under the screws (thinnest)", fixed(r.tab_bone_mm, 1) + " mm");
+    if (r.tab_midline_mm >= 0)
+      row("Tabs from the midsagittal plane (nearest)", fixed(r.tab_midline_mm, 1) + " mm");
+  }
   if (tissue && tissue->checked) {
     row("In soft tissue (CT)", fixed(tissue->intrusion_mm3, 0) + " mm³");
     row("Soft tissue under it",

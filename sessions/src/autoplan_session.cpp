@@ -101,7 +101,9 @@ AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks&
     out.status = AutoplanSession::Status::NoDefect;
     return stop(s.state().message);
   }
-  run(commands::build_implant(params.implant));
+  ImplantParams implant = params.implant;
+  if (implant.tabs.any() && !implant.tabs.midline) implant.tabs.midline = plane;
+  run(commands::build_implant(implant));
   if (!s.state().implant) return stop(s.state().message);
   run(commands::complete_step(8));
   if (!export_path.empty() && !run(commands::export_implant(export_path))) return out;

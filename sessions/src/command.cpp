@@ -227,7 +227,8 @@ int current_version(CommandType type) {
   // edge clearance, under-contour, density, onlay), stretches of the rim with their own
   // clearance ("clearance_zones") and the holes drilled ("perforations"); version 5 is read
   // without them.
-  if (type == CommandType::BuildImplant) return 6;
+  // build_implant 7: fixation tabs ("tabs"); version 6 is read without them.
+  if (type == CommandType::BuildImplant) return 7;
   if (type == CommandType::ProposeMarkers) return 3;
   // load_skull 4: volumes in the patient's frame ("import.patient_frame"), a DICOM folder's
   // series ("import.dicom_series"), a mesh's far pieces dropped ("import.drop_far_pieces");
@@ -345,7 +346,57 @@ Json params_to_json(const ImplantParams& p) {
   j["clearance_zones"] = Json::array();
   for (const ClearanceZone& z : p.clearance_zones) j["clearance_zones"].push_back(to_json(z));
   j["perforations"] = to_json(p.perforations);
+  j["tabs"] = to_json(p.tabs);
   return j;
+}
+
+Json to_json(const TabParams& p) {
+  Json positions = Json::array();
+  for (const auto& v : p.positions) positions.push_back(to_json(v));
+  auto mm = [](double v) { return std::isnan(v) ? Json(nullptr) : Json(v); };
+  return Json{{"automatic", p.automatic},
+              {"count", p.count},
+              {"positions", positions},
+              {"length_mm", p.length_mm},
+              {"width_mm", mm(p.width_mm)},
+              {"thickness_mm", mm(p.thickness_mm)},
+              {"screws", p.screws},
+              {"screw_diameter_mm", p.screw_diameter_mm},
+              {"countersink_diameter_mm", p.countersink_diameter_mm},
+              {"midline_distance_mm", p.midline_distance_mm},
+              {"midline", p.midline ? Json{{"normal", to_json(p.midline->normal)},
+                                           {"offset", p.midline->offset}}
+                                    : Json(nullptr)},
+              {"min_bone_mm", p.min_bone_mm},
+              {"voxel_mm", p.voxel_mm},
+              {"max_voxels", p.max_voxels}};
+}
+
+TabParams tabs_from_json(const ParamReader& r) {
+  TabParams p;
+  p.automatic = r.boolean("automatic");
+  p.count = r.integer("count");
+  const Json& points = r.value("positions");
+  if (!points.is_array()) throw SessionError(r.where(), "positions must be a list");
+  if (points.size() > 1000) throw SessionError(r.where(), "too many tab positions");
+  for (const Json& v : points) p.positions.push_back(vector_from_json(v, r.where(), "a tab"));
+  p.length_mm = r.number("length_mm");
+  p.width_mm = r.number("width_mm");          // null: from the material
+  p.thickness_mm = r.number("thickness_mm");  // null: from the material
+  p.screws = r.integer("screws");
+  p.screw_diameter_mm = r.number("screw_diameter_mm");
+  p.countersink_diameter_mm = r.number("countersink_diameter_mm");
+  p.midline_distance_mm = r.number("midline_distance_mm");
+  if (!r.value("midline").is_null()) {
+    const ParamReader m(r.value("midline"), r.where() + " midline");
+    p.midline = Plane{m.vector3("normal"), m.number("offset")};
+  }
+  p.min_bone_mm = r.number("min_bone_mm");
+  p.voxel_mm = r.number("voxel_mm");
+  p.max_voxels = r.number("max_voxels");
+  if (const std::string problem = tab_problem(p); !problem.empty())
+    throw SessionError(r.where(), problem);
+  return p;
 }
 
 Json to_json(const PerforationParams& p) {
@@ -546,6 +597,9 @@ void params_from_json(const ParamReader& r, ImplantParams& p) {
   if (r.has("perforations"))
     p.perforations =
         perforations_from_json(ParamReader(r.value("perforations"), r.where() + " perforations"));
+  // build_implant 6 and before have no tabs.
+  p.tabs = TabParams{};
+  if (r.has("tabs")) p.tabs = tabs_from_json(ParamReader(r.value("tabs"), r.where() + " tabs"));
   p.clearance_zones.clear();
   if (r.has("clearance_zones")) {
     const Json& zones = r.value("clearance_zones");

@@ -124,6 +124,13 @@ Json to_json(const QualityReport& q) {
     j["holes"] = q.holes;
     j["holes_blocked"] = q.holes_blocked;
   }
+  if (q.tabs > 0) {
+    j["tabs"] = q.tabs;
+    j["screws_blocked"] = q.screws_blocked;
+    j["tab_gap_mm"] = q.tab_gap_mm;
+    j["tab_bone_mm"] = q.tab_bone_mm;
+    if (q.tab_midline_mm >= 0) j["tab_midline_mm"] = q.tab_midline_mm;
+  }
   if (q.clearance_asked) {
     j["clearance_low_mm"] = q.clearance_low_mm;
     j["clearance_high_mm"] = q.clearance_high_mm;

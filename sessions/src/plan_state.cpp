@@ -294,8 +294,7 @@ void rebuild_implant(PlanState& s) {
                   format_count(static_cast<long long>(r.mesh.n_faces())).c_str(),
                   r.watertight ? "watertight" : "not watertight");
     s.message = buf;
-    QualityParams checks = quality_params_for(p.material, p.clearance_zones);
-    checks.holes = r.holes;
+    QualityParams checks = quality_params_for(p, r);
     s.implant = std::make_shared<const ImplantData>(std::move(r), s.skull, std::move(checks));
   } else {
     s.message = "implant not built: " + r.message;

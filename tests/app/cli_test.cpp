@@ -222,6 +222,41 @@ TEST(Cli, AutoplanAndQaWithAMaterial) {
             2);
 }
 
+// Tabs from the command line, through a session: placed evenly off the midline, on the bone,
+// their screws through, printable; the session replays to the same implant; bad values are
+// usage errors.
+TEST(Cli, AutoplanWithFixationTabs) {
+  test::TempDir dir;
+  write_mesh(test::thick_head_defect().defective, dir.path("skull.stl"));
+  std::string out;
+  ASSERT_EQ(test::run_command(kCli + " autoplan --json " + dir.path("skull.stl") +
+                                  " --material peek --tabs --tab-count 4 --session " +
+                                  dir.path("plan.json") + " -o " + dir.path("i.stl"),
+                              &out),
+            0)
+      << out;
+  ASSERT_EQ(test::run_command(kCli + " verify --json " + dir.path("plan.json"), &out), 0) << out;
+  ASSERT_EQ(test::run_command(kCli + " autoplan --json " + dir.path("skull.stl") +
+                                  " --material peek --tabs --tab-count 4 -o " + dir.path("j.stl"),
+                              &out),
+            0)
+      << out;
+  const Json j = Json::parse(out);
+  const Json& q = j["quality"];
+  EXPECT_EQ(q["tabs"].get<int>(), 4) << out;
+  EXPECT_EQ(q["screws_blocked"].get<int>(), 0);
+  EXPECT_LE(q["tab_gap_mm"].get<double>(), 0.2);
+  EXPECT_GE(q["tab_midline_mm"].get<double>(), 10.0);
+  EXPECT_TRUE(q["printable"].get<bool>()) << q.dump();
+  ASSERT_EQ(j["implant"]["tabs"].size(), 4u);
+  EXPECT_EQ(test::run_command(kCli + " autoplan " + dir.path("skull.stl") +
+                                  " --tabs --tab-screws 2 -o " + dir.path("x.stl"),
+                              &out),
+            2)
+      << "two screws need a longer tab";
+  EXPECT_NE(out.find("for two screws"), std::string::npos) << out;
+}
+
 TEST(Cli, StudyInjectsPlansAndScoresDefects) {
   test::TempDir dir;
   write_mesh(test::make_thick_head(), dir.path("thick.stl"));

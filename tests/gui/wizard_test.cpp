@@ -2,6 +2,7 @@
 // surface points, on the sample case. Runs under Xvfb (see tests/CMakeLists.txt).
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <QAction>
 #include <QApplication>
 #include <QCheckBox>
@@ -712,6 +713,62 @@ TEST(WizardHoles, HolesAreAddedAndRemovedByClicksWithUndo) {
   plan.redo();
   plan.wait();
   EXPECT_EQ(near(plan.state().implant->result().holes, between), 1);
+}
+
+// Tabs: placed evenly, then one moved along the rim (a click on it, a click where it goes),
+// one removed and one added by clicks, each a build that undo and redo step through.
+TEST(WizardTabs, TabsAreMovedRemovedAndAddedByClicksWithUndo) {
+  MainWindow w;
+  w.set_interactive(false);
+  ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
+  PlanController& plan = w.controller();
+  plan.push(commands::go_to_step(7));
+  plan.wait();
+  ASSERT_EQ(plan.state().current_step, 7);
+  child<QCheckBox>(w, "tabs")->setChecked(true);
+  click(w, "build");
+  plan.wait();
+  ASSERT_TRUE(plan.state().implant) << plan.state().message;
+  const std::vector<Tab> even = plan.state().implant->result().tabs;
+  ASSERT_GE(even.size(), 3u) << plan.state().message;
+  EXPECT_TRUE(plan.state().implant->quality().watertight);
+  EXPECT_EQ(plan.state().implant->quality().screws_blocked, 0);
+  const auto middle = [](const Tab& t) { return t.rim + 0.5 * t.length_mm * t.outward; };
+
+  // Moved: the first tab, 12 mm along the rim.
+  child<QPushButton>(w, "moveTab")->setChecked(true);
+  emit w.view().surfaceClicked(middle(even[0]));
+  const Eigen::Vector3d along = even[0].normal.cross(even[0].outward);
+  emit w.view().surfaceClicked(middle(even[0]) + 12.0 * along);
+  plan.wait();
+  const std::vector<Tab> moved = plan.state().implant->result().tabs;
+  ASSERT_EQ(moved.size(), even.size()) << plan.state().message;
+  EXPECT_GT((moved[0].rim - even[0].rim).norm(), 6.0);
+  EXPECT_LT((moved[0].rim - even[0].rim).norm(), 18.0);
+  for (size_t k = 1; k < even.size(); ++k) EXPECT_LT((moved[k].rim - even[k].rim).norm(), 1e-6);
+
+  // Removed: the last tab; added: one where it was.
+  child<QPushButton>(w, "removeTab")->setChecked(true);
+  EXPECT_FALSE(child<QPushButton>(w, "moveTab")->isChecked()) << "one click mode at a time";
+  emit w.view().surfaceClicked(middle(even.back()));
+  plan.wait();
+  EXPECT_EQ(plan.state().implant->result().tabs.size(), even.size() - 1);
+  child<QPushButton>(w, "addTab")->setChecked(true);
+  emit w.view().surfaceClicked(middle(even.back()));
+  plan.wait();
+  ASSERT_EQ(plan.state().implant->result().tabs.size(), even.size());
+  EXPECT_LT((plan.state().implant->result().tabs.back().rim - even.back().rim).norm(), 2.0);
+
+  // Undo three times: the tabs as placed evenly; redo: the moved one back.
+  for (int k = 0; k < 3; ++k) {
+    plan.undo();
+    plan.wait();
+  }
+  ASSERT_EQ(plan.state().implant->result().tabs.size(), even.size());
+  EXPECT_LT((plan.state().implant->result().tabs[0].rim - even[0].rim).norm(), 1e-6);
+  plan.redo();
+  plan.wait();
+  EXPECT_LT((plan.state().implant->result().tabs[0].rim - moved[0].rim).norm(), 1e-6);
 }
 
 TEST_F(Wizard, CommandLineScreenshotOfASessionAtAStep) {

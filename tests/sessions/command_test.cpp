@@ -80,7 +80,7 @@ TEST(Commands, EveryTypeRoundTripsThroughJson) {
 // read as recorded, built without the fit.
 TEST(Commands, BuildImplantVersionOneIsReadByItsOwnRules) {
   Json v1 = to_json(commands::build_implant());
-  EXPECT_EQ(v1["version"], 6);
+  EXPECT_EQ(v1["version"], 7);
   v1["version"] = 1;
   v1["params"]["params"].erase("trim");
   v1["params"]["params"].erase("fit_to_bone_mm");
@@ -127,7 +127,7 @@ TEST(Commands, OlderPlansReadTheSkullAndFitTheBoneAsTheyWereMade) {
   p.trim.min_feature_mm = 1.7;
   p.trim.bridge_mm = 0.8;
   const Json build = to_json(commands::build_implant(p));
-  EXPECT_EQ(build["version"], 6);
+  EXPECT_EQ(build["version"], 7);
   ImplantParams back;
   params_from_json(ParamReader(build["params"]["params"], "test"), back);
   EXPECT_EQ(back.trim.min_feature_mm, 1.7);
@@ -173,7 +173,7 @@ TEST(Commands, TheBuildRecordsItsMaterialAndClearanceZones) {
   p.perforations.added = {Eigen::Vector3d(4, 5, 6)};
   p.perforations.removed = {Eigen::Vector3d(7, 8, 9)};
   const Json build = to_json(commands::build_implant(p));
-  EXPECT_EQ(build["version"], 6);
+  EXPECT_EQ(build["version"], 7);
   const Json& recorded = build["params"]["params"];
   EXPECT_EQ(recorded["material"]["name"], "PMMA");
   EXPECT_TRUE(recorded["material"]["thickness_mm"].is_null()) << "follows the bone";
@@ -211,6 +211,51 @@ TEST(Commands, TheBuildRecordsItsMaterialAndClearanceZones) {
   } catch (const SessionError& e) {
     EXPECT_NE(std::string(e.what()).find("edge clearance must be 0 to 3 mm (7 given)"),
               std::string::npos)
+        << e.what();
+  }
+}
+
+// build_implant 7 records the fixation tabs in full (the midline plane they kept off, the user's
+// positions, the sizes left to the material as null); version 6 reads without tabs. A tab out
+// of its ranges in a file is refused with the value named.
+TEST(Commands, TheBuildRecordsItsTabs) {
+  ImplantParams p;
+  p.fit_to_bone_mm = 4.0;
+  p.tabs.automatic = true;
+  p.tabs.count = 5;
+  p.tabs.screws = 2;
+  p.tabs.length_mm = 20.0;
+  p.tabs.positions = {Eigen::Vector3d(1.5, 2.25, -3.125)};
+  p.tabs.midline = Plane{Eigen::Vector3d(0.6, 0.8, 0.0), -12.5};
+  const Json recorded = to_json(commands::build_implant(p))["params"]["params"];
+  EXPECT_TRUE(recorded["tabs"]["width_mm"].is_null()) << "from the material";
+  ImplantParams back;
+  params_from_json(ParamReader(recorded, "test"), back);
+  EXPECT_TRUE(back.tabs.automatic);
+  EXPECT_EQ(back.tabs.count, 5);
+  EXPECT_EQ(back.tabs.screws, 2);
+  EXPECT_EQ(back.tabs.length_mm, 20.0);
+  EXPECT_TRUE(std::isnan(back.tabs.width_mm));
+  EXPECT_TRUE(std::isnan(back.tabs.thickness_mm));
+  ASSERT_EQ(back.tabs.positions.size(), 1u);
+  EXPECT_EQ(back.tabs.positions[0], Eigen::Vector3d(1.5, 2.25, -3.125));
+  ASSERT_TRUE(back.tabs.midline);
+  EXPECT_EQ(back.tabs.midline->normal, Eigen::Vector3d(0.6, 0.8, 0.0));
+  EXPECT_EQ(back.tabs.midline->offset, -12.5);
+  EXPECT_EQ(to_json(commands::build_implant(back))["params"]["params"], recorded);
+
+  Json v6 = recorded;
+  v6.erase("tabs");
+  params_from_json(ParamReader(v6, "test"), back);
+  EXPECT_FALSE(back.tabs.any());
+
+  Json bad = recorded;
+  bad["tabs"]["length_mm"] = 40.0;
+  try {
+    params_from_json(ParamReader(bad, "plan.json"), back);
+    ADD_FAILURE() << "a tab 40 mm long was read";
+  } catch (const SessionError& e) {
+    EXPECT_NE(std::string(e.what()).find("length must be 4 to 25 mm (40 given)"), std::string::npos)
         << e.what();
   }
 }

@@ -17,6 +17,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <memory>
 
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/thin_plate_spline.h"
@@ -744,6 +745,17 @@ std::string finishing_problem(const ImplantParams& params, const SkullMesh* skul
     const std::string problem = perforation_problem(params.perforations);
     if (!problem.empty()) return problem;
   }
+  if (params.tabs.any()) {
+    if (params.method != ImplantMethod::Shell) return "fixation tabs need the shell method";
+    if (!skull || skull->n_faces() == 0) return "fixation tabs are laid on the skull: give it";
+    if (params.material && params.material->onlay_mm > 0.0)
+      return params.material->name +
+             " is laid on the bone and screwed through its own overlap: it has no tabs";
+    const std::string problem = tab_problem(
+        resolved(params.tabs, params.material ? params.material->min_thickness_mm
+                                              : std::numeric_limits<double>::quiet_NaN()));
+    if (!problem.empty()) return problem;
+  }
   if (params.clearance_zones.size() > kMaxClearanceZones)
     return "at most " + std::to_string(kMaxClearanceZones) + " clearance zones";
   for (size_t k = 0; k < params.clearance_zones.size(); ++k) {
@@ -806,10 +818,27 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
       r.message = "fitting to the bone: " + t.message;
     }
   }
+  // The outer side of tabs and holes faces away from the rays' centre (or the skull's centre).
+  Eigen::Vector3d inside = params.radial_center.value_or(Eigen::Vector3d::Zero());
+  if (!params.radial_center && skull && skull->n_vertices() > 0) inside = vertex_centroid(*skull);
+  if (r.usable() && params.tabs.any()) {
+    std::unique_ptr<SurfaceLocator> own;
+    if (!skull_locator) own = std::make_unique<SurfaceLocator>(*skull);
+    const TabParams tabs =
+        resolved(params.tabs, params.material ? params.material->min_thickness_mm
+                                              : std::numeric_limits<double>::quiet_NaN());
+    TabResult t = add_fixation_tabs(r.mesh, skull_locator ? *skull_locator : *own, inside, tabs);
+    if (t.usable()) {
+      r.mesh = std::move(t.mesh);
+      r.tabs = std::move(t.tabs);
+      r.watertight = report_mesh(r.mesh).watertight;
+      r.message += "; " + t.message;
+    } else {
+      r.status = ImplantResult::Status::Failed;
+      r.message = "fixation tabs: " + t.message;
+    }
+  }
   if (r.usable() && params.perforations.any()) {
-    // The holes' outer side faces away from the rays' centre (or the skull's centre).
-    Eigen::Vector3d inside = params.radial_center.value_or(Eigen::Vector3d::Zero());
-    if (!params.radial_center && skull && skull->n_vertices() > 0) inside = vertex_centroid(*skull);
     PerforationParams holes = params.perforations;
     if (params.material) holes.min_thickness_mm = params.material->min_thickness_mm;
     PerforateResult p = perforate(r.mesh, inside, holes);

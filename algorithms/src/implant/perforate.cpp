@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
-#include "cranioplan/algorithms/geometry/parallel.h"
+#include "cranioplan/algorithms/geometry/mesh_distance_field.h"
 #include "cranioplan/algorithms/geometry/point_index.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
@@ -200,45 +200,8 @@ PerforateResult perforate(const SkullMesh& implant, const Eigen::Vector3d& insid
   const std::vector<uint8_t> solid = voxelize_mesh(implant, g);
   // The implant's signed distance (mm, positive inside): exact near its surface, ±10 mm (no
   // more than needed) elsewhere.
-  std::vector<float> field(solid.size());
-  for (size_t c = 0; c < solid.size(); ++c) field[c] = solid[c] ? 10.0f : -10.0f;
+  std::vector<float> field = signed_distance_near_surface(self, solid, g);
   const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
-  // Near the surface: within two voxels (along each axis in turn) of a voxel whose neighbour
-  // along an axis is on the other side.
-  std::vector<uint8_t> band(solid.size(), 0);
-  for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i) {
-        const size_t c = g.index(i, j, k);
-        band[c] = (i + 1 < nx && solid[g.index(i + 1, j, k)] != solid[c]) ||
-                  (j + 1 < ny && solid[g.index(i, j + 1, k)] != solid[c]) ||
-                  (k + 1 < nz && solid[g.index(i, j, k + 1)] != solid[c]);
-      }
-  const size_t step[3] = {1, static_cast<size_t>(nx), static_cast<size_t>(nx) * ny};
-  for (int axis = 0; axis < 3; ++axis) {
-    std::vector<uint8_t> grown = band;
-    for (int k = 0; k < nz; ++k)
-      for (int j = 0; j < ny; ++j)
-        for (int i = 0; i < nx; ++i) {
-          const size_t c = g.index(i, j, k);
-          if (!band[c]) continue;
-          const int at = axis == 0 ? i : axis == 1 ? j : k, n = g.dims[axis];
-          for (int d = -2; d <= 3; ++d)  // the pair (c, c+1) straddles: both sides' reach
-            if (at + d >= 0 && at + d < n)
-              grown[static_cast<size_t>(static_cast<long long>(c) +
-                                        d * static_cast<long long>(step[axis]))] = 1;
-        }
-    band = std::move(grown);
-  }
-  parallel_for(solid.size(), [&](size_t begin, size_t end) {
-    for (size_t c = begin; c < end; ++c) {
-      if (!band[c]) continue;
-      const int i = static_cast<int>(c % nx), j = static_cast<int>((c / nx) % ny),
-                k = static_cast<int>(c / (static_cast<size_t>(nx) * ny));
-      field[c] =
-          static_cast<float>(self.closest(g.center(i, j, k)).distance * (solid[c] ? 1.0 : -1.0));
-    }
-  });
   for (const Hole& hole : r.holes) {
     // The drill goes from above the outer surface to below the inner one at the centre, not
     // on into another part of a curved implant.
@@ -262,14 +225,7 @@ PerforateResult perforate(const SkullMesh& implant, const Eigen::Vector3d& insid
           v = static_cast<float>(smooth_min(v, off_axis - radius, kRimRoundMm));
         }
   }
-  // As a field from 0 (outside) to 1 (inside), ½ on the surface. A value exactly at the
-  // iso-level puts a vertex on a grid point, shared by triangles that then have no area: nudged
-  // off it.
-  for (float& v : field) {
-    v = static_cast<float>(std::clamp(0.5 + v / h, 0.0, 1.0));
-    if (v == 0.5f) v = 0.5f + 1e-4f;
-  }
-  ExtractBoneSurfaceResult s = surface_of_field(std::move(field), g);
+  ExtractBoneSurfaceResult s = surface_of_signed_distance(std::move(field), g);
   if (!s.usable()) {
     r.message = "drilling the holes: " + s.message;
     r.mesh = implant;

@@ -111,4 +111,16 @@ ExtractBoneSurfaceResult surface_of_field(std::vector<float> field, const VoxelG
   return extract_bone_surface(volume, surface);
 }
 
+ExtractBoneSurfaceResult surface_of_signed_distance(std::vector<float> distance,
+                                                    const VoxelGrid& grid) {
+  // From 0 (outside) to 1 (inside), ½ on the surface. A value exactly at the iso-level puts a
+  // vertex on a grid point, shared by triangles that then have no area: nudged off it.
+  const double h = grid.spacing;
+  for (float& v : distance) {
+    v = static_cast<float>(std::clamp(0.5 + v / h, 0.0, 1.0));
+    if (v == 0.5f) v = 0.5f + 1e-4f;
+  }
+  return surface_of_field(std::move(distance), grid);
+}
+
 }  // namespace cranioplan

@@ -62,17 +62,17 @@ void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const Auto
     return;
   }
 
-  r.implant =
-      build_implant(r.markers, &skull, &bone, autoplan_stages::implant_params(r.defect, params));
+  r.implant = build_implant(r.markers, &skull, &bone,
+                            autoplan_stages::implant_params(r.defect, r.plane.plane, params));
   timer.stage("implant");
   if (!r.implant.usable()) {
     r.message = "implant: " + r.implant.message;
     return;
   }
-  QualityParams checks =
-      quality_params_for(params.implant.material, params.implant.clearance_zones);
-  checks.holes = r.implant.holes;
-  r.quality = check_implant(r.implant.mesh, &skull, &bone, checks);
+  r.quality = check_implant(
+      r.implant.mesh, &skull, &bone,
+      quality_params_for(autoplan_stages::implant_params(r.defect, r.plane.plane, params),
+                         r.implant));
   timer.stage("quality");
   r.status = AutoplanResult::Status::Planned;
   r.message = r.defect.message + "; " + describe_method(r.method_used, r.mirror_coverage) + "; " +
@@ -135,9 +135,11 @@ MarkerProposal markers(const DefectRegion& defect, const SurfaceLocator& bone,
   return propose_markers_for_defect(defect, bone, mirror, params.propose, first_id);
 }
 
-ImplantParams implant_params(const DefectRegion& defect, const AutoplanParams& params) {
+ImplantParams implant_params(const DefectRegion& defect, const Plane& plane,
+                             const AutoplanParams& params) {
   ImplantParams implant = params.implant;
   implant.radial_center = defect.center;  // the rays that found the opening
+  if (implant.tabs.any() && !implant.tabs.midline) implant.tabs.midline = plane;
   return implant;
 }
 

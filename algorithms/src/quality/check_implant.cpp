@@ -12,6 +12,7 @@
 #include "cranioplan/algorithms/geometry/self_intersections.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
+#include "cranioplan/algorithms/implant/build_implant.h"
 #include "cranioplan/algorithms/io/mesh_report.h"
 #include "cranioplan/algorithms/quality/thickness_map.h"
 #include "cranioplan/model/plane.h"
@@ -137,6 +138,51 @@ std::vector<double> thickness_samples(const SkullMesh& implant, const SurfaceLoc
   return thickness;
 }
 
+// Whether `p` belongs to tab `t` or to the edge it bridges: within 1 mm of its outline, from
+// 6 mm below its rim point to 12 mm above (a tab climbs onto bone higher than the implant's edge).
+bool under_tab(const Tab& t, const Eigen::Vector3d& p) {
+  const Eigen::Vector3d d = p - t.rim, v = t.normal.cross(t.outward);
+  const double a = d.dot(t.outward);
+  return a <= t.length_mm + 1.0 && std::abs(d.dot(v)) <= 0.5 * t.width_mm + 1.0 &&
+         d.dot(t.normal) >= -6.0 && d.dot(t.normal) <= 12.0 && a >= -6.0;
+}
+
+// The tabs: each one's gap to the bone, its screws through, the bone under them, the midline.
+void measure_tabs(const SurfaceLocator& self, const SurfaceLocator* bone,
+                  const QualityParams& params, QualityReport& q) {
+  q.tabs = static_cast<int>(params.tabs.size());
+  if (params.tabs.empty()) return;
+  for (const Tab& t : params.tabs) {
+    for (const Hole& s : t.screws) q.screws_blocked += !hole_goes_through(self, s);
+    q.tab_bone_mm = q.tab_bone_mm < 0 ? t.bone_mm : std::min(q.tab_bone_mm, t.bone_mm);
+    if (!std::isnan(t.midline_mm))
+      q.tab_midline_mm =
+          q.tab_midline_mm < 0 ? t.midline_mm : std::min(q.tab_midline_mm, t.midline_mm);
+  }
+  if (!bone) return;
+  for (size_t k = 0; k < params.tabs.size(); ++k) {
+    const double gap = tab_gap(self, *bone, params.tabs[k]);
+    if (std::isnan(gap)) continue;
+    if (k == 0 || std::abs(gap) > std::abs(q.tab_gap_mm)) q.tab_gap_mm = gap;
+    if (gap > params.max_tab_gap_mm)
+      q.reasons.push_back(fmt("tab %.0f stands up to %.2f mm off the bone", k + 1.0, gap) +
+                          fmt1(" (limit %.2f mm)", params.max_tab_gap_mm));
+    if (gap < -params.max_tab_gap_mm)
+      q.reasons.push_back(fmt("tab %.0f enters the bone by %.2f mm", k + 1.0, -gap) +
+                          fmt1(" (limit %.2f mm)", params.max_tab_gap_mm));
+  }
+  for (size_t k = 0; k < params.tabs.size(); ++k) {
+    const Tab& t = params.tabs[k];
+    if (t.bone_mm < params.tab_min_bone_mm)
+      q.reasons.push_back(fmt("tab %.0f's screws go into bone %.1f mm thick", k + 1.0, t.bone_mm) +
+                          fmt1(" (at least %.1f mm asked)", params.tab_min_bone_mm));
+    if (!std::isnan(t.midline_mm) && t.midline_mm < params.tab_midline_mm)
+      q.reasons.push_back(
+          fmt("tab %.0f lies %.1f mm from the midsagittal plane", k + 1.0, t.midline_mm) +
+          fmt1(" (at least %.1f mm asked: the sagittal sinus)", params.tab_midline_mm));
+  }
+}
+
 // Against the skull: the gap along the rim (over every 5° arc around the implant's `axis`
 // through `c`, the side-wall vertex nearest the bone; the rim gap is the worst arc) and the
 // overlap on the implant's grid. The distance to the bone on that grid.
@@ -165,9 +211,15 @@ std::vector<float> measure_against_bone(const SkullMesh& implant, const SkullMes
     // The excess of each wall vertex's gap over the clearance asked at the bone it faces: the
     // worst arc's (its nearest vertex to the bone) and the smallest of all.
     std::vector<double> excess(distance.size());
-    for (size_t i = 0; i < distance.size(); ++i)
-      excess[i] =
-          distance[i] - clearance_at(nearest[i], params.edge_clearance_mm, params.clearance_zones);
+    // The edge a tab bridges (with 1 mm to spare on each side) is as asked: the tab holds it.
+    for (size_t i = 0; i < distance.size(); ++i) {
+      const Eigen::Vector3d p = to_eigen(implant.point(SkullMesh::VertexHandle(wall_vertices[i])));
+      const bool bridged = std::any_of(params.tabs.begin(), params.tabs.end(),
+                                       [&](const Tab& t) { return under_tab(t, p); });
+      excess[i] = bridged ? 0.0
+                          : distance[i] - clearance_at(nearest[i], params.edge_clearance_mm,
+                                                       params.clearance_zones);
+    }
     q.clearance_asked = true;
     q.clearance_high_mm = worst_arc_gap(angle, excess, M_PI / 36);
     q.clearance_low_mm = excess.empty() ? 0.0 : *std::min_element(excess.begin(), excess.end());
@@ -225,6 +277,9 @@ void add_reasons(const MeshReport& rep, const QualityParams& params, bool with_b
   if (q.holes_blocked > 0)
     q.reasons.push_back(std::to_string(q.holes_blocked) + " of " + std::to_string(q.holes) +
                         " holes do not go through");
+  if (q.screws_blocked > 0)
+    q.reasons.push_back(std::to_string(q.screws_blocked) +
+                        " of the tabs' screw holes do not go through");
   if (q.penetration_mm3 > params.max_penetration_mm3)
     q.reasons.push_back(fmt("%.1f mm³ overlap the skull (limit %.1f mm³)", q.penetration_mm3,
                             params.max_penetration_mm3));
@@ -241,6 +296,17 @@ QualityParams quality_params_for(const std::optional<Material>& material,
   q.edge_clearance_mm = material->edge_clearance_mm;
   q.density_g_cm3 = material->density_g_cm3;
   q.material_name = material->name;
+  return q;
+}
+
+QualityParams quality_params_for(const ImplantParams& params, const ImplantResult& result) {
+  QualityParams q = quality_params_for(params.material, params.clearance_zones);
+  q.holes = result.holes;
+  q.tabs = result.tabs;
+  if (!result.tabs.empty()) {
+    q.tab_min_bone_mm = params.tabs.min_bone_mm;
+    q.tab_midline_mm = params.tabs.midline ? params.tabs.midline_distance_mm : 0.0;
+  }
   return q;
 }
 
@@ -299,15 +365,17 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
     q.thickness_max_mm = thickness.back();
   }
   std::vector<float> bone_distance;  // empty without a skull
+  std::unique_ptr<SurfaceLocator> own;
+  const SurfaceLocator* bone = nullptr;
   if (skull && skull->n_faces() > 0) {
-    std::unique_ptr<SurfaceLocator> own;
     if (!skull_locator) own = std::make_unique<SurfaceLocator>(*skull);
-    const SurfaceLocator& bone = skull_locator ? *skull_locator : *own;
-    bone_distance = measure_against_bone(implant, *skull, bone, c, axis, std::move(wall_vertices),
+    bone = skull_locator ? skull_locator : own.get();
+    bone_distance = measure_against_bone(implant, *skull, *bone, c, axis, std::move(wall_vertices),
                                          solid, grid, params, q);
   }
   measure_thin_material(solid, depth, grid, bone_distance, params, q);
   add_reasons(rep, params, !bone_distance.empty(), q);
+  measure_tabs(self, bone, params, q);
   q.printable = q.reasons.empty();
   return q;
 }

@@ -5,6 +5,7 @@
 #include <QHBoxLayout>
 #include <QLabel>
 #include <QPushButton>
+#include <QSpinBox>
 #include <algorithm>
 #include <cmath>
 
@@ -112,11 +113,6 @@ BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
     b->setCheckable(true);
     b->setToolTip(tr("Then click the implant"));
   }
-  for (QPushButton* b : {mark_zone_, add_hole_, remove_hole_})
-    connect(b, &QPushButton::toggled, this, [this, b](bool on) {
-      if (on) click_mode(b);
-      host_.view().set_pick_target(pick_target());
-    });
   form_->addRow(perforate_);
   form_->addRow(tr("Hole diameter"), hole_diameter_);
   form_->addRow(tr("Hole spacing"), hole_spacing_);
@@ -125,6 +121,42 @@ BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
   hole_buttons->addWidget(add_hole_);
   hole_buttons->addWidget(remove_hole_);
   form_->addRow(hole_buttons);
+
+  // Fixation tabs: evenly placed, or where the user clicks on the bone beyond the edge.
+  tabs_ = new QCheckBox(tr("Fixation tabs along the rim"), this);
+  tabs_->setObjectName("tabs");
+  tabs_->setToolTip(
+      tr("Tabs onto the outer table with a countersunk screw hole each, away from thin bone "
+         "and from the midline"));
+  tab_count_ = new QSpinBox(this);
+  tab_count_->setObjectName("tabCount");
+  tab_count_->setRange(0, 12);
+  tab_count_->setSpecialValueText(tr("one per 40 mm of rim"));
+  tab_screws_ = new QSpinBox(this);
+  tab_screws_->setObjectName("tabScrews");
+  tab_screws_->setRange(1, 2);
+  tab_length_ = spin("tabLength", 4, 25, 0.5, " mm");
+  tab_length_->setValue(TabParams{}.length_mm);
+  add_tab_ = make_button(tr("Add a tab"), "addTab");
+  move_tab_ = make_button(tr("Move a tab"), "moveTab");
+  remove_tab_ = make_button(tr("Remove a tab"), "removeTab");
+  add_tab_->setToolTip(tr("Then click the bone beyond the implant's edge"));
+  move_tab_->setToolTip(tr("Then click the tab, then the bone where it goes"));
+  remove_tab_->setToolTip(tr("Then click the tab"));
+  for (QPushButton* b : {add_tab_, move_tab_, remove_tab_}) b->setCheckable(true);
+  for (QPushButton* b : {mark_zone_, add_hole_, remove_hole_, add_tab_, move_tab_, remove_tab_})
+    connect(b, &QPushButton::toggled, this, [this, b](bool on) {
+      if (on) click_mode(b);
+      moving_tab_.reset();
+      host_.view().set_pick_target(pick_target());
+    });
+  form_->addRow(tabs_);
+  form_->addRow(tr("Tabs"), tab_count_);
+  form_->addRow(tr("Screws per tab"), tab_screws_);
+  form_->addRow(tr("Tab length"), tab_length_);
+  auto* tab_buttons = new QHBoxLayout;
+  for (QPushButton* b : {add_tab_, move_tab_, remove_tab_}) tab_buttons->addWidget(b);
+  form_->addRow(tab_buttons);
 
   QPushButton* build = add_button(tr("Build implant"), "build");
   connect(build, &QPushButton::clicked, this,
@@ -154,7 +186,7 @@ void BuildPage::rebuild() {
 }
 
 void BuildPage::click_mode(QPushButton* on) {
-  for (QPushButton* b : {mark_zone_, add_hole_, remove_hole_})
+  for (QPushButton* b : {mark_zone_, add_hole_, remove_hole_, add_tab_, move_tab_, remove_tab_})
     if (b != on && b->isChecked()) {
       const QSignalBlocker block(b);
       b->setChecked(false);
@@ -162,12 +194,67 @@ void BuildPage::click_mode(QPushButton* on) {
 }
 
 SkullView::PickTarget BuildPage::pick_target() const {
-  if (mark_zone_->isChecked()) return SkullView::PickTarget::Original;
+  if (mark_zone_->isChecked() || add_tab_->isChecked() || move_tab_->isChecked() ||
+      remove_tab_->isChecked())
+    return SkullView::PickTarget::Original;
   if (add_hole_->isChecked() || remove_hole_->isChecked()) return SkullView::PickTarget::Implant;
   return SkullView::PickTarget::None;
 }
 
+void BuildPage::take_tabs_over() {
+  const PlanState& s = host_.plan();
+  if (!tab_positions_.empty() || !s.implant) return;
+  for (const Tab& t : s.implant->result().tabs) tab_positions_.push_back(t.rim);
+}
+
+namespace {
+// The tab of `tabs` whose middle lies nearest `point`, within 10 mm; none otherwise.
+std::optional<size_t> tab_near(const std::vector<Tab>& tabs, const Eigen::Vector3d& point) {
+  std::optional<size_t> best;
+  double best_mm = 10.0;
+  for (size_t k = 0; k < tabs.size(); ++k) {
+    const double mm = (tabs[k].rim + 0.5 * tabs[k].length_mm * tabs[k].outward - point).norm();
+    if (mm < best_mm) best_mm = mm, best = k;
+  }
+  return best;
+}
+}  // namespace
+
 void BuildPage::surface_clicked(const Eigen::Vector3d& point) {
+  if (add_tab_->isChecked() || move_tab_->isChecked() || remove_tab_->isChecked()) {
+    const PlanState& s = host_.plan();
+    const std::vector<Tab> shown = s.implant ? s.implant->result().tabs : std::vector<Tab>{};
+    if (add_tab_->isChecked()) {
+      if (tabs_->isChecked()) take_tabs_over();
+      tab_positions_.push_back(point);
+      tabs_->setChecked(true);
+      rebuild();
+      return;
+    }
+    if (move_tab_->isChecked() && moving_tab_) {
+      // The second click: where the tab goes.
+      take_tabs_over();
+      if (*moving_tab_ < tab_positions_.size()) tab_positions_[*moving_tab_] = point;
+      moving_tab_.reset();
+      rebuild();
+      return;
+    }
+    const std::optional<size_t> k = tab_near(shown, point);
+    if (!k) {
+      host_.show_message(tr("No tab within 10 mm of the click."), true);
+      return;
+    }
+    if (move_tab_->isChecked()) {
+      moving_tab_ = k;
+      host_.show_message(tr("Tab %1: now click the bone where it goes.").arg(*k + 1), false);
+      return;
+    }
+    take_tabs_over();
+    if (*k < tab_positions_.size()) tab_positions_.erase(tab_positions_.begin() + *k);
+    if (tab_positions_.empty()) tabs_->setChecked(false);  // the last one gone: none
+    rebuild();
+    return;
+  }
   if (add_hole_->isChecked()) {
     added_holes_.push_back(point);
     rebuild();
@@ -234,6 +321,14 @@ ImplantParams BuildPage::params() const {
   p.perforations.edge_distance_mm = hole_edge_->value();
   p.perforations.added = added_holes_;
   p.perforations.removed = removed_holes_;
+  if (tabs_->isChecked()) {
+    p.tabs.automatic = tab_positions_.empty();
+    p.tabs.positions = tab_positions_;
+  }
+  p.tabs.count = tab_count_->value();
+  p.tabs.screws = tab_screws_->value();
+  p.tabs.length_mm = tab_length_->value();
+  if (p.tabs.any()) p.tabs.midline = host_.plan().plane;
   return p;
 }
 
@@ -272,6 +367,12 @@ void BuildPage::show_state(const PlanState& s) {
     hole_edge_->setValue(p.perforations.edge_distance_mm);
     added_holes_ = p.perforations.added;
     removed_holes_ = p.perforations.removed;
+    const QSignalBlocker b7(tabs_);
+    tabs_->setChecked(p.tabs.any());
+    tab_count_->setValue(p.tabs.count);
+    tab_screws_->setValue(p.tabs.screws);
+    tab_length_->setValue(p.tabs.length_mm);
+    tab_positions_ = p.tabs.positions;
   }
   remove_zone_->setEnabled(!zones_.empty());
   QString text =
@@ -285,6 +386,8 @@ void BuildPage::show_state(const PlanState& s) {
     text += "<br>" + tr("%1 holes of %2 mm.")
                          .arg(s.implant->result().holes.size())
                          .arg(hole_diameter_->value(), 0, 'f', 1);
+  if (s.implant && !s.implant->result().tabs.empty())
+    text += "<br>" + tr("%1 fixation tabs.").arg(s.implant->result().tabs.size());
   if (!zones_.empty())
     text += "<br>" + (zones_.size() == 1
                           ? tr("1 clearance zone on the rim (orange).")

@@ -149,6 +149,14 @@ class BuildPage : public StepPage {
   QDoubleSpinBox *hole_diameter_, *hole_spacing_, *hole_edge_;
   QPushButton *add_hole_, *remove_hole_;
   std::vector<Eigen::Vector3d> added_holes_, removed_holes_;
+  QCheckBox* tabs_;
+  QSpinBox *tab_count_, *tab_screws_;
+  QDoubleSpinBox* tab_length_;
+  QPushButton *add_tab_, *move_tab_, *remove_tab_;
+  std::vector<Eigen::Vector3d> tab_positions_;  ///< the user's tabs (empty: evenly placed)
+  std::optional<size_t> moving_tab_;            ///< "Move a tab": the tab clicked first
+  /// The tabs as the user's: the ones shown (evenly placed ones included) when there are none.
+  void take_tabs_over();
   /// Turns the other click modes off when one is turned on.
   void click_mode(QPushButton* on);
   QLabel* info_;

@@ -268,5 +268,18 @@ TEST(BuildImplant, FinishingWithoutTheFitToTheBoneIsRefused) {
             std::string::npos);
 }
 
+// Tabs need the skull they lie on and the shell; a plate laid on the bone has none.
+TEST(BuildImplant, TabsWithoutTheSkullOrOnAPlateAreRefused) {
+  const DefectCase& c = right_parietal_case();
+  ImplantParams p;
+  p.fit_to_bone_mm = 4.0;
+  p.tabs.automatic = true;
+  EXPECT_NE(build_implant(c.markers, nullptr, p).message.find("give it"), std::string::npos);
+  p.material = *material_preset("titanium");
+  const ImplantResult r = build_implant(c.markers, &c.defective, p);
+  EXPECT_FALSE(r.usable());
+  EXPECT_NE(r.message.find("screwed through its own overlap"), std::string::npos) << r.message;
+}
+
 }  // namespace
 }  // namespace cranioplan

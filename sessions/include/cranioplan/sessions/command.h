@@ -114,13 +114,15 @@ void params_from_json(const ParamReader& r, RegisterParams& p);
 void params_from_json(const ParamReader& r, SmoothParams& p);
 void params_from_json(const ParamReader& r, ProposeParams& p);
 void params_from_json(const ParamReader& r, ImplantParams& p);
-/// A build's material and clearance zones as build_implant records them; read back with their
-/// ranges checked (a SessionError names the problem).
+/// A build's material, clearance zones, perforations and tabs as build_implant records them; read
+/// back with their ranges checked (a SessionError names the problem).
 Json to_json(const Material& m);
 Json to_json(const ClearanceZone& z);
 Json to_json(const PerforationParams& p);
+Json to_json(const TabParams& p);
 Material material_from_json(const ParamReader& r);
 PerforationParams perforations_from_json(const ParamReader& r);
+TabParams tabs_from_json(const ParamReader& r);
 ClearanceZone clearance_zone_from_json(const ParamReader& r);
 
 /// Builders: the only way the wizard and the CLI make commands.

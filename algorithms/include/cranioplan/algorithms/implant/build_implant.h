@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "cranioplan/algorithms/implant/fixation_tabs.h"
 #include "cranioplan/algorithms/implant/perforate.h"
 #include "cranioplan/algorithms/implant/trim_to_bone.h"
 #include "cranioplan/model/marker.h"
@@ -50,6 +51,10 @@ struct ImplantParams {
   std::vector<ClearanceZone> clearance_zones;
   /// Holes drilled through the finished implant (perforate.h; the shell method only).
   PerforationParams perforations;
+  /// Fixation tabs onto the outer table (fixation_tabs.h; the shell method with the skull; not
+  /// with a plate laid on the bone, which is screwed through its own overlap). Added before the
+  /// perforations, which keep off them.
+  TabParams tabs;
   /// Radial needs a skull (its centroid is the centre) or `radial_center`; otherwise planar.
   ImplantFrame frame = ImplantFrame::Radial;
   std::optional<Eigen::Vector3d> radial_center;  ///< centre of the rays (inside the skull)
@@ -69,6 +74,7 @@ struct ImplantResult {
   double rim_marker_error_mm = 0.0;  ///< largest distance from an edge marker to its rim
   int rim_points = 0;                ///< samples along each rim
   std::vector<Hole> holes;           ///< the perforations drilled
+  std::vector<Tab> tabs;             ///< the fixation tabs added
   double seconds = 0.0;
   bool usable() const { return status == Status::Built; }
 };

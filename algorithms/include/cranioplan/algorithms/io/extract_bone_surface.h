@@ -70,5 +70,9 @@ struct VoxelGrid;
 /// largest piece, in the order the meshing gives (not canonical: an implant fitted to the bone
 /// or drilled follows from the canonical skull and the markers already).
 ExtractBoneSurfaceResult surface_of_field(std::vector<float> field, const VoxelGrid& grid);
+/// A solid given by its signed distance (mm, positive inside) meshed at 0: the field is mapped
+/// to surface_of_field's 0..1 over one voxel on either side of the surface.
+ExtractBoneSurfaceResult surface_of_signed_distance(std::vector<float> distance,
+                                                    const VoxelGrid& grid);
 
 }  // namespace cranioplan

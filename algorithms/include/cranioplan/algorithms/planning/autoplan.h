@@ -95,8 +95,9 @@ MarkerProposal markers(const DefectRegion& defect, const SurfaceLocator& bone,
                        const SurfaceLocator& mirror, const AutoplanParams& params,
                        int first_id = 1);
 /// The implant's parameters: the automatic plan's, in the frame of the rays that found the
-/// opening.
-ImplantParams implant_params(const DefectRegion& defect, const AutoplanParams& params);
+/// opening, with the plan's plane as the tabs' midline (when tabs are asked without one).
+ImplantParams implant_params(const DefectRegion& defect, const Plane& plane,
+                             const AutoplanParams& params);
 
 }  // namespace autoplan_stages
 

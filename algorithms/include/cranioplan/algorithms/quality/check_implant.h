@@ -4,6 +4,7 @@
 #include <string>
 #include <vector>
 
+#include "cranioplan/algorithms/implant/fixation_tabs.h"
 #include "cranioplan/algorithms/implant/perforate.h"
 #include "cranioplan/model/material.h"
 #include "cranioplan/model/mesh.h"
@@ -35,12 +36,27 @@ struct QualityParams {
   std::string material_name;            ///< as the report names it (empty: none)
   /// The perforations drilled (ImplantResult::holes): each must go through.
   std::vector<Hole> holes;
+  /// The fixation tabs added (ImplantResult::tabs). Each must lie on the bone (its underside at
+  /// most `max_tab_gap_mm` off it, and not in it by more), its screw holes go through, its screws
+  /// into bone at least `tab_min_bone_mm` thick, and it keep `tab_midline_mm` from the
+  /// midsagittal plane. The edge under a tab, which the tab bridges, is not judged by the rim
+  /// gap and the clearance.
+  std::vector<Tab> tabs;
+  double max_tab_gap_mm = 0.2;   ///< mm
+  double tab_min_bone_mm = 0.0;  ///< mm
+  double tab_midline_mm = 0.0;   ///< mm (judged when the tabs were placed with the plane)
 };
 
 /// The quality check a build with a material asks for: its minimum thickness, clearance,
 /// clearance zones and density; the defaults without one.
 QualityParams quality_params_for(const std::optional<Material>& material,
                                  const std::vector<ClearanceZone>& zones = {});
+
+struct ImplantParams;
+struct ImplantResult;
+/// The quality check a build asks for: its material's and clearance zones' (above), the holes
+/// it drilled and the tabs it added with their limits.
+QualityParams quality_params_for(const ImplantParams& params, const ImplantResult& result);
 
 struct QualityReport {
   bool watertight = false;
@@ -64,6 +80,11 @@ struct QualityReport {
   bool clearance_asked = false;      ///< a clearance (or zone) was asked
   double mass_g = 0.0;               ///< volume × density (0 without a density)
   int holes = 0, holes_blocked = 0;  ///< perforations, and those that do not go through
+  int tabs = 0, screws_blocked = 0;  ///< fixation tabs, and screw holes that do not go through
+  /// The largest gap between a tab's underside and the bone, mm (negative: into the bone; 0
+  /// without tabs), and the thinnest bone under a screw and the nearest tab to the midline
+  /// (−1: none measured).
+  double tab_gap_mm = 0.0, tab_bone_mm = -1.0, tab_midline_mm = -1.0;
   std::string material_name;
   double penetration_mm3 = -1.0;  ///< −1 without a skull
   bool printable = false;

@@ -1,0 +1,19 @@
+#pragma once
+// A closed mesh as a signed distance field on a voxel grid: what implant operations that re-mesh
+// the implant (drilling holes, adding fixation tabs) combine with other solids before meshing.
+#include <cstdint>
+#include <vector>
+
+namespace cranioplan {
+
+class SurfaceLocator;
+struct VoxelGrid;
+
+/// The signed distance to the surface located by `locator` (mm, positive inside) at the grid's
+/// voxel centres, with `solid` the surface's voxel mask on that grid: exact (the closest point
+/// on the surface) within two to three voxels of where the mask changes, ±`far_mm` elsewhere.
+std::vector<float> signed_distance_near_surface(const SurfaceLocator& locator,
+                                                const std::vector<uint8_t>& solid,
+                                                const VoxelGrid& grid, float far_mm = 10.0f);
+
+}  // namespace cranioplan

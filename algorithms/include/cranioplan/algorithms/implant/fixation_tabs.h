@@ -1,0 +1,91 @@
+#pragma once
+// Fixation tabs: strips of the implant's material that reach beyond its edge onto the skull's
+// outer table, following the bone, each with one or two countersunk screw holes. They are
+// placed evenly along the rim (away from thin bone and from the midline's sinus) or where the
+// user puts them, and joined to the implant as one solid: the implant's signed distance and the
+// tabs' (a layer over the bone and the implant, inside each tab's outline) are combined on a
+// fine grid, the screw holes subtracted, and the result meshed again.
+#include <Eigen/Core>
+#include <limits>
+#include <optional>
+#include <string>
+#include <vector>
+
+#include "cranioplan/algorithms/implant/perforate.h"
+#include "cranioplan/model/mesh.h"
+#include "cranioplan/model/plane.h"
+
+namespace cranioplan {
+
+class SurfaceLocator;
+
+struct TabParams {
+  /// Tabs placed evenly along the rim (with `count`), unless `positions` are given.
+  bool automatic = false;
+  /// How many tabs the even placement puts, 1..12; 0: one per 40 mm of rim (3 to 8).
+  int count = 0;
+  /// A tab at the rim point nearest each of these points (the user's tabs); when given, the
+  /// even placement is not used.
+  std::vector<Eigen::Vector3d> positions;
+  double length_mm = 9.0;  ///< how far a tab reaches beyond the implant's edge, mm (4..25)
+  /// Across, mm (3..15; its far end is round); NaN: the countersink (or hole) with a ring of the
+  /// material's minimum thickness plus 0.5 mm on either side, at least 6 mm.
+  double width_mm = std::numeric_limits<double>::quiet_NaN();
+  /// Of the tab, mm (0.5..5); NaN: the material's minimum thickness under the countersink plus
+  /// 0.4 mm, at least 1.5 mm (without a material, a minimum of 1 mm).
+  double thickness_mm = std::numeric_limits<double>::quiet_NaN();
+  int screws = 1;                        ///< per tab, 1 or 2 (two lie along the tab)
+  double screw_diameter_mm = 1.8;        ///< hole for the screw's shank, mm (1..3)
+  double countersink_diameter_mm = 3.0;  ///< at the tab's top (90°), mm (0: none; else > the hole)
+  /// The even placement keeps the tabs this far from the midsagittal plane (the superior
+  /// sagittal sinus lies under the midline), mm (0..40); used with `midline`.
+  double midline_distance_mm = 10.0;
+  std::optional<Plane> midline;  ///< the plan's midsagittal plane
+  /// The even placement puts screws only into bone at least this thick, mm (0..10).
+  double min_bone_mm = 2.0;
+  double voxel_mm = 0.2;      ///< grid of the union, mm (0.05..1)
+  double max_voxels = 1.2e7;  ///< a large implant's grid is coarsened to this many voxels
+  bool any() const { return automatic || !positions.empty(); }
+};
+/// Why the parameters cannot be used (a value out of its range), or empty.
+std::string tab_problem(const TabParams& p);
+
+/// The parameters with the width and thickness set (those left NaN derived from the material's
+/// minimum thickness, `material_min_thickness_mm`, NaN without a material).
+TabParams resolved(const TabParams& p, double material_min_thickness_mm);
+
+/// A tab as placed: its frame at the implant's edge and its screws.
+struct Tab {
+  Eigen::Vector3d rim = Eigen::Vector3d::Zero();       ///< where it leaves the implant's edge
+  Eigen::Vector3d outward = Eigen::Vector3d::UnitX();  ///< along the tab, away from the implant
+  Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();   ///< the bone's outer normal under it
+  double length_mm = 0.0, width_mm = 0.0, thickness_mm = 0.0;
+  std::vector<Hole> screws;  ///< each hole's centre on the tab's top, drilled along `normal`
+  double bone_mm = 0.0;      ///< the thinnest bone under its screws, mm
+  double midline_mm = std::numeric_limits<double>::quiet_NaN();  ///< nearest to the midline
+  bool added = false;  ///< placed by the user (TabParams::positions)
+};
+
+struct TabResult {
+  enum class Status { Added, Failed };
+  Status status = Status::Failed;
+  std::string message;
+  SkullMesh mesh;  ///< the implant with its tabs (the input, untouched, when Failed)
+  std::vector<Tab> tabs;
+  double rim_length_mm = 0.0;  ///< of the implant's edge, along which the tabs are placed
+  double seconds = 0.0;
+  bool usable() const { return status == Status::Added; }
+};
+
+/// Adds tabs to `implant` (closed, outward-oriented) fitted onto the skull located by `bone`
+/// (the bone as a solid). `inside`: a point inside the skull. `params` with the width and
+/// thickness set (resolved()).
+TabResult add_fixation_tabs(const SkullMesh& implant, const SurfaceLocator& bone,
+                            const Eigen::Vector3d& inside, const TabParams& params);
+
+/// The largest gap between a tab's underside and the bone over the part of it that lies on the
+/// bone (beyond its edge's groove, away from the screw holes), mm; negative where the tab enters
+/// the bone. `implant` (with the tab) is located by `self`.
+double tab_gap(const SurfaceLocator& self, const SurfaceLocator& bone, const Tab& tab);
+
+}  // namespace cranioplan

@@ -1,0 +1,222 @@
+#include "cranioplan/algorithms/implant/fixation_tabs.h"
+
+#include <gtest/gtest.h>
+
+#include <Eigen/Geometry>
+#include <cmath>
+#include <functional>
+
+#include "cranioplan/algorithms/geometry/surface_locator.h"
+#include "cranioplan/algorithms/geometry/voxelize_mesh.h"
+#include "cranioplan/algorithms/io/extract_bone_surface.h"
+#include "cranioplan/algorithms/io/mesh_report.h"
+#include "cranioplan/algorithms/quality/check_implant.h"
+
+namespace cranioplan {
+namespace {
+
+// A flat bone 6 mm thick (z 0 to `top`) over 100 × 100 mm with a 40 × 40 mm opening (x and y
+// 30 to 70), and an implant filling the opening with a 1 mm gap all round, both meshed from
+// masks on a 0.25 mm grid as the planner's surfaces are (each surface halfway between the last
+// voxel centre inside and the first outside: the bone's top at `top` − 0.125 mm, its bottom at
+// 0.125 mm); the skull's inside lies below.
+SkullMesh solid_of(const std::function<bool(const Eigen::Vector3d&)>& inside,
+                   const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  const VoxelGrid g = VoxelGrid::covering(lo, hi, 0.25, 3);
+  std::vector<uint8_t> mask(g.size());
+  for (int k = 0; k < g.dims[2]; ++k)
+    for (int j = 0; j < g.dims[1]; ++j)
+      for (int i = 0; i < g.dims[0]; ++i) mask[g.index(i, j, k)] = inside(g.center(i, j, k));
+  ExtractBoneSurfaceParams surface;
+  surface.threshold = 0.5;
+  return extract_bone_surface(mask_volume(mask, g), surface).mesh;
+}
+SkullMesh bone(double top = 6.0) {
+  return solid_of(
+      [top](const Eigen::Vector3d& p) {
+        const bool slab = p.z() > 0 && p.z() < top;
+        const bool hole = p.x() > 30 && p.x() < 70 && p.y() > 30 && p.y() < 70;
+        return slab && !hole;
+      },
+      {0, 0, 0}, {100, 100, top});
+}
+SkullMesh plug() {
+  return solid_of(
+      [](const Eigen::Vector3d& p) {
+        return p.z() > 0 && p.z() < 6 && p.x() > 31 && p.x() < 69 && p.y() > 31 && p.y() < 69;
+      },
+      {31, 31, 0}, {69, 69, 6});
+}
+const Eigen::Vector3d kInside(50, 50, -60);
+constexpr double kTop = 5.875, kBoneMm = 5.75;  // the meshed bone's top and thickness
+
+// Euler characteristic V − E + F of a closed surface: 2 − 2·genus, one genus per hole through.
+long long genus(const SkullMesh& m) {
+  const long long chi = static_cast<long long>(m.n_vertices()) -
+                        static_cast<long long>(m.n_edges()) + static_cast<long long>(m.n_faces());
+  return (2 - chi) / 2;
+}
+
+// Evenly placed tabs on a flat rim: one per 40 mm of the 152 mm edge, each lying on the bone
+// (its underside within 0.2 mm of it), reaching its length beyond the edge, 2 mm thick, with a
+// screw hole through; tabs and plate one closed, manifold solid with a tunnel per screw, which
+// the quality report passes.
+TEST(FixationTabs, EvenlyPlacedTabsLieOnTheBoneWithTheirScrewsThrough) {
+  const SkullMesh skull = bone(), implant = plug();
+  const SurfaceLocator on_bone(skull);
+  TabParams p = resolved(TabParams{}, std::nan(""));
+  p.automatic = true;
+  EXPECT_DOUBLE_EQ(p.width_mm, 6.0);
+  EXPECT_DOUBLE_EQ(p.thickness_mm, 2.0);  // 1 mm under a 0.6 mm countersink, + 0.4
+  const TabResult r = add_fixation_tabs(implant, on_bone, kInside, p);
+  ASSERT_TRUE(r.usable()) << r.message;
+  EXPECT_NEAR(r.rim_length_mm, 4 * 38.0, 6.0);
+  ASSERT_EQ(r.tabs.size(), 4u);
+  const SurfaceLocator self(r.mesh);
+  for (const Tab& t : r.tabs) {
+    EXPECT_NEAR(t.normal.z(), 1.0, 1e-3);
+    EXPECT_NEAR(t.rim.z(), kTop, 0.3);
+    EXPECT_LT(std::abs(t.outward.z()), 1e-3);
+    ASSERT_EQ(t.screws.size(), 1u);
+    EXPECT_NEAR(t.screws[0].center.z(), kTop + 0.05 + 2.0, 0.01) << "on the tab's top";
+    EXPECT_TRUE(hole_goes_through(self, t.screws[0]));
+    EXPECT_NEAR(t.bone_mm, kBoneMm, 0.01);
+    const double gap = tab_gap(self, on_bone, t);
+    EXPECT_GE(gap, -0.05);
+    EXPECT_LE(gap, 0.2);
+    // The top 2 mm above the underside, over the bone.
+    const Eigen::Vector3d on = t.rim + (t.length_mm - 1.0) * t.outward;
+    const auto top = self.first_hit(on + 10.0 * t.normal, on);
+    ASSERT_TRUE(top.has_value());
+    EXPECT_NEAR(top->point.z(), kTop + 0.05 + 2.0, 0.1);
+    // The tab's far end lies its length beyond the implant's edge (at 69 or 31).
+    const Eigen::Vector3d end = t.rim + (t.length_mm + 0.3) * t.outward,
+                          before = t.rim + (t.length_mm - 0.3) * t.outward;
+    EXPECT_FALSE(self.first_hit(end + Eigen::Vector3d(0, 0, 10), end));
+    EXPECT_TRUE(self.first_hit(before + Eigen::Vector3d(0, 0, 10), before));
+  }
+  const MeshReport rep = report_mesh(r.mesh);
+  EXPECT_TRUE(rep.watertight);
+  EXPECT_EQ(rep.nonmanifold_edges, 0);
+  EXPECT_EQ(rep.pieces, 1);
+  EXPECT_EQ(genus(r.mesh), 4) << "a tunnel per screw";
+  QualityParams q;
+  q.edge_clearance_mm = 1.0;  // the plug's gap all round
+  q.tabs = r.tabs;
+  const QualityReport report = check_implant(r.mesh, &skull, q);
+  EXPECT_TRUE(report.printable) << (report.reasons.empty() ? "" : report.reasons.front());
+  EXPECT_EQ(report.tabs, 4);
+  EXPECT_EQ(report.screws_blocked, 0);
+  EXPECT_LE(report.tab_gap_mm, 0.2);
+}
+
+// The midline: with the plane x = 50 and 10 mm asked, no tab comes nearer it; the tabs that
+// would lie across it move along the rim.
+TEST(FixationTabs, TheEvenPlacementKeepsOffTheMidline) {
+  const SkullMesh skull = bone(), implant = plug();
+  const SurfaceLocator on_bone(skull);
+  TabParams p = resolved(TabParams{}, std::nan(""));
+  p.automatic = true;
+  p.midline = Plane{Eigen::Vector3d::UnitX(), 50.0};
+  const TabResult r = add_fixation_tabs(implant, on_bone, kInside, p);
+  ASSERT_TRUE(r.usable()) << r.message;
+  ASSERT_GE(r.tabs.size(), 3u);
+  for (const Tab& t : r.tabs) {
+    EXPECT_GE(t.midline_mm, 10.0);
+    for (const Hole& s : t.screws) EXPECT_GE(std::abs(s.center.x() - 50.0), 10.0);
+  }
+}
+
+// Thin bone: asked for screws into bone 7 mm thick on a 6 mm bone, no place is found and the
+// implant is left as it was.
+TEST(FixationTabs, NoPlaceOnBoneThinnerThanAskedIsRefused) {
+  const SkullMesh skull = bone(), implant = plug();
+  const SurfaceLocator on_bone(skull);
+  TabParams p = resolved(TabParams{}, std::nan(""));
+  p.automatic = true;
+  p.min_bone_mm = 7.0;
+  const TabResult r = add_fixation_tabs(implant, on_bone, kInside, p);
+  EXPECT_FALSE(r.usable());
+  EXPECT_NE(r.message.find("7"), std::string::npos) << r.message;
+  EXPECT_EQ(r.mesh.n_faces(), implant.n_faces());
+}
+
+// A tab the user puts: at the rim point nearest the point given, reaching away from the
+// implant there.
+TEST(FixationTabs, AUsersTabGoesToTheNearestRimPoint) {
+  const SkullMesh skull = bone(), implant = plug();
+  const SurfaceLocator on_bone(skull);
+  TabParams p = resolved(TabParams{}, std::nan(""));
+  p.positions = {Eigen::Vector3d(45, 95, 6)};
+  const TabResult r = add_fixation_tabs(implant, on_bone, kInside, p);
+  ASSERT_TRUE(r.usable()) << r.message;
+  ASSERT_EQ(r.tabs.size(), 1u);
+  EXPECT_TRUE(r.tabs[0].added);
+  EXPECT_NEAR(r.tabs[0].rim.y(), 69.0, 0.5);
+  EXPECT_NEAR(r.tabs[0].rim.x(), 45.0, 2.0);
+  EXPECT_NEAR(r.tabs[0].outward.y(), 1.0, 0.05);
+  EXPECT_EQ(genus(r.mesh), 1);
+  // Two tabs closer than their width overlap: refused, naming them.
+  p.positions = {Eigen::Vector3d(45, 95, 6), Eigen::Vector3d(48, 95, 6)};
+  const TabResult both = add_fixation_tabs(implant, on_bone, kInside, p);
+  EXPECT_FALSE(both.usable());
+  EXPECT_NE(both.message.find("tabs 1 and 2 overlap"), std::string::npos) << both.message;
+}
+
+// The quality report's tab checks fail on constructed bad cases: a tab standing off the bone
+// (the bone 0.5 mm lower than the tabs were laid on), screws into bone thinner than asked, a
+// tab nearer the midline than asked.
+TEST(FixationTabs, TheQualityReportRefusesATabOffTheBone) {
+  const SkullMesh skull = bone(), implant = plug();
+  const SurfaceLocator on_bone(skull);
+  TabParams p = resolved(TabParams{}, std::nan(""));
+  p.positions = {Eigen::Vector3d(50, 95, 6)};
+  const TabResult r = add_fixation_tabs(implant, on_bone, kInside, p);
+  ASSERT_TRUE(r.usable()) << r.message;
+  QualityParams q;
+  q.tabs = r.tabs;
+  const SkullMesh lower = bone(5.5);
+  const QualityReport off = check_implant(r.mesh, &lower, q);
+  EXPECT_FALSE(off.printable);
+  EXPECT_NEAR(off.tab_gap_mm, 0.55, 0.1);
+  bool said = false;
+  for (const std::string& s : off.reasons)
+    said = said || s.find("tab 1 stands") != std::string::npos;
+  EXPECT_TRUE(said);
+
+  q.tab_min_bone_mm = 8.0;
+  q.tab_midline_mm = 10.0;
+  q.tabs[0].midline_mm = 4.0;
+  const QualityReport near = check_implant(r.mesh, &skull, q);
+  EXPECT_FALSE(near.printable);
+  int found = 0;
+  for (const std::string& s : near.reasons)
+    found += s.find("tab 1's screws go into bone") != std::string::npos ||
+             s.find("4.0 mm from the midsagittal plane") != std::string::npos;
+  EXPECT_EQ(found, 2);
+}
+
+TEST(FixationTabs, ParametersOutOfRangeAreNamed) {
+  TabParams p;
+  p.automatic = true;
+  EXPECT_EQ(tab_problem(p), "");
+  p.screws = 2;
+  EXPECT_NE(tab_problem(resolved(p, 2.0)).find("for two screws"), std::string::npos);
+  p.length_mm = 20.0;
+  EXPECT_EQ(tab_problem(resolved(p, 2.0)), "");
+  p.screws = 3;
+  EXPECT_EQ(tab_problem(p), "a tab has one or two screws");
+  p.screws = 1;
+  p.thickness_mm = 0.6;
+  p.countersink_diameter_mm = 3.4;
+  EXPECT_NE(tab_problem(p).find("countersink"), std::string::npos);
+  p = TabParams{};
+  p.count = 13;
+  EXPECT_NE(tab_problem(p).find("count"), std::string::npos);
+  p = TabParams{};
+  p.positions = {Eigen::Vector3d(std::nan(""), 0, 0)};
+  EXPECT_EQ(tab_problem(p), "a tab's position is not a point");
+}
+
+}  // namespace
+}  // namespace cranioplan
