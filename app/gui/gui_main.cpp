@@ -1,5 +1,5 @@
 // cranioplan [MESH|VOLUME|SESSION] [--sample] [--units U] [--step N] [--screenshot OUT.png]
-// [--quit]
+// [--report OUT.html] [--quit]
 #include <QApplication>
 #include <QCommandLineParser>
 #include <QFileInfo>
@@ -32,8 +32,10 @@ int main(int argc, char** argv) {
   const QCommandLineOption window_preset("window", "CT window: bone, soft or brain", "W");
   const QCommandLineOption thickness("thickness-map",
                                      "colour the implant by its thickness (View → Thickness map)");
+  const QCommandLineOption report(
+      "report", "write the design report (HTML, its pictures and a PDF beside it)", "OUT.html");
   parser.addOptions(
-      {sample, units, step, screenshot, quit, view, layout, window_preset, thickness});
+      {sample, units, step, screenshot, quit, view, layout, window_preset, thickness, report});
   parser.process(app);
 
   cranioplan::gui::MainWindow window;
@@ -94,7 +96,16 @@ int main(int argc, char** argv) {
     const QString w = parser.value(window_preset).toLower();
     window.slices().apply_preset(w == "brain" ? P::Brain : w == "soft" ? P::SoftTissue : P::Bone);
   }
-  if (parser.isSet(screenshot)) {
+  if (parser.isSet(report)) {
+    const QString out = parser.value(report);
+    QTimer::singleShot(300, &window, [&window, out, automated, &ok] {
+      const bool written = window.write_design_report(out);
+      std::fprintf(written ? stdout : stderr, "%s %s\n", written ? "wrote" : "cannot write",
+                   out.toLocal8Bit().constData());
+      ok = ok && written;
+      if (automated) QApplication::exit(ok ? 0 : 3);
+    });
+  } else if (parser.isSet(screenshot)) {
     const QString out = parser.value(screenshot);
     QTimer::singleShot(300, &window, [&window, out, automated, ok, &failed] {
       const bool saved = window.screenshot().save(out);

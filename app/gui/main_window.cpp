@@ -229,6 +229,12 @@ void MainWindow::add_points_actions(QMenu* file) {
     const QString dir = QFileDialog::getExistingDirectory(this, tr("The CT of this skull"));
     if (!dir.isEmpty()) attach_ct(dir);
   });
+  file->addAction(tr("Design report…"), this, [this] {
+    const QString path =
+        QFileDialog::getSaveFileName(this, tr("Design report for sign-off (HTML; a PDF beside it)"),
+                                     QStringLiteral("design-report.html"), tr("HTML (*.html)"));
+    if (!path.isEmpty()) write_design_report(path);
+  });
   file->addAction(tr("Export implant over the CT…"), this,
                   [this] {
                     const QString path = QFileDialog::getSaveFileName(
@@ -987,7 +993,7 @@ bool MainWindow::save_session_to(const QString& path) {
   return true;
 }
 
-bool MainWindow::export_to(const QString& path) {
+bool MainWindow::export_to(const QString& path, bool with_mould) {
   const PlanState& s = controller_->state();
   if (!s.implant) {
     show_message(tr("There is no implant to export: build it first (step 7)."), true);
@@ -1009,7 +1015,9 @@ bool MainWindow::export_to(const QString& path) {
                      .arg(q(r.reasons.empty() ? std::string() : r.reasons.front())),
                  true);
   }
-  return controller_->push(commands::export_implant(path.toStdString()));
+  return controller_->push(commands::export_implant(
+      path.toStdString(), "",
+      with_mould ? std::optional<MouldParams>(MouldParams{}) : std::nullopt));
 }
 
 void MainWindow::open_audit(const QString& path) {

@@ -59,6 +59,10 @@ class MainWindow : public QMainWindow, public PageHost {
   void set_layout(Layout layout);
   /// View → Thickness map on or off.
   void set_thickness_map_shown(bool shown);
+  /// The design report for sign-off at `html_path`, its pictures beside it (NAME_front.png,
+  /// ...) and a PDF of it (NAME.pdf); false, with a message, without an implant or when a file
+  /// cannot be written.
+  bool write_design_report(const QString& html_path);
   Layout layout() const { return layout_; }
   void show_slices() override { set_layout(Layout::ThreeDAndSlices); }
 
@@ -89,7 +93,7 @@ class MainWindow : public QMainWindow, public PageHost {
   /// Shows the plan as it was when step `step` was current (commands of later steps undone).
   void replay_to_step(int step);
   bool save_session_to(const QString& path);
-  bool export_to(const QString& path) override;
+  bool export_to(const QString& path, bool with_mould = false) override;
   /// A CT for a plan made from a mesh (its bone surface at `threshold`, NaN: 300 HU or 0.5,
   /// must lie on the skull), shown in the slice views.
   void attach_ct(const QString& path, double threshold = std::numeric_limits<double>::quiet_NaN());

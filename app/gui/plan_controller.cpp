@@ -40,6 +40,8 @@ bool PlanController::is_long(const Command& c) {
     case CommandType::BuildImplant:
     case CommandType::SmoothMarkers:
       return true;
+    case CommandType::ExportImplant:  // a mould takes seconds
+      return c.params.contains("mould");
     default:
       return false;
   }

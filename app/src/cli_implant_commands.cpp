@@ -16,10 +16,13 @@
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/implant/build_implant.h"
+#include "cranioplan/algorithms/implant/casting_mould.h"
 #include "cranioplan/algorithms/implant/smooth_markers.h"
 #include "cranioplan/algorithms/implant/snap_markers.h"
+#include "cranioplan/algorithms/io/file_io.h"
 #include "cranioplan/algorithms/io/load_skull.h"
 #include "cranioplan/algorithms/io/read_volume.h"
+#include "cranioplan/algorithms/io/write_3mf.h"
 #include "cranioplan/algorithms/io/write_labelmap.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/algorithms/planning/autoplan.h"
@@ -295,7 +298,7 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
         o->params.material = material_from(o->material);
         o->params.clearance_zones = zones_from(o->material);
         o->params.perforations = perforations_from(o->holes);
-        o->params.tabs = tabs_from(o->tabs, std::nullopt);
+        o->params.tabs = tabs_from(o->tabs, o->params.material);
         const ImplantResult r = build_implant(snapped.markers, &skull, o->params);
         Json j = implant_json(r);
         j["method"] = o->method;
@@ -313,6 +316,79 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
 }
 
 // qa
+// mould
+Subcommand add_mould(CLI::App& app, const bool& json) {
+  struct Opts {
+    std::string implant, skull, output;
+    MouldParams params;
+  };
+  auto o = std::make_shared<Opts>();
+  auto* cmd = app.add_subcommand(
+      "mould", "A two-part casting mould of an implant (PMMA in theatre), for FDM printing");
+  cmd->add_option("IMPLANT", o->implant, "implant mesh")->required();
+  cmd->add_option("--skull", o->skull,
+                  "the skull it is made for (its centre tells the implant's outer surface)")
+      ->required();
+  cmd->add_option("--wall", o->params.wall_mm, "the block beyond the cavity (mm)")
+      ->capture_default_str()
+      ->check(CLI::Range(4.0, 30.0));
+  cmd->add_option("--key-diameter", o->params.key_diameter_mm, "alignment keys (mm)")
+      ->capture_default_str()
+      ->check(CLI::Range(2.0, 12.0));
+  cmd->add_option("--key-clearance", o->params.key_clearance_mm,
+                  "sockets wider than the keys by this (mm)")
+      ->capture_default_str()
+      ->check(CLI::Range(0.0, 1.0));
+  cmd->add_option("--channel-diameter", o->params.channel_diameter_mm, "pour channel (mm)")
+      ->capture_default_str()
+      ->check(CLI::Range(2.0, 12.0));
+  cmd->add_option("--vent-diameter", o->params.vent_diameter_mm, "air vent (mm)")
+      ->capture_default_str()
+      ->check(CLI::Range(1.0, 6.0));
+  cmd->add_option("-o,--output", o->output,
+                  "OUT.3mf (the implant and both halves, named) or OUT.stl (OUT_outer.stl and "
+                  "OUT_inner.stl)")
+      ->required();
+  return Subcommand{
+      cmd, [o, &json]() -> int {
+        if (const std::string problem = mould_problem(o->params); !problem.empty())
+          throw CLI::ValidationError("--wall", problem);
+        const MeshFormat format = mesh_format_for_path(o->output);
+        if (format == MeshFormat::BinaryPLY)
+          throw CLI::ValidationError("--output", "a mould is written as .3mf or .stl");
+        const SkullMesh implant = load_surface(o->implant).mesh;
+        const LoadedSkull skull = load_skull(o->skull);
+        const MouldResult r = make_casting_mould(implant, vertex_centroid(skull.mesh), o->params);
+        Json j{{"status", r.usable() ? "made" : "failed"},
+               {"message", r.message},
+               {"cavity_max_mm", r.cavity_max_mm},
+               {"cavity_p95_mm", r.cavity_p95_mm},
+               {"undercut_mm2", r.undercut_mm2},
+               {"axis", to_json(r.axis)},
+               {"pour", to_json(r.pour)},
+               {"vent", to_json(r.vent)},
+               {"seconds", r.seconds}};
+        if (!r.usable()) {
+          print_result(j, json);
+          return kUnusable;
+        }
+        if (format == MeshFormat::ThreeMF) {
+          write_file_atomically(o->output, encode_3mf({{"implant", &implant},
+                                                       {"mould outer", &r.outer},
+                                                       {"mould inner", &r.inner}},
+                                                      {{"Application", "Cranioplan"}}));
+          j["output"] = o->output;
+        } else {
+          const std::string stem = o->output.substr(0, o->output.size() - 4);
+          write_mesh(r.outer, stem + "_outer.stl");
+          write_mesh(r.inner, stem + "_inner.stl");
+          j["output"] = Json::array({stem + "_outer.stl", stem + "_inner.stl"});
+        }
+        print_result(j, json);
+        return kOk;
+      }};
+}
+
 Subcommand add_qa(CLI::App& app, const bool& json) {
   struct Opts {
     std::string implant, skull, ct, series;
@@ -520,7 +596,8 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
         o->params.implant.material = material_from(o->material);
         o->params.implant.clearance_zones = zones_from(o->material);
         o->params.implant.perforations = perforations_from(o->holes);
-        o->params.implant.tabs = tabs_from(o->tabs, std::nullopt);  // the plan's plane, later
+        // The midline is the plan's plane (autoplan sets it).
+        o->params.implant.tabs = tabs_from(o->tabs, o->params.implant.material);
         auto markers_path = [&](size_t k) {
           return o->markers_out.empty() ? std::string() : numbered_path(o->markers_out, k);
         };
@@ -561,9 +638,9 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
 }  // namespace
 
 std::vector<Subcommand> add_implant_commands(CLI::App& app, const bool& json) {
-  return {add_smooth(app, json),   add_implant(app, json), add_qa(app, json),
-          add_labelmap(app, json), add_compare(app, json), add_inject_defect(app, json),
-          add_autoplan(app, json)};
+  return {add_smooth(app, json),        add_implant(app, json),  add_qa(app, json),
+          add_mould(app, json),         add_labelmap(app, json), add_compare(app, json),
+          add_inject_defect(app, json), add_autoplan(app, json)};
 }
 
 }  // namespace cranioplan::cli

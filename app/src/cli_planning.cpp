@@ -1,6 +1,7 @@
 #include "cli_planning.h"
 
 #include <CLI/CLI.hpp>
+#include <limits>
 #include <sstream>
 
 #include "cli_output.h"
@@ -165,12 +166,12 @@ void add_tab_options(CLI::App* cmd, TabOptions& o) {
                   "even placement)");
 }
 
-TabParams tabs_from(const TabOptions& o, const std::optional<Plane>& midline) {
+TabParams tabs_from(const TabOptions& o, const std::optional<Material>& material) {
   TabParams p = o.params;
   for (const std::string& t : o.at) p.positions.push_back(parse_point(t, "--tab"));
-  if (p.any()) p.midline = midline;
-  if (const std::string problem = tab_problem(p); !problem.empty())
-    throw CLI::ValidationError("--tabs", problem);
+  const std::string problem = tab_problem(resolved(
+      p, material ? material->min_thickness_mm : std::numeric_limits<double>::quiet_NaN()));
+  if (!problem.empty()) throw CLI::ValidationError("--tabs", problem);
   return p;
 }
 

@@ -46,9 +46,9 @@ struct TabOptions {
   std::vector<std::string> at;
 };
 void add_tab_options(CLI::App* cmd, TabOptions& o);
-/// The tabs the options ask for (a CLI::ValidationError for a bad one), with `midline` (the
-/// plan's plane) when the plan has one.
-TabParams tabs_from(const TabOptions& o, const std::optional<Plane>& midline);
+/// The tabs the options ask for (a CLI::ValidationError for a bad one, sizes checked as the
+/// material makes them).
+TabParams tabs_from(const TabOptions& o, const std::optional<Material>& material);
 /// The material and zones the options ask for (a CLI::ValidationError for a bad one); none
 /// when no option was given.
 std::optional<Material> material_from(const MaterialOptions& o);

@@ -1,6 +1,7 @@
 #include "cli_session_commands.h"
 
 #include <memory>
+#include <optional>
 
 #include "cli_output.h"
 #include "cranioplan/algorithms/io/file_io.h"
@@ -92,6 +93,66 @@ std::vector<Subcommand> add_session_commands(CLI::App& app, const bool& json) {
                        write_landmarks_file(state.landmarks, o->landmarks);
                        j["landmarks_file"] = o->landmarks;
                      }
+                     print_result(j, json);
+                     return kOk;
+                   }});
+  }
+  {  // export
+    struct Opts {
+      std::string session, output;
+      bool mould = false;
+      MouldParams mould_params;
+    };
+    auto o = std::make_shared<Opts>();
+    auto* cmd = app.add_subcommand(
+        "export", "Export a plan's implant as a recorded command (.stl, .ply or .3mf)");
+    cmd->add_option("SESSION", o->session, "session (.json); saved with the export recorded")
+        ->required();
+    cmd->add_option("-o,--output", o->output, "the implant (.stl, .ply or .3mf)")->required();
+    cmd->add_flag("--mould", o->mould,
+                  "a .3mf with the two halves of a casting mould beside the implant");
+    cmd->add_option("--mould-wall", o->mould_params.wall_mm, "the mould's wall (mm)")
+        ->capture_default_str()
+        ->check(CLI::Range(4.0, 30.0));
+    out.push_back({cmd, [o, &json] {
+                     Session s = Session::open(o->session);
+                     const PushResult r = s.push(commands::export_implant(
+                         o->output, "",
+                         o->mould ? std::optional<MouldParams>(o->mould_params) : std::nullopt));
+                     Json j{{"exported", r.accepted}, {"message", r.message}};
+                     if (!r.accepted) {
+                       print_result(j, json);
+                       return kUnusable;
+                     }
+                     s.save(o->session);
+                     j["output"] = o->output;
+                     j["sha256"] = s.effective_commands().back().params["sha256"];
+                     print_result(j, json);
+                     return kOk;
+                   }});
+  }
+  {  // approve
+    struct Opts {
+      std::string session, by, role = "neurosurgeon";
+    };
+    auto o = std::make_shared<Opts>();
+    auto* cmd = app.add_subcommand(
+        "approve", "Sign off a plan's implant as it stands (any later change withdraws it)");
+    cmd->add_option("SESSION", o->session, "session (.json); saved with the approval recorded")
+        ->required();
+    cmd->add_option("--by", o->by, "who approves (name)")->required();
+    cmd->add_option("--role", o->role, "in what role")->capture_default_str();
+    out.push_back({cmd, [o, &json] {
+                     Session s = Session::open(o->session);
+                     const PushResult r = s.push(commands::approve(o->by, o->role));
+                     Json j{{"approved", r.accepted}, {"message", r.message}};
+                     if (!r.accepted) {
+                       print_result(j, json);
+                       return kUnusable;
+                     }
+                     s.save(o->session);
+                     j["implant_sha256"] = s.state().approval->implant_sha256;
+                     j["time"] = s.journal().back().time;
                      print_result(j, json);
                      return kOk;
                    }});

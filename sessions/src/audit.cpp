@@ -1,5 +1,6 @@
 #include "cranioplan/sessions/audit.h"
 
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <cstdio>
 #include <ctime>
@@ -82,6 +83,53 @@ std::string duration_text(double seconds) {
 
 }  // namespace
 
+namespace {
+
+// The sign-off, for a plan that has one or had one: who approved and when (the journal's time
+// of the approval), and which exported files on disk are the approved implant. Not approved (or
+// withdrawn by a later change), or an approved export changed on disk: not ok.
+std::optional<VerifyCheck> approval_check(const Session& session, const SessionDocument& doc,
+                                          const std::string& dir) {
+  const PlanState& s = session.state();
+  if (!s.approval && s.approval_withdrawn.empty()) return std::nullopt;
+  VerifyCheck check{"approval", false, ""};
+  if (!s.approval) {
+    check.detail = s.approval_withdrawn + ": not approved";
+    return check;
+  }
+  std::string when;
+  for (const JournalEntry& e : doc.journal)
+    if (e.event == "do" && e.command && e.command->type == CommandType::Approve &&
+        e.command->params.value("implant_sha256", std::string()) == s.approval->implant_sha256)
+      when = e.time;
+  check.ok = true;
+  check.detail = "approved by " + s.approval->by + " (" + s.approval->role + ")" +
+                 (when.empty() ? "" : " at " + when) + ", implant SHA-256 " +
+                 s.approval->implant_sha256.substr(0, 12) + "…";
+  std::string approved, other;
+  for (const ExportRecord& e : s.exports) {
+    if (e.implant_sha256 != s.approval->implant_sha256) {
+      other += (other.empty() ? "" : ", ") + e.path;
+      continue;
+    }
+    const std::string found = resolve(e.path, dir);
+    std::string state = "unchanged";
+    if (found.empty()) {
+      state = "not found";
+    } else if (sha256_file(found) != e.recorded_sha256) {
+      state = "CHANGED on disk";
+      check.ok = false;
+    }
+    approved += (approved.empty() ? "" : ", ") + e.path + " (" + state + ")";
+  }
+  check.detail += approved.empty() ? "; no export of the approved implant"
+                                   : "; the approved implant in " + approved;
+  if (!other.empty()) check.detail += "; exports of another implant, not approved: " + other;
+  return check;
+}
+
+}  // namespace
+
 VerifyReport verify_session(const std::string& path) {
   VerifyReport report;
   const SessionDocument doc = read_session_document(path);
@@ -139,6 +187,9 @@ VerifyReport verify_session(const std::string& path) {
       replay.detail = std::to_string(session.effective_commands().size()) + " commands replayed; " +
                       std::to_string(matching) + " of " + std::to_string(exports.size()) +
                       " export(s) reproduced byte for byte";
+    report.checks.push_back(replay);
+    if (const auto approval = approval_check(session, doc, dir)) report.checks.push_back(*approval);
+    return report;
   } catch (const Error& e) {
     replay.detail = e.what();
   }
@@ -436,6 +487,111 @@ std::string quality_report_html(const QualityReport& r, const SoftTissueCheck* t
     for (const auto& reason : r.reasons) h += "<li>" + html_escape(reason) + "</li>";
     h += "</ul>";
   }
+  return h;
+}
+
+std::string design_report_html(const Session& session, const std::vector<ReportImage>& images,
+                               const std::string& program_version) {
+  const PlanState& st = session.state();
+  const ImplantData& implant = *st.implant;
+  const QualityReport& q = implant.quality();
+  const SkullMesh& mesh = implant.result().mesh;
+  auto fixed = [](double v, int decimals) {
+    return fmt(("%." + std::to_string(decimals) + "f").c_str(), v);
+  };
+  auto point = [&](const Eigen::Vector3d& x) {
+    return fixed(x.x(), 1) + ", " + fixed(x.y(), 1) + ", " + fixed(x.z(), 1);
+  };
+  std::string h = html_head("Cranioplan design report") + "<h1>Implant design report</h1>";
+  // Sign-off first: what is being signed.
+  if (st.approval)
+    h += "<p class=ok><b>Approved</b> by " + html_escape(st.approval->by) + " (" +
+         html_escape(st.approval->role) + ") for the implant with STL SHA-256 <code>" +
+         st.approval->implant_sha256 + "</code>.</p>";
+  else if (!st.approval_withdrawn.empty())
+    h += "<p class=bad>Not approved: " + html_escape(st.approval_withdrawn) + ".</p>";
+  else
+    h += "<p><b>Not approved yet.</b> Approved by: ____________________ &nbsp; Date: ____________ "
+         "&nbsp; Signature: ____________________</p>";
+  if (!images.empty()) {  // two to a row, to fit an A4 page
+    h += "<table>";
+    for (size_t k = 0; k < images.size(); ++k) {
+      if (k % 2 == 0) h += "<tr>";
+      h += "<td><img src=\"" + html_escape(images[k].file) + "\" width=240><br>" +
+           html_escape(images[k].caption) + "</td>";
+      if (k % 2 == 1 || k + 1 == images.size()) h += "</tr>";
+    }
+    h += "</table>";
+  }
+  // Dimensions along the implant's principal axes.
+  const Eigen::Vector3d c = vertex_centroid(mesh);
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (auto vh : mesh.vertices()) {
+    const Eigen::Vector3d d = to_eigen(mesh.point(vh)) - c;
+    cov += d * d.transpose();
+  }
+  const Eigen::Matrix3d axes = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors();
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  for (auto vh : mesh.vertices()) {
+    const Eigen::Vector3d d = axes.transpose() * (to_eigen(mesh.point(vh)) - c);
+    lo = lo.cwiseMin(d);
+    hi = hi.cwiseMax(d);
+  }
+  const Eigen::Vector3d extent = hi - lo;
+  h += "<h2>Dimensions</h2><table>";
+  auto row = [&](const std::string& k, const std::string& v) {
+    h += "<tr><th>" + k + "</th><td>" + v + "</td></tr>";
+  };
+  row("Extent (principal axes)",
+      fixed(extent.z(), 1) + " × " + fixed(extent.y(), 1) + " × " + fixed(extent.x(), 1) + " mm");
+  row("Surface area", fixed(q.area_mm2, 0) + " mm²");
+  row("Volume", fixed(q.volume_mm3, 0) + " mm³");
+  if (st.implant_params && st.implant_params->material) {
+    row("Material", html_escape(describe(*st.implant_params->material)));
+    row("Mass", fixed(q.volume_mm3 * 1e-3 * st.implant_params->material->density_g_cm3, 1) + " g");
+  }
+  row("Triangles", std::to_string(mesh.n_faces()));
+  h += "</table><h2>Quality</h2>" + quality_report_html(q);
+  const ImplantResult& built = implant.result();
+  if (!built.holes.empty()) {
+    h += "<h2>Perforations</h2><table><tr><th>#</th><th>Centre (mm)</th><th>Axis</th>"
+         "<th>Placed</th></tr>";
+    for (size_t k = 0; k < built.holes.size(); ++k) {
+      const Hole& hole = built.holes[k];
+      h += "<tr><td>" + std::to_string(k + 1) + "</td><td>" + point(hole.center) + "</td><td>" +
+           fixed(hole.axis.x(), 2) + ", " + fixed(hole.axis.y(), 2) + ", " +
+           fixed(hole.axis.z(), 2) + "</td><td>" + (hole.added ? "by hand" : "pattern") +
+           "</td></tr>";
+    }
+    h += "</table>";
+  }
+  if (!built.tabs.empty()) {
+    h += "<h2>Fixation tabs</h2><table><tr><th>#</th><th>At the rim (mm)</th><th>Length × "
+         "width × thickness</th><th>Screws</th><th>Bone under the screws</th><th>From the "
+         "midline</th></tr>";
+    for (size_t k = 0; k < built.tabs.size(); ++k) {
+      const Tab& t = built.tabs[k];
+      h += "<tr><td>" + std::to_string(k + 1) + "</td><td>" + point(t.rim) + "</td><td>" +
+           fixed(t.length_mm, 1) + " × " + fixed(t.width_mm, 1) + " × " + fixed(t.thickness_mm, 1) +
+           " mm</td><td>" + std::to_string(t.screws.size()) + "</td><td>" + fixed(t.bone_mm, 1) +
+           " mm</td><td>" +
+           (std::isnan(t.midline_mm) ? std::string("—") : fixed(t.midline_mm, 1) + " mm") +
+           "</td></tr>";
+    }
+    h += "</table>";
+  }
+  h += "<h2>Provenance</h2><table>";
+  for (const Command& cmd : session.effective_commands())
+    if (cmd.type == CommandType::LoadSkull || cmd.type == CommandType::AttachCt)
+      row(cmd.type == CommandType::LoadSkull ? "Skull" : "CT",
+          html_escape(cmd.params.value("path", std::string())) + "<br><code>SHA-256 " +
+              cmd.params.value("sha256", std::string()) + "</code>");
+  row("Plan (journal's last hash)",
+      "<code>" + (session.journal().empty() ? std::string("—") : session.journal().back().hash) +
+          "</code>");
+  row("Implant (binary STL SHA-256)", "<code>" + implant.stl_sha256() + "</code>");
+  row("Program", "Cranioplan " + html_escape(program_version));
+  h += "</table></body></html>";
   return h;
 }
 

@@ -6,6 +6,7 @@
 #include <limits>
 
 #include "cranioplan/algorithms/io/write_mesh.h"
+#include "cranioplan/model/error.h"
 #include "cranioplan/sessions/marker_files.h"
 #include "cranioplan/sessions/session_error.h"
 
@@ -44,6 +45,7 @@ const std::vector<TypeInfo>& type_table() {
       {CommandType::CompleteStep, "complete_step", {"step"}},
       {CommandType::Note, "note", {"text"}},
       {CommandType::AttachCt, "attach_ct", {"path", "sha256", "import"}},
+      {CommandType::Approve, "approve", {"by", "role", "implant_sha256"}},
   };
   return table;
 }
@@ -370,6 +372,30 @@ Json to_json(const TabParams& p) {
               {"min_bone_mm", p.min_bone_mm},
               {"voxel_mm", p.voxel_mm},
               {"max_voxels", p.max_voxels}};
+}
+
+Json to_json(const MouldParams& p) {
+  return Json{{"wall_mm", p.wall_mm},
+              {"key_diameter_mm", p.key_diameter_mm},
+              {"key_clearance_mm", p.key_clearance_mm},
+              {"channel_diameter_mm", p.channel_diameter_mm},
+              {"vent_diameter_mm", p.vent_diameter_mm},
+              {"voxel_mm", p.voxel_mm},
+              {"max_voxels", p.max_voxels}};
+}
+
+MouldParams mould_from_json(const ParamReader& r) {
+  MouldParams p;
+  p.wall_mm = r.number("wall_mm");
+  p.key_diameter_mm = r.number("key_diameter_mm");
+  p.key_clearance_mm = r.number("key_clearance_mm");
+  p.channel_diameter_mm = r.number("channel_diameter_mm");
+  p.vent_diameter_mm = r.number("vent_diameter_mm");
+  p.voxel_mm = r.number("voxel_mm");
+  p.max_voxels = r.number("max_voxels");
+  if (const std::string problem = mould_problem(p); !problem.empty())
+    throw SessionError(r.where(), problem);
+  return p;
 }
 
 TabParams tabs_from_json(const ParamReader& r) {
@@ -714,6 +740,9 @@ std::string describe(const Command& c) {
       return "Note: " + p.value("text", std::string());
     case CommandType::AttachCt:
       return "Attach CT " + p.value("path", std::string());
+    case CommandType::Approve:
+      return "Approved by " + p.value("by", std::string()) + " (" + p.value("role", std::string()) +
+             ")";
   }
   return type_tag(c.type);
 }
@@ -812,13 +841,25 @@ Command build_implant(const ImplantParams& params) {
   return make(CommandType::BuildImplant, {{"params", params_to_json(params)}}, 7);
 }
 
-Command export_implant(const std::string& path, const std::string& sha256) {
+Command export_implant(const std::string& path, const std::string& sha256,
+                       const std::optional<MouldParams>& mould) {
   const MeshFormat format = mesh_format_for_path(path);
-  return make(CommandType::ExportImplant,
-              {{"path", path},
-               {"format", format == MeshFormat::BinarySTL ? "stl" : "ply"},
-               {"sha256", sha256}},
-              9);
+  Json params{{"path", path},
+              {"format", format == MeshFormat::BinarySTL   ? "stl"
+                         : format == MeshFormat::BinaryPLY ? "ply"
+                                                           : "3mf"},
+              {"sha256", sha256}};
+  if (mould) {
+    if (format != MeshFormat::ThreeMF)
+      throw InputError(path, "a mould is exported in a .3mf package with the implant");
+    params["mould"] = to_json(*mould);
+  }
+  return make(CommandType::ExportImplant, std::move(params), 9);
+}
+
+Command approve(const std::string& by, const std::string& role, const std::string& implant_sha256) {
+  return make(CommandType::Approve,
+              {{"by", by}, {"role", role}, {"implant_sha256", implant_sha256}}, 9);
 }
 
 Command go_to_step(int step) { return make(CommandType::GoToStep, {{"step", step}}, step); }

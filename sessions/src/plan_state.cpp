@@ -11,6 +11,7 @@
 #include "cranioplan/algorithms/io/file_io.h"
 #include "cranioplan/algorithms/io/load_skull.h"
 #include "cranioplan/algorithms/io/read_volume.h"
+#include "cranioplan/algorithms/io/write_3mf.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/algorithms/planning/propose_markers.h"
 #include "cranioplan/algorithms/quality/ct_agreement.h"
@@ -218,6 +219,8 @@ int command_step(const PlanState& s, const Command& c) {
     case CommandType::GoToStep:
     case CommandType::CompleteStep:
       return std::clamp(p.value("step", 1), 1, 9);
+    case CommandType::Approve:
+      return 9;
     case CommandType::Note:
     case CommandType::AttachCt:
       return 0;
@@ -756,22 +759,69 @@ void apply_build(PlanState& s, const ParamReader& r, int version) {
   rebuild_implant(s);
 }
 
+}  // namespace
+
+std::string plan_description(const std::string& plan_sha256, const std::string& implant_sha256) {
+  return "Cranioplan plan SHA-256 " + plan_sha256 + "; implant STL SHA-256 " + implant_sha256;
+}
+
+std::string export_bytes(const PlanState& s, const ExportSpec& spec, std::string* why) {
+  const ImplantData& implant = *s.implant;
+  const SkullMesh& mesh = implant.result().mesh;
+  if (spec.format != "3mf")
+    return encode_mesh(mesh, spec.format == "stl" ? MeshFormat::BinarySTL : MeshFormat::BinaryPLY);
+  const std::vector<std::pair<std::string, std::string>> metadata = {
+      {"Application", "Cranioplan"},
+      {"Description", plan_description(spec.plan_sha256, implant.stl_sha256())}};
+  if (!spec.mould) return encode_3mf({{"implant", &mesh}}, metadata);
+  const Eigen::Vector3d inside = s.skull ? vertex_centroid(s.skull->surface->mesh)
+                                         : vertex_centroid(mesh) - 80.0 * Eigen::Vector3d::UnitZ();
+  const MouldResult m = make_casting_mould(mesh, inside, *spec.mould);
+  if (!m.usable()) {
+    if (why) *why = "the mould could not be made: " + m.message;
+    return {};
+  }
+  return encode_3mf({{"implant", &mesh}, {"mould outer", &m.outer}, {"mould inner", &m.inner}},
+                    metadata);
+}
+
+namespace {
+
 void apply_export(PlanState& s, const ParamReader& r) {
   if (!s.implant) throw Refusal{"there is no implant to export: build it first"};
   ExportRecord e;
   e.path = r.string("path");
   e.format = r.string("format");
-  if (e.format != "stl" && e.format != "ply")
-    throw Refusal{"export format must be \"stl\" or \"ply\", not \"" + e.format + "\""};
+  if (e.format != "stl" && e.format != "ply" && e.format != "3mf")
+    throw Refusal{"export format must be \"stl\", \"ply\" or \"3mf\", not \"" + e.format + "\""};
   e.recorded_sha256 = r.string("sha256");
-  e.replayed_sha256 = sha256_hex(encode_mesh(
-      s.implant->result().mesh, e.format == "stl" ? MeshFormat::BinarySTL : MeshFormat::BinaryPLY));
+  ExportSpec spec;
+  spec.format = e.format;
+  if (r.has("plan_sha256")) spec.plan_sha256 = r.string("plan_sha256");
+  if (r.has("mould"))
+    spec.mould = mould_from_json(ParamReader(r.value("mould"), r.where() + " mould"));
+  std::string why;
+  const std::string bytes = export_bytes(s, spec, &why);
+  if (!why.empty()) throw Refusal{why};
+  e.replayed_sha256 = sha256_hex(bytes);
   e.implant_sha256 = s.implant->stl_sha256();
   s.message = e.recorded_sha256 == e.replayed_sha256
                   ? "implant exported to " + e.path
                   : "implant exported to " + e.path +
                         " — but the implant now encodes to different bytes than were recorded";
   s.exports.push_back(std::move(e));
+}
+
+void apply_approve(PlanState& s, const ParamReader& r) {
+  if (!s.implant) throw Refusal{"there is no implant to approve: build it first"};
+  PlanState::Approval a{r.string("by"), r.string("role"), r.string("implant_sha256")};
+  if (a.by.empty()) throw Refusal{"an approval names who approves"};
+  if (a.implant_sha256 != s.implant->stl_sha256())
+    throw Refusal{"the approval is of another implant (SHA-256 " + a.implant_sha256.substr(0, 12) +
+                  "…) than this plan's"};
+  s.approval = a;
+  s.approval_withdrawn.clear();
+  s.message = "implant approved by " + a.by + " (" + a.role + ")";
 }
 
 void apply_step(PlanState& s, CommandType type, const ParamReader& r) {
@@ -890,11 +940,20 @@ ApplyOutcome apply_command(const PlanState& before, const Command& command,
       case CommandType::AttachCt:
         apply_attach_ct(s, r, context, out.record);
         break;
+      case CommandType::Approve:
+        apply_approve(s, r);
+        break;
     }
   } catch (const Refusal& refusal) {
     out.message = refusal.message;
     out.state = before;
     return out;
+  }
+  // A sign-off holds for the implant signed, not for another.
+  if (s.approval && (!s.implant || s.implant->stl_sha256() != s.approval->implant_sha256)) {
+    s.approval_withdrawn = "the implant changed after " + s.approval->by + " approved it";
+    s.approval.reset();
+    s.message += (s.message.empty() ? "" : "; ") + s.approval_withdrawn + ": approval withdrawn";
   }
   if (step >= 1) s.stale.erase(step);
   out.accepted = true;

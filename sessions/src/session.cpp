@@ -428,14 +428,30 @@ PreparedCommand Session::prepare(Command command) {
     if (!ec) command.params["path"] = absolute.lexically_normal().string();
     if (command.params.value("sha256", std::string()).empty())
       command.params["sha256"] = sha256_file(command.params["path"].get<std::string>());
+  } else if (command.type == CommandType::Approve) {
+    // What is approved: the implant as it stands.
+    if (before.implant && command.params.value("implant_sha256", std::string()).empty())
+      command.params["implant_sha256"] = before.implant->stl_sha256();
   } else if (command.type == CommandType::ExportImplant) {
     if (!before.implant) {
       p.message = "there is no implant to export: build it first";
       return p;
     }
     const std::string path = command.params.value("path", std::string());
-    const std::string bytes =
-        encode_mesh(before.implant->result().mesh, mesh_format_for_path(path));
+    ExportSpec spec;
+    spec.format = command.params.value("format", std::string("stl"));
+    // A 3MF carries the plan's hash as it stands before the export.
+    if (spec.format == "3mf")
+      command.params["plan_sha256"] = spec.plan_sha256 =
+          journal_.empty() ? genesis_hash(header_) : journal_.back().hash;
+    if (command.params.contains("mould"))
+      spec.mould = mould_from_json(ParamReader(command.params["mould"], "export_implant mould"));
+    std::string why;
+    const std::string bytes = export_bytes(before, spec, &why);
+    if (!why.empty()) {
+      p.message = why;
+      return p;
+    }
     write_file_atomically(path, bytes);
     command.params["sha256"] = sha256_hex(bytes);
   }

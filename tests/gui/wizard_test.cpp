@@ -771,6 +771,29 @@ TEST(WizardTabs, TabsAreMovedRemovedAndAddedByClicksWithUndo) {
   EXPECT_LT((plan.state().implant->result().tabs[0].rim - moved[0].rim).norm(), 1e-6);
 }
 
+// The design report from the command line: the HTML, its five pictures of the plan and a PDF.
+TEST_F(Wizard, CommandLineDesignReportWithPicturesAndPdf) {
+  test::TempDir tmp;
+  const std::string html = tmp.path("report.html");
+  std::string out;
+  ASSERT_EQ(test::run_command(std::string(CRANIOPLAN_GUI) + " " +
+                                  test::planned_defect_case().session_path + " --report " + html +
+                                  " --quit",
+                              &out),
+            0)
+      << out;
+  const std::string text = test::read_bytes(html);
+  EXPECT_NE(text.find("Implant design report"), std::string::npos);
+  for (const char* suffix : {"defect", "front", "right", "top", "thickness"}) {
+    const std::string png = tmp.path(std::string("report_") + suffix + ".png");
+    QImage image;
+    ASSERT_TRUE(image.load(QString::fromStdString(png))) << png;
+    EXPECT_GT(image.width(), 200);
+    EXPECT_NE(text.find(std::string("report_") + suffix + ".png"), std::string::npos);
+  }
+  EXPECT_EQ(test::read_bytes(tmp.path("report.pdf")).substr(0, 4), "%PDF");
+}
+
 TEST_F(Wizard, CommandLineScreenshotOfASessionAtAStep) {
   test::TempDir tmp;
   const std::string session = tmp.path("auto.json"), implant = tmp.path("auto.stl");

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <filesystem>
+
+#include "cranioplan/algorithms/io/file_io.h"
 #include "cranioplan/algorithms/planning/autoplan.h"
 #include "cranioplan/model/error.h"
 #include "cranioplan/sessions/autoplan_session.h"
@@ -12,7 +15,10 @@
 namespace cranioplan {
 namespace {
 
+namespace fs = std::filesystem;
+
 using test::PlannedCase;
+using test::push_ok;
 
 const PlannedCase& planned() { return test::planned_defect_case(); }
 
@@ -84,6 +90,74 @@ TEST(Verify, CliExitsFourWhenAnyCheckFails) {
                               replayed),
             0);
   EXPECT_EQ(sha256_file(replayed), c.implant_sha);
+}
+
+// Sign-off from the command line: approve records who, in what role and the implant's hash
+// (the journal gives when); verify names the approved exports and finds one changed on disk;
+// a later change of the implant withdraws the approval visibly, and verify then fails.
+TEST(Verify, ApprovalNamesTheApprovedExportsAndIsWithdrawnByAChange) {
+  test::TempDir dir;
+  const std::string plan = dir.path("plan.json");
+  fs::copy_file(planned().session_path, plan);
+  const std::string cli = std::string(CRANIOPLAN_CLI);
+  std::string out;
+  ASSERT_EQ(test::run_command(cli + " approve --json " + plan + " --by \"Dr Ada Lovelace\"", &out),
+            0)
+      << out;
+  EXPECT_EQ(Json::parse(out)["implant_sha256"], planned().implant_sha);
+  ASSERT_EQ(
+      test::run_command(cli + " export --json " + plan + " -o " + dir.path("signed.stl"), &out), 0)
+      << out;
+  ASSERT_EQ(test::run_command(cli + " verify --json " + plan, &out), 0) << out;
+  const std::string approval = Json::parse(out)["approval"];
+  EXPECT_NE(approval.find("holds: approved by Dr Ada Lovelace (neurosurgeon) at 20"),
+            std::string::npos)
+      << approval;
+  EXPECT_NE(approval.find("signed.stl (unchanged)"), std::string::npos) << approval;
+  const Session approved = Session::open(plan);
+  ASSERT_TRUE(approved.state().approval);
+  EXPECT_EQ(approved.state().approval->by, "Dr Ada Lovelace");
+
+  // The exported file changed on disk: verify fails.
+  write_file_atomically(dir.path("signed.stl"), "not the implant");
+  EXPECT_EQ(test::run_command(cli + " verify --json " + plan, &out), 4);
+  EXPECT_NE(out.find("signed.stl (CHANGED on disk)"), std::string::npos) << out;
+
+  // A change of the implant after the approval withdraws it.
+  Session s = Session::open(plan);
+  ImplantParams p = *s.state().implant_params;
+  p.resolution_mm *= 1.5;
+  const PushResult changed = s.push(commands::build_implant(p));
+  ASSERT_TRUE(changed.accepted) << changed.message;
+  EXPECT_FALSE(s.state().approval);
+  EXPECT_NE(changed.message.find("approval withdrawn"), std::string::npos) << changed.message;
+  s.save(plan);
+  EXPECT_EQ(test::run_command(cli + " verify --json " + plan, &out), 4);
+  EXPECT_NE(out.find("the implant changed after Dr Ada Lovelace approved it: not approved"),
+            std::string::npos)
+      << out;
+  // Undone, the approval holds again (the implant is the approved one).
+  s.undo();
+  EXPECT_TRUE(s.state().approval);
+  // An approval of another implant's hash is refused.
+  EXPECT_FALSE(s.push(commands::approve("Dr B", "neurosurgeon", std::string(64, 'a'))).accepted);
+}
+
+// The design report names what is signed: dimensions, quality, provenance (the skull's and the
+// implant's SHA-256, the plan's hash), the pictures given, the approval or the lines to sign.
+TEST(DesignReport, NamesTheImplantItsProvenanceAndItsSignOff) {
+  Session s = Session::open(planned().session_path);
+  std::string html = design_report_html(s, {{"Front", "r_front.png"}}, "9.9.9");
+  for (const std::string& want :
+       {std::string("Implant design report"), std::string("Not approved yet"),
+        std::string("Extent (principal axes)"), std::string("Volume"), std::string("Printable"),
+        std::string("<img src=\"r_front.png\""), std::string("Cranioplan 9.9.9"),
+        s.state().implant->stl_sha256(), s.journal().back().hash,
+        s.effective_commands().front().params["sha256"].get<std::string>()})
+    EXPECT_NE(html.find(want), std::string::npos) << want;
+  push_ok(s, commands::approve("Dr <B>", "neurosurgeon"));
+  html = design_report_html(s, {}, "9.9.9");
+  EXPECT_NE(html.find("Approved</b> by Dr &lt;B&gt; (neurosurgeon)"), std::string::npos);
 }
 
 TEST(Audit, TimelineNamesWhoWhenWhatAndStepTimes) {

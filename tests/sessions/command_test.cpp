@@ -46,6 +46,8 @@ TEST(Commands, EveryTypeRoundTripsThroughJson) {
       commands::complete_step(4),
       commands::note("checked with the surgeon"),
       commands::attach_ct("ct.nrrd", {}, std::string(64, 'd')),
+      commands::approve("Dr A", "neurosurgeon", std::string(64, 'e')),
+      commands::export_implant("implant.3mf", std::string(64, 'f'), MouldParams{}),
   };
   RegisterParams with_roi;
   with_roi.roi = RegionOfInterest{RegionOfInterest::Shape::Box, {1, 2, 3}, 10, {4, 5, 6}};

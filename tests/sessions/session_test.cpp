@@ -8,6 +8,7 @@
 
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
 #include "cranioplan/algorithms/io/mesh_report.h"
+#include "cranioplan/algorithms/io/write_3mf.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/model/error.h"
 #include "cranioplan/sessions/audit.h"
@@ -585,6 +586,30 @@ TEST(SessionFile, ACtAttachedToAMeshPlanIsCheckedRecordedAndVerified) {
   Session t;
   push_ok(t, commands::load_skull(dir.path("skull.stl")));
   EXPECT_FALSE(t.state().ct);
+}
+
+// A 3MF export: the implant and, asked for, a casting mould's two halves in millimetres with
+// the plan's hash as it stood (the journal's last entry); verify replays it to the same bytes.
+// A mould is only exported in a 3MF.
+TEST(SessionFile, A3mfExportWithAMouldReplaysToTheSameBytes) {
+  test::TempDir dir;
+  Session s = Session::open(test::planned_defect_case().session_path);
+  ASSERT_TRUE(s.state().implant);
+  const std::string head = s.journal().back().hash;
+  MouldParams mould;
+  mould.voxel_mm = 0.4;  // a coarser grid: the test's time
+  push_ok(s, commands::export_implant(dir.path("plan.3mf"), "", mould));
+  const Read3mf package = read_3mf(dir.path("plan.3mf"));
+  ASSERT_EQ(package.parts.size(), 3u);
+  EXPECT_EQ(package.parts[0].first, "implant");
+  EXPECT_EQ(package.parts[1].first, "mould outer");
+  EXPECT_EQ(package.parts[2].first, "mould inner");
+  EXPECT_EQ(package.metadata.at("Description"),
+            plan_description(head, s.state().implant->stl_sha256()));
+  for (const auto& [name, mesh] : package.parts) EXPECT_TRUE(report_mesh(mesh).watertight) << name;
+  s.save(dir.path("plan.json"));
+  EXPECT_TRUE(verify_session(dir.path("plan.json")).ok());
+  EXPECT_THROW(commands::export_implant(dir.path("x.stl"), "", mould), InputError);
 }
 
 TEST(SessionFile, AutosaveOffersRecoveryOfUnsavedCommands) {

@@ -5,6 +5,7 @@
 #include <cstring>
 
 #include "cranioplan/algorithms/io/file_io.h"
+#include "cranioplan/algorithms/io/write_3mf.h"
 #include "cranioplan/model/error.h"
 #include "file_bytes.h"
 
@@ -60,11 +61,20 @@ MeshFormat mesh_format_for_path(const std::string& path) {
   const std::string ext = detail::lower_extension(path);
   if (ext == ".stl") return MeshFormat::BinarySTL;
   if (ext == ".ply") return MeshFormat::BinaryPLY;
-  throw InputError(path, "cannot write '" + ext + "' meshes (use .stl or .ply)");
+  if (ext == ".3mf") return MeshFormat::ThreeMF;
+  throw InputError(path, "cannot write '" + ext + "' meshes (use .stl, .ply or .3mf)");
 }
 
 std::string encode_mesh(const SkullMesh& mesh, MeshFormat format) {
-  return format == MeshFormat::BinarySTL ? encode_stl(mesh) : encode_ply(mesh);
+  switch (format) {
+    case MeshFormat::BinarySTL:
+      return encode_stl(mesh);
+    case MeshFormat::BinaryPLY:
+      return encode_ply(mesh);
+    case MeshFormat::ThreeMF:
+      return encode_3mf({{"implant", &mesh}}, {{"Application", "Cranioplan"}});
+  }
+  return {};
 }
 
 void write_mesh(const SkullMesh& mesh, const std::string& path, MeshFormat format) {

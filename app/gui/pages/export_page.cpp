@@ -1,7 +1,12 @@
+#include <QCheckBox>
 #include <QFileDialog>
+#include <QInputDialog>
+#include <QLabel>
+#include <QLineEdit>
 #include <QPushButton>
 #include <QTextBrowser>
 #include <QVBoxLayout>
+#include <utility>
 
 #include "step_pages.h"
 
@@ -11,19 +16,61 @@ ExportPage::ExportPage(PageHost& host) : StepPage(9, host) {
   report_ = new QTextBrowser(this);
   report_->setObjectName("exportReport");
   layout_->addWidget(report_, 1);
-  for (const char* ext : {"stl", "ply"}) {
-    QPushButton* b = make_button(tr("Export %1…").arg(QString(ext).toUpper()),
-                                 ext[0] == 's' ? "exportStl" : "exportPly");
-    connect(b, &QPushButton::clicked, this, [this, ext] {
+  // STL and PLY for any printer's software; 3MF (millimetres, the plan's hash inside) for
+  // those that take it.
+  const std::pair<const char*, const char*> formats[] = {
+      {"stl", "exportStl"}, {"ply", "exportPly"}, {"3mf", "export3mf"}};
+  for (const auto& [ext, name] : formats) {
+    QPushButton* b = make_button(tr("Export %1…").arg(QString(ext).toUpper()), name);
+    connect(b, &QPushButton::clicked, this, [this, ext = ext] {
       const QString path = QFileDialog::getSaveFileName(
           this, tr("Export the implant"), QStringLiteral("implant.%1").arg(ext),
           QStringLiteral("%1 (*.%2)").arg(QString(ext).toUpper(), ext));
-      if (!path.isEmpty()) host_.export_to(path);
+      if (!path.isEmpty()) host_.export_to(path, QString(ext) == "3mf" && mould_->isChecked());
     });
     layout_->addWidget(b);
   }
+  mould_ = new QCheckBox(tr("3MF with a casting mould (PMMA in theatre)"), this);
+  mould_->setObjectName("exportMould");
+  mould_->setToolTip(
+      tr("Two printable halves around the implant, with alignment keys, a pour channel and a "
+         "vent, in the 3MF beside the implant"));
+  layout_->addWidget(mould_);
+  // Sign-off: the surgeon approves the implant as it stands; any later change withdraws it.
+  QPushButton* approve = make_button(tr("Approve the implant…"), "approve");
+  approve->setToolTip(tr("Records who approved, when, and the implant's SHA-256"));
+  connect(approve, &QPushButton::clicked, this, [this] {
+    bool ok = false;
+    const QString by =
+        QInputDialog::getText(this, tr("Approve the implant"), tr("Approved by (name):"),
+                              QLineEdit::Normal, QString(), &ok);
+    if (!ok || by.trimmed().isEmpty()) return;
+    const QString role = QInputDialog::getText(this, tr("Approve the implant"), tr("Role:"),
+                                               QLineEdit::Normal, tr("neurosurgeon"), &ok);
+    if (!ok) return;
+    host_.push(commands::approve(by.trimmed().toStdString(), role.trimmed().toStdString()),
+               tr("Approving the implant"));
+  });
+  approval_ = new QLabel(this);
+  approval_->setObjectName("approval");
+  approval_->setWordWrap(true);
+  layout_->addWidget(approval_);
 }
 
 void ExportPage::show_quality(const QString& html) { report_->setHtml(html); }
+
+void ExportPage::show_state(const PlanState& s) {
+  if (s.approval)
+    approval_->setText(tr("<span style='color:#060'><b>Approved</b> by %1 (%2); implant SHA-256 "
+                          "%3…</span>")
+                           .arg(QString::fromStdString(s.approval->by).toHtmlEscaped(),
+                                QString::fromStdString(s.approval->role).toHtmlEscaped(),
+                                QString::fromStdString(s.approval->implant_sha256.substr(0, 12))));
+  else if (!s.approval_withdrawn.empty())
+    approval_->setText(tr("<span style='color:#a00'><b>Approval withdrawn:</b> %1.</span>")
+                           .arg(QString::fromStdString(s.approval_withdrawn).toHtmlEscaped()));
+  else
+    approval_->setText(tr("Not approved yet."));
+}
 
 }  // namespace cranioplan::gui

@@ -32,7 +32,8 @@ class PageHost {
   /// Opens a skull (mesh, CT, DICOM folder) as a new plan; asks the threshold for a CT.
   virtual void open_skull(const QString& path) = 0;
   virtual void open_sample() = 0;
-  virtual bool export_to(const QString& path) = 0;
+  /// `with_mould`: a .3mf path, the package also holds a casting mould's halves.
+  virtual bool export_to(const QString& path, bool with_mould = false) = 0;
   /// Shows the CT slices beside the 3D view.
   virtual void show_slices() = 0;
   /// Markers from a file (.mrk.json, .json, .csv), as one command.

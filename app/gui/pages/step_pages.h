@@ -189,9 +189,13 @@ class ExportPage : public StepPage {
  public:
   explicit ExportPage(PageHost& host);
   void show_quality(const QString& html) override;
+  /// Whether (and by whom) the implant is approved, or why an approval was withdrawn.
+  void show_state(const PlanState& state) override;
 
  private:
   QTextBrowser* report_;
+  QCheckBox* mould_;  ///< the 3MF export with a casting mould
+  QLabel* approval_;
 };
 
 }  // namespace cranioplan::gui

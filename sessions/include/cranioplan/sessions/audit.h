@@ -76,4 +76,16 @@ std::string training_report_html(const TrainingReport& report);
 std::string quality_report_html(const QualityReport& report,
                                 const SoftTissueCheck* tissue = nullptr);
 
+/// A picture in the design report: its caption and its file (beside the report).
+struct ReportImage {
+  std::string caption, file;
+};
+/// The design report for the surgeon's sign-off (HTML): the plan's pictures, the implant's
+/// dimensions (extent along its principal axes, area, volume, mass for its material), the
+/// quality table, the perforations and the fixation tabs, the inputs' SHA-256, the plan's hash
+/// (the journal's last), the implant's STL hash, the approval (or that there is none, or why it
+/// was withdrawn) and the program's version. The plan must have an implant.
+std::string design_report_html(const Session& session, const std::vector<ReportImage>& images,
+                               const std::string& program_version);
+
 }  // namespace cranioplan

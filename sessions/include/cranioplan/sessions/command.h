@@ -11,6 +11,7 @@
 #include "cranioplan/algorithms/alignment/fit_sagittal_plane.h"
 #include "cranioplan/algorithms/alignment/register_icp.h"
 #include "cranioplan/algorithms/implant/build_implant.h"
+#include "cranioplan/algorithms/implant/casting_mould.h"
 #include "cranioplan/algorithms/implant/smooth_markers.h"
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
 #include "cranioplan/algorithms/planning/propose_markers.h"
@@ -45,6 +46,7 @@ enum class CommandType {
   CompleteStep,
   Note,
   AttachCt,
+  Approve,
 };
 
 /// Every command type, in the order above.
@@ -120,6 +122,8 @@ Json to_json(const Material& m);
 Json to_json(const ClearanceZone& z);
 Json to_json(const PerforationParams& p);
 Json to_json(const TabParams& p);
+Json to_json(const MouldParams& p);
+MouldParams mould_from_json(const ParamReader& r);
 Material material_from_json(const ParamReader& r);
 PerforationParams perforations_from_json(const ParamReader& r);
 TabParams tabs_from_json(const ParamReader& r);
@@ -156,7 +160,14 @@ Command propose_markers(const ProposeParams& params = {});
 Command smooth_markers(const SmoothParams& params, bool project_onto_mirror = true);
 Command build_implant(const ImplantParams& params = {});
 /// `sha256` may be empty: the session writes the file and records the hash of its bytes.
-Command export_implant(const std::string& path, const std::string& sha256 = "");
+/// With `mould` (a .3mf path only), the package also holds the two halves of a casting mould.
+/// A surgeon's sign-off of the implant as it stands (`implant_sha256`, the implant's STL hash,
+/// is filled in when the command is done): who (`by`) in what role. Any change of the implant
+/// afterwards withdraws it.
+Command approve(const std::string& by, const std::string& role,
+                const std::string& implant_sha256 = "");
+Command export_implant(const std::string& path, const std::string& sha256 = "",
+                       const std::optional<MouldParams>& mould = std::nullopt);
 Command go_to_step(int step);
 Command complete_step(int step);
 Command note(const std::string& text);

@@ -14,6 +14,7 @@
 #include "cranioplan/algorithms/alignment/register_icp.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/implant/build_implant.h"
+#include "cranioplan/algorithms/implant/casting_mould.h"
 #include "cranioplan/algorithms/io/load_skull.h"
 #include "cranioplan/algorithms/planning/detect_defect.h"
 #include "cranioplan/algorithms/quality/check_implant.h"
@@ -78,9 +79,26 @@ class ImplantData {
   mutable QualityReport quality_;
 };
 
+/// What an export writes: the format ("stl", "ply" or "3mf"); for a 3MF, the plan's hash at
+/// the export (the journal's last hash), carried in its metadata with the implant's STL hash
+/// (plan_description), and optionally a casting mould's halves as parts beside the implant.
+struct PlanState;
+/// A 3MF export's "Description" metadata: "Cranioplan plan SHA-256 …; implant STL SHA-256 …"
+/// (the 3MF core's metadata names are the ones every reader accepts).
+std::string plan_description(const std::string& plan_sha256, const std::string& implant_sha256);
+struct ExportSpec {
+  std::string format = "stl";
+  std::string plan_sha256;
+  std::optional<MouldParams> mould;
+};
+/// The bytes an export of the plan's implant (there must be one) writes; the mould's outer
+/// half lies away from the skull's centre. A mould that cannot be made gives no bytes and says
+/// why in `why`.
+std::string export_bytes(const PlanState& state, const ExportSpec& spec, std::string* why);
+
 struct ExportRecord {
   std::string path;
-  std::string format;           ///< "stl" or "ply"
+  std::string format;           ///< "stl", "ply" or "3mf"
   std::string recorded_sha256;  ///< what the command says was written
   std::string replayed_sha256;  ///< the bytes this state's implant encodes to
   std::string implant_sha256;   ///< the implant's STL hash at the time of the export
@@ -125,6 +143,13 @@ struct PlanState {
   std::shared_ptr<const ImplantData> implant;
   // Step 9
   std::vector<ExportRecord> exports;
+  /// The surgeon's sign-off of the implant with this STL hash (approve); withdrawn, with the
+  /// reason in `approval_withdrawn`, when the implant changes.
+  struct Approval {
+    std::string by, role, implant_sha256;
+  };
+  std::optional<Approval> approval;
+  std::string approval_withdrawn;
   // Wizard
   std::array<bool, 10> acknowledged{};  ///< steps completed by hand (3, 4, 8)
   std::map<int, std::string> stale;     ///< step → why its results were recomputed

@@ -5,14 +5,15 @@
 
 namespace cranioplan {
 
-enum class MeshFormat { BinarySTL, BinaryPLY };
+enum class MeshFormat { BinarySTL, BinaryPLY, ThreeMF };
 
-/// The format a path's extension asks for (.stl or .ply, case-insensitive); throws InputError
-/// for other extensions.
+/// The format a path's extension asks for (.stl, .ply or .3mf, case-insensitive); throws
+/// InputError for other extensions.
 MeshFormat mesh_format_for_path(const std::string& path);
 
 /// The bytes `write_mesh` writes (deterministic: the same mesh gives the same bytes, so the
-/// SHA-256 of an export can be checked by replaying a plan).
+/// SHA-256 of an export can be checked by replaying a plan). A 3MF holds the mesh as the part
+/// "implant" in millimetres (write_3mf.h).
 std::string encode_mesh(const SkullMesh& mesh, MeshFormat format);
 /// Writes the mesh atomically (temporary file in the same folder, then rename). Throws
 /// InputError when the file cannot be written.

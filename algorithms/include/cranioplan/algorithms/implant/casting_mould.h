@@ -1,0 +1,51 @@
+#pragma once
+// A two-part casting mould for an implant cast in theatre (PMMA bone cement), printed on a
+// desktop FDM printer: a block around the implant split along a parting surface through the
+// middle of the implant's side wall, its cavity the implant, with hemispherical alignment keys
+// on the parting face and a pour channel and an air vent through the outer half.
+#include <Eigen/Core>
+#include <string>
+
+#include "cranioplan/model/mesh.h"
+
+namespace cranioplan {
+
+struct MouldParams {
+  double wall_mm = 8.0;              ///< the block beyond the cavity, mm (4..30)
+  double key_diameter_mm = 5.0;      ///< the alignment keys' hemispheres, mm (2..12)
+  double key_clearance_mm = 0.2;     ///< sockets wider than the keys by this, mm (0..1)
+  double channel_diameter_mm = 5.0;  ///< the pour channel, mm (2..12)
+  double vent_diameter_mm = 2.0;     ///< the air vent, mm (1..6)
+  double voxel_mm = 0.2;             ///< grid of the halves, mm (0.05..1)
+  double max_voxels = 3e7;           ///< a large mould's grid is coarsened to this many voxels
+};
+/// Why the parameters cannot be used (a value out of its range), or empty.
+std::string mould_problem(const MouldParams& p);
+
+struct MouldResult {
+  enum class Status { Made, Failed };
+  Status status = Status::Failed;
+  std::string message;
+  SkullMesh outer, inner;  ///< the halves: the one over the implant's outer surface, the other
+  /// The halves part along it (outer: +): of the implant's thinnest principal axis and the
+  /// directions 10° and 20° around it, the one that traps the least of the implant.
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ();
+  Eigen::Vector3d pour = Eigen::Vector3d::Zero(), vent = Eigen::Vector3d::Zero();  ///< openings
+  /// How far the cavity's surface lies from the implant's: over the implant's vertices (away
+  /// from the channel and vent), the distance to the nearer half, mm: the largest and the 95th
+  /// percentile.
+  double cavity_max_mm = 0.0, cavity_p95_mm = 0.0;
+  double cavity_beyond_0_2 = 0.0;  ///< the share of those vertices farther than 0.2 mm (0..1)
+  /// The implant's surface that a half would trap (its normal turns more than 2° against the
+  /// half's pull), mm²: 0 for a mould that opens.
+  double undercut_mm2 = 0.0;
+  double seconds = 0.0;
+  bool usable() const { return status == Status::Made; }
+};
+
+/// The mould of `implant` (closed, outward-oriented); `inside`: a point inside the skull, which
+/// tells the implant's outer surface from its inner one.
+MouldResult make_casting_mould(const SkullMesh& implant, const Eigen::Vector3d& inside,
+                               const MouldParams& params = {});
+
+}  // namespace cranioplan

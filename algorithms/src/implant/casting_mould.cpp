@@ -1,0 +1,370 @@
+#include "cranioplan/algorithms/implant/casting_mould.h"
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <deque>
+
+#include "cranioplan/algorithms/geometry/mesh_distance_field.h"
+#include "cranioplan/algorithms/geometry/parallel.h"
+#include "cranioplan/algorithms/geometry/surface_locator.h"
+#include "cranioplan/algorithms/geometry/voxelize_mesh.h"
+#include "cranioplan/algorithms/io/extract_bone_surface.h"
+
+namespace cranioplan {
+namespace {
+
+bool within(double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; }
+
+std::string range_problem(const char* what, double v, double lo, double hi) {
+  char buf[160];
+  std::snprintf(buf, sizeof(buf), "the mould's %s must be %g to %g mm (%g given)", what, lo, hi, v);
+  return buf;
+}
+
+// The parting surface's grid over the plane across the axis, mm.
+constexpr double kPartingStep = 0.5;
+
+// Heights along the axis over a grid across it: the implant's top and bottom where a line along
+// the axis meets it, and the parting surface (midway between them there; beyond the implant,
+// that of the nearest cell over it, smoothed).
+struct Parting {
+  double u0 = 0, v0 = 0, step = kPartingStep;
+  int nu = 0, nv = 0;
+  std::vector<double> top, bottom, height;
+  std::vector<uint8_t> over;  // a line there meets the implant
+
+  size_t at(int i, int j) const { return static_cast<size_t>(j) * nu + i; }
+  double sample(const std::vector<double>& m, double u, double v) const {
+    const double fu = std::clamp((u - u0) / step, 0.0, nu - 1.0),
+                 fv = std::clamp((v - v0) / step, 0.0, nv - 1.0);
+    const int i = std::min(nu - 2, static_cast<int>(fu)),
+              j = std::min(nv - 2, static_cast<int>(fv));
+    const double a = fu - i, b = fv - j;
+    return (1 - a) * (1 - b) * m[at(i, j)] + a * (1 - b) * m[at(i + 1, j)] +
+           (1 - a) * b * m[at(i, j + 1)] + a * b * m[at(i + 1, j + 1)];
+  }
+};
+
+// A pull direction's frame, parting surface and the implant's area it traps.
+struct Pull {
+  Eigen::Vector3d axis = Eigen::Vector3d::UnitZ(), e1 = Eigen::Vector3d::UnitX(),
+                  e2 = Eigen::Vector3d::UnitY();
+  Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();  // local bounds
+  Parting part;
+  double undercut_mm2 = 0.0;
+};
+
+Pull part_along(const SkullMesh& implant, const SurfaceLocator& self, const Eigen::Vector3d& c,
+                const Eigen::Vector3d& axis, double wall_mm) {
+  Pull out;
+  out.axis = axis.normalized();
+  out.e1 = out.axis.unitOrthogonal();
+  out.e2 = out.axis.cross(out.e1);
+  auto local = [&](const Eigen::Vector3d& x) {
+    const Eigen::Vector3d d = x - c;
+    return Eigen::Vector3d(d.dot(out.e1), d.dot(out.e2), d.dot(out.axis));
+  };
+  auto world = [&](double u, double v, double h) {
+    return c + u * out.e1 + v * out.e2 + h * out.axis;
+  };
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  for (auto vh : implant.vertices()) {
+    const Eigen::Vector3d q = local(to_eigen(implant.point(vh)));
+    lo = lo.cwiseMin(q);
+    hi = hi.cwiseMax(q);
+  }
+  out.lo = lo;
+  out.hi = hi;
+  Parting& part = out.part;
+  part.u0 = lo.x() - wall_mm;
+  part.v0 = lo.y() - wall_mm;
+  part.nu = static_cast<int>(std::ceil((hi.x() - lo.x() + 2 * wall_mm) / part.step)) + 1;
+  part.nv = static_cast<int>(std::ceil((hi.y() - lo.y() + 2 * wall_mm) / part.step)) + 1;
+  const size_t cells = static_cast<size_t>(part.nu) * part.nv;
+  part.top.assign(cells, 0.0);
+  part.bottom.assign(cells, 0.0);
+  part.height.assign(cells, 0.0);
+  part.over.assign(cells, 0);
+  parallel_for(cells, [&](size_t begin, size_t end) {
+    for (size_t q = begin; q < end; ++q) {
+      const double u = part.u0 + static_cast<double>(q % part.nu) * part.step,
+                   v = part.v0 + static_cast<double>(q / part.nu) * part.step;
+      const auto down = self.first_hit(world(u, v, hi.z() + 1.0), world(u, v, lo.z() - 1.0));
+      if (!down) continue;
+      const auto up = self.first_hit(world(u, v, lo.z() - 1.0), world(u, v, hi.z() + 1.0));
+      part.top[q] = local(down->point).z();
+      part.bottom[q] = up ? local(up->point).z() : part.top[q];
+      part.height[q] = 0.5 * (part.top[q] + part.bottom[q]);
+      part.over[q] = 1;
+    }
+  });
+  // Beyond the implant: the nearest cell's over it (breadth first), then smoothed there.
+  std::vector<uint8_t> set = part.over;
+  std::deque<size_t> queue;
+  for (size_t q = 0; q < cells; ++q)
+    if (set[q]) queue.push_back(q);
+  if (queue.empty()) {
+    part.nu = 0;  // no line across the implant meets it
+    return out;
+  }
+  while (!queue.empty()) {
+    const size_t q = queue.front();
+    queue.pop_front();
+    const int i = static_cast<int>(q % part.nu), j = static_cast<int>(q / part.nu);
+    const int di[4] = {1, -1, 0, 0}, dj[4] = {0, 0, 1, -1};
+    for (int k = 0; k < 4; ++k) {
+      const int ii = i + di[k], jj = j + dj[k];
+      if (ii < 0 || jj < 0 || ii >= part.nu || jj >= part.nv) continue;
+      const size_t n = part.at(ii, jj);
+      if (set[n]) continue;
+      set[n] = 1;
+      part.height[n] = part.height[q];
+      queue.push_back(n);
+    }
+  }
+  for (int it = 0; it < 40; ++it) {
+    std::vector<double> next = part.height;
+    for (int j = 1; j + 1 < part.nv; ++j)
+      for (int i = 1; i + 1 < part.nu; ++i) {
+        const size_t q = part.at(i, j);
+        if (part.over[q]) continue;
+        next[q] = 0.25 * (part.height[part.at(i + 1, j)] + part.height[part.at(i - 1, j)] +
+                          part.height[part.at(i, j + 1)] + part.height[part.at(i, j - 1)]);
+      }
+    part.height = std::move(next);
+  }
+  // Undercuts: implant faces above the parting surface facing down, or below it facing up.
+  const double slack = std::sin(2.0 * M_PI / 180.0);
+  for (auto fh : implant.faces()) {
+    Eigen::Vector3d q[3];
+    int k = 0;
+    for (auto vh : implant.fv_range(fh)) q[k++] = to_eigen(implant.point(vh));
+    const Eigen::Vector3d cross = (q[1] - q[0]).cross(q[2] - q[0]);
+    if (cross.norm() == 0) continue;
+    const Eigen::Vector3d m = local((q[0] + q[1] + q[2]) / 3.0);
+    const double facing = cross.normalized().dot(out.axis);
+    const bool upper = m.z() > part.sample(part.height, m.x(), m.y());
+    if ((upper && facing < -slack) || (!upper && facing > slack))
+      out.undercut_mm2 += 0.5 * cross.norm();
+  }
+  return out;
+}
+
+}  // namespace
+
+std::string mould_problem(const MouldParams& p) {
+  if (!within(p.wall_mm, 4.0, 30.0)) return range_problem("wall", p.wall_mm, 4, 30);
+  if (!within(p.key_diameter_mm, 2.0, 12.0))
+    return range_problem("keys' diameter", p.key_diameter_mm, 2, 12);
+  if (p.key_diameter_mm + 2.0 > p.wall_mm)
+    return range_problem("wall", p.wall_mm, p.key_diameter_mm + 2.0, 30) + " for its keys";
+  if (!within(p.key_clearance_mm, 0.0, 1.0))
+    return range_problem("keys' clearance", p.key_clearance_mm, 0, 1);
+  if (!within(p.channel_diameter_mm, 2.0, 12.0))
+    return range_problem("pour channel's diameter", p.channel_diameter_mm, 2, 12);
+  if (!within(p.vent_diameter_mm, 1.0, 6.0))
+    return range_problem("vent's diameter", p.vent_diameter_mm, 1, 6);
+  if (!within(p.voxel_mm, 0.05, 1.0)) return range_problem("grid", p.voxel_mm, 0.05, 1.0);
+  if (!(p.max_voxels >= 1e5 && p.max_voxels <= 1e8))
+    return "the mould's grid must have 100,000 to 100,000,000 voxels";
+  return {};
+}
+
+MouldResult make_casting_mould(const SkullMesh& implant, const Eigen::Vector3d& inside,
+                               const MouldParams& p) {
+  const auto t0 = std::chrono::steady_clock::now();
+  MouldResult r;
+  auto done = [&]() -> MouldResult& {
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    return r;
+  };
+  if (const std::string problem = mould_problem(p); !problem.empty()) {
+    r.message = problem;
+    return done();
+  }
+  if (implant.n_faces() == 0) {
+    r.message = "the implant has no triangles";
+    return done();
+  }
+  // The pull: of the implant's thinnest principal axis (pointing away from the skull's inside)
+  // and the directions 10° and 20° around it, the one whose parting traps the least of the
+  // implant (the first of equals).
+  const Eigen::Vector3d c = vertex_centroid(implant);
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (auto vh : implant.vertices()) {
+    const Eigen::Vector3d d = to_eigen(implant.point(vh)) - c;
+    cov += d * d.transpose();
+  }
+  Eigen::Vector3d principal =
+      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
+  if (principal.dot(c - inside) < 0) principal = -principal;
+  const SurfaceLocator self(implant);
+  std::vector<Eigen::Vector3d> pulls{principal};
+  const Eigen::Vector3d p1 = principal.unitOrthogonal(), p2 = principal.cross(p1);
+  for (const double tilt : {10.0, 20.0})
+    for (int k = 0; k < 8; ++k) {
+      const double t = tilt * M_PI / 180.0, az = k * M_PI / 4.0;
+      pulls.push_back(std::cos(t) * principal +
+                      std::sin(t) * (std::cos(az) * p1 + std::sin(az) * p2));
+    }
+  Pull best;
+  for (const Eigen::Vector3d& pull : pulls) {
+    Pull candidate = part_along(implant, self, c, pull, p.wall_mm);
+    if (best.part.nu == 0 || candidate.undercut_mm2 < best.undercut_mm2 - 1e-9)
+      best = std::move(candidate);
+  }
+  if (best.part.nu == 0) {
+    r.message = "no line across the implant meets it";
+    return done();
+  }
+  const Eigen::Vector3d axis = best.axis, e1 = best.e1, e2 = best.e2;
+  const Parting& part = best.part;
+  const Eigen::Vector3d lo = best.lo, hi = best.hi;
+  const size_t cells = static_cast<size_t>(part.nu) * part.nv;
+  r.axis = axis;
+  r.undercut_mm2 = best.undercut_mm2;
+  auto local = [&](const Eigen::Vector3d& x) {
+    const Eigen::Vector3d d = x - c;
+    return Eigen::Vector3d(d.dot(e1), d.dot(e2), d.dot(axis));
+  };
+  auto world = [&](double u, double v, double h) { return c + u * e1 + v * e2 + h * axis; };
+
+  // The pour channel over the implant's thickest point; the vent over the point of the
+  // implant farthest from it with the vent's width of implant around it.
+  size_t pour = 0;
+  double thickest = -1.0;
+  for (size_t q = 0; q < cells; ++q)
+    if (part.over[q] && part.top[q] - part.bottom[q] > thickest)
+      thickest = part.top[q] - part.bottom[q], pour = q;
+  const auto uv = [&](size_t q) {
+    return Eigen::Vector2d(part.u0 + static_cast<double>(q % part.nu) * part.step,
+                           part.v0 + static_cast<double>(q / part.nu) * part.step);
+  };
+  size_t vent = pour;
+  double farthest = -1.0;
+  const int rim = static_cast<int>(std::ceil((0.5 * p.vent_diameter_mm + 1.0) / part.step));
+  for (size_t q = 0; q < cells; ++q) {
+    if (!part.over[q]) continue;
+    const int i = static_cast<int>(q % part.nu), j = static_cast<int>(q / part.nu);
+    bool inside_rim = true;
+    for (int dj = -rim; dj <= rim && inside_rim; ++dj)
+      for (int di = -rim; di <= rim && inside_rim; ++di) {
+        const int ii = i + di, jj = j + dj;
+        inside_rim =
+            ii >= 0 && jj >= 0 && ii < part.nu && jj < part.nv && part.over[part.at(ii, jj)];
+      }
+    const double d = (uv(q) - uv(pour)).norm();
+    if (inside_rim && d > farthest) farthest = d, vent = q;
+  }
+  struct Opening {
+    Eigen::Vector2d at;
+    double radius, from;  // from this height up
+  };
+  const Opening openings[2] = {{uv(pour), 0.5 * p.channel_diameter_mm, part.top[pour] - 0.5},
+                               {uv(vent), 0.5 * p.vent_diameter_mm, part.top[vent] - 0.5}};
+  r.pour = world(openings[0].at.x(), openings[0].at.y(), part.top[pour]);
+  r.vent = world(openings[1].at.x(), openings[1].at.y(), part.top[vent]);
+
+  // The block, and the keys at its corners on the parting surface.
+  const double U0 = lo.x() - p.wall_mm, U1 = hi.x() + p.wall_mm, V0 = lo.y() - p.wall_mm,
+               V1 = hi.y() + p.wall_mm;
+  double H0 = lo.z(), H1 = hi.z();
+  for (size_t q = 0; q < cells; ++q) {
+    H0 = std::min(H0, part.height[q]);
+    H1 = std::max(H1, part.height[q]);
+  }
+  H0 -= p.wall_mm;
+  H1 += p.wall_mm;
+  const double rk = 0.5 * p.key_diameter_mm, inset = 0.5 * p.wall_mm;
+  std::vector<Eigen::Vector3d> keys;
+  for (const double u : {U0 + inset, U1 - inset})
+    for (const double v : {V0 + inset, V1 - inset})
+      keys.emplace_back(u, v, part.sample(part.height, u, v));
+
+  Eigen::Vector3d wlo = Eigen::Vector3d::Constant(1e300), whi = -wlo;
+  for (const double u : {U0, U1})
+    for (const double v : {V0, V1})
+      for (const double h : {H0, H1}) {
+        const Eigen::Vector3d x = world(u, v, h);
+        wlo = wlo.cwiseMin(x);
+        whi = whi.cwiseMax(x);
+      }
+  const VoxelGrid g = VoxelGrid::covering_at_most(wlo, whi, p.voxel_mm, p.max_voxels, 2);
+  const std::vector<float> cavity =
+      signed_distance_near_surface(self, voxelize_mesh(implant, g), g);
+  std::vector<float> outer(g.size()), inner(g.size());
+  parallel_for(g.size(), [&](size_t begin, size_t end) {
+    for (size_t cc = begin; cc < end; ++cc) {
+      const int i = static_cast<int>(cc % g.dims[0]),
+                j = static_cast<int>((cc / g.dims[0]) % g.dims[1]),
+                k = static_cast<int>(cc / (static_cast<size_t>(g.dims[0]) * g.dims[1]));
+      const Eigen::Vector3d x = local(g.center(i, j, k));
+      const double block =
+          std::min({x.x() - U0, U1 - x.x(), x.y() - V0, V1 - x.y(), x.z() - H0, H1 - x.z()});
+      const double split = x.z() - part.sample(part.height, x.x(), x.y());
+      const double not_implant = -static_cast<double>(cavity[cc]);
+      double o = std::min({block, split, not_implant}), n = std::min({block, -split, not_implant});
+      for (const Eigen::Vector3d& key : keys) {
+        const double d = (x - key).norm();
+        n = std::max(n, std::min(rk - d, block));        // the key on the inner half
+        o = std::min(o, d - (rk + p.key_clearance_mm));  // its socket in the outer
+      }
+      for (const Opening& hole : openings) {
+        const double radial = (x.head<2>() - hole.at).norm();
+        o = std::min(o, -std::min(hole.radius - radial, x.z() - hole.from));
+      }
+      outer[cc] = static_cast<float>(o);
+      inner[cc] = static_cast<float>(n);
+    }
+  });
+  ExtractBoneSurfaceResult mo = surface_of_signed_distance(std::move(outer), g);
+  ExtractBoneSurfaceResult mi = surface_of_signed_distance(std::move(inner), g);
+  if (!mo.usable() || !mi.usable()) {
+    r.message = "meshing the mould: " + (mo.usable() ? mi.message : mo.message);
+    return done();
+  }
+  r.outer = std::move(mo.mesh);
+  r.inner = std::move(mi.mesh);
+
+  // The cavity against the implant: each implant vertex's distance to the nearer half, away
+  // from the openings (where the cavity is open to the top).
+  const SurfaceLocator lo_half(r.inner), hi_half(r.outer);
+  std::vector<double> gaps;
+  for (auto vh : implant.vertices()) {
+    const Eigen::Vector3d x = to_eigen(implant.point(vh));
+    const Eigen::Vector3d q = local(x);
+    bool open = false;
+    for (const Opening& hole : openings)
+      open = open || (q.head<2>() - hole.at).norm() < hole.radius + 1.0;
+    if (open) continue;
+    gaps.push_back(std::min(lo_half.closest(x).distance, hi_half.closest(x).distance));
+  }
+  std::sort(gaps.begin(), gaps.end());
+  if (!gaps.empty()) {
+    r.cavity_beyond_0_2 =
+        static_cast<double>(gaps.end() - std::upper_bound(gaps.begin(), gaps.end(), 0.2)) /
+        static_cast<double>(gaps.size());
+    r.cavity_max_mm = gaps.back();
+    r.cavity_p95_mm = gaps[static_cast<size_t>(0.95 * static_cast<double>(gaps.size() - 1))];
+  }
+  r.status = MouldResult::Status::Made;
+  char buf[240];
+  std::snprintf(buf, sizeof(buf),
+                "mould of %.0f × %.0f × %.0f mm in two halves; the cavity within %.2f mm of the "
+                "implant (95 %% within %.2f mm, %.2f %% beyond 0.2 mm)",
+                U1 - U0, V1 - V0, H1 - H0, r.cavity_max_mm, r.cavity_p95_mm,
+                100.0 * r.cavity_beyond_0_2);
+  r.message = buf;
+  if (r.undercut_mm2 > 1.0) {
+    std::snprintf(buf, sizeof(buf), "; %.0f mm² of the implant is undercut along the parting",
+                  r.undercut_mm2);
+    r.message += buf;
+  }
+  return done();
+}
+
+}  // namespace cranioplan
