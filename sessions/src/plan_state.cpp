@@ -101,7 +101,8 @@ const std::array<WizardStep, 9>& wizard_steps() {
        "move markers where needed: the implant follows. Press Done when satisfied."},
       {9, "Check and export",
        "Read the quality report (watertight, thickness, gap to bone, overlap) and export the "
-       "implant as STL or PLY. Done when the current implant has been exported."},
+       "implant as STL, PLY or 3MF (with a casting mould if wanted); the surgeon approves it. "
+       "Done when the current implant has been exported."},
   }};
   return steps;
 }

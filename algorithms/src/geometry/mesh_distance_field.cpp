@@ -1,10 +1,18 @@
 #include "cranioplan/algorithms/geometry/mesh_distance_field.h"
 
+#include <algorithm>
+#include <cmath>
+
 #include "cranioplan/algorithms/geometry/parallel.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 
 namespace cranioplan {
+
+double smooth_min(double a, double b, double k) {
+  const double w = std::max(k - std::abs(a - b), 0.0) / k;
+  return std::min(a, b) - 0.25 * w * w * k;
+}
 
 std::vector<float> signed_distance_near_surface(const SurfaceLocator& locator,
                                                 const std::vector<uint8_t>& solid,

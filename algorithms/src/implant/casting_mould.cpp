@@ -214,6 +214,7 @@ MouldResult make_casting_mould(const SkullMesh& implant, const Eigen::Vector3d& 
   Pull best;
   for (const Eigen::Vector3d& pull : pulls) {
     Pull candidate = part_along(implant, self, c, pull, p.wall_mm);
+    if (candidate.part.nu == 0) continue;  // no line along it meets the implant
     if (best.part.nu == 0 || candidate.undercut_mm2 < best.undercut_mm2 - 1e-9)
       best = std::move(candidate);
   }

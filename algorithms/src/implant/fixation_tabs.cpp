@@ -40,15 +40,9 @@ constexpr double kCrackRadiusMm = 0.6, kCrackDepthMm = 0.3;
 constexpr double kEdgeRoundMm = 1.5;
 // The even placement spaces tabs by one per this much rim, mm.
 constexpr double kRimPerTabMm = 40.0;
-// The rim is sampled in this many sectors around the implant's axis.
+// The rim is sampled in this many sectors around the direction from the skull's inside to the
+// implant's centre.
 constexpr int kSectors = 360;
-
-// The smooth minimum of two signed distances (positive inside): their intersection, its edge
-// rounded over `k`.
-double smooth_min(double a, double b, double k) {
-  const double w = std::max(k - std::abs(a - b), 0.0) / k;
-  return std::min(a, b) - 0.25 * w * w * k;
-}
 
 // How deep the 90° countersink reaches into the tab, mm.
 double countersink_depth(const TabParams& p) {

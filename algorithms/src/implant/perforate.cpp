@@ -25,13 +25,6 @@ constexpr size_t kMaxHoles = 1000;
 // deburring one is the first thing a workshop does.
 constexpr double kRimRoundMm = 1.0;
 
-// The smooth minimum of two signed distances (positive inside): their intersection, its edge
-// rounded over `k`.
-double smooth_min(double a, double b, double k) {
-  const double w = std::max(k - std::abs(a - b), 0.0) / k;
-  return std::min(a, b) - 0.25 * w * w * k;
-}
-
 std::string range_problem(const char* what, double v, double lo, double hi) {
   char buf[160];
   std::snprintf(buf, sizeof(buf), "the holes' %s must be %g to %g mm (%g given)", what, lo, hi, v);

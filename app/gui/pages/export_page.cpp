@@ -51,6 +51,7 @@ ExportPage::ExportPage(PageHost& host) : StepPage(9, host) {
     host_.push(commands::approve(by.trimmed().toStdString(), role.trimmed().toStdString()),
                tr("Approving the implant"));
   });
+  layout_->addWidget(approve);
   approval_ = new QLabel(this);
   approval_->setObjectName("approval");
   approval_->setWordWrap(true);

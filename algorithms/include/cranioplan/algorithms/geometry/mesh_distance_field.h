@@ -16,4 +16,8 @@ std::vector<float> signed_distance_near_surface(const SurfaceLocator& locator,
                                                 const std::vector<uint8_t>& solid,
                                                 const VoxelGrid& grid, float far_mm = 10.0f);
 
+/// The smooth minimum of two signed distances (positive inside): their intersection, its edge
+/// rounded over `k` mm (a cut's rim deburred, a tab's edges rounded).
+double smooth_min(double a, double b, double k);
+
 }  // namespace cranioplan
