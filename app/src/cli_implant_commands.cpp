@@ -363,6 +363,7 @@ Subcommand add_mould(CLI::App& app, const bool& json) {
                {"message", r.message},
                {"cavity_max_mm", r.cavity_max_mm},
                {"cavity_p95_mm", r.cavity_p95_mm},
+               {"cavity_beyond_0_2", r.cavity_beyond_0_2},
                {"undercut_mm2", r.undercut_mm2},
                {"axis", to_json(r.axis)},
                {"pour", to_json(r.pour)},

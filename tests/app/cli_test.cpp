@@ -4,8 +4,11 @@
 #include <cstdio>
 #include <filesystem>
 
+#include "cranioplan/algorithms/geometry/voxelize_mesh.h"
+#include "cranioplan/algorithms/io/extract_bone_surface.h"
 #include "cranioplan/algorithms/io/load_skull.h"
 #include "cranioplan/algorithms/io/mesh_report.h"
+#include "cranioplan/algorithms/io/read_mesh.h"
 #include "cranioplan/algorithms/io/read_volume.h"
 #include "cranioplan/algorithms/io/write_3mf.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
@@ -228,6 +231,39 @@ TEST(Cli, AutoplanAndQaWithAMaterial) {
 // midline, on the bone, their screws through, printable; the 3MF holds the implant in
 // millimetres with the plan's hash, and the session replays to the same bytes; bad values are
 // usage errors.
+// The mould from the command line: two STL halves beside the name given, or one 3MF with the
+// implant and both halves; a PLY is a usage error.
+TEST(Cli, MouldWritesTwoHalvesOrOne3mf) {
+  test::TempDir dir;
+  // A plate meshed from a mask, as implants are (a bare box's eight corners are sharper than
+  // any grid follows).
+  const VoxelGrid g = VoxelGrid::covering({-2.25, -2.25, 4.75}, {32.25, 32.25, 13.25}, 0.5);
+  ExtractBoneSurfaceParams mask;
+  mask.threshold = 0.5;
+  write_mesh(
+      extract_bone_surface(
+          mask_volume(voxelize_mesh(build_mesh(test::box_soup({0, 0, 7}, {30, 30, 11})), g), g),
+          mask)
+          .mesh,
+      dir.path("plate.stl"));
+  write_mesh(build_mesh(test::box_soup({-50, -50, -50}, {50, 50, 0})), dir.path("skull.stl"));
+  std::string out;
+  const std::string mould = kCli + " mould --json " + dir.path("plate.stl") + " --skull " +
+                            dir.path("skull.stl") + " -o ";
+  ASSERT_EQ(test::run_command(mould + dir.path("m.stl"), &out), 0) << out;
+  const Json j = Json::parse(out);
+  EXPECT_LE(j["cavity_p95_mm"].get<double>(), 0.2) << out;
+  EXPECT_LE(j["cavity_max_mm"].get<double>(), 0.2) << out;
+  EXPECT_EQ(j["cavity_beyond_0_2"].get<double>(), 0.0);
+  for (const char* half : {"m_outer.stl", "m_inner.stl"})
+    EXPECT_TRUE(report_mesh(read_mesh(dir.path(half)).mesh).watertight) << half;
+  ASSERT_EQ(test::run_command(mould + dir.path("m.3mf"), &out), 0) << out;
+  const Read3mf package = read_3mf(dir.path("m.3mf"));
+  ASSERT_EQ(package.parts.size(), 3u);
+  EXPECT_EQ(package.parts[1].first, "mould outer");
+  EXPECT_EQ(test::run_command(mould + dir.path("m.ply"), &out), 2);
+}
+
 TEST(Cli, AutoplanWithFixationTabs) {
   test::TempDir dir;
   write_mesh(test::thick_head_defect().defective, dir.path("skull.stl"));
