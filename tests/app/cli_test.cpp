@@ -4,8 +4,6 @@
 #include <cstdio>
 #include <filesystem>
 
-#include "cranioplan/algorithms/geometry/voxelize_mesh.h"
-#include "cranioplan/algorithms/io/extract_bone_surface.h"
 #include "cranioplan/algorithms/io/load_skull.h"
 #include "cranioplan/algorithms/io/mesh_report.h"
 #include "cranioplan/algorithms/io/read_mesh.h"
@@ -237,15 +235,7 @@ TEST(Cli, MouldWritesTwoHalvesOrOne3mf) {
   test::TempDir dir;
   // A plate meshed from a mask, as implants are (a bare box's eight corners are sharper than
   // any grid follows).
-  const VoxelGrid g = VoxelGrid::covering({-2.25, -2.25, 4.75}, {32.25, 32.25, 13.25}, 0.5);
-  ExtractBoneSurfaceParams mask;
-  mask.threshold = 0.5;
-  write_mesh(
-      extract_bone_surface(
-          mask_volume(voxelize_mesh(build_mesh(test::box_soup({0, 0, 7}, {30, 30, 11})), g), g),
-          mask)
-          .mesh,
-      dir.path("plate.stl"));
+  write_mesh(test::mask_meshed_box({0, 0, 7}, {30, 30, 11}), dir.path("plate.stl"));
   write_mesh(build_mesh(test::box_soup({-50, -50, -50}, {50, 50, 0})), dir.path("skull.stl"));
   std::string out;
   const std::string mould = kCli + " mould --json " + dir.path("plate.stl") + " --skull " +

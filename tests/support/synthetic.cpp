@@ -75,6 +75,21 @@ Landmarks head_landmarks() {
   return lm;
 }
 
+SkullMesh mask_meshed_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+  const SkullMesh box = build_mesh(box_soup(lo, hi));
+  const Eigen::Vector3d margin = Eigen::Vector3d::Constant(2.25);
+  const VoxelGrid g = VoxelGrid::covering(lo - margin, hi + margin, 0.5);
+  ExtractBoneSurfaceParams mask;
+  mask.threshold = 0.5;
+  return extract_bone_surface(mask_volume(voxelize_mesh(box, g), g), mask).mesh;
+}
+
+long long genus(const SkullMesh& m) {
+  const long long chi = static_cast<long long>(m.n_vertices()) -
+                        static_cast<long long>(m.n_edges()) + static_cast<long long>(m.n_faces());
+  return (2 - chi) / 2;
+}
+
 TriangleSoup box_soup(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
   TriangleSoup s;
   for (int i = 0; i < 8; ++i)

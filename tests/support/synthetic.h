@@ -22,6 +22,14 @@ Landmarks head_landmarks();
 /// A closed, outward-oriented axis-aligned box as a triangle soup (12 triangles).
 TriangleSoup box_soup(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
 
+/// The box [lo, hi] meshed from its voxel mask on a 0.5 mm grid reaching 2.25 mm beyond it, as
+/// implants are meshed (each face halfway between voxel centres, the corners cut).
+SkullMesh mask_meshed_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
+
+/// The genus of a closed surface from its Euler characteristic V − E + F = 2 − 2·genus: one per
+/// tunnel through it (a drilled hole, a screw hole).
+long long genus(const SkullMesh& mesh);
+
 /// Removes every face whose centroid lies within `radius` of `center`.
 SkullMesh cut_hole(const SkullMesh& mesh, const Eigen::Vector3d& center, double radius);
 

@@ -13,16 +13,13 @@
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
+#include "param_ranges.h"
 
 namespace cranioplan {
 namespace {
 
-bool within(double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; }
-
 std::string range_problem(const char* what, double v, double lo, double hi) {
-  char buf[160];
-  std::snprintf(buf, sizeof(buf), "the mould's %s must be %g to %g mm (%g given)", what, lo, hi, v);
-  return buf;
+  return parameter_range_problem("the mould's", what, v, lo, hi);
 }
 
 // The parting surface's grid over the plane across the axis, mm.

@@ -11,12 +11,11 @@
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
+#include "param_ranges.h"
 
 namespace cranioplan {
 
 namespace {
-
-bool within(double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; }
 
 // Holes added or taken away one by one: far more than a plate can hold.
 constexpr size_t kMaxHoles = 1000;
@@ -26,9 +25,7 @@ constexpr size_t kMaxHoles = 1000;
 constexpr double kRimRoundMm = 1.0;
 
 std::string range_problem(const char* what, double v, double lo, double hi) {
-  char buf[160];
-  std::snprintf(buf, sizeof(buf), "the holes' %s must be %g to %g mm (%g given)", what, lo, hi, v);
-  return buf;
+  return parameter_range_problem("the holes'", what, v, lo, hi);
 }
 
 // The implant's faces by the side they face: away from the inside point (outer), towards it

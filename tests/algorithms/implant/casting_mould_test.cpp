@@ -5,8 +5,6 @@
 #include <cmath>
 
 #include "cranioplan/algorithms/geometry/surface_locator.h"
-#include "cranioplan/algorithms/geometry/voxelize_mesh.h"
-#include "cranioplan/algorithms/io/extract_bone_surface.h"
 #include "cranioplan/algorithms/io/mesh_report.h"
 #include "support/synthetic.h"
 
@@ -15,20 +13,8 @@ namespace {
 
 // A 40 × 40 × 4 mm plate (z 7 to 11) meshed from a mask, as an implant is; the skull's inside
 // lies below it.
-SkullMesh plate() {
-  const SkullMesh box = build_mesh(test::box_soup({0, 0, 7}, {40, 40, 11}));
-  const VoxelGrid g = VoxelGrid::covering({-2.25, -2.25, 4.75}, {42.25, 42.25, 13.25}, 0.5);
-  ExtractBoneSurfaceParams mask;
-  mask.threshold = 0.5;
-  return extract_bone_surface(mask_volume(voxelize_mesh(box, g), g), mask).mesh;
-}
+SkullMesh plate() { return test::mask_meshed_box({0, 0, 7}, {40, 40, 11}); }
 const Eigen::Vector3d kInside(20, 20, -60);
-
-long long genus(const SkullMesh& m) {
-  const long long chi = static_cast<long long>(m.n_vertices()) -
-                        static_cast<long long>(m.n_edges()) + static_cast<long long>(m.n_faces());
-  return (2 - chi) / 2;
-}
 
 // The mould of a plate: two closed halves parting along its middle, the cavity within 0.2 mm of
 // the plate everywhere, no undercut; the outer half has the pour channel and the vent through it
@@ -49,8 +35,8 @@ TEST(CastingMould, APlatesMouldHasItsCavityWithinAFifthOfAMillimetre) {
     EXPECT_EQ(rep.nonmanifold_edges, 0);
     EXPECT_EQ(rep.pieces, 1);
   }
-  EXPECT_EQ(genus(r.outer), 2) << "pour channel and vent";
-  EXPECT_EQ(genus(r.inner), 0);
+  EXPECT_EQ(test::genus(r.outer), 2) << "pour channel and vent";
+  EXPECT_EQ(test::genus(r.inner), 0);
   // The pour over the plate's top (z 11), the vent at least 20 mm from it.
   EXPECT_NEAR(r.pour.z(), 11.0, 0.3);
   EXPECT_GT((r.vent - r.pour).norm(), 20.0);

@@ -11,6 +11,7 @@
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
 #include "cranioplan/algorithms/io/mesh_report.h"
 #include "cranioplan/algorithms/quality/check_implant.h"
+#include "support/synthetic.h"
 
 namespace cranioplan {
 namespace {
@@ -49,13 +50,6 @@ SkullMesh plug() {
 }
 const Eigen::Vector3d kInside(50, 50, -60);
 constexpr double kTop = 5.875, kBoneMm = 5.75;  // the meshed bone's top and thickness
-
-// Euler characteristic V − E + F of a closed surface: 2 − 2·genus, one genus per hole through.
-long long genus(const SkullMesh& m) {
-  const long long chi = static_cast<long long>(m.n_vertices()) -
-                        static_cast<long long>(m.n_edges()) + static_cast<long long>(m.n_faces());
-  return (2 - chi) / 2;
-}
 
 // Evenly placed tabs on a flat rim: one per 40 mm of the 152 mm edge, each lying on the bone
 // (its underside within 0.2 mm of it), reaching its length beyond the edge, 2 mm thick, with a
@@ -99,7 +93,7 @@ TEST(FixationTabs, EvenlyPlacedTabsLieOnTheBoneWithTheirScrewsThrough) {
   EXPECT_TRUE(rep.watertight);
   EXPECT_EQ(rep.nonmanifold_edges, 0);
   EXPECT_EQ(rep.pieces, 1);
-  EXPECT_EQ(genus(r.mesh), 4) << "a tunnel per screw";
+  EXPECT_EQ(test::genus(r.mesh), 4) << "a tunnel per screw";
   QualityParams q;
   q.edge_clearance_mm = 1.0;  // the plug's gap all round
   q.tabs = r.tabs;
@@ -155,7 +149,7 @@ TEST(FixationTabs, AUsersTabGoesToTheNearestRimPoint) {
   EXPECT_NEAR(r.tabs[0].rim.y(), 69.0, 0.5);
   EXPECT_NEAR(r.tabs[0].rim.x(), 45.0, 2.0);
   EXPECT_NEAR(r.tabs[0].outward.y(), 1.0, 0.05);
-  EXPECT_EQ(genus(r.mesh), 1);
+  EXPECT_EQ(test::genus(r.mesh), 1);
   // Two tabs closer than their width overlap: refused, naming them.
   p.positions = {Eigen::Vector3d(45, 95, 6), Eigen::Vector3d(48, 95, 6)};
   const TabResult both = add_fixation_tabs(implant, on_bone, kInside, p);

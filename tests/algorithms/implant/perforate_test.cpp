@@ -18,21 +18,8 @@ namespace {
 
 // A 40 × 40 × 4 mm plate (z 7 to 11) meshed from a mask, as an implant is: the inside of the
 // skull lies below it.
-SkullMesh plate() {
-  const SkullMesh box = build_mesh(test::box_soup({0, 0, 7}, {40, 40, 11}));
-  const VoxelGrid g = VoxelGrid::covering({-2.25, -2.25, 4.75}, {42.25, 42.25, 13.25}, 0.5);
-  ExtractBoneSurfaceParams mask;
-  mask.threshold = 0.5;
-  return extract_bone_surface(mask_volume(voxelize_mesh(box, g), g), mask).mesh;
-}
+SkullMesh plate() { return test::mask_meshed_box({0, 0, 7}, {40, 40, 11}); }
 const Eigen::Vector3d kInside(20, 20, -60);
-
-// Euler characteristic V − E + F of a closed surface: 2 − 2·genus, one genus per hole through.
-long long genus(const SkullMesh& m) {
-  const long long chi = static_cast<long long>(m.n_vertices()) -
-                        static_cast<long long>(m.n_edges()) + static_cast<long long>(m.n_faces());
-  return (2 - chi) / 2;
-}
 
 // The pattern on a plate: holes on a hexagonal lattice 10 mm apart, none within 6 mm of the
 // edge, each drilled straight down and through; the plate stays one closed, manifold surface
@@ -58,7 +45,7 @@ TEST(Perforate, APatternOnAPlateGoesThroughEveryHole) {
   EXPECT_TRUE(rep.watertight);
   EXPECT_EQ(rep.nonmanifold_edges, 0);
   EXPECT_EQ(rep.pieces, 1);
-  EXPECT_EQ(genus(r.mesh), static_cast<long long>(r.holes.size())) << "one tunnel per hole";
+  EXPECT_EQ(test::genus(r.mesh), static_cast<long long>(r.holes.size())) << "one tunnel per hole";
   // Each hole's volume is gone: π r² × 4 mm, its rims rounded a little more.
   const double hole = M_PI * 1.0 * 4.0;
   EXPECT_NEAR(report_mesh(p).volume_mm3 - rep.volume_mm3, r.holes.size() * hole,
@@ -86,7 +73,7 @@ TEST(Perforate, HolesAreAddedAndTakenAway) {
   EXPECT_NEAR((r.holes.front().center - Eigen::Vector3d(20, 20, 11)).norm(), 0.0, 0.05);
   for (size_t k = 1; k < r.holes.size(); ++k)
     EXPECT_GT((r.holes[k].center - r.holes[0].center).norm(), 0.5 * params.spacing_mm);
-  EXPECT_EQ(genus(r.mesh), static_cast<long long>(r.holes.size()));
+  EXPECT_EQ(test::genus(r.mesh), static_cast<long long>(r.holes.size()));
 
   params.added.clear();
   params.removed = {perforate(p, kInside, params).holes.front().center};
