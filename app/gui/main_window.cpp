@@ -128,6 +128,9 @@ MainWindow::MainWindow(QWidget* parent)
     pages_->setEnabled(!busy);
   });
   connect(view_, &SkullView::surfaceClicked, this, &MainWindow::on_surface_clicked);
+  connect(view_, &SkullView::handleDropped, this, [this](int id, const Eigen::Vector3d& p) {
+    step_pages_[static_cast<size_t>(controller_->state().current_step - 1)]->handle_dropped(id, p);
+  });
   // One cursor: a click on the skull moves the slices there, a click on a slice the 3D cursor.
   connect(view_, &SkullView::pointed, this, [this](const Eigen::Vector3d& p) {
     if (layout_ == Layout::ThreeD) return;
@@ -725,6 +728,7 @@ void MainWindow::refresh_steps() {
   const bool editable = !controller_->read_only();
   view_->set_pick_target(editable ? page->pick_target() : SkullView::PickTarget::None);
   view_->set_markers_editable(editable && page->markers_editable());
+  view_->set_handles(editable ? page->handles(s) : std::vector<SkullView::Handle>{});
 }
 
 void MainWindow::refresh_history() {

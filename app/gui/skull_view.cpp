@@ -260,8 +260,10 @@ struct SkullView::Impl {
   GlyphLayer outer_edge{sphere(1.6), kEdge}, inner_edge{cube(2.4), kEdge},
       outer_surface{sphere(1.6), kSurface}, inner_surface{cube(2.4), kSurface},
       landmarks{sphere(2.6), {0.90, 0.15, 0.10}}, selected{sphere(2.8), {1.0, 0.95, 0.1}},
-      cursor{sphere(1.8), {0.0, 0.85, 1.0}},  // the slice views' shared cursor
-      zones{sphere(1.0), {1.0, 0.55, 0.0}};   // clearance zones, scaled to their radius
+      cursor{sphere(1.8), {0.0, 0.85, 1.0}},         // the slice views' shared cursor
+      zones{sphere(1.0), {1.0, 0.55, 0.0}},          // clearance zones, scaled to their radius
+      handle_balls{sphere(1.3), {0.15, 0.45, 1.0}},  // tabs and holes that can be dragged
+      handle_drop{sphere(1.8), {1.0, 0.95, 0.1}};    // where the dragged one would go
   vtkNew<vtkPlaneSource> plane_source;
   vtkNew<vtkPolyDataMapper> plane_mapper;
   vtkNew<vtkActor> plane_actor;
@@ -291,6 +293,9 @@ struct SkullView::Impl {
   bool mirror_wanted = true, plane_wanted = true, markers_editable = false, camera_set = false;
   PickTarget target = PickTarget::None;
   int selected_id = 0, drag_id = 0;
+  std::vector<Handle> handles;
+  int handle_id = 0;                         // the handle pressed on (0: none)
+  std::optional<Eigen::Vector3d> handle_at;  // where it has been dragged to
   QPoint press_pos;
   bool moved = false;
   Eigen::Vector3d center = Eigen::Vector3d::Zero();
@@ -365,7 +370,7 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
        {d.skull.actor.Get(), d.mirror.actor.Get(), d.implant.actor.Get(), d.outer_edge.actor.Get(),
         d.inner_edge.actor.Get(), d.outer_surface.actor.Get(), d.inner_surface.actor.Get(),
         d.landmarks.actor.Get(), d.selected.actor.Get(), d.cursor.actor.Get(), d.zones.actor.Get(),
-        d.plane_actor.Get()}) {
+        d.handle_balls.actor.Get(), d.handle_drop.actor.Get(), d.plane_actor.Get()}) {
     a->SetVisibility(false);
     d.renderer->AddActor(a);
   }
@@ -683,6 +688,23 @@ void SkullView::set_thickness_visible(bool visible) {
 
 bool SkullView::thickness_shown() const { return d_->thickness_bar->GetVisibility(); }
 
+void SkullView::set_handles(std::vector<Handle> handles) {
+  Impl& d = *d_;
+  d.handles = std::move(handles);
+  std::vector<Eigen::Vector3d> at;
+  for (const Handle& h : d.handles) at.push_back(h.position);
+  d.handle_balls.set(at);
+  d.handle_drop.set({});
+  d.handle_id = 0;
+  update();
+}
+
+int SkullView::handles_shown() const {
+  return d_->handle_balls.actor->GetVisibility()
+             ? static_cast<int>(d_->handle_balls.points_data->GetNumberOfPoints())
+             : 0;
+}
+
 void SkullView::set_cursor(const std::optional<Eigen::Vector3d>& point) {
   d_->cursor.set(point ? std::vector<Eigen::Vector3d>{*point} : std::vector<Eigen::Vector3d>{});
   update();
@@ -765,6 +787,23 @@ int marker_near(SkullView& view, const std::vector<Marker>& markers, const QPoin
   return best;
 }
 
+// The handle drawn nearest `at`, within 10 pixels.
+const SkullView::Handle* handle_near(SkullView& view, const std::vector<SkullView::Handle>& handles,
+                                     const QPoint& at) {
+  const SkullView::Handle* best = nullptr;
+  double best_d2 = 10.0 * 10.0;
+  for (const auto& h : handles) {
+    const auto p = view.project(h.position);
+    if (!p) continue;
+    const double dx = p->x() - at.x(), dy = p->y() - at.y();
+    if (dx * dx + dy * dy < best_d2) {
+      best_d2 = dx * dx + dy * dy;
+      best = &h;
+    }
+  }
+  return best;
+}
+
 }  // namespace
 
 void SkullView::forward_button(QMouseEvent* e, bool press) {
@@ -801,6 +840,13 @@ void SkullView::mousePressEvent(QMouseEvent* e) {
       return;
     }
   }
+  if (e->button() == Qt::LeftButton) {
+    if (const Handle* h = handle_near(*this, d.handles, pos)) {
+      d.handle_id = h->id;
+      d.handle_at.reset();
+      return;
+    }
+  }
   forward_button(e, true);
 }
 
@@ -821,6 +867,22 @@ void SkullView::mouseMoveEvent(QMouseEvent* e) {
     if (p && (*p - m->position).norm() < 20.0) emit markerDragged(d.drag_id, *p);
     return;
   }
+  if (d.handle_id) {
+    if (!d.moved) return;
+    const Handle* h = nullptr;
+    for (const Handle& x : d.handles)
+      if (x.id == d.handle_id) h = &x;
+    if (!h) return;
+    // As a marker: it slides over its surface and does not jump through an opening.
+    const auto p = pick(pos, h->surface);
+    const Eigen::Vector3d last = d.handle_at.value_or(h->position);
+    if (p && (*p - last).norm() < 20.0) {
+      d.handle_at = *p;
+      d.handle_drop.set({*p});
+      update();
+    }
+    return;
+  }
   d.interactor->SetEventInformationFlipY(d.display_x(pos), static_cast<int>(pos.y() * d.dpr),
                                          e->modifiers() & Qt::ControlModifier,
                                          e->modifiers() & Qt::ShiftModifier);
@@ -839,7 +901,21 @@ void SkullView::mouseReleaseEvent(QMouseEvent* e) {
       emit markerClicked(id);
     return;
   }
-  forward_button(e, false);
+  if (d.handle_id) {
+    const int id = d.handle_id;
+    const std::optional<Eigen::Vector3d> to = d.handle_at;
+    d.handle_id = 0;
+    d.handle_at.reset();
+    if (d.moved) {
+      d.handle_drop.set({});
+      update();
+      if (to) emit handleDropped(id, *to);
+      return;
+    }
+    // Not moved: a click where it was pressed, below.
+  } else {
+    forward_button(e, false);
+  }
   if (e->button() != Qt::LeftButton || d.moved) return;
   if (const int id = marker_near(*this, d.markers, pos)) {
     set_selected_marker(id);

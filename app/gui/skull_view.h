@@ -6,6 +6,7 @@
 #include <QOpenGLWidget>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include "cranioplan/algorithms/quality/thickness_map.h"
 #include "cranioplan/model/marker.h"
@@ -41,6 +42,16 @@ class SkullView : public QOpenGLWidget {
   void set_pick_target(PickTarget target);
   /// Whether markers can be dragged (steps 5, 6 and 8).
   void set_markers_editable(bool editable);
+  /// A part of the implant the user can drag (a tab, a hole): drawn as a small blue ball; a
+  /// press on it and a move slide it over `surface`, and the drop is reported once
+  /// (`handleDropped`). A press and release without a move is a click like any other.
+  struct Handle {
+    int id = 0;
+    Eigen::Vector3d position = Eigen::Vector3d::Zero();
+    PickTarget surface = PickTarget::Original;
+  };
+  void set_handles(std::vector<Handle> handles);
+  int handles_shown() const;
   void set_selected_marker(int id);
   /// The slice views' cursor, drawn as a small cyan ball (none: hidden).
   void set_cursor(const std::optional<Eigen::Vector3d>& point);
@@ -67,6 +78,7 @@ class SkullView : public QOpenGLWidget {
   void markerClicked(int id);
   void markerDragged(int id, const Eigen::Vector3d& point);
   void markerDragFinished(int id);
+  void handleDropped(int id, const Eigen::Vector3d& point);
 
  protected:
   void initializeGL() override;

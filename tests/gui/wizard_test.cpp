@@ -31,6 +31,7 @@
 #include "cranioplan/sessions/session.h"
 #include "cranioplan/sessions/sha256.h"
 #include "main_window.h"
+#include "pages/step_pages.h"
 #include "support/session_cases.h"
 #include "support/synthetic.h"
 #include "support/test_files.h"
@@ -64,6 +65,14 @@ void mouse(QWidget* target, QEvent::Type type, const QPoint& at, Qt::MouseButton
   QMouseEvent e(type, QPointF(at), target->mapToGlobal(QPointF(at)),
                 type == QEvent::MouseMove ? Qt::NoButton : Qt::LeftButton, buttons, Qt::NoModifier);
   QApplication::sendEvent(target, &e);
+}
+
+// A left-button drag on the view from `from` to `to` in small steps, as a hand moves.
+void drag_view(SkullView& view, const QPoint& from, const QPoint& to) {
+  mouse(&view, QEvent::MouseButtonPress, from, Qt::LeftButton);
+  for (int k = 1; k <= 12; ++k)
+    mouse(&view, QEvent::MouseMove, from + (to - from) * k / 12, Qt::LeftButton);
+  mouse(&view, QEvent::MouseButtonRelease, to, Qt::NoButton);
 }
 
 void click_view(SkullView& view, const QPoint& at) {
@@ -660,10 +669,14 @@ TEST(WizardThickness, TheThicknessMapColoursTheImplantAndTheBoneAroundIt) {
 }
 
 // Step 7's perforations in the whole wizard: a pattern built, a hole added by a click on the
-// implant, another taken away, each a build that undo takes back and redo does again.
-TEST(WizardHoles, HolesAreAddedAndRemovedByClicksWithUndo) {
+// implant, one dragged over it, another taken away, each a build that undo takes back and
+// redo does again.
+TEST(WizardHoles, HolesAreAddedDraggedAndRemovedWithUndo) {
   MainWindow w;
   w.set_interactive(false);
+  w.resize(1500, 950);
+  w.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&w));
   ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
   PlanController& plan = w.controller();
   plan.push(commands::go_to_step(7));
@@ -690,6 +703,43 @@ TEST(WizardHoles, HolesAreAddedAndRemovedByClicksWithUndo) {
                          [&](const Hole& h) { return (h.center - p).norm() < 1.5; });
   };
   EXPECT_EQ(near(added, between), 1) << plan.state().message;
+  ASSERT_EQ(w.view().handles_shown(), static_cast<int>(added.size())) << "a ball on each hole";
+
+  // Dragged: a hole of the pattern seen from outside, 4 mm towards the pattern's middle.
+  w.view().look_at_markers();
+  QTest::qWait(50);
+  Eigen::Vector3d middle = Eigen::Vector3d::Zero();
+  for (const Hole& h : added) middle += h.center;
+  middle /= static_cast<double>(added.size());
+  std::optional<Hole> dragged;
+  std::optional<QPoint> from, to;
+  for (const Hole& h : added) {
+    if (h.added || (h.center - middle).norm() < 8.0) continue;
+    from = w.view().project(h.center);
+    to = w.view().project(h.center + 4.0 * (middle - h.center).normalized());
+    if (from && to && (*to - *from).manhattanLength() > 12) {
+      dragged = h;
+      break;
+    }
+  }
+  ASSERT_TRUE(dragged) << "a hole of the pattern in view";
+  const size_t before_drag = plan.session().index();
+  drag_view(w.view(), *from, *to);
+  plan.wait();
+  EXPECT_EQ(plan.session().index(), before_drag + 1) << "the drop is one build";
+  const ImplantParams& after_drag = *plan.state().implant_params;
+  ASSERT_FALSE(after_drag.perforations.added.empty());
+  const Eigen::Vector3d dropped = after_drag.perforations.added.back();
+  EXPECT_GT((dropped - dragged->center).norm(), 2.0);
+  EXPECT_LT((dropped - dragged->center).norm(), 7.0);
+  EXPECT_EQ(near(plan.state().implant->result().holes, dropped), 1) << plan.state().message;
+  EXPECT_EQ(near(plan.state().implant->result().holes, dragged->center), 0);
+  EXPECT_EQ(plan.state().implant->quality().holes_blocked, 0);
+  plan.undo();
+  plan.wait();
+  ASSERT_EQ(plan.state().implant->result().holes.size(), added.size());
+  EXPECT_EQ(near(plan.state().implant->result().holes, dragged->center), 1) << "undone";
+
   // Removed: the pattern's hole farthest from the added one.
   const Hole far =
       *std::max_element(pattern.begin(), pattern.end(), [&](const Hole& a, const Hole& b) {
@@ -715,11 +765,14 @@ TEST(WizardHoles, HolesAreAddedAndRemovedByClicksWithUndo) {
   EXPECT_EQ(near(plan.state().implant->result().holes, between), 1);
 }
 
-// Tabs: placed evenly, then one moved along the rim (a click on it, a click where it goes),
-// one removed and one added by clicks, each a build that undo and redo step through.
-TEST(WizardTabs, TabsAreMovedRemovedAndAddedByClicksWithUndo) {
+// Tabs: placed evenly, then one dragged along the rim, one removed and one added by clicks,
+// each a build that undo and redo step through.
+TEST(WizardTabs, TabsAreDraggedRemovedAndAddedWithUndo) {
   MainWindow w;
   w.set_interactive(false);
+  w.resize(1500, 950);
+  w.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&w));
   ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
   PlanController& plan = w.controller();
   plan.push(commands::go_to_step(7));
@@ -733,23 +786,38 @@ TEST(WizardTabs, TabsAreMovedRemovedAndAddedByClicksWithUndo) {
   ASSERT_GE(even.size(), 3u) << plan.state().message;
   EXPECT_TRUE(plan.state().implant->quality().watertight);
   EXPECT_EQ(plan.state().implant->quality().screws_blocked, 0);
+  EXPECT_EQ(w.view().handles_shown(), static_cast<int>(even.size())) << "a ball on each tab";
   const auto middle = [](const Tab& t) { return t.rim + 0.5 * t.length_mm * t.outward; };
 
-  // Moved: the first tab, 12 mm along the rim.
-  child<QPushButton>(w, "moveTab")->setChecked(true);
-  emit w.view().surfaceClicked(middle(even[0]));
-  const Eigen::Vector3d along = even[0].normal.cross(even[0].outward);
-  emit w.view().surfaceClicked(middle(even[0]) + 12.0 * along);
+  // Dragged: a tab in view, by the ball on its top, 12 mm along the rim over the bone.
+  w.view().look_at_markers();
+  QTest::qWait(50);
+  size_t k = even.size();
+  std::optional<QPoint> from, to;
+  for (size_t i = 0; i < even.size() && k == even.size(); ++i) {
+    const Tab& t = even[i];
+    from = w.view().project(BuildPage::tab_handle(t));
+    to = w.view().project(middle(t) + 12.0 * t.normal.cross(t.outward));
+    if (from && to && (*to - *from).manhattanLength() > 20) k = i;
+  }
+  ASSERT_LT(k, even.size()) << "a tab in view";
+  const size_t before_drag = plan.session().index();
+  drag_view(w.view(), *from, *to);
   plan.wait();
+  EXPECT_EQ(plan.session().index(), before_drag + 1) << "the drop is one build";
   const std::vector<Tab> moved = plan.state().implant->result().tabs;
   ASSERT_EQ(moved.size(), even.size()) << plan.state().message;
-  EXPECT_GT((moved[0].rim - even[0].rim).norm(), 6.0);
-  EXPECT_LT((moved[0].rim - even[0].rim).norm(), 18.0);
-  for (size_t k = 1; k < even.size(); ++k) EXPECT_LT((moved[k].rim - even[k].rim).norm(), 1e-6);
+  EXPECT_GT((moved[k].rim - even[k].rim).norm(), 6.0);
+  EXPECT_LT((moved[k].rim - even[k].rim).norm(), 18.0);
+  for (size_t i = 0; i < even.size(); ++i)
+    if (i != k) {
+      EXPECT_LT((moved[i].rim - even[i].rim).norm(), 1e-6);
+    }
 
   // Removed: the last tab; added: one where it was.
+  child<QPushButton>(w, "addTab")->setChecked(true);
   child<QPushButton>(w, "removeTab")->setChecked(true);
-  EXPECT_FALSE(child<QPushButton>(w, "moveTab")->isChecked()) << "one click mode at a time";
+  EXPECT_FALSE(child<QPushButton>(w, "addTab")->isChecked()) << "one click mode at a time";
   emit w.view().surfaceClicked(middle(even.back()));
   plan.wait();
   EXPECT_EQ(plan.state().implant->result().tabs.size(), even.size() - 1);
@@ -759,16 +827,16 @@ TEST(WizardTabs, TabsAreMovedRemovedAndAddedByClicksWithUndo) {
   ASSERT_EQ(plan.state().implant->result().tabs.size(), even.size());
   EXPECT_LT((plan.state().implant->result().tabs.back().rim - even.back().rim).norm(), 2.0);
 
-  // Undo three times: the tabs as placed evenly; redo: the moved one back.
-  for (int k = 0; k < 3; ++k) {
+  // Undo three times: the tabs as placed evenly; redo: the dragged one back.
+  for (int n = 0; n < 3; ++n) {
     plan.undo();
     plan.wait();
   }
   ASSERT_EQ(plan.state().implant->result().tabs.size(), even.size());
-  EXPECT_LT((plan.state().implant->result().tabs[0].rim - even[0].rim).norm(), 1e-6);
+  EXPECT_LT((plan.state().implant->result().tabs[k].rim - even[k].rim).norm(), 1e-6);
   plan.redo();
   plan.wait();
-  EXPECT_LT((plan.state().implant->result().tabs[0].rim - moved[0].rim).norm(), 1e-6);
+  EXPECT_LT((plan.state().implant->result().tabs[k].rim - moved[k].rim).norm(), 1e-6);
 }
 
 // The design report from the command line: the HTML, its five pictures of the plan and a PDF.

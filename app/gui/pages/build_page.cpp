@@ -138,16 +138,13 @@ BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
   tab_length_ = spin("tabLength", 4, 25, 0.5, " mm");
   tab_length_->setValue(TabParams{}.length_mm);
   add_tab_ = make_button(tr("Add a tab"), "addTab");
-  move_tab_ = make_button(tr("Move a tab"), "moveTab");
   remove_tab_ = make_button(tr("Remove a tab"), "removeTab");
   add_tab_->setToolTip(tr("Then click the bone beyond the implant's edge"));
-  move_tab_->setToolTip(tr("Then click the tab, then the bone where it goes"));
   remove_tab_->setToolTip(tr("Then click the tab"));
-  for (QPushButton* b : {add_tab_, move_tab_, remove_tab_}) b->setCheckable(true);
-  for (QPushButton* b : {mark_zone_, add_hole_, remove_hole_, add_tab_, move_tab_, remove_tab_})
+  for (QPushButton* b : {add_tab_, remove_tab_}) b->setCheckable(true);
+  for (QPushButton* b : {mark_zone_, add_hole_, remove_hole_, add_tab_, remove_tab_})
     connect(b, &QPushButton::toggled, this, [this, b](bool on) {
       if (on) click_mode(b);
-      moving_tab_.reset();
       host_.view().set_pick_target(pick_target());
     });
   form_->addRow(tabs_);
@@ -155,8 +152,13 @@ BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
   form_->addRow(tr("Screws per tab"), tab_screws_);
   form_->addRow(tr("Tab length"), tab_length_);
   auto* tab_buttons = new QHBoxLayout;
-  for (QPushButton* b : {add_tab_, move_tab_, remove_tab_}) tab_buttons->addWidget(b);
+  for (QPushButton* b : {add_tab_, remove_tab_}) tab_buttons->addWidget(b);
   form_->addRow(tab_buttons);
+  auto* drag_hint = new QLabel(tr("Drag a tab (along the rim) or a hole (over the implant) by "
+                                  "its blue ball to move it."),
+                               this);
+  drag_hint->setWordWrap(true);
+  form_->addRow(drag_hint);
 
   QPushButton* build = add_button(tr("Build implant"), "build");
   connect(build, &QPushButton::clicked, this,
@@ -186,7 +188,7 @@ void BuildPage::rebuild() {
 }
 
 void BuildPage::click_mode(QPushButton* on) {
-  for (QPushButton* b : {mark_zone_, add_hole_, remove_hole_, add_tab_, move_tab_, remove_tab_})
+  for (QPushButton* b : {mark_zone_, add_hole_, remove_hole_, add_tab_, remove_tab_})
     if (b != on && b->isChecked()) {
       const QSignalBlocker block(b);
       b->setChecked(false);
@@ -194,8 +196,7 @@ void BuildPage::click_mode(QPushButton* on) {
 }
 
 SkullView::PickTarget BuildPage::pick_target() const {
-  if (mark_zone_->isChecked() || add_tab_->isChecked() || move_tab_->isChecked() ||
-      remove_tab_->isChecked())
+  if (mark_zone_->isChecked() || add_tab_->isChecked() || remove_tab_->isChecked())
     return SkullView::PickTarget::Original;
   if (add_hole_->isChecked() || remove_hole_->isChecked()) return SkullView::PickTarget::Implant;
   return SkullView::PickTarget::None;
@@ -221,7 +222,7 @@ std::optional<size_t> tab_near(const std::vector<Tab>& tabs, const Eigen::Vector
 }  // namespace
 
 void BuildPage::surface_clicked(const Eigen::Vector3d& point) {
-  if (add_tab_->isChecked() || move_tab_->isChecked() || remove_tab_->isChecked()) {
+  if (add_tab_->isChecked() || remove_tab_->isChecked()) {
     const PlanState& s = host_.plan();
     const std::vector<Tab> shown = s.implant ? s.implant->result().tabs : std::vector<Tab>{};
     if (add_tab_->isChecked()) {
@@ -231,22 +232,9 @@ void BuildPage::surface_clicked(const Eigen::Vector3d& point) {
       rebuild();
       return;
     }
-    if (move_tab_->isChecked() && moving_tab_) {
-      // The second click: where the tab goes.
-      take_tabs_over();
-      if (*moving_tab_ < tab_positions_.size()) tab_positions_[*moving_tab_] = point;
-      moving_tab_.reset();
-      rebuild();
-      return;
-    }
     const std::optional<size_t> k = tab_near(shown, point);
     if (!k) {
       host_.show_message(tr("No tab within 10 mm of the click."), true);
-      return;
-    }
-    if (move_tab_->isChecked()) {
-      moving_tab_ = k;
-      host_.show_message(tr("Tab %1: now click the bone where it goes.").arg(*k + 1), false);
       return;
     }
     take_tabs_over();
@@ -291,6 +279,61 @@ void BuildPage::surface_clicked(const Eigen::Vector3d& point) {
     host_.show_message(tr("Zone marked: it applies when the implant is built (fit to the bone)."),
                        false);
     return;
+  }
+  rebuild();
+}
+
+namespace {
+// Handles' ids: holes from 1, tabs from kTabHandle (indices into the implant's lists).
+constexpr int kTabHandle = 10000;
+}  // namespace
+
+Eigen::Vector3d BuildPage::tab_handle(const Tab& t) {
+  return t.rim + (t.length_mm + 1.5) * t.outward + 1.3 * t.normal;
+}
+
+std::vector<SkullView::Handle> BuildPage::handles(const PlanState& s) const {
+  std::vector<SkullView::Handle> out;
+  if (!s.implant) return out;
+  const ImplantResult& r = s.implant->result();
+  for (size_t k = 0; k < r.holes.size(); ++k)
+    out.push_back({static_cast<int>(k) + 1, r.holes[k].center, SkullView::PickTarget::Implant});
+  // A tab's ball on the bone just beyond its tip (where no part of the tab hides it); it is
+  // dragged over the bone.
+  for (size_t k = 0; k < r.tabs.size(); ++k)
+    out.push_back(
+        {kTabHandle + static_cast<int>(k), tab_handle(r.tabs[k]), SkullView::PickTarget::Original});
+  return out;
+}
+
+void BuildPage::handle_dropped(int id, const Eigen::Vector3d& point) {
+  const PlanState& s = host_.plan();
+  if (!s.implant) return;
+  const ImplantResult& r = s.implant->result();
+  if (id >= kTabHandle) {
+    // The tab goes to the rim nearest where it was let go.
+    const auto k = static_cast<size_t>(id - kTabHandle);
+    if (k >= r.tabs.size()) return;
+    take_tabs_over();
+    if (k < tab_positions_.size()) tab_positions_[k] = point;
+    rebuild();
+    return;
+  }
+  const auto k = static_cast<size_t>(id - 1);
+  if (id < 1 || k >= r.holes.size()) return;
+  const Hole& moved = r.holes[k];
+  if (moved.added) {
+    // One of the user's: the nearest of the page's list goes to the new place.
+    auto closest = std::min_element(added_holes_.begin(), added_holes_.end(),
+                                    [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+                                      return (a - moved.center).norm() < (b - moved.center).norm();
+                                    });
+    if (closest == added_holes_.end()) return;
+    *closest = point;
+  } else {
+    // The pattern's: left out there, added here.
+    removed_holes_.push_back(moved.center);
+    added_holes_.push_back(point);
   }
   rebuild();
 }

@@ -59,6 +59,16 @@ class StepPage : public QWidget {
   virtual SkullView::PickTarget pick_target() const { return SkullView::PickTarget::None; }
   /// Whether markers can be dragged while this step is current.
   virtual bool markers_editable() const { return false; }
+  /// What the user can drag in the view while this step is current, besides markers.
+  virtual std::vector<SkullView::Handle> handles(const PlanState& state) const {
+    (void)state;
+    return {};
+  }
+  /// One of `handles()` dragged to `point` (on its surface) and let go.
+  virtual void handle_dropped(int id, const Eigen::Vector3d& point) {
+    (void)id;
+    (void)point;
+  }
 
  protected:
   /// The keys line under the instructions.

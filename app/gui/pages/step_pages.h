@@ -127,6 +127,11 @@ class BuildPage : public StepPage {
   /// With "Mark a wider clearance" on, a click on the rim adds a clearance zone there.
   void surface_clicked(const Eigen::Vector3d& point) override;
   SkullView::PickTarget pick_target() const override;
+  /// The implant's holes and tabs, each dragged to move it (one build per drop).
+  std::vector<SkullView::Handle> handles(const PlanState& state) const override;
+  void handle_dropped(int id, const Eigen::Vector3d& point) override;
+  /// Where a tab's handle is drawn: on the bone just beyond its tip.
+  static Eigen::Vector3d tab_handle(const Tab& tab);
 
  private:
   ImplantParams params() const;
@@ -152,9 +157,8 @@ class BuildPage : public StepPage {
   QCheckBox* tabs_;
   QSpinBox *tab_count_, *tab_screws_;
   QDoubleSpinBox* tab_length_;
-  QPushButton *add_tab_, *move_tab_, *remove_tab_;
+  QPushButton *add_tab_, *remove_tab_;
   std::vector<Eigen::Vector3d> tab_positions_;  ///< the user's tabs (empty: evenly placed)
-  std::optional<size_t> moving_tab_;            ///< "Move a tab": the tab clicked first
   /// The tabs as the user's: the ones shown (evenly placed ones included) when there are none.
   void take_tabs_over();
   /// Turns the other click modes off when one is turned on.
