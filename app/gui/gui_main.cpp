@@ -1,6 +1,7 @@
 // cranioplan [MESH|VOLUME|SESSION] [--sample] [--units U] [--step N] [--screenshot OUT.png]
-// [--report OUT.html] [--quit]
+// [--thickness-map] [--mould] [--report OUT.html] [--quit]
 #include <QApplication>
+#include <QCheckBox>
 #include <QCommandLineParser>
 #include <QFileInfo>
 #include <QTimer>
@@ -32,10 +33,12 @@ int main(int argc, char** argv) {
   const QCommandLineOption window_preset("window", "CT window: bone, soft or brain", "W");
   const QCommandLineOption thickness("thickness-map",
                                      "colour the implant by its thickness (View → Thickness map)");
+  const QCommandLineOption mould(
+      "mould", "in step 9, show the casting mould opened apart (3MF with a mould)");
   const QCommandLineOption report(
       "report", "write the design report (HTML, its pictures and a PDF beside it)", "OUT.html");
-  parser.addOptions(
-      {sample, units, step, screenshot, quit, view, layout, window_preset, thickness, report});
+  parser.addOptions({sample, units, step, screenshot, quit, view, layout, window_preset, thickness,
+                     mould, report});
   parser.process(app);
 
   cranioplan::gui::MainWindow window;
@@ -91,6 +94,10 @@ int main(int argc, char** argv) {
     window.slices().wait_loaded();
   }
   if (parser.isSet(thickness)) window.set_thickness_map_shown(true);
+  if (parser.isSet(mould)) {
+    if (auto* box = window.findChild<QCheckBox*>("exportMould")) box->setChecked(true);
+    window.wait_mould();
+  }
   if (parser.isSet(window_preset)) {
     using P = cranioplan::gui::SlicePanel::Preset;
     const QString w = parser.value(window_preset).toLower();

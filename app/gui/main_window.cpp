@@ -65,6 +65,16 @@ QString quality_html(const QualityReport& r, const SoftTissueCheck* tissue = nul
   return q(quality_report_html(r, tissue));
 }
 
+// A worker's watcher whose result is of no use now: deleted once its work is done.
+void drop_watcher(QFutureWatcherBase* watcher, QObject* receiver) {
+  if (!watcher) return;
+  QObject::disconnect(watcher, nullptr, receiver, nullptr);
+  if (watcher->isRunning())
+    QObject::connect(watcher, &QFutureWatcherBase::finished, watcher, &QObject::deleteLater);
+  else
+    watcher->deleteLater();
+}
+
 }  // namespace
 
 MainWindow::MainWindow(QWidget* parent)
@@ -662,6 +672,7 @@ void MainWindow::refresh() {
     if (!s.markers.empty()) view_->look_at_markers();
   }
   refresh_steps();
+  update_mould();
   refresh_history();
   refresh_quality();
   for (StepPage* page : step_pages_) page->show_state(s);
@@ -776,14 +787,7 @@ void MainWindow::show_quality() {
   const std::shared_ptr<const Volume> ct = s.skull ? slices_->ct() : nullptr;
   const Eigen::Vector3d inside =
       s.defect_center ? *s.defect_center : (s.skull ? s.skull->centroid : Eigen::Vector3d::Zero());
-  if (quality_watcher_) {  // an earlier report, of no use now: dropped when done
-    disconnect(quality_watcher_, nullptr, this, nullptr);
-    if (quality_watcher_->isRunning())
-      connect(quality_watcher_, &QFutureWatcherBase::finished, quality_watcher_,
-              &QObject::deleteLater);
-    else
-      quality_watcher_->deleteLater();
-  }
+  drop_watcher(quality_watcher_, this);  // an earlier report, of no use now
   quality_watcher_ = new QFutureWatcher<std::shared_ptr<QualityView>>(this);
   connect(quality_watcher_, &QFutureWatcherBase::finished, this, [this] {
     const std::shared_ptr<QualityView> v = quality_watcher_->result();
@@ -808,6 +812,51 @@ void MainWindow::show_quality() {
 }
 
 void MainWindow::set_thickness_map_shown(bool shown) { show_thickness_->setChecked(shown); }
+
+void MainWindow::show_mould(bool shown) {
+  mould_wanted_ = shown;
+  update_mould();
+}
+
+void MainWindow::update_mould() {
+  const PlanState& s = controller_->state();
+  if (!mould_wanted_ || !s.implant || s.current_step != 9) {
+    if (mould_of_) view_->set_mould(nullptr);
+    for (StepPage* page : step_pages_) page->show_mould_message(QString());
+    mould_of_ = nullptr;
+    drop_watcher(mould_watcher_, this);
+    mould_watcher_ = nullptr;
+    return;
+  }
+  if (mould_of_ == s.implant.get()) return;  // shown, or being made
+  // The mould the 3MF export would hold (seconds on a real implant), made on a worker thread.
+  mould_of_ = s.implant.get();
+  view_->set_mould(nullptr);
+  drop_watcher(mould_watcher_, this);
+  mould_watcher_ = new QFutureWatcher<std::shared_ptr<const MouldResult>>(this);
+  const std::shared_ptr<const ImplantData> implant = s.implant;
+  const std::shared_ptr<const SkullInput> skull = s.skull;
+  connect(mould_watcher_, &QFutureWatcherBase::finished, this, [this, implant] {
+    const std::shared_ptr<const MouldResult> m = mould_watcher_->result();
+    if (implant.get() != mould_of_) return;  // the plan moved on
+    view_->set_mould(m);
+    const QString text =
+        (m->usable() ? tr("Casting mould, shown opened apart: %1.") : tr("No casting mould: %1."))
+            .arg(q(m->message));
+    for (StepPage* page : step_pages_) page->show_mould_message(text);
+    show_message(text, !m->usable());
+  });
+  for (StepPage* page : step_pages_) page->show_mould_message(tr("Making the casting mould…"));
+  mould_watcher_->setFuture(QtConcurrent::run([implant, skull] {
+    return std::make_shared<const MouldResult>(
+        mould_of(implant->result().mesh, skull ? &skull->surface->mesh : nullptr, MouldParams{}));
+  }));
+}
+
+void MainWindow::wait_mould() {
+  if (mould_watcher_) mould_watcher_->waitForFinished();
+  QCoreApplication::processEvents();
+}
 
 void MainWindow::wait_quality() {
   if (quality_timer_->isActive()) {

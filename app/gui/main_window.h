@@ -65,6 +65,10 @@ class MainWindow : public QMainWindow, public PageHost {
   bool write_design_report(const QString& html_path);
   Layout layout() const { return layout_; }
   void show_slices() override { set_layout(Layout::ThreeDAndSlices); }
+  /// In step 9, the casting mould of the implant (made off the GUI thread) shown in the view.
+  void show_mould(bool shown) override;
+  /// Waits until the mould asked for is made and shown (tests).
+  void wait_mould();
 
   // The pages' host.
   const PlanState& plan() const override { return controller_->state(); }
@@ -181,6 +185,12 @@ class MainWindow : public QMainWindow, public PageHost {
   QTimer* quality_timer_ = nullptr;
   struct QualityView;
   QFutureWatcher<std::shared_ptr<QualityView>>* quality_watcher_ = nullptr;
+  /// The mould shown in step 9: asked for, of which implant, and being made.
+  bool mould_wanted_ = false;
+  const void* mould_of_ = nullptr;
+  QFutureWatcher<std::shared_ptr<const MouldResult>>* mould_watcher_ = nullptr;
+  /// Makes or hides the mould as the state and the wish say.
+  void update_mould();
   QElapsedTimer total_timer_, step_timer_;
   int timed_step_ = 0;
 

@@ -5,6 +5,7 @@
 // clang-format on
 
 #include <vtkActor.h>
+#include <vtkActorCollection.h>
 #include <vtkAnnotatedCubeActor.h>
 #include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
@@ -42,6 +43,8 @@
 #include <algorithm>
 #include <array>
 #include <vector>
+
+#include "cranioplan/algorithms/implant/casting_mould.h"
 
 namespace cranioplan::gui {
 
@@ -257,6 +260,8 @@ struct SkullView::Impl {
   vtkNew<vtkInteractorStyleTrackballCamera> style;
   vtkNew<vtkPlane> clip;
   MeshLayer skull, mirror, implant;
+  MeshLayer mould_outer, mould_inner;  // a casting mould's halves, opened apart
+  std::shared_ptr<const MouldResult> mould;
   GlyphLayer outer_edge{sphere(1.6), kEdge}, inner_edge{cube(2.4), kEdge},
       outer_surface{sphere(1.6), kSurface}, inner_surface{cube(2.4), kSurface},
       landmarks{sphere(2.6), {0.90, 0.15, 0.10}}, selected{sphere(2.8), {1.0, 0.95, 0.1}},
@@ -350,6 +355,11 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
   d.implant.actor->GetProperty()->SetColor(kImplant[0], kImplant[1], kImplant[2]);
   d.implant.actor->GetProperty()->SetSpecular(0.3);
   d.selected.actor->GetProperty()->SetOpacity(0.55);
+  for (MeshLayer* half : {&d.mould_outer, &d.mould_inner}) {
+    half->actor->GetProperty()->SetColor(0.55, 0.72, 0.90);
+    half->actor->GetProperty()->SetOpacity(0.5);
+    half->actor->GetProperty()->SetSpecular(0.2);
+  }
   d.plane_actor->SetMapper(d.plane_mapper);
   d.plane_mapper->SetInputConnection(d.plane_source->GetOutputPort());
   d.plane_actor->GetProperty()->SetColor(0.30, 0.55, 1.0);
@@ -367,9 +377,10 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
   d.unseen_actor->GetProperty()->SetDiffuse(0.0);
   d.unseen_actor->GetProperty()->RenderLinesAsTubesOn();
   for (vtkActor* a :
-       {d.skull.actor.Get(), d.mirror.actor.Get(), d.implant.actor.Get(), d.outer_edge.actor.Get(),
-        d.inner_edge.actor.Get(), d.outer_surface.actor.Get(), d.inner_surface.actor.Get(),
-        d.landmarks.actor.Get(), d.selected.actor.Get(), d.cursor.actor.Get(), d.zones.actor.Get(),
+       {d.skull.actor.Get(), d.mirror.actor.Get(), d.implant.actor.Get(), d.mould_outer.actor.Get(),
+        d.mould_inner.actor.Get(), d.outer_edge.actor.Get(), d.inner_edge.actor.Get(),
+        d.outer_surface.actor.Get(), d.inner_surface.actor.Get(), d.landmarks.actor.Get(),
+        d.selected.actor.Get(), d.cursor.actor.Get(), d.zones.actor.Get(),
         d.handle_balls.actor.Get(), d.handle_drop.actor.Get(), d.plane_actor.Get()}) {
     a->SetVisibility(false);
     d.renderer->AddActor(a);
@@ -451,7 +462,24 @@ void SkullView::paintGL() {
   d.window->SetReadyForRendering(true);
   d.window->SetSize(static_cast<int>(width() * d.dpr), static_cast<int>(height() * d.dpr));
   follow_camera(d.renderer->GetActiveCamera(), d.orientation->GetActiveCamera());
+  // With a mould shown, it and the implant alone: the rest of the scene is hidden while drawn.
+  std::vector<vtkActor*> hidden;
+  if (d.mould_outer.visible()) {
+    vtkActorCollection* actors = d.renderer->GetActors();
+    actors->InitTraversal();
+    while (vtkActor* a = actors->GetNextActor())
+      if (a->GetVisibility() && a != d.implant.actor.Get() && a != d.mould_outer.actor.Get() &&
+          a != d.mould_inner.actor.Get()) {
+        a->SetVisibility(false);
+        hidden.push_back(a);
+      }
+    if (d.unseen_actor->GetVisibility()) {
+      d.unseen_actor->SetVisibility(false);
+      hidden.push_back(d.unseen_actor.Get());
+    }
+  }
   d.window->Render();
+  for (vtkActor* a : hidden) a->SetVisibility(true);
   d.window->SetReadyForRendering(false);
 }
 
@@ -673,6 +701,59 @@ void SkullView::set_thickness_map(const SkullMesh* implant,
   d_->thickness_of = implant;
   set_thickness_visible(d_->thickness_wanted);
 }
+
+void SkullView::set_mould(std::shared_ptr<const MouldResult> mould) {
+  Impl& d = *d_;
+  d.mould = std::move(mould);
+  if (!d.mould || !d.mould->usable()) {
+    d.mould_outer.show(nullptr, nullptr);
+    d.mould_inner.show(nullptr, nullptr);
+    update();
+    return;
+  }
+  // Each half moved off the implant along the pull by its own depth and 10 mm more: the
+  // cavity and the implant between them show.
+  const auto depth = [&](const SkullMesh& half) {
+    double lo = 1e300, hi = -1e300;
+    for (auto vh : half.vertices()) {
+      const double h = to_eigen(half.point(vh)).dot(d.mould->axis);
+      lo = std::min(lo, h);
+      hi = std::max(hi, h);
+    }
+    return hi - lo;
+  };
+  const double apart = 0.5 * std::max(depth(d.mould->outer), depth(d.mould->inner)) + 10.0;
+  d.mould_outer.show(&d.mould->outer, d.mould);
+  d.mould_inner.show(&d.mould->inner, d.mould);
+  d.mould_outer.set_motion({Eigen::Matrix3d::Identity(), apart * d.mould->axis});
+  d.mould_inner.set_motion({Eigen::Matrix3d::Identity(), -apart * d.mould->axis});
+  // Seen from the side, across the pull (the side nearest the present view), pull upwards.
+  vtkCamera* camera = d.renderer->GetActiveCamera();
+  Eigen::Vector3d toward;
+  camera->GetDirectionOfProjection(toward.data());
+  toward -= toward.dot(d.mould->axis) * d.mould->axis;
+  if (toward.norm() < 1e-6) toward = d.mould->axis.unitOrthogonal();
+  toward.normalize();
+  const Eigen::Vector3d centre =
+      0.5 * (vertex_centroid(d.mould->inner) + vertex_centroid(d.mould->outer));
+  const Eigen::Vector3d eye = centre - 100.0 * toward;
+  camera->SetFocalPoint(centre.x(), centre.y(), centre.z());
+  camera->SetPosition(eye.x(), eye.y(), eye.z());
+  camera->SetViewUp(d.mould->axis.x(), d.mould->axis.y(), d.mould->axis.z());
+  double bounds[6], inner[6];
+  d.mould_outer.actor->GetBounds(bounds);
+  d.mould_inner.actor->GetBounds(inner);
+  for (int k = 0; k < 3; ++k) {
+    bounds[2 * k] = std::min(bounds[2 * k], inner[2 * k]);
+    bounds[2 * k + 1] = std::max(bounds[2 * k + 1], inner[2 * k + 1]);
+  }
+  d.renderer->ResetCamera(bounds);
+  camera->Zoom(1.4);  // ResetCamera fits the bounding sphere
+  d.renderer->ResetCameraClippingRange();
+  update();
+}
+
+bool SkullView::mould_shown() const { return d_->mould_outer.visible(); }
 
 void SkullView::set_thickness_visible(bool visible) {
   Impl& d = *d_;

@@ -12,6 +12,10 @@
 #include "cranioplan/model/marker.h"
 #include "cranioplan/sessions/plan_state.h"
 
+namespace cranioplan {
+struct MouldResult;
+}
+
 namespace cranioplan::gui {
 
 class SkullView : public QOpenGLWidget {
@@ -60,6 +64,10 @@ class SkullView : public QOpenGLWidget {
   /// near it by its gap to the implant, each with a legend.
   void set_thickness_map(const SkullMesh* implant, std::shared_ptr<const ThicknessMap> map);
   void set_thickness_visible(bool visible);
+  /// A casting mould of the implant shown (none: hidden): its two halves drawn translucent,
+  /// opened apart along their pull so the implant shows between them.
+  void set_mould(std::shared_ptr<const MouldResult> mould);
+  bool mould_shown() const;
   /// Whether the thickness map is drawn now.
   bool thickness_shown() const;
   int selected_marker() const;

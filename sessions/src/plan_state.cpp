@@ -766,6 +766,12 @@ std::string plan_description(const std::string& plan_sha256, const std::string& 
   return "Cranioplan plan SHA-256 " + plan_sha256 + "; implant STL SHA-256 " + implant_sha256;
 }
 
+MouldResult mould_of(const SkullMesh& implant, const SkullMesh* skull, const MouldParams& params) {
+  const Eigen::Vector3d inside =
+      skull ? vertex_centroid(*skull) : vertex_centroid(implant) - 80.0 * Eigen::Vector3d::UnitZ();
+  return make_casting_mould(implant, inside, params);
+}
+
 std::string export_bytes(const PlanState& s, const ExportSpec& spec, std::string* why) {
   const ImplantData& implant = *s.implant;
   const SkullMesh& mesh = implant.result().mesh;
@@ -775,9 +781,7 @@ std::string export_bytes(const PlanState& s, const ExportSpec& spec, std::string
       {"Application", "Cranioplan"},
       {"Description", plan_description(spec.plan_sha256, implant.stl_sha256())}};
   if (!spec.mould) return encode_3mf({{"implant", &mesh}}, metadata);
-  const Eigen::Vector3d inside = s.skull ? vertex_centroid(s.skull->surface->mesh)
-                                         : vertex_centroid(mesh) - 80.0 * Eigen::Vector3d::UnitZ();
-  const MouldResult m = make_casting_mould(mesh, inside, *spec.mould);
+  const MouldResult m = mould_of(mesh, s.skull ? &s.skull->surface->mesh : nullptr, *spec.mould);
   if (!m.usable()) {
     if (why) *why = "the mould could not be made: " + m.message;
     return {};

@@ -35,6 +35,7 @@ class RecordingHost : public PageHost {
   }
   void import_markers(const QString& path) override { opened.push_back(path); }
   void show_slices() override { opened.push_back("slices"); }
+  void show_mould(bool shown) override { opened.push_back(shown ? "mould" : "no mould"); }
   std::shared_ptr<const PlanState> preview(const Command& command) override {
     previewed.push_back(command);
     return nullptr;

@@ -839,6 +839,53 @@ TEST(WizardTabs, TabsAreDraggedRemovedAndAddedWithUndo) {
   EXPECT_LT((plan.state().implant->result().tabs[k].rim - moved[k].rim).norm(), 1e-6);
 }
 
+// Step 9's "3MF with a casting mould": the mould the export would hold, made off the GUI thread
+// and shown opened apart with the implant alone; hidden again in another step.
+TEST(WizardMould, TheMouldIsShownOpenedApartInStep9) {
+  MainWindow w;
+  w.set_interactive(false);
+  w.resize(1280, 800);
+  w.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&w));
+  ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
+  PlanController& plan = w.controller();
+  plan.push(commands::go_to_step(9));
+  plan.wait();
+  ASSERT_EQ(plan.state().current_step, 9);
+  ASSERT_TRUE(plan.state().implant);
+  const auto mould_pixels = [&] {  // the halves' light blue
+    QTest::qWait(50);
+    const QImage image = w.view().grabFramebuffer().convertToFormat(QImage::Format_RGB32);
+    int n = 0;
+    for (int y = 0; y < image.height(); y += 2)
+      for (int x = 0; x < image.width(); x += 2) {
+        const QRgb p = image.pixel(x, y);
+        n += qBlue(p) > 150 && qBlue(p) > qRed(p) + 40 && qGreen(p) > qRed(p) + 10;
+      }
+    return n;
+  };
+  const int before = mould_pixels();
+  EXPECT_FALSE(w.view().mould_shown());
+  child<QCheckBox>(w, "exportMould")->setChecked(true);
+  w.wait_mould();
+  ASSERT_TRUE(w.view().mould_shown());
+  const QLabel* info = child<QLabel>(w, "mouldInfo");
+  ASSERT_TRUE(info);
+  EXPECT_TRUE(info->text().contains("cavity within")) << info->text().toStdString();
+  EXPECT_GT(mould_pixels(), before + 2000) << "the halves drawn";
+  // Another step: the mould goes; back in step 9 with the box on, it comes back.
+  plan.push(commands::go_to_step(7));
+  plan.wait();
+  EXPECT_FALSE(w.view().mould_shown());
+  EXPECT_TRUE(info->text().isEmpty());
+  plan.push(commands::go_to_step(9));
+  plan.wait();
+  w.wait_mould();
+  EXPECT_TRUE(w.view().mould_shown());
+  child<QCheckBox>(w, "exportMould")->setChecked(false);
+  EXPECT_FALSE(w.view().mould_shown());
+}
+
 // The design report from the command line: the HTML, its five pictures of the plan and a PDF.
 TEST_F(Wizard, CommandLineDesignReportWithPicturesAndPdf) {
   test::TempDir tmp;

@@ -34,8 +34,14 @@ ExportPage::ExportPage(PageHost& host) : StepPage(9, host) {
   mould_->setObjectName("exportMould");
   mould_->setToolTip(
       tr("Two printable halves around the implant, with alignment keys, a pour channel and a "
-         "vent, in the 3MF beside the implant"));
+         "vent, in the 3MF beside the implant; shown opened apart in the view"));
+  connect(mould_, &QCheckBox::toggled, this, [this](bool on) { host_.show_mould(on); });
   layout_->addWidget(mould_);
+  mould_info_ = new QLabel(this);
+  mould_info_->setObjectName("mouldInfo");
+  mould_info_->setWordWrap(true);
+  mould_info_->hide();
+  layout_->addWidget(mould_info_);
   // Sign-off: the surgeon approves the implant as it stands; any later change withdraws it.
   QPushButton* approve = make_button(tr("Approve the implant…"), "approve");
   approve->setToolTip(tr("Records who approved, when, and the implant's SHA-256"));
@@ -59,6 +65,11 @@ ExportPage::ExportPage(PageHost& host) : StepPage(9, host) {
 }
 
 void ExportPage::show_quality(const QString& html) { report_->setHtml(html); }
+
+void ExportPage::show_mould_message(const QString& text) {
+  mould_info_->setText(text);
+  mould_info_->setVisible(!text.isEmpty());
+}
 
 void ExportPage::show_state(const PlanState& s) {
   if (s.approval)

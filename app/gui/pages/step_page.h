@@ -36,6 +36,8 @@ class PageHost {
   virtual bool export_to(const QString& path, bool with_mould = false) = 0;
   /// Shows the CT slices beside the 3D view.
   virtual void show_slices() = 0;
+  /// The casting mould of the implant shown in the view (step 9) or hidden.
+  virtual void show_mould(bool shown) = 0;
   /// Markers from a file (.mrk.json, .json, .csv), as one command.
   virtual void import_markers(const QString& path) = 0;
   /// The state a command would give, without recording it.
@@ -53,6 +55,9 @@ class StepPage : public QWidget {
   virtual void show_state(const PlanState& state) { (void)state; }
   /// The implant's quality report, when it changes (empty while it is being computed).
   virtual void show_quality(const QString& html) { (void)html; }
+  /// What became of the casting mould asked for (its cavity's figures, or why there is none);
+  /// empty: none shown.
+  virtual void show_mould_message(const QString& text) { (void)text; }
   /// A click on the skull while this step is current.
   virtual void surface_clicked(const Eigen::Vector3d& point) { (void)point; }
   /// Which surface clicks place on while this step is current.

@@ -195,10 +195,12 @@ class ExportPage : public StepPage {
   void show_quality(const QString& html) override;
   /// Whether (and by whom) the implant is approved, or why an approval was withdrawn.
   void show_state(const PlanState& state) override;
+  void show_mould_message(const QString& text) override;
 
  private:
   QTextBrowser* report_;
   QCheckBox* mould_;  ///< the 3MF export with a casting mould
+  QLabel* mould_info_;
   QLabel* approval_;
 };
 

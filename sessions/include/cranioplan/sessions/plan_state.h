@@ -95,6 +95,9 @@ struct ExportSpec {
 /// half lies away from the skull's centre. A mould that cannot be made gives no bytes and says
 /// why in `why`.
 std::string export_bytes(const PlanState& state, const ExportSpec& spec, std::string* why);
+/// The casting mould of a plan's implant, its outer half away from the skull's centre (none:
+/// the implant's centroid 80 mm up): the one a 3MF export with `params` holds.
+MouldResult mould_of(const SkullMesh& implant, const SkullMesh* skull, const MouldParams& params);
 
 struct ExportRecord {
   std::string path;
