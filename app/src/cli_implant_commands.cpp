@@ -365,6 +365,8 @@ Subcommand add_mould(CLI::App& app, const bool& json) {
                {"cavity_p95_mm", r.cavity_p95_mm},
                {"cavity_beyond_0_2", r.cavity_beyond_0_2},
                {"undercut_mm2", r.undercut_mm2},
+               {"trapped_mm2", r.trapped_mm2},
+               {"cavity_free_max_mm", r.cavity_free_max_mm},
                {"axis", to_json(r.axis)},
                {"pour", to_json(r.pour)},
                {"vent", to_json(r.vent)},

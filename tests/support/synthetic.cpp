@@ -76,12 +76,25 @@ Landmarks head_landmarks() {
 }
 
 SkullMesh mask_meshed_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
-  const SkullMesh box = build_mesh(box_soup(lo, hi));
+  return mask_meshed_boxes({{lo, hi}});
+}
+
+SkullMesh mask_meshed_boxes(const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>& boxes) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e300), hi = -lo;
+  for (const auto& [a, b] : boxes) {
+    lo = lo.cwiseMin(a);
+    hi = hi.cwiseMax(b);
+  }
   const Eigen::Vector3d margin = Eigen::Vector3d::Constant(2.25);
   const VoxelGrid g = VoxelGrid::covering(lo - margin, hi + margin, 0.5);
+  std::vector<uint8_t> inside(g.size(), 0);
+  for (const auto& [a, b] : boxes) {
+    const std::vector<uint8_t> one = voxelize_mesh(build_mesh(box_soup(a, b)), g);
+    for (size_t k = 0; k < inside.size(); ++k) inside[k] |= one[k];
+  }
   ExtractBoneSurfaceParams mask;
   mask.threshold = 0.5;
-  return extract_bone_surface(mask_volume(voxelize_mesh(box, g), g), mask).mesh;
+  return extract_bone_surface(mask_volume(inside, g), mask).mesh;
 }
 
 long long genus(const SkullMesh& m) {

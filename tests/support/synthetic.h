@@ -25,6 +25,8 @@ TriangleSoup box_soup(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
 /// The box [lo, hi] meshed from its voxel mask on a 0.5 mm grid reaching 2.25 mm beyond it, as
 /// implants are meshed (each face halfway between voxel centres, the corners cut).
 SkullMesh mask_meshed_box(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi);
+/// The union of boxes, each given as {lo, hi}, meshed the same way.
+SkullMesh mask_meshed_boxes(const std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>>& boxes);
 
 /// The genus of a closed surface from its Euler characteristic V − E + F = 2 − 2·genus: one per
 /// tunnel through it (a drilled hole, a screw hole).

@@ -53,7 +53,23 @@ struct Pull {
   Eigen::Vector3d lo = Eigen::Vector3d::Zero(), hi = Eigen::Vector3d::Zero();  // local bounds
   Parting part;
   double undercut_mm2 = 0.0;
+  std::vector<SkullMesh::FaceHandle> undercut;  // the faces
 };
+
+// How many times the line along `axis` through `x` crosses the surface (counted up to 8).
+int crossings(const SurfaceLocator& self, const Eigen::Vector3d& x, const Eigen::Vector3d& axis,
+              double reach) {
+  Eigen::Vector3d from = x - reach * axis;
+  const Eigen::Vector3d to = x + reach * axis;
+  int n = 0;
+  while (n < 8) {
+    const auto hit = self.first_hit(from, to);
+    if (!hit) break;
+    ++n;
+    from = hit->point + 1e-4 * axis;
+  }
+  return n;
+}
 
 Pull part_along(const SkullMesh& implant, const SurfaceLocator& self, const Eigen::Vector3d& c,
                 const Eigen::Vector3d& axis, double wall_mm) {
@@ -145,8 +161,10 @@ Pull part_along(const SkullMesh& implant, const SurfaceLocator& self, const Eige
     const Eigen::Vector3d m = local((q[0] + q[1] + q[2]) / 3.0);
     const double facing = cross.normalized().dot(out.axis);
     const bool upper = m.z() > part.sample(part.height, m.x(), m.y());
-    if ((upper && facing < -slack) || (!upper && facing > slack))
+    if ((upper && facing < -slack) || (!upper && facing > slack)) {
       out.undercut_mm2 += 0.5 * cross.norm();
+      out.undercut.push_back(fh);
+    }
   }
   return out;
 }
@@ -225,6 +243,16 @@ MouldResult make_casting_mould(const SkullMesh& implant, const Eigen::Vector3d& 
   const size_t cells = static_cast<size_t>(part.nu) * part.nv;
   r.axis = axis;
   r.undercut_mm2 = best.undercut_mm2;
+  // Of the undercut, what no parting could free: faces on a line along the pull that crosses
+  // the implant more than twice.
+  const double reach = (hi - lo).norm() + 1.0;
+  for (const auto fh : best.undercut) {
+    Eigen::Vector3d q[3];
+    int k = 0;
+    for (auto vh : implant.fv_range(fh)) q[k++] = to_eigen(implant.point(vh));
+    if (crossings(self, (q[0] + q[1] + q[2]) / 3.0, axis, reach) > 2)
+      r.trapped_mm2 += 0.5 * (q[1] - q[0]).cross(q[2] - q[0]).norm();
+  }
   auto local = [&](const Eigen::Vector3d& x) {
     const Eigen::Vector3d d = x - c;
     return Eigen::Vector3d(d.dot(e1), d.dot(e2), d.dot(axis));
@@ -340,6 +368,9 @@ MouldResult make_casting_mould(const SkullMesh& implant, const Eigen::Vector3d& 
       open = open || (q.head<2>() - hole.at).norm() < hole.radius + 1.0;
     if (open) continue;
     gaps.push_back(std::min(lo_half.closest(x).distance, hi_half.closest(x).distance));
+    // Where the implant can be lifted out (its line along the pull crosses it twice).
+    if (gaps.back() > r.cavity_free_max_mm && crossings(self, x, axis, reach) <= 2)
+      r.cavity_free_max_mm = gaps.back();
   }
   std::sort(gaps.begin(), gaps.end());
   if (!gaps.empty()) {
@@ -350,16 +381,19 @@ MouldResult make_casting_mould(const SkullMesh& implant, const Eigen::Vector3d& 
     r.cavity_p95_mm = gaps[static_cast<size_t>(0.95 * static_cast<double>(gaps.size() - 1))];
   }
   r.status = MouldResult::Status::Made;
-  char buf[240];
+  char buf[300];
   std::snprintf(buf, sizeof(buf),
                 "mould of %.0f × %.0f × %.0f mm in two halves; the cavity within %.2f mm of the "
-                "implant (95 %% within %.2f mm, %.2f %% beyond 0.2 mm)",
+                "implant (95 %% within %.2f mm, %.2f %% beyond 0.2 mm; within %.2f mm outside "
+                "the folds)",
                 U1 - U0, V1 - V0, H1 - H0, r.cavity_max_mm, r.cavity_p95_mm,
-                100.0 * r.cavity_beyond_0_2);
+                100.0 * r.cavity_beyond_0_2, r.cavity_free_max_mm);
   r.message = buf;
   if (r.undercut_mm2 > 1.0) {
-    std::snprintf(buf, sizeof(buf), "; %.0f mm² of the implant is undercut along the parting",
-                  r.undercut_mm2);
+    std::snprintf(buf, sizeof(buf),
+                  "; %.0f mm² of the implant is undercut along the parting (%.0f mm² in folds: "
+                  "where it folds back along the pull)",
+                  r.undercut_mm2, r.trapped_mm2);
     r.message += buf;
   }
   return done();

@@ -28,6 +28,7 @@ TEST(CastingMould, APlatesMouldHasItsCavityWithinAFifthOfAMillimetre) {
   EXPECT_NEAR(std::abs(r.axis.z()), 1.0, 1e-6);
   EXPECT_GT(r.axis.z(), 0.0) << "the outer half away from the inside";
   EXPECT_LE(r.cavity_max_mm, 0.2);
+  EXPECT_EQ(r.cavity_free_max_mm, r.cavity_max_mm) << "no folds";
   EXPECT_LT(r.undercut_mm2, 1.0);
   for (const SkullMesh* half : {&r.outer, &r.inner}) {
     const MeshReport rep = report_mesh(*half);
@@ -52,6 +53,22 @@ TEST(CastingMould, APlatesMouldHasItsCavityWithinAFifthOfAMillimetre) {
   const auto on_key = inner.first_hit(Eigen::Vector3d(-4, -4, 30), Eigen::Vector3d(-4, -4, 0));
   ASSERT_TRUE(on_key.has_value());
   EXPECT_NEAR(on_key->point.z(), 9.0 + 2.5, 0.15) << "a key's top over the parting at z 9";
+}
+
+// A staple (two 40 × 40 × 2 mm flanges 4 mm apart, joined along one side) folds back over
+// itself along any pull near its thin axis: the inner faces of the flanges are undercut whatever
+// the parting, and the result says so (trapped), where a plate has none.
+TEST(CastingMould, AShapeThatFoldsBackAlongThePullIsReportedTrapped) {
+  const SkullMesh staple = test::mask_meshed_boxes(
+      {{{0, 0, 7}, {40, 40, 9}}, {{0, 0, 13}, {40, 40, 15}}, {{0, 0, 7}, {4, 40, 15}}});
+  const MouldResult r = make_casting_mould(staple, kInside, {});
+  ASSERT_TRUE(r.usable()) << r.message;
+  EXPECT_GT(r.trapped_mm2, 1000.0) << "at least one flange's inner face, 36 × 40 mm";
+  EXPECT_GE(r.trapped_mm2, 0.9 * r.undercut_mm2);
+  EXPECT_NE(r.message.find("folds back"), std::string::npos) << r.message;
+  EXPECT_LE(r.cavity_free_max_mm, 0.2) << "outside the folds, the cavity is the staple";
+  const MouldResult flat = make_casting_mould(plate(), kInside, {});
+  EXPECT_EQ(flat.trapped_mm2, 0.0);
 }
 
 TEST(CastingMould, ParametersOutOfRangeAreNamed) {

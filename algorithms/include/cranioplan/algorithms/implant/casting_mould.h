@@ -36,9 +36,16 @@ struct MouldResult {
   /// percentile.
   double cavity_max_mm = 0.0, cavity_p95_mm = 0.0;
   double cavity_beyond_0_2 = 0.0;  ///< the share of those vertices farther than 0.2 mm (0..1)
+  /// The largest over the vertices outside the folds (`trapped_mm2`): where a line along the
+  /// pull crosses the implant only twice, mm.
+  double cavity_free_max_mm = 0.0;
   /// The implant's surface that a half would trap (its normal turns more than 2° against the
   /// half's pull), mm²: 0 for a mould that opens.
   double undercut_mm2 = 0.0;
+  /// Of that, the area where a line along the pull crosses the implant four or more times: the
+  /// implant folds back over itself along the pull there, so no parting surface frees it (a
+  /// bulging side wall, a lip); the rest is the parting's 0.5 mm sampling at steep walls, mm².
+  double trapped_mm2 = 0.0;
   double seconds = 0.0;
   bool usable() const { return status == Status::Made; }
 };
