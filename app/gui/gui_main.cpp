@@ -24,7 +24,8 @@ int main(int argc, char** argv) {
   parser.addVersionOption();
   parser.addPositionalArgument("FILE", "a skull mesh, a CT volume or a saved session (.json)");
   const QCommandLineOption sample("sample", "open the sample case (Cranium.inv3)");
-  const QCommandLineOption step("step", "show a session as it was at step N (1-9)", "N");
+  const QCommandLineOption step(
+      "step", "show a session as it was at step N (1-9); a skull just opened, step N", "N");
   const QCommandLineOption screenshot("screenshot", "save a picture of the window", "OUT.png");
   const QCommandLineOption quit("quit", "quit when done (no dialogs)");
   const QCommandLineOption view("view", "front, back, left, right, top or markers", "VIEW");
@@ -70,6 +71,8 @@ int main(int argc, char** argv) {
       if (ok && parser.isSet(step)) window.replay_to_step(parser.value(step).toInt());
     } else {
       window.open_input(file);
+      window.controller().wait();
+      if (parser.isSet(step)) window.replay_to_step(parser.value(step).toInt());
     }
   } else if (!automated) {
     window.offer_recovery();

@@ -20,11 +20,14 @@ namespace {
 // The least span of a loop taken for a cut at the border (a scan's end crosses at least the
 // vault's cap); smaller flat loops at the border are holes.
 constexpr double kCutSpanMm = 30.0;
+// A cut's plane lies this near the mesh's end along its normal (mm), and is taken as an axis's
+// plane within this angle of it (degrees).
+constexpr double kBorderReachMm = 2.0;
+constexpr double kAxisSnapDeg = 1.0;
 
 // The chains of boundary edges (welded vertex ids), measured and placed.
 std::vector<BoundaryLoop> boundary_loops(const TriangleSoup& welded,
-                                         const std::vector<std::pair<int, int>>& edges,
-                                         const Eigen::Vector3d& lo, const Eigen::Vector3d& hi) {
+                                         const std::vector<std::pair<int, int>>& edges) {
   std::unordered_map<int, int> parent;
   std::function<int(int)> find = [&](int a) {
     int r = a;
@@ -68,9 +71,8 @@ std::vector<BoundaryLoop> boundary_loops(const TriangleSoup& welded,
     for (int v : m)
       l.flatness_mm =
           std::max(l.flatness_mm, std::abs((welded.vertices[v] - l.centroid).dot(l.normal)));
-    // At the border: flat, its normal along an axis, and its plane where the mesh ends.
-    int axis = 0;
-    l.normal.cwiseAbs().maxCoeff(&axis);
+    // At the border: flat, and its plane where the mesh ends along its normal, in any
+    // orientation (a gantry tilt, a crop by an exporter, a skull that came in turned).
     Eigen::Vector3d a = l.centroid, b = l.centroid;
     for (int v : m) {
       a = a.cwiseMin(welded.vertices[v]);
@@ -80,15 +82,50 @@ std::vector<BoundaryLoop> boundary_loops(const TriangleSoup& welded,
     // the head.
     const bool flat =
         l.flatness_mm <= std::max(1.0, 0.01 * l.length_mm) && (b - a).norm() >= kCutSpanMm;
-    if (!flat || std::abs(l.normal[axis]) < 0.9) continue;
+    if (!flat) continue;
+    double lowest = l.centroid.dot(l.normal), highest = lowest;
+    for (const Eigen::Vector3d& p : welded.vertices) {
+      lowest = std::min(lowest, p.dot(l.normal));
+      highest = std::max(highest, p.dot(l.normal));
+    }
+    const double at = l.centroid.dot(l.normal);
+    if (at - lowest <= kBorderReachMm)
+      l.outward = -l.normal;
+    else if (highest - at <= kBorderReachMm)
+      l.outward = l.normal;
+    else
+      continue;
+    // Named by the patient's direction nearest its outward normal; within 1° of it, the
+    // normal is that axis (a slice's plane, up to rounding).
+    int axis = 0;
+    l.outward.cwiseAbs().maxCoeff(&axis);
+    const double sign = l.outward[axis] < 0 ? -1.0 : 1.0;
+    if (std::abs(l.outward[axis]) >= std::cos(kAxisSnapDeg * M_PI / 180.0))
+      l.outward = sign * Eigen::Vector3d::Unit(axis);
     static const char* const kLow[3] = {"right", "front", "lower"};
     static const char* const kHigh[3] = {"left", "back", "upper"};
-    if (l.centroid[axis] - lo[axis] <= 2.0) {
+    l.at_border = true;
+    l.border = sign < 0 ? kLow[axis] : kHigh[axis];
+  }
+  // The cut also leaves small loops in its plane (around islands of bone the plane crosses, in
+  // the orbits or the nose): each lying within reach of a border's plane is part of that cut.
+  std::vector<size_t> cuts;
+  for (size_t i = 0; i < loops.size(); ++i)
+    if (loops[i].at_border) cuts.push_back(i);
+  for (size_t i = 0; i < loops.size(); ++i) {
+    BoundaryLoop& l = loops[i];
+    if (l.at_border) continue;
+    for (size_t c : cuts) {
+      const BoundaryLoop& cut = loops[c];
+      const double offset = cut.outward.dot(cut.centroid);
+      const bool in_plane = std::all_of(members[i].begin(), members[i].end(), [&](int v) {
+        return std::abs(cut.outward.dot(welded.vertices[v]) - offset) <= kBorderReachMm;
+      });
+      if (!in_plane) continue;
       l.at_border = true;
-      l.border = kLow[axis];
-    } else if (hi[axis] - l.centroid[axis] <= 2.0) {
-      l.at_border = true;
-      l.border = kHigh[axis];
+      l.border = cut.border;
+      l.outward = cut.outward;
+      break;
     }
   }
   std::stable_sort(loops.begin(), loops.end(), [](const BoundaryLoop& a, const BoundaryLoop& b) {
@@ -110,19 +147,26 @@ std::vector<std::string> describe_openings(const MeshReport& report) {
   static const char* const kAxis = "xyz";
   for (const char* side : {"lower", "upper", "front", "back", "right", "left"}) {
     long long count = 0;
-    double length = 0.0, at = 0.0;
-    int axis = 0;
+    double length = 0.0;
+    const BoundaryLoop* first = nullptr;
     for (const BoundaryLoop& l : report.loops) {
       if (!l.at_border || l.border != side) continue;
       ++count;
       length += l.length_mm;
-      l.normal.cwiseAbs().maxCoeff(&axis);
-      at = std::round(l.centroid[axis] * 10.0) / 10.0 + 0.0;  // no "-0.0"
+      if (!first) first = &l;
     }
     if (count == 0) continue;
-    out.push_back(std::string("open along a flat cut at its ") + side + " border (" + kAxis[axis] +
-                  fmt(" = %.1f mm): ", at) + std::to_string(count) +
-                  (count == 1 ? " loop, " : " loops, ") + fmt("%.0f mm", length) +
+    int axis = 0;
+    first->outward.cwiseAbs().maxCoeff(&axis);
+    const double at = std::round(first->centroid[axis] * 10.0) / 10.0 + 0.0;  // no "-0.0"
+    const double tilt = std::acos(std::min(1.0, std::abs(first->outward[axis]))) * 180.0 / M_PI;
+    const std::string where = tilt == 0.0 ? std::string(1, kAxis[axis]) + fmt(" = %.1f mm", at)
+                                          : fmt("a plane tilted %.0f° from ", tilt) + kAxis[axis] +
+                                                " = const, through " + kAxis[axis] +
+                                                fmt(" = %.1f mm at its centre", at);
+    out.push_back(std::string("open along a flat cut at its ") + side + " border (" + where +
+                  "): " + std::to_string(count) + (count == 1 ? " loop, " : " loops, ") +
+                  fmt("%.0f mm", length) +
                   " long, where the scan ended; the bone's inside is taken by votes through it");
   }
   long long holes = 0;
@@ -191,7 +235,7 @@ MeshReport report_mesh(const SkullMesh& mesh) {
   for (const auto& [p, i] : weld) soup.vertices[i] = {p[0], p[1], p[2]};
   // In the edges' order of the welded ids, not the hash map's: the same loops on any run.
   std::sort(boundary.begin(), boundary.end());
-  r.loops = boundary_loops(soup, boundary, r.bbox_min, r.bbox_max);
+  r.loops = boundary_loops(soup, boundary);
   r.pieces = static_cast<long long>(soup_components(soup).sizes.size());
   r.watertight = r.boundary_edges == 0 && r.nonmanifold_edges == 0;
   return r;

@@ -41,15 +41,24 @@ RayThroughBone cast_through_bone(const SurfaceLocator& locator, const Eigen::Vec
   return h;
 }
 
+namespace {
+// A cut's plane lies within 2 mm of the mesh's end (mesh_report): a ray meets it within the
+// box widened by a little more along the axes the plane crosses steeply.
+constexpr double kBorderSlackMm = 2.5;
+}  // namespace
+
 bool ScanBorder::reached_by(const Eigen::Vector3d& from, const Eigen::Vector3d& dir) const {
   const double along = dir.dot(normal);
   if (along <= 1e-9) return false;  // parallel to the plane, or away from it
   const double t = (offset - from.dot(normal)) / along;
   if (t <= 0.0) return false;
   const Eigen::Vector3d hit = from + t * dir;
-  // Within the box but along the normal, where the hit lies on the plane.
-  for (int k = 0; k < 3; ++k)
-    if (std::abs(normal[k]) < 0.5 && (hit[k] < box_min[k] || hit[k] > box_max[k])) return false;
+  // Within the box: along the axes that lie in the plane, exactly; along those the plane
+  // crosses steeply (for an axis plane, its normal), within the cut's reach of the mesh's end.
+  for (int k = 0; k < 3; ++k) {
+    const double slack = std::abs(normal[k]) < 0.5 ? 0.0 : kBorderSlackMm;
+    if (hit[k] < box_min[k] - slack || hit[k] > box_max[k] + slack) return false;
+  }
   return true;
 }
 
@@ -60,12 +69,8 @@ std::vector<ScanBorder> scan_borders(const MeshReport& report) {
     if (!loop.at_border || std::find(sides.begin(), sides.end(), loop.border) != sides.end())
       continue;
     sides.push_back(loop.border);
-    int axis = 0;
-    loop.normal.cwiseAbs().maxCoeff(&axis);
     ScanBorder b;
-    const bool low =
-        loop.centroid[axis] - report.bbox_min[axis] <= report.bbox_max[axis] - loop.centroid[axis];
-    b.normal = (low ? -1.0 : 1.0) * Eigen::Vector3d::Unit(axis);
+    b.normal = loop.outward;
     b.offset = b.normal.dot(loop.centroid);
     b.box_min = report.bbox_min;
     b.box_max = report.bbox_max;

@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "support/synthetic.h"
 
 namespace cranioplan {
@@ -76,6 +79,78 @@ TEST(MeshReport, ACutAtTheBorderAndAHoleAreToldApart) {
   EXPECT_NE(said[0].find("1 loop, "), std::string::npos) << said[0];
   EXPECT_EQ(said[1].rfind("1 hole in the surface", 0), 0u) << said[1];
   EXPECT_TRUE(describe_openings(whole).empty());
+}
+
+// The same head cut along a plane tilted 30° from the axial (a tilted gantry, or a skull that
+// came in turned): the cut is still the lower border, its outward normal the plane's.
+TEST(MeshReport, AnObliqueCutAtTheBorderIsFoundInItsOwnPlane) {
+  const SkullMesh head = test::make_symmetric_head(5);
+  const MeshReport whole = report_mesh(head);
+  const Eigen::Vector3d up(0.0, std::sin(M_PI / 6), std::cos(M_PI / 6));
+  const Eigen::Vector3d through(0, 0, whole.bbox_min.z() + 45.0);
+  SkullMesh cut = test::cut_open(head, through, up);
+  for (auto vh : cut.vertices())
+    if (cut.is_boundary(vh)) {
+      const Eigen::Vector3d p = to_eigen(cut.point(vh));
+      cut.set_point(vh, to_point(p - (p - through).dot(up) * up + 0.5 * up));
+    }
+  const MeshReport r = report_mesh(cut);
+  ASSERT_EQ(r.loops.size(), 1u);
+  EXPECT_TRUE(r.loops[0].at_border);
+  EXPECT_EQ(r.loops[0].border, "lower");
+  EXPECT_LT(std::acos(std::clamp(-r.loops[0].outward.dot(up), -1.0, 1.0)), 1e-3);
+  const std::vector<std::string> said = describe_openings(r);
+  ASSERT_EQ(said.size(), 1u);
+  EXPECT_EQ(
+      said[0].rfind("open along a flat cut at its lower border (a plane tilted 30° from z", 0), 0u)
+      << said[0];
+}
+
+// Bone the scan's cut crosses besides the vault (an island in the orbits, the nose) leaves small
+// loops in the cut's plane: they are the same cut, not holes.
+TEST(MeshReport, SmallLoopsInTheCutsPlaneArePartOfTheCut) {
+  const SkullMesh head = test::make_symmetric_head(5);
+  const MeshReport whole = report_mesh(head);
+  const double cut_z = whole.bbox_min.z() + 30.0;
+  const Eigen::Vector3d up = Eigen::Vector3d::UnitZ();
+  TriangleSoup s = to_soup(test::cut_open(head, Eigen::Vector3d(0, 0, cut_z), up));
+  // A 10 × 10 mm bar below the head's middle, cut by the same plane: a loop of 40 mm.
+  const Eigen::Vector3d mid = 0.5 * (whole.bbox_min + whole.bbox_max);
+  const TriangleSoup bar = to_soup(
+      test::cut_open(test::mask_meshed_box(Eigen::Vector3d(mid.x() - 5, mid.y() - 5, cut_z - 10),
+                                           Eigen::Vector3d(mid.x() + 5, mid.y() + 5, cut_z + 20)),
+                     Eigen::Vector3d(0, 0, cut_z), up));
+  const int base = static_cast<int>(s.vertices.size());
+  s.vertices.insert(s.vertices.end(), bar.vertices.begin(), bar.vertices.end());
+  for (const auto& t : bar.triangles) s.triangles.push_back(t + Eigen::Vector3i::Constant(base));
+  const MeshReport r = report_mesh(build_mesh(s));
+  ASSERT_EQ(r.loops.size(), 2u);
+  EXPECT_LT(r.loops[1].length_mm, 50.0) << "the bar's loop";
+  for (const BoundaryLoop& l : r.loops) {
+    EXPECT_TRUE(l.at_border);
+    EXPECT_EQ(l.border, "lower");
+  }
+  const std::vector<std::string> said = describe_openings(r);
+  ASSERT_EQ(said.size(), 1u) << "no holes";
+  EXPECT_NE(said[0].find("2 loops, "), std::string::npos) << said[0];
+}
+
+// A slot 3 mm wide through the right half of the head: its loop is flat and long, but the head
+// goes on on both sides of its plane, so it is a hole, not where a scan ended.
+TEST(MeshReport, AFlatLoopWithTheMeshOnBothSidesIsAHole) {
+  TriangleSoup s = to_soup(test::make_symmetric_head(5));
+  std::vector<Eigen::Vector3i> kept;
+  for (const auto& t : s.triangles) {
+    const Eigen::Vector3d c = (s.vertices[t[0]] + s.vertices[t[1]] + s.vertices[t[2]]) / 3.0;
+    if (!(c.x() < -5.0 && std::abs(c.z() - 20.0) < 1.5)) kept.push_back(t);
+  }
+  s.triangles = kept;
+  const MeshReport r = report_mesh(build_mesh(s));
+  ASSERT_EQ(r.loops.size(), 1u);
+  EXPECT_GT(r.loops[0].length_mm, 200.0);
+  EXPECT_LE(r.loops[0].flatness_mm, 0.01 * r.loops[0].length_mm) << "flat enough for a cut";
+  EXPECT_FALSE(r.loops[0].at_border);
+  EXPECT_EQ(r.loops[0].outward, Eigen::Vector3d::Zero());
 }
 
 }  // namespace

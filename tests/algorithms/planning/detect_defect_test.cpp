@@ -63,14 +63,15 @@ struct OpenHead {
   Eigen::Vector3d defect_direction;
 };
 
-OpenHead open_head_with_defect(const Eigen::Vector3d& direction, double right_x) {
+OpenHead open_head_with_defect(const Eigen::Vector3d& direction, double right_x,
+                               const Eigen::Vector3d& cut_normal = Eigen::Vector3d::UnitX()) {
   const SkullMesh intact = test::make_thick_head(0.93, 1.0);
   InjectDefectParams p;
   p.center = test::head_surface_point(direction.normalized()) * 0.965;
   p.size_mm = 55;
   p.voxel_mm = 1.0;
   const SkullMesh defective = inject_defect(intact, p).defective;
-  return {test::cut_open(defective, Eigen::Vector3d(right_x, 0, 0), Eigen::Vector3d::UnitX()),
+  return {test::cut_open(defective, Eigen::Vector3d(right_x, 0, 0), cut_normal.normalized()),
           direction.normalized()};
 }
 
@@ -89,6 +90,23 @@ TEST(DetectDefect, TheScansCutIsNeverTheDefect) {
   ASSERT_TRUE(without.found()) << without.message;
   EXPECT_LT(angle_deg(without.axis, -Eigen::Vector3d::UnitX()), 10.0) << "the cut, planned";
   EXPECT_EQ(without.other_openings, 1) << without.message;
+  const DefectRegion with = detect(h.skull, true);
+  ASSERT_TRUE(with.found()) << with.message;
+  EXPECT_LT(angle_deg(with.axis, h.defect_direction), 10.0);
+  EXPECT_EQ(with.other_openings, 0) << with.message;
+}
+
+// The same with the cut tilted 35° (no axis's plane): its border is found in its own plane
+// and the cut is still never planned.
+TEST(DetectDefect, AnObliqueCutIsNeverTheDefect) {
+  const Eigen::Vector3d tilted(std::cos(35 * M_PI / 180), 0.0, std::sin(35 * M_PI / 180));
+  const OpenHead h = open_head_with_defect(Eigen::Vector3d(0.7, 0.1, 0.7), -20.0, tilted);
+  const std::vector<ScanBorder> borders = scan_borders(report_mesh(h.skull));
+  ASSERT_EQ(borders.size(), 1u);
+  EXPECT_LT(angle_deg(borders[0].normal, -tilted), 2.0);
+  const DefectRegion without = detect(h.skull, false);
+  ASSERT_TRUE(without.found()) << without.message;
+  EXPECT_GT(angle_deg(without.axis, h.defect_direction), 30.0) << "the cut, planned";
   const DefectRegion with = detect(h.skull, true);
   ASSERT_TRUE(with.found()) << with.message;
   EXPECT_LT(angle_deg(with.axis, h.defect_direction), 10.0);

@@ -14,6 +14,7 @@
 #include <vtkTriangleFilter.h>
 #include <vtkWindowedSincPolyDataFilter.h>
 
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <filesystem>
@@ -151,6 +152,18 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
          const SkullMesh m = load_skull(path).mesh;
          return to_polydata(
              test::cut_open(m, Eigen::Vector3d(0, 0, 60.0), Eigen::Vector3d::UnitZ()));
+       },
+       true, false},
+      // A gantry tilted 20° (or a skull cropped obliquely by an exporter): the cut rises
+      // towards the back, through the orbits at the front, in no axis's plane.
+      {"cropped along a plane tilted 20° (gantry tilt)",
+       [&] {
+         const SkullMesh m = load_skull(path).mesh;
+         const MeshReport box = report_mesh(m);
+         const double tilt = 20.0 * M_PI / 180.0;
+         return to_polydata(test::cut_open(
+             m, Eigen::Vector3d(0, 0.5 * (box.bbox_min.y() + box.bbox_max.y()), 60.0),
+             Eigen::Vector3d(0, -std::sin(tilt), std::cos(tilt))));
        },
        true, false},
   };

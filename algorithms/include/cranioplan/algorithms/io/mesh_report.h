@@ -16,10 +16,14 @@ struct BoundaryLoop {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();   ///< of the plane that fits it best
   double flatness_mm = 0.0;  ///< the largest distance of its vertices from that plane
   /// Flat, at least 30 mm across, and its plane is where the mesh ends along the normal (within
-  /// 2 mm): the cut where a scan ended, or where an exporter cropped the surface.
+  /// 2 mm), in any orientation: the cut where a scan ended (a tilted gantry's too), or where an
+  /// exporter cropped the surface.
   bool at_border = false;
-  /// Which border, in the patient's LPS frame: "lower" (−z), "upper" (+z), "front" (−y),
-  /// "back" (+y), "right" (−x), "left" (+x); empty unless at_border.
+  /// At the border: the unit normal pointing out of the surface through the cut (an axis when
+  /// within 1° of one); zero otherwise.
+  Eigen::Vector3d outward = Eigen::Vector3d::Zero();
+  /// Which border, in the patient's LPS frame, by the axis nearest `outward`: "lower" (−z),
+  /// "upper" (+z), "front" (−y), "back" (+y), "right" (−x), "left" (+x); empty unless at_border.
   std::string border;
 };
 
