@@ -833,23 +833,25 @@ void MainWindow::update_mould() {
   mould_of_ = s.implant.get();
   view_->set_mould(nullptr);
   drop_watcher(mould_watcher_, this);
-  mould_watcher_ = new QFutureWatcher<std::shared_ptr<const MouldResult>>(this);
+  mould_watcher_ = new QFutureWatcher<std::shared_ptr<const SkullView::PreparedMould>>(this);
   const std::shared_ptr<const ImplantData> implant = s.implant;
   const std::shared_ptr<const SkullInput> skull = s.skull;
   connect(mould_watcher_, &QFutureWatcherBase::finished, this, [this, implant] {
-    const std::shared_ptr<const MouldResult> m = mould_watcher_->result();
+    const std::shared_ptr<const SkullView::PreparedMould> prepared = mould_watcher_->result();
     if (implant.get() != mould_of_) return;  // the plan moved on
-    view_->set_mould(m);
+    const MouldResult& m = SkullView::result_of(*prepared);
+    view_->set_mould(prepared);
     const QString text =
-        (m->usable() ? tr("Casting mould, shown opened apart: %1.") : tr("No casting mould: %1."))
-            .arg(q(m->message));
+        (m.usable() ? tr("Casting mould, shown opened apart: %1.") : tr("No casting mould: %1."))
+            .arg(q(m.message));
     for (StepPage* page : step_pages_) page->show_mould_message(text);
-    show_message(text, !m->usable());
+    show_message(text, !m.usable());
   });
   for (StepPage* page : step_pages_) page->show_mould_message(tr("Making the casting mould…"));
+  // The mould and VTK's meshes of its halves, both off the GUI thread.
   mould_watcher_->setFuture(QtConcurrent::run([implant, skull] {
-    return std::make_shared<const MouldResult>(
-        mould_of(implant->result().mesh, skull ? &skull->surface->mesh : nullptr, MouldParams{}));
+    return SkullView::prepare_mould(std::make_shared<const MouldResult>(
+        mould_of(implant->result().mesh, skull ? &skull->surface->mesh : nullptr, MouldParams{})));
   }));
 }
 

@@ -188,7 +188,7 @@ class MainWindow : public QMainWindow, public PageHost {
   /// The mould shown in step 9: asked for, of which implant, and being made.
   bool mould_wanted_ = false;
   const void* mould_of_ = nullptr;
-  QFutureWatcher<std::shared_ptr<const MouldResult>>* mould_watcher_ = nullptr;
+  QFutureWatcher<std::shared_ptr<const SkullView::PreparedMould>>* mould_watcher_ = nullptr;
   /// Makes or hides the mould as the state and the wish say.
   void update_mould();
   QElapsedTimer total_timer_, step_timer_;

@@ -146,6 +146,16 @@ struct MeshLayer {
     keep = std::move(owner);
     actor->SetVisibility(true);
   }
+  /// Shows a mesh already converted (`key` names it, `owner` keeps it alive).
+  void show_polydata(const void* key, vtkPolyData* poly, std::shared_ptr<const void> owner) {
+    if (key != shown) {
+      mapper->SetInputData(poly);
+      shown = key;
+    }
+    locator = nullptr;
+    keep = std::move(owner);
+    actor->SetVisibility(true);
+  }
   static vtkSmartPointer<vtkPolyData> to_polydata_or_shared(const SkullMesh& mesh,
                                                             const MeshLayer* reflection_of) {
     vtkPolyData* shared = reflection_of && reflection_of->shown == &mesh
@@ -261,7 +271,6 @@ struct SkullView::Impl {
   vtkNew<vtkPlane> clip;
   MeshLayer skull, mirror, implant;
   MeshLayer mould_outer, mould_inner;  // a casting mould's halves, opened apart
-  std::shared_ptr<const MouldResult> mould;
   GlyphLayer outer_edge{sphere(1.6), kEdge}, inner_edge{cube(2.4), kEdge},
       outer_surface{sphere(1.6), kSurface}, inner_surface{cube(2.4), kSurface},
       landmarks{sphere(2.6), {0.90, 0.15, 0.10}}, selected{sphere(2.8), {1.0, 0.95, 0.1}},
@@ -702,44 +711,62 @@ void SkullView::set_thickness_map(const SkullMesh* implant,
   set_thickness_visible(d_->thickness_wanted);
 }
 
-void SkullView::set_mould(std::shared_ptr<const MouldResult> mould) {
-  Impl& d = *d_;
-  d.mould = std::move(mould);
-  if (!d.mould || !d.mould->usable()) {
-    d.mould_outer.show(nullptr, nullptr);
-    d.mould_inner.show(nullptr, nullptr);
-    update();
-    return;
-  }
-  // Each half moved off the implant along the pull by its own depth and 10 mm more: the
-  // cavity and the implant between them show.
+struct SkullView::PreparedMould {
+  std::shared_ptr<const MouldResult> mould;
+  vtkSmartPointer<vtkPolyData> outer, inner;
+  double apart = 0.0;  // each half's shift off the implant along the pull, mm
+};
+
+std::shared_ptr<const SkullView::PreparedMould> SkullView::prepare_mould(
+    std::shared_ptr<const MouldResult> mould) {
+  auto p = std::make_shared<PreparedMould>();
+  p->mould = std::move(mould);
+  if (!p->mould || !p->mould->usable()) return p;
+  p->outer = to_polydata(p->mould->outer);
+  p->inner = to_polydata(p->mould->inner);
+  // Both halves moved off the implant along the pull, by half the deeper one's depth and 10 mm
+  // more: the cavities and the implant between them show.
   const auto depth = [&](const SkullMesh& half) {
     double lo = 1e300, hi = -1e300;
     for (auto vh : half.vertices()) {
-      const double h = to_eigen(half.point(vh)).dot(d.mould->axis);
+      const double h = to_eigen(half.point(vh)).dot(p->mould->axis);
       lo = std::min(lo, h);
       hi = std::max(hi, h);
     }
     return hi - lo;
   };
-  const double apart = 0.5 * std::max(depth(d.mould->outer), depth(d.mould->inner)) + 10.0;
-  d.mould_outer.show(&d.mould->outer, d.mould);
-  d.mould_inner.show(&d.mould->inner, d.mould);
-  d.mould_outer.set_motion({Eigen::Matrix3d::Identity(), apart * d.mould->axis});
-  d.mould_inner.set_motion({Eigen::Matrix3d::Identity(), -apart * d.mould->axis});
+  p->apart = 0.5 * std::max(depth(p->mould->outer), depth(p->mould->inner)) + 10.0;
+  return p;
+}
+
+const MouldResult& SkullView::result_of(const PreparedMould& prepared) { return *prepared.mould; }
+
+void SkullView::set_mould(std::shared_ptr<const PreparedMould> mould) {
+  Impl& d = *d_;
+  if (!mould || !mould->outer || !mould->inner) {
+    d.mould_outer.show(nullptr, nullptr);
+    d.mould_inner.show(nullptr, nullptr);
+    update();
+    return;
+  }
+  const Eigen::Vector3d axis = mould->mould->axis;
+  d.mould_outer.show_polydata(mould->outer.Get(), mould->outer, mould);
+  d.mould_inner.show_polydata(mould->inner.Get(), mould->inner, mould);
+  d.mould_outer.set_motion({Eigen::Matrix3d::Identity(), mould->apart * axis});
+  d.mould_inner.set_motion({Eigen::Matrix3d::Identity(), -mould->apart * axis});
   // Seen from the side, across the pull (the side nearest the present view), pull upwards.
   vtkCamera* camera = d.renderer->GetActiveCamera();
   Eigen::Vector3d toward;
   camera->GetDirectionOfProjection(toward.data());
-  toward -= toward.dot(d.mould->axis) * d.mould->axis;
-  if (toward.norm() < 1e-6) toward = d.mould->axis.unitOrthogonal();
+  toward -= toward.dot(axis) * axis;
+  if (toward.norm() < 1e-6) toward = axis.unitOrthogonal();
   toward.normalize();
   const Eigen::Vector3d centre =
-      0.5 * (vertex_centroid(d.mould->inner) + vertex_centroid(d.mould->outer));
+      0.5 * (vertex_centroid(mould->mould->inner) + vertex_centroid(mould->mould->outer));
   const Eigen::Vector3d eye = centre - 100.0 * toward;
   camera->SetFocalPoint(centre.x(), centre.y(), centre.z());
   camera->SetPosition(eye.x(), eye.y(), eye.z());
-  camera->SetViewUp(d.mould->axis.x(), d.mould->axis.y(), d.mould->axis.z());
+  camera->SetViewUp(axis.x(), axis.y(), axis.z());
   double bounds[6], inner[6];
   d.mould_outer.actor->GetBounds(bounds);
   d.mould_inner.actor->GetBounds(inner);

@@ -64,9 +64,15 @@ class SkullView : public QOpenGLWidget {
   /// near it by its gap to the implant, each with a legend.
   void set_thickness_map(const SkullMesh* implant, std::shared_ptr<const ThicknessMap> map);
   void set_thickness_visible(bool visible);
+  /// A casting mould made ready for drawing: its halves turned into VTK's meshes, which takes
+  /// a few tenths of a second for a real mould, so it is done on the worker that made it.
+  struct PreparedMould;
+  static std::shared_ptr<const PreparedMould> prepare_mould(
+      std::shared_ptr<const MouldResult> mould);
+  static const MouldResult& result_of(const PreparedMould& prepared);
   /// A casting mould of the implant shown (none: hidden): its two halves drawn translucent,
   /// opened apart along their pull so the implant shows between them.
-  void set_mould(std::shared_ptr<const MouldResult> mould);
+  void set_mould(std::shared_ptr<const PreparedMould> mould);
   bool mould_shown() const;
   /// Whether the thickness map is drawn now.
   bool thickness_shown() const;
