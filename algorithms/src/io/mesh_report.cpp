@@ -18,7 +18,7 @@ namespace cranioplan {
 namespace {
 
 // The least span of a loop taken for a cut at the border (a scan's end crosses at least the
-// vault's cap); smaller flat loops at the border are holes.
+// vault's cap); a smaller loop is part of a cut only by lying in that cut's plane.
 constexpr double kCutSpanMm = 30.0;
 // A cut's plane lies this near the mesh's end along its normal (mm), and is taken as an axis's
 // plane within this angle of it (degrees).
