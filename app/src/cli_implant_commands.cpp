@@ -245,7 +245,7 @@ Subcommand add_smooth(CLI::App& app, const bool& json) {
 // implant
 Subcommand add_implant(CLI::App& app, const bool& json) {
   struct Opts {
-    std::string skull, mirrored, markers, output, method = "shell";
+    std::string skull, mirrored, markers, plane, output, method = "shell";
     ImplantParams params;
     MaterialOptions material;
     HoleOptions holes;
@@ -277,10 +277,15 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
   add_material_options(cmd, o->material);
   add_hole_options(cmd, o->holes);
   add_tab_options(cmd, o->tabs);
+  cmd->add_option("--plane", o->plane,
+                  "the midsagittal plane (JSON {normal, offset_mm}, as `plane -o` writes): tabs "
+                  "keep --tab-midline-distance from it");
   cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
   return Subcommand{
       cmd, [o, &json] {
         const std::vector<Marker> raw = read_markers_file(o->markers);
+        const std::optional<Plane> midline =
+            o->plane.empty() ? std::nullopt : std::optional<Plane>(read_plane_file(o->plane));
         const LoadedSkull loaded = load_skull(o->skull);
         const SkullMesh& skull = loaded.mesh;
         const SurfaceLocator skull_surface(skull);
@@ -299,6 +304,7 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
         o->params.clearance_zones = zones_from(o->material);
         o->params.perforations = perforations_from(o->holes);
         o->params.tabs = tabs_from(o->tabs, o->params.material);
+        if (o->params.tabs.any()) o->params.tabs.midline = midline;
         const ImplantResult r = build_implant(snapped.markers, &skull, o->params);
         Json j = implant_json(r);
         j["method"] = o->method;

@@ -292,6 +292,40 @@ TEST(Cli, AutoplanWithFixationTabs) {
       << "two screws need a longer tab";
 }
 
+// `implant` from a plan's markers with tabs: with the midsagittal plane given (--plane), every
+// tab keeps the distance asked from it; without it, no distance is kept or reported.
+TEST(Cli, ImplantTabsKeepOffTheMidlineOfAPlaneGiven) {
+  test::TempDir dir;
+  write_mesh(test::thick_head_defect().defective, dir.path("skull.stl"));
+  std::string out;
+  ASSERT_EQ(test::run_command(kCli + " autoplan " + dir.path("skull.stl") + " -o " +
+                                  dir.path("a.stl") + " --markers-out " + dir.path("m.json"),
+                              &out),
+            0)
+      << out;
+  // Its edge markers (the surface markers lie on the mirror, not given here).
+  Json markers = Json::parse(test::read_bytes(dir.path("m.json")));
+  Json edges = Json::array();
+  for (const Json& m : markers["markers"])
+    if (m["type"].get<int>() <= 1) edges.push_back(m);
+  markers["markers"] = edges;
+  test::write_bytes(dir.path("e.json"), markers.dump());
+  // The thick head's midsagittal plane is x = 0.
+  test::write_bytes(dir.path("plane.json"), R"({"normal":[1,0,0],"offset_mm":0})");
+  const std::string implant = kCli + " implant --json --skull " + dir.path("skull.stl") +
+                              " --markers " + dir.path("e.json") +
+                              " --fit-to-bone 4 --material peek --tabs --tab-count 4" +
+                              " --tab-midline-distance 12 -o " + dir.path("i.stl");
+  ASSERT_EQ(test::run_command(implant + " --plane " + dir.path("plane.json"), &out), 0) << out;
+  const Json with = Json::parse(out);
+  ASSERT_EQ(with["tabs"].size(), 4u) << out;
+  EXPECT_GE(with["quality"]["tab_midline_mm"].get<double>(), 12.0) << out;
+  EXPECT_TRUE(with["quality"]["printable"].get<bool>()) << out;
+  ASSERT_EQ(test::run_command(implant, &out), 0) << out;
+  EXPECT_FALSE(Json::parse(out)["quality"].contains("tab_midline_mm")) << out;
+  EXPECT_EQ(test::run_command(implant + " --plane " + dir.path("missing.json"), &out), 3);
+}
+
 TEST(Cli, StudyInjectsPlansAndScoresDefects) {
   test::TempDir dir;
   write_mesh(test::make_thick_head(), dir.path("thick.stl"));
