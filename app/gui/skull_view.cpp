@@ -880,36 +880,28 @@ std::optional<Eigen::Vector3d> SkullView::pick(const QPoint& position, PickTarge
 
 namespace {
 
-int marker_near(SkullView& view, const std::vector<Marker>& markers, const QPoint& at) {
-  int best = 0;
+// The item drawn nearest `at` on the screen, within 10 pixels (markers by their position,
+// handles by theirs); none: nullptr.
+template <class Item>
+const Item* drawn_near(SkullView& view, const std::vector<Item>& items, const QPoint& at) {
+  const Item* best = nullptr;
   double best_d2 = 10.0 * 10.0;
-  for (const auto& m : markers) {
-    const auto p = view.project(m.position);
+  for (const Item& item : items) {
+    const auto p = view.project(item.position);
     if (!p) continue;
     const double dx = p->x() - at.x(), dy = p->y() - at.y();
     if (dx * dx + dy * dy < best_d2) {
       best_d2 = dx * dx + dy * dy;
-      best = m.id;
+      best = &item;
     }
   }
   return best;
 }
 
-// The handle drawn nearest `at`, within 10 pixels.
-const SkullView::Handle* handle_near(SkullView& view, const std::vector<SkullView::Handle>& handles,
-                                     const QPoint& at) {
-  const SkullView::Handle* best = nullptr;
-  double best_d2 = 10.0 * 10.0;
-  for (const auto& h : handles) {
-    const auto p = view.project(h.position);
-    if (!p) continue;
-    const double dx = p->x() - at.x(), dy = p->y() - at.y();
-    if (dx * dx + dy * dy < best_d2) {
-      best_d2 = dx * dx + dy * dy;
-      best = &h;
-    }
-  }
-  return best;
+// The id of the marker drawn nearest `at`, within 10 pixels; 0 for none.
+int marker_near(SkullView& view, const std::vector<Marker>& markers, const QPoint& at) {
+  const Marker* m = drawn_near(view, markers, at);
+  return m ? m->id : 0;
 }
 
 }  // namespace
@@ -949,7 +941,7 @@ void SkullView::mousePressEvent(QMouseEvent* e) {
     }
   }
   if (e->button() == Qt::LeftButton) {
-    if (const Handle* h = handle_near(*this, d.handles, pos)) {
+    if (const Handle* h = drawn_near(*this, d.handles, pos)) {
       d.handle_id = h->id;
       d.handle_at.reset();
       return;

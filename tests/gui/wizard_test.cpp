@@ -668,20 +668,26 @@ TEST(WizardThickness, TheThicknessMapColoursTheImplantAndTheBoneAroundIt) {
   EXPECT_FALSE(w.view().thickness_shown());
 }
 
+// A window showing the planned sample case at `step`, for the tests that edit its implant.
+void open_planned_at_step(MainWindow& w, int step, const QSize& size) {
+  w.set_interactive(false);
+  w.resize(size);
+  w.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&w));
+  ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
+  w.controller().push(commands::go_to_step(step));
+  w.controller().wait();
+  ASSERT_EQ(w.controller().state().current_step, step);
+}
+
 // Step 7's perforations in the whole wizard: a pattern built, a hole added by a click on the
 // implant, one dragged over it, another taken away, each a build that undo takes back and
 // redo does again.
 TEST(WizardHoles, HolesAreAddedDraggedAndRemovedWithUndo) {
   MainWindow w;
-  w.set_interactive(false);
-  w.resize(1500, 950);
-  w.show();
-  ASSERT_TRUE(QTest::qWaitForWindowExposed(&w));
-  ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
+  open_planned_at_step(w, 7, QSize(1500, 950));
+  if (HasFatalFailure()) return;
   PlanController& plan = w.controller();
-  plan.push(commands::go_to_step(7));
-  plan.wait();
-  ASSERT_EQ(plan.state().current_step, 7);
   child<QCheckBox>(w, "perforate")->setChecked(true);
   child<QDoubleSpinBox>(w, "holeSpacing")->setValue(12);
   click(w, "build");
@@ -769,15 +775,9 @@ TEST(WizardHoles, HolesAreAddedDraggedAndRemovedWithUndo) {
 // each a build that undo and redo step through.
 TEST(WizardTabs, TabsAreDraggedRemovedAndAddedWithUndo) {
   MainWindow w;
-  w.set_interactive(false);
-  w.resize(1500, 950);
-  w.show();
-  ASSERT_TRUE(QTest::qWaitForWindowExposed(&w));
-  ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
+  open_planned_at_step(w, 7, QSize(1500, 950));
+  if (HasFatalFailure()) return;
   PlanController& plan = w.controller();
-  plan.push(commands::go_to_step(7));
-  plan.wait();
-  ASSERT_EQ(plan.state().current_step, 7);
   child<QCheckBox>(w, "tabs")->setChecked(true);
   click(w, "build");
   plan.wait();
@@ -843,15 +843,9 @@ TEST(WizardTabs, TabsAreDraggedRemovedAndAddedWithUndo) {
 // and shown opened apart with the implant alone; hidden again in another step.
 TEST(WizardMould, TheMouldIsShownOpenedApartInStep9) {
   MainWindow w;
-  w.set_interactive(false);
-  w.resize(1280, 800);
-  w.show();
-  ASSERT_TRUE(QTest::qWaitForWindowExposed(&w));
-  ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
+  open_planned_at_step(w, 9, QSize(1280, 800));
+  if (HasFatalFailure()) return;
   PlanController& plan = w.controller();
-  plan.push(commands::go_to_step(9));
-  plan.wait();
-  ASSERT_EQ(plan.state().current_step, 9);
   ASSERT_TRUE(plan.state().implant);
   const auto mould_pixels = [&] {  // the halves' light blue
     QTest::qWait(50);
