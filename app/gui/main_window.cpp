@@ -135,7 +135,8 @@ MainWindow::MainWindow(QWidget* parent)
     progress_->setVisible(busy);
     cancel_->setVisible(busy);
     if (busy) show_message(what + QStringLiteral("…"), false);
-    pages_->setEnabled(!busy);
+    // While a marker edit is computed the hand goes on: the next edits queue.
+    pages_->setEnabled(!busy || controller_->editing());
   });
   connect(view_, &SkullView::surfaceClicked, this, &MainWindow::on_surface_clicked);
   connect(view_, &SkullView::handleDropped, this, [this](int id, const Eigen::Vector3d& p) {
@@ -151,6 +152,10 @@ MainWindow::MainWindow(QWidget* parent)
   connect(slices_, &SlicePanel::cursorMoved, view_,
           [this](const Eigen::Vector3d& p) { view_->set_cursor(p); });
   connect(view_, &SkullView::markerDragged, this, &MainWindow::on_marker_dragged);
+  connect(view_, &SkullView::markerDragging, this, [this](int id, const Eigen::Vector3d& p) {
+    if (auto preview = controller_->preview_edit(commands::move_marker(id, p)))
+      view_->show_state(*preview);
+  });
   connect(view_, &SkullView::markerClicked, this, [this](int id) {
     show_message(tr("Marker %1 selected (Del deletes it, drag moves it).").arg(id), false);
   });
@@ -664,8 +669,8 @@ void MainWindow::build_plan_dock() {
 
 void MainWindow::refresh() {
   const PlanState& s = controller_->state();
-  if (!controller_->read_only()) view_->show_state(s);
-  if (layout_ != Layout::ThreeD) slices_->show_state(s);
+  if (!controller_->read_only()) view_->show_state(controller_->shown_state());
+  if (layout_ != Layout::ThreeD) slices_->show_state(controller_->shown_state());
   // A new proposal: turn to the defect it found.
   if (s.proposal_message != last_proposal_) {
     last_proposal_ = s.proposal_message;
@@ -780,7 +785,9 @@ struct MainWindow::QualityView {
 
 void MainWindow::show_quality() {
   const PlanState& s = controller_->state();
-  if (!s.implant) return;
+  // Marker edits still computed: the report waits for the implant they leave (the last one's
+  // finish refreshes it), rather than take the core from them.
+  if (!s.implant || controller_->editing()) return;
   // The report (a few tenths of a second on a real skull) and, with the plan's CT at hand, the
   // soft tissue under the implant are computed on a worker thread: the window stays live.
   const std::shared_ptr<const ImplantData> implant = s.implant;
@@ -890,10 +897,7 @@ void MainWindow::show_message(const QString& text, bool problem) {
 // Actions
 
 void MainWindow::push(Command command, const QString& what) {
-  if (PlanController::is_long(command))
-    controller_->push_async(std::move(command), what.isEmpty() ? q(describe(command)) : what);
-  else
-    controller_->push(std::move(command));
+  controller_->submit(std::move(command), what);
 }
 
 void MainWindow::set_marker_type(MarkerType type) {
@@ -1229,6 +1233,8 @@ QImage MainWindow::screenshot() {
 }
 
 void MainWindow::closeEvent(QCloseEvent* event) {
+  // Marker edits are the user's work: they are finished, a long computation is cancelled.
+  if (controller_->editing()) controller_->wait();
   if (controller_->busy()) controller_->cancel();
   if (!confirm_discard()) {
     event->ignore();

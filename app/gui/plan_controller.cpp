@@ -4,6 +4,7 @@
 #include <QFutureWatcher>
 #include <QtConcurrent/QtConcurrentRun>
 
+#include "cranioplan/algorithms/implant/build_implant.h"
 #include "cranioplan/model/error.h"
 
 namespace cranioplan::gui {
@@ -27,7 +28,31 @@ void PlanController::set_session(Session session) {
   emit stateChanged();
 }
 
-bool PlanController::is_long(const Command& c) {
+namespace {
+
+// `command` applied to `base` with the implant rebuilt as its quick preview; none when the
+// command is refused there.
+std::shared_ptr<const PlanState> quick_apply(const PlanState& base, const Command& command,
+                                             const ApplyContext& context) {
+  PlanState copy = base;
+  if (copy.implant_params) copy.implant_params = live_preview_params(*copy.implant_params);
+  try {
+    ApplyOutcome out = apply_command(copy, command, context);
+    if (!out.accepted) return nullptr;
+    return std::make_shared<const PlanState>(std::move(out.state));
+  } catch (const Error&) {
+    return nullptr;
+  }
+}
+
+}  // namespace
+
+bool PlanController::is_marker_edit(const Command& c) {
+  return c.type == CommandType::AddMarker || c.type == CommandType::MoveMarker ||
+         c.type == CommandType::DeleteMarker || c.type == CommandType::RetypeMarker;
+}
+
+bool PlanController::is_long(const Command& c, const PlanState& state) {
   switch (c.type) {
     case CommandType::LoadSkull:
     case CommandType::AttachCt:
@@ -42,6 +67,13 @@ bool PlanController::is_long(const Command& c) {
       return true;
     case CommandType::ExportImplant:  // a mould takes seconds
       return c.params.contains("mould");
+    case CommandType::AddMarker:  // the implant follows the markers: fitted, in a second
+    case CommandType::MoveMarker:
+    case CommandType::DeleteMarker:
+    case CommandType::RetypeMarker:
+    case CommandType::ImportMarkers:
+    case CommandType::ClearMarkers:
+      return state.implant_params && state.implant_params->fit_to_bone_mm > 0.0;
     default:
       return false;
   }
@@ -90,6 +122,8 @@ void PlanController::push_async(Command command, const QString& what) {
     return;
   }
   cancelled_ = false;
+  running_edit_ = is_marker_edit(running_.command);
+  if (running_edit_) intent_ = quick_apply(state(), running_.command, session_->context());
   watcher_ = new QFutureWatcher<Computed>(this);
   connect(watcher_, &QFutureWatcher<Computed>::finished, this, &PlanController::finish);
   std::shared_ptr<const PlanState> state = session_->shared_state();
@@ -109,27 +143,89 @@ void PlanController::push_async(Command command, const QString& what) {
   emit busyChanged(true, what);
 }
 
+void PlanController::submit(Command command, const QString& what) {
+  if (read_only_) {
+    emit refused(tr("This plan is open for audit only."));
+    return;
+  }
+  if (editing()) {
+    if (is_marker_edit(command))
+      if (auto next = quick_apply(shown_state(), command, session_->context()))
+        intent_ = std::move(next);
+    queue_.push_back({std::move(command), what});
+    emit stateChanged();
+    return;
+  }
+  start(std::move(command), what);
+}
+
+void PlanController::start(Command command, const QString& what) {
+  if (is_long(command, state()))
+    push_async(std::move(command),
+               what.isEmpty() ? QString::fromStdString(describe(command)) : what);
+  else
+    push(std::move(command));
+}
+
+void PlanController::start_queued() {
+  while (!busy() && !queue_.empty()) {
+    Queued next = std::move(queue_.front());
+    queue_.pop_front();
+    start(std::move(next.command), next.what);
+  }
+}
+
+void PlanController::update_intent() {
+  intent_.reset();
+  if (!editing()) return;
+  std::shared_ptr<const PlanState> at;
+  auto add = [&](const Command& c) {
+    if (!is_marker_edit(c)) return;
+    if (auto next = quick_apply(at ? *at : state(), c, session_->context())) at = std::move(next);
+  };
+  if (!cancelled_) add(running_.command);
+  for (const Queued& q : queue_) add(q.command);
+  intent_ = std::move(at);
+}
+
+const PlanState& PlanController::shown_state() const {
+  return intent_ && busy() ? *intent_ : state();
+}
+
+std::shared_ptr<const PlanState> PlanController::preview_edit(const Command& command) {
+  return quick_apply(shown_state(), command, session_->context());
+}
+
 void PlanController::finish() {
   Computed c = watcher_->result();
   watcher_->deleteLater();
   watcher_ = nullptr;
   const bool cancelled = cancelled_;
-  emit busyChanged(false, QString());
-  if (cancelled) return;
-  if (!c.error.empty()) {
-    emit failed(QString::fromStdString(c.error));
-    return;
+  running_edit_ = false;
+  if (!cancelled) {
+    if (!c.error.empty()) {
+      emit failed(QString::fromStdString(c.error));
+    } else {
+      const PushResult r = session_->commit(running_, std::move(c.outcome));
+      if (!r.accepted) emit refused(QString::fromStdString(r.message));
+    }
   }
-  const PushResult r = session_->commit(running_, std::move(c.outcome));
-  if (!r.accepted) {
-    emit refused(QString::fromStdString(r.message));
-    return;
+  // The next queued command starts on the plan as this one left it (a refused or failed edit
+  // leaves the plan as it was; those queued after it still run).
+  start_queued();
+  if (!busy()) {
+    intent_.reset();
+    emit busyChanged(false, QString());
   }
   emit stateChanged();
 }
 
 void PlanController::cancel() {
-  if (busy()) cancelled_ = true;
+  if (!busy()) return;
+  cancelled_ = true;
+  queue_.clear();
+  update_intent();
+  emit stateChanged();
 }
 
 void PlanController::wait() {
@@ -147,7 +243,17 @@ std::shared_ptr<const PlanState> PlanController::preview(const Command& command)
 }
 
 void PlanController::undo() {
-  if (busy() || read_only_) return;
+  if (read_only_) return;
+  if (editing()) {  // the last edit given: queued, or the one being computed
+    if (!queue_.empty())
+      queue_.pop_back();
+    else
+      cancelled_ = true;
+    update_intent();
+    emit stateChanged();
+    return;
+  }
+  if (busy()) return;
   if (session_->undo()) emit stateChanged();
 }
 
@@ -163,6 +269,7 @@ void PlanController::set_index(size_t index) {
 }
 
 void PlanController::save(const QString& path) {
+  if (editing()) wait();  // the marker edits given so far are part of what is saved
   try {
     session_->save(path.toStdString());
     read_only_ = false;

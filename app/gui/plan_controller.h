@@ -4,6 +4,7 @@
 // vtkSMUndoStack: Qt signals around a session that knows nothing of Qt.
 #include <QObject>
 #include <QString>
+#include <deque>
 #include <memory>
 
 #include "cranioplan/sessions/session.h"
@@ -40,17 +41,35 @@ class PlanController : public QObject {
   /// Runs a long command off the GUI thread; `busyChanged` brackets it. While busy, other
   /// pushes are refused.
   void push_async(Command command, const QString& what);
-  /// Commands that take long enough to run off the GUI thread.
-  static bool is_long(const Command& command);
+  /// The window's way in: runs the command now, or off the GUI thread when it is long in this
+  /// state. While a marker edit is computed, further commands wait their turn in order (the
+  /// hand goes on editing) and are refused otherwise.
+  void submit(Command command, const QString& what = QString());
+  /// Commands that take long enough to run off the GUI thread: the long ones, and marker edits
+  /// in a plan whose implant is fitted to the bone (each rebuilds it).
+  static bool is_long(const Command& command, const PlanState& state);
+  /// Adding, moving, deleting or retyping a marker.
+  static bool is_marker_edit(const Command& command);
   bool busy() const { return watcher_ != nullptr; }
-  /// Drops the running computation's result: the plan stays as it was.
+  /// A marker edit is being computed (the window stays usable; further edits queue).
+  bool editing() const { return busy() && running_edit_; }
+  size_t queued() const { return queue_.size(); }
+  /// Drops the running computation's result: the plan stays as it was. Queued edits go too.
   void cancel();
   /// Waits (processing events) until no computation runs; for tests and the command line.
   void wait();
 
   /// The state the command would give, without recording it (live previews).
   std::shared_ptr<const PlanState> preview(const Command& command);
+  /// The same with the implant rebuilt quickly (live_preview_params: no fit to the bone),
+  /// from what the view shows: for a marker while it is dragged.
+  std::shared_ptr<const PlanState> preview_edit(const Command& command);
+  /// What the view shows: the plan, or while marker edits are computed and queued, the plan
+  /// as they will leave it with the implant previewed (the fitted one follows).
+  const PlanState& shown_state() const;
 
+  /// While marker edits are computed, undo takes back the last of them (queued, or the running
+  /// one) instead of waiting.
   void undo();
   void redo();
   void set_index(size_t index);
@@ -65,10 +84,21 @@ class PlanController : public QObject {
 
  private:
   void finish();
+  void start(Command command, const QString& what);
+  void start_queued();
+  /// The previews of the running and queued edits, from the plan as it stands.
+  void update_intent();
 
+  struct Queued {
+    Command command;
+    QString what;
+  };
   std::unique_ptr<Session> session_;
   QFutureWatcher<Computed>* watcher_ = nullptr;
   PreparedCommand running_;
+  bool running_edit_ = false;
+  std::deque<Queued> queue_;
+  std::shared_ptr<const PlanState> intent_;  ///< shown while edits are computed
   bool cancelled_ = false;
   bool read_only_ = false;
 };

@@ -307,6 +307,7 @@ struct SkullView::Impl {
   bool mirror_wanted = true, plane_wanted = true, markers_editable = false, camera_set = false;
   PickTarget target = PickTarget::None;
   int selected_id = 0, drag_id = 0;
+  std::optional<Eigen::Vector3d> drag_to;  // where the dragged marker is, while dragged
   std::vector<Handle> handles;
   int handle_id = 0;                         // the handle pressed on (0: none)
   std::optional<Eigen::Vector3d> handle_at;  // where it has been dragged to
@@ -936,6 +937,7 @@ void SkullView::mousePressEvent(QMouseEvent* e) {
   if (e->button() == Qt::LeftButton && d.markers_editable) {
     if (const int id = marker_near(*this, d.markers, pos)) {
       d.drag_id = id;
+      d.drag_to.reset();
       set_selected_marker(id);
       return;
     }
@@ -964,7 +966,10 @@ void SkullView::mouseMoveEvent(QMouseEvent* e) {
         pos, m->surface == MarkerSurface::Mirrored ? PickTarget::Mirrored : PickTarget::Original);
     // A drag slides along the surface: a pick that jumps (through the opening onto the far
     // wall, or off the skull's silhouette) is not followed.
-    if (p && (*p - m->position).norm() < 20.0) emit markerDragged(d.drag_id, *p);
+    if (p && (*p - d.drag_to.value_or(m->position)).norm() < 20.0) {
+      d.drag_to = *p;
+      emit markerDragging(d.drag_id, *p);
+    }
     return;
   }
   if (d.handle_id) {
@@ -994,11 +999,14 @@ void SkullView::mouseReleaseEvent(QMouseEvent* e) {
   const QPoint pos = e->position().toPoint();
   if (d.drag_id) {
     const int id = d.drag_id;
+    const std::optional<Eigen::Vector3d> to = d.drag_to;
     d.drag_id = 0;
-    if (d.moved)
-      emit markerDragFinished(id);
-    else
+    d.drag_to.reset();
+    if (d.moved) {
+      if (to) emit markerDragged(id, *to);
+    } else {
       emit markerClicked(id);
+    }
     return;
   }
   if (d.handle_id) {

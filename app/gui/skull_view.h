@@ -90,8 +90,10 @@ class SkullView : public QOpenGLWidget {
   /// A click (not a drag) on the skull, in any step: the slice views go there.
   void pointed(const Eigen::Vector3d& point);
   void markerClicked(int id);
+  /// A marker being dragged is over `point` (on its surface): for a preview.
+  void markerDragging(int id, const Eigen::Vector3d& point);
+  /// A marker dragged and let go at `point`: one move.
   void markerDragged(int id, const Eigen::Vector3d& point);
-  void markerDragFinished(int id);
   void handleDropped(int id, const Eigen::Vector3d& point);
 
  protected:

@@ -839,6 +839,88 @@ TEST(WizardTabs, TabsAreDraggedRemovedAndAddedWithUndo) {
   EXPECT_LT((plan.state().implant->result().tabs[k].rim - moved[k].rim).norm(), 1e-6);
 }
 
+// Markers dragged in a plan fitted to the bone (step 8): while dragged the view previews the
+// implant without the fit, no command is pushed; let go, the move is one command computed off
+// the GUI thread, and the next drags queue behind it instead of waiting; undo takes back the
+// last queued one. The plan ends as the same commands pushed one by one leave it.
+TEST(WizardMarkers, DragsInAFittedPlanQueueOffTheGuiThread) {
+  MainWindow w;
+  open_planned_at_step(w, 8, QSize(1500, 950));
+  if (HasFatalFailure()) return;
+  PlanController& plan = w.controller();
+  ASSERT_TRUE(plan.state().implant && plan.state().implant_params);
+  ASSERT_GT(plan.state().implant_params->fit_to_bone_mm, 0.0) << "an automatic plan is fitted";
+  w.view().look_at_markers();
+  QTest::qWait(50);
+  const std::vector<Marker> before = plan.state().markers;
+  Eigen::Vector3d middle = Eigen::Vector3d::Zero();
+  for (const Marker& m : before) middle += m.position;
+  middle /= static_cast<double>(before.size());
+  // Three surface markers in view, each to be dragged 4 mm towards the markers' middle.
+  struct Drag {
+    Marker marker;
+    QPoint from, to;
+  };
+  std::vector<Drag> drags;
+  for (const Marker& m : before) {
+    if (drags.size() == 3) break;
+    if (m.type != MarkerType::OuterSurface || (m.position - middle).norm() < 10.0) continue;
+    const auto from = w.view().project(m.position);
+    const auto to = w.view().project(m.position + 4.0 * (middle - m.position).normalized());
+    const bool apart = std::all_of(drags.begin(), drags.end(), [&](const Drag& d) {
+      return from && (d.from - *from).manhattanLength() > 30;
+    });
+    if (from && to && apart && (*to - *from).manhattanLength() > 12)
+      drags.push_back({m, *from, *to});
+  }
+  ASSERT_EQ(drags.size(), 3u) << "three surface markers in view";
+  const size_t index = plan.session().index();
+  const auto position = [](const PlanState& s, int id) {
+    for (const Marker& m : s.markers)
+      if (m.id == id) return m.position;
+    return Eigen::Vector3d(Eigen::Vector3d::Constant(std::nan("")));
+  };
+
+  // The first drag: moves preview, the drop is computed off the GUI thread.
+  mouse(&w.view(), QEvent::MouseButtonPress, drags[0].from, Qt::LeftButton);
+  for (int k = 1; k <= 12; ++k)
+    mouse(&w.view(), QEvent::MouseMove, drags[0].from + (drags[0].to - drags[0].from) * k / 12,
+          Qt::LeftButton);
+  EXPECT_EQ(plan.session().index(), index) << "no command while the marker is dragged";
+  mouse(&w.view(), QEvent::MouseButtonRelease, drags[0].to, Qt::NoButton);
+  EXPECT_TRUE(plan.editing()) << "the fitted rebuild runs off the GUI thread";
+  const int a = drags[0].marker.id;
+  const Eigen::Vector3d dropped_a = position(plan.shown_state(), a);
+  EXPECT_GT((dropped_a - drags[0].marker.position).norm(), 1.5) << "the view shows the drop";
+  EXPECT_LT((position(plan.state(), a) - drags[0].marker.position).norm(), 1e-9);
+
+  // Two more while the first is computed: they queue; undo takes back the last.
+  drag_view(w.view(), drags[1].from, drags[1].to);
+  drag_view(w.view(), drags[2].from, drags[2].to);
+  EXPECT_EQ(plan.queued(), 2u);
+  const int b = drags[1].marker.id, c = drags[2].marker.id;
+  const Eigen::Vector3d dropped_b = position(plan.shown_state(), b);
+  EXPECT_GT((position(plan.shown_state(), c) - drags[2].marker.position).norm(), 1.5);
+  plan.undo();
+  EXPECT_EQ(plan.queued(), 1u);
+  EXPECT_LT((position(plan.shown_state(), c) - drags[2].marker.position).norm(), 1e-9);
+  plan.wait();
+
+  EXPECT_EQ(plan.session().index(), index + 2) << "two moves, one command each";
+  EXPECT_EQ(&plan.shown_state(), &plan.state());
+  EXPECT_LT((position(plan.state(), a) - dropped_a).norm(), 1e-9);
+  EXPECT_LT((position(plan.state(), b) - dropped_b).norm(), 1e-9);
+  EXPECT_LT((position(plan.state(), c) - drags[2].marker.position).norm(), 1e-9);
+  ASSERT_TRUE(plan.state().implant) << plan.state().message;
+  // The same two moves pushed one by one: the same implant, byte for byte.
+  Session direct = Session::open(test::planned_defect_case().session_path);
+  direct.push(commands::go_to_step(8));
+  ASSERT_TRUE(direct.push(commands::move_marker(a, dropped_a)).accepted);
+  ASSERT_TRUE(direct.push(commands::move_marker(b, dropped_b)).accepted);
+  ASSERT_TRUE(direct.state().implant);
+  EXPECT_EQ(direct.state().implant->stl_sha256(), plan.state().implant->stl_sha256());
+}
+
 // Step 9's "3MF with a casting mould": the mould the export would hold, made off the GUI thread
 // and shown opened apart with the implant alone; hidden again in another step.
 TEST(WizardMould, TheMouldIsShownOpenedApartInStep9) {

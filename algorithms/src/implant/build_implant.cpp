@@ -856,4 +856,17 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
   return r;
 }
 
+ImplantParams live_preview_params(ImplantParams params) {
+  params.fit_to_bone_mm = 0.0;
+  params.clearance_zones.clear();
+  params.tabs = TabParams{};
+  params.perforations = PerforationParams{};
+  if (params.material) {
+    params.material->edge_clearance_mm = 0.0;
+    params.material->under_contour_mm = 0.0;
+    params.material->onlay_mm = 0.0;
+  }
+  return params;
+}
+
 }  // namespace cranioplan

@@ -268,6 +268,37 @@ TEST(BuildImplant, FinishingWithoutTheFitToTheBoneIsRefused) {
             std::string::npos);
 }
 
+// The preview while a marker is dragged: every finishing a full build would do is left out, so
+// it builds where the finished implant builds, as the shell through the same markers with the
+// material's thickness.
+TEST(BuildImplant, TheLivePreviewIsTheShellThroughTheSameMarkers) {
+  const DefectCase& c = right_parietal_case();
+  ImplantParams full;
+  full.fit_to_bone_mm = 4.0;
+  full.material = peek_with(1.0, 0.5);
+  full.material->thickness_mm = 4.0;
+  full.clearance_zones.push_back(ClearanceZone{c.markers.front().position, 10.0, 2.0});
+  full.tabs.automatic = true;
+  full.perforations.pattern = true;
+  const ImplantParams live = live_preview_params(full);
+  EXPECT_EQ(live.fit_to_bone_mm, 0.0);
+  EXPECT_TRUE(live.clearance_zones.empty());
+  EXPECT_FALSE(live.tabs.any());
+  EXPECT_FALSE(live.perforations.any());
+  ASSERT_TRUE(live.material);
+  EXPECT_EQ(live.material->thickness_mm, 4.0);
+  EXPECT_EQ(live.material->min_thickness_mm, full.material->min_thickness_mm);
+  const ImplantResult preview = build_implant(c.markers, &c.defective, live);
+  ASSERT_TRUE(preview.usable()) << preview.message;
+  EXPECT_TRUE(preview.watertight);
+  ImplantParams shell;  // the same material, nothing to finish
+  shell.material = peek_with(0.0, 0.0);
+  shell.material->thickness_mm = 4.0;
+  const ImplantResult plain = build_implant(c.markers, &c.defective, shell);
+  ASSERT_TRUE(plain.usable()) << plain.message;
+  EXPECT_NEAR(report_mesh(preview.mesh).volume_mm3, report_mesh(plain.mesh).volume_mm3, 1e-6);
+}
+
 // Tabs need the skull they lie on and the shell; a plate laid on the bone has none.
 TEST(BuildImplant, TabsWithoutTheSkullOrOnAPlateAreRefused) {
   const DefectCase& c = right_parietal_case();

@@ -98,4 +98,10 @@ class SurfaceLocator;
 ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh* skull,
                             const SurfaceLocator* skull_locator, const ImplantParams& params);
 
+/// The parameters of a quick preview of the same implant, for the view while a marker is being
+/// dragged: the same method, surfaces and thickness, without the fit to the bone and what needs
+/// it (edge clearance, clearance zones, under-contour, onlay) or comes after it (tabs, holes).
+/// On the sample: about 15 ms where the fitted implant takes a second.
+ImplantParams live_preview_params(ImplantParams params);
+
 }  // namespace cranioplan
