@@ -45,37 +45,86 @@ void lower_envelope(const double* f, double* d, int n, std::vector<int>& v,
 
 }  // namespace
 
-std::vector<float> distance_to_mask(const std::vector<uint8_t>& mask, const VoxelGrid& grid) {
+namespace {
+
+// The squared distances (voxel units) of every voxel to the mask, in `T`: float when every
+// squared distance in the grid is an integer float holds exactly (below 2^24), else double;
+// the same values either way. Lines along x are contiguous; along y and z they are taken 16
+// neighbours in x at a time, so each cache line read serves 16 lines.
+template <class T>
+std::vector<float> distance_in(const std::vector<uint8_t>& mask, const VoxelGrid& grid) {
   const int dims[3] = {grid.dims[0], grid.dims[1], grid.dims[2]};
-  std::vector<double> sq(mask.size());
-  for (size_t c = 0; c < mask.size(); ++c) sq[c] = mask[c] ? 0.0 : kFar;
+  const T far = static_cast<T>(kFar);
+  std::vector<T> sq(mask.size());
+  for (size_t c = 0; c < mask.size(); ++c) sq[c] = mask[c] ? T(0) : far;
   const int longest = std::max({dims[0], dims[1], dims[2]});
   const size_t stride[3] = {1, static_cast<size_t>(dims[0]),
                             static_cast<size_t>(dims[0]) * dims[1]};
+  constexpr int kTile = 16;
   for (int axis = 0; axis < 3; ++axis) {
-    const int a = (axis + 1) % 3, b = (axis + 2) % 3;
-    // The lines along the axis are independent: each thread takes a range of them.
+    const int n = dims[axis];
+    // The lines along the axis are independent: each thread takes a range of them, by the
+    // dimension that is neither the axis nor x (by z for lines along x).
+    const int across = axis == 2 ? 1 : 2;
+    const int along_x = axis == 0 ? 1 : 0;  // the other dimension the lines are indexed by
     parallel_for(
-        static_cast<size_t>(dims[b]),
+        static_cast<size_t>(dims[across]),
         [&](size_t first, size_t last) {
           std::vector<double> line(longest), out(longest);
           std::vector<int> v(longest);
           std::vector<double> z(longest + 1);
-          for (size_t j = first; j < last; ++j)
-            for (int i = 0; i < dims[a]; ++i) {
-              const size_t base = i * stride[a] + j * stride[b];
-              for (int q = 0; q < dims[axis]; ++q) line[q] = sq[base + q * stride[axis]];
-              lower_envelope(line.data(), out.data(), dims[axis], v, z);
-              for (int q = 0; q < dims[axis]; ++q) sq[base + q * stride[axis]] = out[q];
+          std::vector<T> tile(static_cast<size_t>(kTile) * longest);
+          for (size_t o = first; o < last; ++o)
+            for (int x0 = 0; x0 < dims[along_x]; x0 += kTile) {
+              const int w = std::min(kTile, dims[along_x] - x0);
+              const size_t base = o * stride[across] + x0 * stride[along_x];
+              if (axis == 0) {  // contiguous lines, one at a time
+                for (int t = 0; t < w; ++t) {
+                  T* l = &sq[base + t * stride[along_x]];
+                  for (int q = 0; q < n; ++q) line[q] = l[q];
+                  lower_envelope(line.data(), out.data(), n, v, z);
+                  for (int q = 0; q < n; ++q) l[q] = static_cast<T>(out[q]);
+                }
+                continue;
+              }
+              for (int q = 0; q < n; ++q) {
+                const T* row = &sq[base + q * stride[axis]];
+                for (int t = 0; t < w; ++t) tile[t * static_cast<size_t>(n) + q] = row[t];
+              }
+              for (int t = 0; t < w; ++t) {
+                T* l = &tile[t * static_cast<size_t>(n)];
+                for (int q = 0; q < n; ++q) line[q] = l[q];
+                lower_envelope(line.data(), out.data(), n, v, z);
+                for (int q = 0; q < n; ++q) l[q] = static_cast<T>(out[q]);
+              }
+              for (int q = 0; q < n; ++q) {
+                T* row = &sq[base + q * stride[axis]];
+                for (int t = 0; t < w; ++t) row[t] = tile[t * static_cast<size_t>(n) + q];
+              }
             }
         },
         4);
   }
   std::vector<float> d(mask.size());
-  for (size_t c = 0; c < mask.size(); ++c)
-    d[c] = sq[c] >= kFar ? std::numeric_limits<float>::infinity()
-                         : static_cast<float>(grid.spacing * std::sqrt(sq[c]));
+  parallel_for(
+      mask.size(),
+      [&](size_t first, size_t last) {
+        for (size_t c = first; c < last; ++c)
+          d[c] = static_cast<double>(sq[c]) >= kFar
+                     ? std::numeric_limits<float>::infinity()
+                     : static_cast<float>(grid.spacing * std::sqrt(static_cast<double>(sq[c])));
+      },
+      1 << 16);
   return d;
+}
+
+}  // namespace
+
+std::vector<float> distance_to_mask(const std::vector<uint8_t>& mask, const VoxelGrid& grid) {
+  const double largest = double(grid.dims[0]) * grid.dims[0] + double(grid.dims[1]) * grid.dims[1] +
+                         double(grid.dims[2]) * grid.dims[2];
+  return largest < double(1 << 24) ? distance_in<float>(mask, grid)
+                                   : distance_in<double>(mask, grid);
 }
 
 std::vector<float> depth_in_mask(const std::vector<uint8_t>& mask, const VoxelGrid& grid) {
@@ -111,6 +160,126 @@ std::vector<uint8_t> open_by_ball(const std::vector<uint8_t>& mask, const VoxelG
   for (size_t c = 0; c < mask.size(); ++c)
     out[c] = mask[c] && to_centre[c] <= radius + 0.5 * grid.spacing;
   return out;
+}
+
+namespace {
+
+// The squared distance, in voxel units, from voxel (i,j,k) to the nearest voxel of the box
+// within `reach` voxels of it where `site(index, a, b, c)` holds; -1 when there is none. A site
+// outside the box lies (reach + 1)² or more away.
+template <class Site>
+long long nearest_in_box(const VoxelGrid& g, int i, int j, int k, int reach, Site&& site) {
+  long long best = -1;
+  for (int c = std::max(0, k - reach); c <= std::min(g.dims[2] - 1, k + reach); ++c)
+    for (int b = std::max(0, j - reach); b <= std::min(g.dims[1] - 1, j + reach); ++b)
+      for (int a = std::max(0, i - reach); a <= std::min(g.dims[0] - 1, i + reach); ++a) {
+        const long long d2 = static_cast<long long>(a - i) * (a - i) +
+                             static_cast<long long>(b - j) * (b - j) +
+                             static_cast<long long>(c - k) * (c - k);
+        if ((best < 0 || d2 < best) && site(g.index(a, b, c), a, b, c)) best = d2;
+      }
+  return best;
+}
+
+// distance_to_mask's value for a squared distance in voxel units (the same float).
+float distance_value(const VoxelGrid& g, long long squared) {
+  return static_cast<float>(g.spacing * std::sqrt(static_cast<double>(squared)));
+}
+
+// The box half-width beyond which every voxel lies farther than `mm` by at least two voxels.
+int reach_beyond(const VoxelGrid& g, double mm) {
+  return static_cast<int>(std::ceil(mm / g.spacing)) + 1;
+}
+
+void voxel_of(const VoxelGrid& g, size_t c, int& i, int& j, int& k) {
+  i = static_cast<int>(c % g.dims[0]);
+  j = static_cast<int>((c / g.dims[0]) % g.dims[1]);
+  k = static_cast<int>(c / (static_cast<size_t>(g.dims[0]) * g.dims[1]));
+}
+
+}  // namespace
+
+std::vector<uint8_t> within_steps(const std::vector<uint8_t>& in, const VoxelGrid& g, int steps) {
+  const uint8_t cap = static_cast<uint8_t>(std::min(steps + 1, 255));
+  std::vector<uint8_t> d(in.size());
+  for (size_t c = 0; c < in.size(); ++c) d[c] = in[c] ? 0 : cap;
+  const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
+  const size_t sy = static_cast<size_t>(nx), sz = sy * ny;
+  auto relax = [cap](uint8_t& to, uint8_t from) {
+    const uint8_t v = static_cast<uint8_t>(std::min<int>(from + 1, cap));
+    if (v < to) to = v;
+  };
+  // Along x: each row by itself; along y: row by row within a slice (slices on all threads).
+  parallel_for(
+      static_cast<size_t>(nz),
+      [&](size_t first, size_t last) {
+        for (size_t k = first; k < last; ++k) {
+          uint8_t* slice = &d[k * sz];
+          for (int j = 0; j < ny; ++j) {
+            uint8_t* row = slice + j * sy;
+            for (int i = 1; i < nx; ++i) relax(row[i], row[i - 1]);
+            for (int i = nx - 2; i >= 0; --i) relax(row[i], row[i + 1]);
+          }
+          for (int j = 1; j < ny; ++j)
+            for (int i = 0; i < nx; ++i) relax(slice[j * sy + i], slice[(j - 1) * sy + i]);
+          for (int j = ny - 2; j >= 0; --j)
+            for (int i = 0; i < nx; ++i) relax(slice[j * sy + i], slice[(j + 1) * sy + i]);
+        }
+      },
+      2);
+  // Along z: slice by slice, rows of y on all threads.
+  parallel_for(
+      static_cast<size_t>(ny),
+      [&](size_t first, size_t last) {
+        for (size_t j = first; j < last; ++j) {
+          for (int k = 1; k < nz; ++k)
+            for (int i = 0; i < nx; ++i)
+              relax(d[k * sz + j * sy + i], d[(k - 1) * sz + j * sy + i]);
+          for (int k = nz - 2; k >= 0; --k)
+            for (int i = 0; i < nx; ++i)
+              relax(d[k * sz + j * sy + i], d[(k + 1) * sz + j * sy + i]);
+        }
+      },
+      2);
+  std::vector<uint8_t> out(in.size());
+  for (size_t c = 0; c < in.size(); ++c) out[c] = d[c] <= steps;
+  return out;
+}
+
+bool farther_than(const std::vector<uint8_t>& mask, const VoxelGrid& g, size_t c, float mm) {
+  int i, j, k;
+  voxel_of(g, c, i, j, k);
+  const int r = reach_beyond(g, mm);
+  const long long best =
+      nearest_in_box(g, i, j, k, r, [&](size_t v, int, int, int) { return mask[v] != 0; });
+  if (best < 0 || best > static_cast<long long>(r + 1) * (r + 1)) return true;
+  return distance_value(g, best) > mm;
+}
+
+bool in_opening(const std::vector<uint8_t>& mask, const VoxelGrid& g, size_t c, double radius,
+                std::vector<int8_t>& centre) {
+  const double need = radius + 0.5 * g.spacing;  // ball_centres: depth_in_mask ≥ need
+  const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
+  const int r_depth = reach_beyond(g, need);
+  auto is_centre = [&](size_t v, int a, int b, int z) {
+    if (centre[v] < 0) {
+      // depth_in_mask: the distance to the nearest voxel outside the mask or on the grid's
+      // outermost layer.
+      const long long best =
+          nearest_in_box(g, a, b, z, r_depth, [&](size_t u, int x, int y, int w) {
+            return !mask[u] || x == 0 || y == 0 || w == 0 || x == nx - 1 || y == ny - 1 ||
+                   w == nz - 1;
+          });
+      centre[v] = best < 0 || best > static_cast<long long>(r_depth + 1) * (r_depth + 1) ||
+                  distance_value(g, best) >= need;
+    }
+    return centre[v] == 1;
+  };
+  int i, j, k;
+  voxel_of(g, c, i, j, k);
+  const double grow = radius + 0.5 * g.spacing;  // open_by_ball: distance to a centre ≤ grow
+  const long long best = nearest_in_box(g, i, j, k, reach_beyond(g, grow), is_centre);
+  return best >= 0 && distance_value(g, best) <= grow;
 }
 
 }  // namespace cranioplan

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <cmath>
 #include <memory>
+#include <numeric>
 #include <vector>
 
 #include "cranioplan/algorithms/geometry/distance_transform.h"
@@ -17,6 +18,26 @@ namespace cranioplan {
 namespace {
 
 using Mask = std::vector<uint8_t>;
+
+// Calls f(k) for every slice k < nz on all threads, the slices dealt in a spread order (k = q ·
+// step mod nz) so that each thread gets some of the implant's slices and some of the empty
+// ones. f must write only its own slice's voxels.
+template <class F>
+void for_slices_spread(int nz, F&& f) {
+  const size_t n = static_cast<size_t>(nz);
+  size_t step = 1;
+  for (size_t s : {7, 11, 13, 17, 19, 23})
+    if (std::gcd(s, n) == 1) {
+      step = s;
+      break;
+    }
+  parallel_for(
+      n,
+      [&](size_t first, size_t last) {
+        for (size_t q = first; q < last; ++q) f(static_cast<int>(q * step % n));
+      },
+      2);
+}
 
 // One step of 6-neighbour dilation (slices on all threads; each voxel written once).
 Mask dilate(const Mask& in, const VoxelGrid& g) {
@@ -92,11 +113,8 @@ int first_along(const Mask& implant, const Mask& bone, const VoxelGrid& g, int i
 // Fills the voxels of cracks narrower than twice `steps` voxels between implant and bone.
 Mask bridge_cracks(const Mask& implant, const Mask& bone, const VoxelGrid& g, int steps) {
   // Candidates: within `steps` (6-neighbour steps) of both.
-  Mask near_implant = implant, near_bone = bone;
-  for (int s = 0; s < steps; ++s) {
-    near_implant = dilate(near_implant, g);
-    near_bone = dilate(near_bone, g);
-  }
+  const Mask near_implant = within_steps(implant, g, steps),
+             near_bone = within_steps(bone, g, steps);
   static const int dirs[13][3] = {{1, 0, 0},  {0, 1, 0},  {0, 0, 1}, {1, 1, 0},  {1, -1, 0},
                                   {1, 0, 1},  {1, 0, -1}, {0, 1, 1}, {0, 1, -1}, {1, 1, 1},
                                   {1, 1, -1}, {1, -1, 1}, {-1, 1, 1}};
@@ -108,7 +126,7 @@ Mask bridge_cracks(const Mask& implant, const Mask& bone, const VoxelGrid& g, in
     reach[n] = std::max(1, static_cast<int>(std::floor(steps / len + 1e-9)));
   }
   Mask out = implant;
-  for (int k = 0; k < g.dims[2]; ++k)
+  for_slices_spread(g.dims[2], [&](int k) {
     for (int j = 0; j < g.dims[1]; ++j)
       for (int i = 0; i < g.dims[0]; ++i) {
         const size_t c = g.index(i, j, k);
@@ -124,6 +142,7 @@ Mask bridge_cracks(const Mask& implant, const Mask& bone, const VoxelGrid& g, in
           }
         }
       }
+  });
   return out;
 }
 
@@ -142,24 +161,40 @@ std::vector<float> blur(const Mask& in, const VoxelGrid& g, double sigma_voxels)
   const size_t stride[3] = {1, static_cast<size_t>(dims[0]),
                             static_cast<size_t>(dims[0]) * dims[1]};
   for (int axis = 0; axis < 3; ++axis) {
-    // Slices on all threads: each voxel's sum, in the same order, written once.
+    // Slices on all threads; each voxel's sum is taken over the taps in order (the same
+    // float operations however the loops run) and written once. Along y and z a whole row in
+    // x has the same taps: it is summed tap by tap.
     parallel_for(
         static_cast<size_t>(dims[2]),
         [&](size_t first, size_t last) {
           for (int k = static_cast<int>(first); k < static_cast<int>(last); ++k)
-            for (int j = 0; j < dims[1]; ++j)
-              for (int i = 0; i < dims[0]; ++i) {
-                const int pos[3] = {i, j, k};
-                const size_t c = g.index(i, j, k);
-                float v = 0;
-                for (int t = -r; t <= r; ++t) {
-                  const int q = pos[axis] + t;
-                  if (q < 0 || q >= dims[axis]) continue;
-                  v += w[t + r] * a[c + static_cast<std::ptrdiff_t>(t) *
-                                            static_cast<std::ptrdiff_t>(stride[axis])];
+            for (int j = 0; j < dims[1]; ++j) {
+              const size_t row = g.index(0, j, k);
+              float* out = &b[row];
+              if (axis == 0) {
+                for (int i = 0; i < dims[0]; ++i) {
+                  const float* at = &a[row + i];
+                  float v = 0;
+                  if (i >= r && i + r < dims[0]) {
+                    for (int t = -r; t <= r; ++t) v += w[t + r] * at[t];
+                  } else {
+                    for (int t = -r; t <= r; ++t)
+                      if (i + t >= 0 && i + t < dims[0]) v += w[t + r] * at[t];
+                  }
+                  out[i] = v;
                 }
-                b[c] = v;
+                continue;
               }
+              const int pos = axis == 1 ? j : k;
+              std::fill(out, out + dims[0], 0.0f);
+              for (int t = -r; t <= r; ++t) {
+                if (pos + t < 0 || pos + t >= dims[axis]) continue;
+                const float wt = w[t + r];
+                const float* in = &a[row + static_cast<std::ptrdiff_t>(t) *
+                                               static_cast<std::ptrdiff_t>(stride[axis])];
+                for (int i = 0; i < dims[0]; ++i) out[i] += wt * in[i];
+              }
+            }
         },
         2);
     a.swap(b);
@@ -209,7 +244,7 @@ std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const Vo
   double widest = clearance;
   for (const ClearanceZone& z : zones) widest = std::max(widest, z.clearance_mm);
   // Bone within two voxels of the implant joins the blur.
-  const Mask near_implant = dilate(dilate(mask, g), g);
+  const Mask near_implant = within_steps(mask, g, 2);
   Mask joined = mask;
   for (size_t c = 0; c < joined.size(); ++c) joined[c] = mask[c] || (bone[c] && near_implant[c]);
   std::vector<float> field = blur(joined, g, sigma_voxels);
@@ -223,13 +258,13 @@ std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const Vo
   // that band while the clearance is at most a voxel; a wider one takes the distance to it.
   Mask near_bone;
   if (widest <= h) {
-    near_bone = dilate(dilate(bone, g), g);
+    near_bone = within_steps(bone, g, 2);
   } else {
     near_bone.resize(to_bone.size());
     const float band = static_cast<float>(widest + 2.0 * h);
     for (size_t c = 0; c < to_bone.size(); ++c) near_bone[c] = to_bone[c] <= band;
   }
-  for (int k = 0; k < g.dims[2]; ++k)
+  for_slices_spread(g.dims[2], [&](int k) {
     for (int j = 0; j < g.dims[1]; ++j)
       for (int i = 0; i < g.dims[0]; ++i) {
         const size_t c = g.index(i, j, k);
@@ -240,6 +275,7 @@ std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const Vo
         const double cap = std::clamp(0.5 + (d - want) / h, 0.0, 1.0);
         field[c] = std::min(field[c], static_cast<float>(cap));
       }
+  });
   // Every bone voxel is in the band, and half a voxel or more inside the surface its cap is 0
   // (a distance to fewer triangles is never shorter), so the blur leaves nothing in the bone.
   return field;
@@ -313,16 +349,18 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
     // between the implant's edge and a fragment; a wall between the implant and a cut face is
     // thick along the cut): what lies within a millimetre of the bone is the fill's contact.
     if (params.thin_fills_removed && params.min_feature_mm > 0) {
-      const std::vector<float> computed =
-          to_bone.empty() ? distance_to_mask(bone, grid) : std::vector<float>();
-      const std::vector<float>& distance = to_bone.empty() ? computed : to_bone;
-      auto far_fill = [&](size_t c) { return bridged[c] && !mask[c] && distance[c] > 1.0f; };
+      Mask far(bridged.size(), 0);
       bool any = false;
-      for (size_t c = 0; c < bridged.size() && !any; ++c) any = far_fill(c);
-      if (any) {  // the opening costs two distance transforms: only when there is a far fill
-        const Mask thick = open_by_ball(bridged, grid, 0.5 * params.min_feature_mm);
+      for (size_t c = 0; c < bridged.size(); ++c)
+        if (bridged[c] && !mask[c])
+          any |= far[c] = to_bone.empty() ? farther_than(bone, grid, c, 1.0f) : to_bone[c] > 1.0f;
+      if (any) {  // whether each far fill lies in the fills' opening, from the voxels around it
+        std::vector<int8_t> centre(bridged.size(), -1);
+        std::vector<size_t> thin;
         for (size_t c = 0; c < bridged.size(); ++c)
-          if (far_fill(c) && !thick[c]) bridged[c] = 0;
+          if (far[c] && !in_opening(bridged, grid, c, 0.5 * params.min_feature_mm, centre))
+            thin.push_back(c);
+        for (size_t c : thin) bridged[c] = 0;
       }
     }
     mask = std::move(bridged);

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <array>
 #include <cmath>
 #include <random>
 
@@ -34,6 +35,118 @@ TEST(DistanceTransform, AgreesWithBruteForce) {
         EXPECT_NEAR(d[g.index(i, j, k)], best, 1e-5);
       }
   EXPECT_TRUE(std::isinf(distance_to_mask(std::vector<uint8_t>(g.size(), 0), g)[0]));
+}
+
+// A mask of random balls and single voxels on a grid wider than the transform's tiles of 16
+// lines, anisotropic so that axis mix-ups show.
+std::vector<uint8_t> random_blobs(const VoxelGrid& g, unsigned seed) {
+  std::vector<uint8_t> mask(g.size(), 0);
+  std::mt19937 rng(seed);
+  for (int n = 0; n < 14; ++n) {
+    const int ci = int(rng() % g.dims[0]), cj = int(rng() % g.dims[1]), ck = int(rng() % g.dims[2]);
+    const int r = 1 + int(rng() % 5);
+    for (int k = 0; k < g.dims[2]; ++k)
+      for (int j = 0; j < g.dims[1]; ++j)
+        for (int i = 0; i < g.dims[0]; ++i)
+          if ((i - ci) * (i - ci) + (j - cj) * (j - cj) + (k - ck) * (k - ck) <= r * r)
+            mask[g.index(i, j, k)] = 1;
+  }
+  for (int n = 0; n < 40; ++n) mask[rng() % g.size()] = 1;  // specks
+  return mask;
+}
+
+VoxelGrid test_grid(double spacing) {
+  VoxelGrid g;
+  g.spacing = spacing;
+  g.dims = {37, 23, 19};
+  return g;
+}
+
+// Every value is the float of spacing·√(integer squared distance), as brute force gives it.
+TEST(DistanceTransform, IsExactOnGridsWiderThanItsTiles) {
+  const VoxelGrid g = test_grid(0.25);
+  const std::vector<uint8_t> mask = random_blobs(g, 5);
+  const std::vector<float> d = distance_to_mask(mask, g);
+  std::vector<std::array<int, 3>> marked;
+  for (int k = 0; k < g.dims[2]; ++k)
+    for (int j = 0; j < g.dims[1]; ++j)
+      for (int i = 0; i < g.dims[0]; ++i)
+        if (mask[g.index(i, j, k)]) marked.push_back({i, j, k});
+  for (int k = 0; k < g.dims[2]; ++k)
+    for (int j = 0; j < g.dims[1]; ++j)
+      for (int i = 0; i < g.dims[0]; ++i) {
+        long long best = -1;
+        for (const auto& m : marked) {
+          const long long d2 =
+              (i - m[0]) * (i - m[0]) + (j - m[1]) * (j - m[1]) + (k - m[2]) * (k - m[2]);
+          if (best < 0 || d2 < best) best = d2;
+        }
+        ASSERT_EQ(d[g.index(i, j, k)],
+                  static_cast<float>(g.spacing * std::sqrt(static_cast<double>(best))));
+      }
+}
+
+// The sweeps give what `steps` 6-neighbour dilations give.
+TEST(DistanceTransform, WithinStepsIsRepeatedDilation) {
+  const VoxelGrid g = test_grid(0.25);
+  const std::vector<uint8_t> mask = random_blobs(g, 7);
+  auto dilate = [&](const std::vector<uint8_t>& in) {
+    std::vector<uint8_t> out(in);
+    for (int k = 0; k < g.dims[2]; ++k)
+      for (int j = 0; j < g.dims[1]; ++j)
+        for (int i = 0; i < g.dims[0]; ++i) {
+          const int nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k},
+                                {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
+          for (const auto& n : nb)
+            if (n[0] >= 0 && n[1] >= 0 && n[2] >= 0 && n[0] < g.dims[0] && n[1] < g.dims[1] &&
+                n[2] < g.dims[2] && in[g.index(n[0], n[1], n[2])])
+              out[g.index(i, j, k)] = 1;
+        }
+    return out;
+  };
+  std::vector<uint8_t> grown = mask;
+  for (int steps = 0; steps <= 6; ++steps) {
+    EXPECT_EQ(within_steps(mask, g, steps), grown) << steps << " steps";
+    grown = dilate(grown);
+  }
+  EXPECT_EQ(within_steps(std::vector<uint8_t>(g.size(), 0), g, 3),
+            std::vector<uint8_t>(g.size(), 0));
+}
+
+// The local tests agree with the whole-grid transforms on every voxel, at several distances
+// and spacings (the fit to the bone asks them of the few voxels a bridging fill adds).
+TEST(DistanceTransform, LocalTestsAgreeWithTheWholeGrid) {
+  for (const double spacing : {0.25, 0.4, 1.0}) {
+    SCOPED_TRACE(spacing);
+    const VoxelGrid g = test_grid(spacing);
+    const std::vector<uint8_t> mask = random_blobs(g, 11);
+    const std::vector<float> d = distance_to_mask(mask, g);
+    for (const float mm : {0.3f, 1.0f, 1.7f}) {
+      size_t far = 0;
+      for (size_t c = 0; c < g.size(); ++c) {
+        ASSERT_EQ(farther_than(mask, g, c, mm), d[c] > mm) << c << " at " << mm << " mm";
+        far += d[c] > mm;
+      }
+      EXPECT_GT(far, 0u);
+      EXPECT_LT(far, g.size());
+    }
+    for (const double radius : {0.5, 0.9}) {
+      const std::vector<uint8_t> opened = open_by_ball(mask, g, radius);
+      std::vector<int8_t> centre(g.size(), -1);
+      size_t kept = 0, removed = 0;
+      for (size_t c = 0; c < g.size(); ++c) {
+        if (!mask[c]) continue;
+        ASSERT_EQ(in_opening(mask, g, c, radius, centre), opened[c] != 0)
+            << c << " radius " << radius;
+        kept += opened[c] != 0;
+        removed += opened[c] == 0;
+      }
+      if (spacing < 0.5) {
+        EXPECT_GT(kept, 0u);
+        EXPECT_GT(removed, 0u);
+      }
+    }
+  }
 }
 
 }  // namespace

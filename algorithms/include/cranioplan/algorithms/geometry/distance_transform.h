@@ -33,4 +33,20 @@ std::vector<uint8_t> ball_centres(const std::vector<float>& depth, const VoxelGr
 std::vector<uint8_t> open_by_ball(const std::vector<uint8_t>& mask, const VoxelGrid& grid,
                                   double radius);
 
+/// The voxels within `steps` 6-neighbour steps of `mask` (its 6-neighbour dilation `steps`
+/// times, 0 ≤ steps ≤ 254): the city-block distance, exact, by forward and backward sweeps
+/// along each axis.
+std::vector<uint8_t> within_steps(const std::vector<uint8_t>& mask, const VoxelGrid& grid,
+                                  int steps);
+
+/// distance_to_mask(mask)[voxel] > mm — the same test on the same float — from the voxels
+/// around that one alone: for a few voxels, where a whole transform would cost more.
+bool farther_than(const std::vector<uint8_t>& mask, const VoxelGrid& grid, size_t voxel, float mm);
+
+/// open_by_ball(mask, grid, radius)[voxel] — the same tests on the same floats — from the voxels
+/// around that one alone. `centre` caches ball_centres over calls on the same mask: as many
+/// entries as the grid has voxels, -1 where not known yet.
+bool in_opening(const std::vector<uint8_t>& mask, const VoxelGrid& grid, size_t voxel,
+                double radius, std::vector<int8_t>& centre);
+
 }  // namespace cranioplan
