@@ -164,37 +164,9 @@ std::vector<uint8_t> open_by_ball(const std::vector<uint8_t>& mask, const VoxelG
 
 namespace {
 
-// The squared distance, in voxel units, from voxel (i,j,k) to the nearest voxel of the box
-// within `reach` voxels of it where `site(index, a, b, c)` holds; -1 when there is none. A site
-// outside the box lies (reach + 1)² or more away.
-template <class Site>
-long long nearest_in_box(const VoxelGrid& g, int i, int j, int k, int reach, Site&& site) {
-  long long best = -1;
-  for (int c = std::max(0, k - reach); c <= std::min(g.dims[2] - 1, k + reach); ++c)
-    for (int b = std::max(0, j - reach); b <= std::min(g.dims[1] - 1, j + reach); ++b)
-      for (int a = std::max(0, i - reach); a <= std::min(g.dims[0] - 1, i + reach); ++a) {
-        const long long d2 = static_cast<long long>(a - i) * (a - i) +
-                             static_cast<long long>(b - j) * (b - j) +
-                             static_cast<long long>(c - k) * (c - k);
-        if ((best < 0 || d2 < best) && site(g.index(a, b, c), a, b, c)) best = d2;
-      }
-  return best;
-}
-
 // distance_to_mask's value for a squared distance in voxel units (the same float).
 float distance_value(const VoxelGrid& g, long long squared) {
   return static_cast<float>(g.spacing * std::sqrt(static_cast<double>(squared)));
-}
-
-// The box half-width beyond which every voxel lies farther than `mm` by at least two voxels.
-int reach_beyond(const VoxelGrid& g, double mm) {
-  return static_cast<int>(std::ceil(mm / g.spacing)) + 1;
-}
-
-void voxel_of(const VoxelGrid& g, size_t c, int& i, int& j, int& k) {
-  i = static_cast<int>(c % g.dims[0]);
-  j = static_cast<int>((c / g.dims[0]) % g.dims[1]);
-  k = static_cast<int>(c / (static_cast<size_t>(g.dims[0]) * g.dims[1]));
 }
 
 }  // namespace
@@ -246,40 +218,69 @@ std::vector<uint8_t> within_steps(const std::vector<uint8_t>& in, const VoxelGri
   return out;
 }
 
-bool farther_than(const std::vector<uint8_t>& mask, const VoxelGrid& g, size_t c, float mm) {
-  int i, j, k;
-  voxel_of(g, c, i, j, k);
-  const int r = reach_beyond(g, mm);
-  const long long best =
-      nearest_in_box(g, i, j, k, r, [&](size_t v, int, int, int) { return mask[v] != 0; });
-  if (best < 0 || best > static_cast<long long>(r + 1) * (r + 1)) return true;
-  return distance_value(g, best) > mm;
+VoxelOffsets::VoxelOffsets(const VoxelGrid& grid, double mm) : grid_(grid) {
+  const int r = static_cast<int>(std::ceil(mm / grid.spacing)) + 1;
+  struct Entry {
+    long long d2;
+    int di, dj, dk;
+  };
+  std::vector<Entry> entries;
+  for (int dk = -r; dk <= r; ++dk)
+    for (int dj = -r; dj <= r; ++dj)
+      for (int di = -r; di <= r; ++di) {
+        const long long d2 = static_cast<long long>(di) * di + static_cast<long long>(dj) * dj +
+                             static_cast<long long>(dk) * dk;
+        if (distance_value(grid, d2) <= mm) entries.push_back({d2, di, dj, dk});
+      }
+  std::stable_sort(entries.begin(), entries.end(),
+                   [](const Entry& a, const Entry& b) { return a.d2 < b.d2; });
+  for (const Entry& e : entries) {
+    offsets_.push_back({e.di, e.dj, e.dk});
+    distance_.push_back(distance_value(grid, e.d2));
+  }
 }
 
-bool in_opening(const std::vector<uint8_t>& mask, const VoxelGrid& g, size_t c, double radius,
-                std::vector<int8_t>& centre) {
-  const double need = radius + 0.5 * g.spacing;  // ball_centres: depth_in_mask ≥ need
-  const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
-  const int r_depth = reach_beyond(g, need);
-  auto is_centre = [&](size_t v, int a, int b, int z) {
-    if (centre[v] < 0) {
-      // depth_in_mask: the distance to the nearest voxel outside the mask or on the grid's
-      // outermost layer.
-      const long long best =
-          nearest_in_box(g, a, b, z, r_depth, [&](size_t u, int x, int y, int w) {
-            return !mask[u] || x == 0 || y == 0 || w == 0 || x == nx - 1 || y == ny - 1 ||
-                   w == nz - 1;
-          });
-      centre[v] = best < 0 || best > static_cast<long long>(r_depth + 1) * (r_depth + 1) ||
-                  distance_value(g, best) >= need;
-    }
-    return centre[v] == 1;
-  };
-  int i, j, k;
-  voxel_of(g, c, i, j, k);
-  const double grow = radius + 0.5 * g.spacing;  // open_by_ball: distance to a centre ≤ grow
-  const long long best = nearest_in_box(g, i, j, k, reach_beyond(g, grow), is_centre);
-  return best >= 0 && distance_value(g, best) <= grow;
+LocalDistance::LocalDistance(const std::vector<uint8_t>& mask, const VoxelGrid& grid, float mm)
+    : mask_(mask), offsets_(grid, mm), mm_(mm) {}
+
+bool LocalDistance::farther(size_t voxel) const {
+  // The first voxel of the mask met in order of distance decides: within `mm` or not.
+  return !offsets_.first(
+      voxel, [&](size_t v, int, int, int) { return mask_[v] != 0; },
+      [&](float d) { return d <= mm_; });
+}
+
+LocalOpening::LocalOpening(const std::vector<uint8_t>& mask, const VoxelGrid& grid, double radius)
+    : mask_(mask),
+      need_(radius + 0.5 * grid.spacing),
+      depth_(grid, need_),
+      grow_(grid, radius + 0.5 * grid.spacing),
+      centre_(mask.size(), -1) {}
+
+bool LocalOpening::is_centre(size_t v) {
+  if (centre_[v] < 0) {
+    // ball_centres: depth_in_mask ≥ need, the depth being the distance to the nearest voxel
+    // outside the mask or on the grid's outermost layer.
+    const VoxelGrid& g = depth_.grid();
+    const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
+    const bool shallow = depth_.first(
+        v,
+        [&](size_t u, int x, int y, int z) {
+          return !mask_[u] || x == 0 || y == 0 || z == 0 || x == nx - 1 || y == ny - 1 ||
+                 z == nz - 1;
+        },
+        [&](float d) { return d < need_; });
+    centre_[v] = !shallow;
+  }
+  return centre_[v] == 1;
+}
+
+bool LocalOpening::contains(size_t voxel) {
+  // open_by_ball: within radius + ½ voxel of a centre.
+  const double grow = need_;
+  return mask_[voxel] && grow_.first(
+                             voxel, [&](size_t v, int, int, int) { return is_centre(v); },
+                             [&](float d) { return d <= grow; });
 }
 
 }  // namespace cranioplan

@@ -351,15 +351,15 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
     if (params.thin_fills_removed && params.min_feature_mm > 0) {
       Mask far(bridged.size(), 0);
       bool any = false;
+      const LocalDistance from_bone(bone, grid, 1.0f);
       for (size_t c = 0; c < bridged.size(); ++c)
         if (bridged[c] && !mask[c])
-          any |= far[c] = to_bone.empty() ? farther_than(bone, grid, c, 1.0f) : to_bone[c] > 1.0f;
+          any |= far[c] = to_bone.empty() ? from_bone.farther(c) : to_bone[c] > 1.0f;
       if (any) {  // whether each far fill lies in the fills' opening, from the voxels around it
-        std::vector<int8_t> centre(bridged.size(), -1);
+        LocalOpening opening(bridged, grid, 0.5 * params.min_feature_mm);
         std::vector<size_t> thin;
         for (size_t c = 0; c < bridged.size(); ++c)
-          if (far[c] && !in_opening(bridged, grid, c, 0.5 * params.min_feature_mm, centre))
-            thin.push_back(c);
+          if (far[c] && !opening.contains(c)) thin.push_back(c);
         for (size_t c : thin) bridged[c] = 0;
       }
     }

@@ -123,8 +123,9 @@ TEST(DistanceTransform, LocalTestsAgreeWithTheWholeGrid) {
     const std::vector<float> d = distance_to_mask(mask, g);
     for (const float mm : {0.3f, 1.0f, 1.7f}) {
       size_t far = 0;
+      const LocalDistance local(mask, g, mm);
       for (size_t c = 0; c < g.size(); ++c) {
-        ASSERT_EQ(farther_than(mask, g, c, mm), d[c] > mm) << c << " at " << mm << " mm";
+        ASSERT_EQ(local.farther(c), d[c] > mm) << c << " at " << mm << " mm";
         far += d[c] > mm;
       }
       EXPECT_GT(far, 0u);
@@ -132,12 +133,11 @@ TEST(DistanceTransform, LocalTestsAgreeWithTheWholeGrid) {
     }
     for (const double radius : {0.5, 0.9}) {
       const std::vector<uint8_t> opened = open_by_ball(mask, g, radius);
-      std::vector<int8_t> centre(g.size(), -1);
+      LocalOpening local(mask, g, radius);
       size_t kept = 0, removed = 0;
       for (size_t c = 0; c < g.size(); ++c) {
         if (!mask[c]) continue;
-        ASSERT_EQ(in_opening(mask, g, c, radius, centre), opened[c] != 0)
-            << c << " radius " << radius;
+        ASSERT_EQ(local.contains(c), opened[c] != 0) << c << " radius " << radius;
         kept += opened[c] != 0;
         removed += opened[c] == 0;
       }

@@ -1,6 +1,8 @@
 #pragma once
 // Exact Euclidean distance transform of a voxel mask (Felzenszwalb & Huttenlocher's lower
 // envelope of parabolas, one axis at a time): the ground of thickness and clearance measures.
+#include <array>
+#include <cstddef>
 #include <cstdint>
 #include <vector>
 
@@ -39,14 +41,60 @@ std::vector<uint8_t> open_by_ball(const std::vector<uint8_t>& mask, const VoxelG
 std::vector<uint8_t> within_steps(const std::vector<uint8_t>& mask, const VoxelGrid& grid,
                                   int steps);
 
+/// The voxel offsets within `mm` of a voxel (by distance_to_mask's float of their distance), in
+/// order of distance: to decide a distance test at single voxels from their neighbourhood.
+class VoxelOffsets {
+ public:
+  VoxelOffsets(const VoxelGrid& grid, double mm);
+  const VoxelGrid& grid() const { return grid_; }
+  /// Whether some voxel at an offset whose distance passes `within` (tested in order of
+  /// distance; the first that fails ends the search) is a site: site(index, i, j, k).
+  template <class Site, class Within>
+  bool first(size_t voxel, Site&& site, Within&& within) const {
+    const int nx = grid_.dims[0], ny = grid_.dims[1], nz = grid_.dims[2];
+    const int i = static_cast<int>(voxel % nx), j = static_cast<int>((voxel / nx) % ny),
+              k = static_cast<int>(voxel / (static_cast<size_t>(nx) * ny));
+    for (size_t n = 0; n < offsets_.size(); ++n) {
+      if (!within(distance_[n])) return false;
+      const int a = i + offsets_[n][0], b = j + offsets_[n][1], c = k + offsets_[n][2];
+      if (a < 0 || b < 0 || c < 0 || a >= nx || b >= ny || c >= nz) continue;
+      if (site(grid_.index(a, b, c), a, b, c)) return true;
+    }
+    return false;
+  }
+
+ private:
+  VoxelGrid grid_;
+  std::vector<std::array<int, 3>> offsets_;
+  std::vector<float> distance_;
+};
+
 /// distance_to_mask(mask)[voxel] > mm — the same test on the same float — from the voxels
 /// around that one alone: for a few voxels, where a whole transform would cost more.
-bool farther_than(const std::vector<uint8_t>& mask, const VoxelGrid& grid, size_t voxel, float mm);
+class LocalDistance {
+ public:
+  LocalDistance(const std::vector<uint8_t>& mask, const VoxelGrid& grid, float mm);
+  bool farther(size_t voxel) const;
+
+ private:
+  const std::vector<uint8_t>& mask_;
+  VoxelOffsets offsets_;
+  float mm_;
+};
 
 /// open_by_ball(mask, grid, radius)[voxel] — the same tests on the same floats — from the voxels
-/// around that one alone. `centre` caches ball_centres over calls on the same mask: as many
-/// entries as the grid has voxels, -1 where not known yet.
-bool in_opening(const std::vector<uint8_t>& mask, const VoxelGrid& grid, size_t voxel,
-                double radius, std::vector<int8_t>& centre);
+/// around that one alone, the ball centres found on the way kept for the next voxels.
+class LocalOpening {
+ public:
+  LocalOpening(const std::vector<uint8_t>& mask, const VoxelGrid& grid, double radius);
+  bool contains(size_t voxel);
+
+ private:
+  bool is_centre(size_t voxel);
+  const std::vector<uint8_t>& mask_;
+  double need_;
+  VoxelOffsets depth_, grow_;
+  std::vector<int8_t> centre_;  ///< -1 not known yet
+};
 
 }  // namespace cranioplan
