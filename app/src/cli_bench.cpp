@@ -193,6 +193,19 @@ Json run_bench(const BenchOptions& options) {
         session.push(commands::note("separates the drags"));
         session.push(commands::move_marker(m.id, to));
       });
+      // What the wizard does for every mouse move while the marker is dragged: the same move
+      // applied with the implant previewed without the fit (the fitted one is computed on a
+      // worker once the marker is let go).
+      if (session.state().implant_params) {
+        PlanState live = session.state();
+        live.implant_params = live_preview_params(*live.implant_params);
+        int n = 0;
+        out["drag_preview_s"] = median_seconds(runs, [&] {
+          const Eigen::Vector3d to =
+              surface.closest(m.position + Eigen::Vector3d(0, 0.2 * ++n, 0)).point;
+          apply_command(live, commands::move_marker(m.id, to), session.context());
+        });
+      }
       out["session_undo_s"] = median_seconds(runs,
                                              [&] {
                                                session.undo();

@@ -78,12 +78,24 @@ std::vector<float> distance_in(const std::vector<uint8_t>& mask, const VoxelGrid
             for (int x0 = 0; x0 < dims[along_x]; x0 += kTile) {
               const int w = std::min(kTile, dims[along_x] - x0);
               const size_t base = o * stride[across] + x0 * stride[along_x];
-              if (axis == 0) {  // contiguous lines, one at a time
+              if (axis == 0) {
+                // Contiguous lines of sites and empty voxels: the squared distance to the
+                // nearest site on the line, by a forward and a backward sweep (the same
+                // integers as the envelope).
                 for (int t = 0; t < w; ++t) {
                   T* l = &sq[base + t * stride[along_x]];
-                  for (int q = 0; q < n; ++q) line[q] = l[q];
-                  lower_envelope(line.data(), out.data(), n, v, z);
-                  for (int q = 0; q < n; ++q) l[q] = static_cast<T>(out[q]);
+                  int last = -1;
+                  for (int q = 0; q < n; ++q) {
+                    if (l[q] == T(0)) last = q;
+                    out[q] = last < 0 ? -1.0 : double(q - last);
+                  }
+                  int next = -1;
+                  for (int q = n - 1; q >= 0; --q) {
+                    if (l[q] == T(0)) next = q;
+                    double best = out[q];
+                    if (next >= 0 && (best < 0.0 || next - q < best)) best = next - q;
+                    l[q] = best < 0.0 ? far : static_cast<T>(best * best);
+                  }
                 }
                 continue;
               }

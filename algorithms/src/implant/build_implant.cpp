@@ -419,7 +419,7 @@ class ShellBuilder {
       if (m.type == MarkerType::OuterEdge || has_inner_)
         result_.rim_marker_error_mm = std::max(result_.rim_marker_error_mm, best);
     }
-    result_.watertight = report_mesh(result_.mesh).watertight;
+    result_.watertight = is_watertight(result_.mesh);
     result_.status = ImplantResult::Status::Built;
     result_.message = has_inner_
                           ? "shell through outer and inner markers"
@@ -718,7 +718,7 @@ ImplantResult build_delaunay(const std::vector<Marker>& markers, const ImplantPa
   if (signed_volume(soup) < 0)
     for (auto& t : soup.triangles) std::swap(t[1], t[2]);
   result.mesh = build_mesh(soup);
-  result.watertight = report_mesh(result.mesh).watertight;
+  result.watertight = is_watertight(result.mesh);
   result.status = ImplantResult::Status::Built;
   result.message = result.watertight ? "Delaunay 3D surface (watertight)"
                                      : "Delaunay 3D surface (not watertight)";
@@ -812,7 +812,7 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
     TrimToBoneResult t = trim_to_bone(r.mesh, *skull, params.trim);
     if (t.usable()) {
       r.mesh = std::move(t.mesh);
-      r.watertight = report_mesh(r.mesh).watertight;
+      r.watertight = is_watertight(r.mesh);
     } else {
       r.status = ImplantResult::Status::Failed;
       r.message = "fitting to the bone: " + t.message;
@@ -831,7 +831,7 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
     if (t.usable()) {
       r.mesh = std::move(t.mesh);
       r.tabs = std::move(t.tabs);
-      r.watertight = report_mesh(r.mesh).watertight;
+      r.watertight = is_watertight(r.mesh);
       r.message += "; " + t.message;
     } else {
       r.status = ImplantResult::Status::Failed;
@@ -845,7 +845,7 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
     if (p.usable()) {
       r.mesh = std::move(p.mesh);
       r.holes = std::move(p.holes);
-      r.watertight = report_mesh(r.mesh).watertight;
+      r.watertight = is_watertight(r.mesh);
       r.message += "; " + p.message;
     } else {
       r.status = ImplantResult::Status::Failed;

@@ -241,4 +241,43 @@ MeshReport report_mesh(const SkullMesh& mesh) {
   return r;
 }
 
+bool is_watertight(const SkullMesh& mesh) {
+  const size_t n = mesh.n_vertices();
+  if (n == 0) return false;
+  // Weld: the vertices in order of position, equal positions one id.
+  std::vector<int> order(n);
+  for (size_t i = 0; i < n; ++i) order[i] = static_cast<int>(i);
+  auto key = [&](int i) {
+    const auto& p = mesh.point(OpenMesh::VertexHandle(i));
+    return std::array<double, 3>{p[0], p[1], p[2]};
+  };
+  std::sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
+  std::vector<unsigned> id(n);
+  unsigned next = 0;
+  for (size_t r = 0; r < n; ++r) {
+    if (r > 0 && key(order[r]) != key(order[r - 1])) ++next;
+    id[order[r]] = next;
+  }
+  // Every undirected edge of the welded triangles twice: no boundary, nothing non-manifold.
+  std::vector<unsigned long long> edges;
+  edges.reserve(3 * mesh.n_faces());
+  for (auto fh : mesh.faces()) {
+    unsigned v[3];
+    int k = 0;
+    for (auto vh : mesh.fv_range(fh)) v[k++] = id[vh.idx()];
+    for (k = 0; k < 3; ++k) {
+      const unsigned long long a = v[k], b = v[(k + 1) % 3];
+      edges.push_back(std::min(a, b) << 32 | std::max(a, b));
+    }
+  }
+  std::sort(edges.begin(), edges.end());
+  for (size_t e = 0; e < edges.size();) {
+    size_t run = 1;
+    while (e + run < edges.size() && edges[e + run] == edges[e]) ++run;
+    if (run != 2) return false;
+    e += run;
+  }
+  return !edges.empty();
+}
+
 }  // namespace cranioplan

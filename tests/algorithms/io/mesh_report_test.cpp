@@ -43,6 +43,27 @@ TEST(MeshReport, NonManifoldEdgeIsCounted) {
   EXPECT_FALSE(r.watertight);
 }
 
+// The flag alone agrees with the full report: closed, holed, non-manifold (three triangles on
+// an edge, which the mesh builder splits into vertices at equal positions), two closed pieces.
+TEST(MeshReport, IsWatertightAgreesWithTheReport) {
+  TriangleSoup fin;
+  fin.vertices = {{0, 0, 0}, {1, 0, 0}, {0, 1, 0}, {0, -1, 0}, {0, 0, 1}};
+  fin.triangles = {{0, 1, 2}, {1, 0, 3}, {0, 1, 4}};
+  TriangleSoup two = to_soup(test::make_symmetric_head(2));
+  const size_t n = two.vertices.size(), m = two.triangles.size();
+  for (size_t i = 0; i < n; ++i)
+    two.vertices.push_back(two.vertices[i] + Eigen::Vector3d(300, 0, 0));
+  for (size_t t = 0; t < m; ++t)
+    two.triangles.push_back(two.triangles[t] + Eigen::Vector3i::Constant(static_cast<int>(n)));
+  const SkullMesh meshes[] = {test::make_symmetric_head(3),
+                              test::cut_hole(test::make_symmetric_head(3), {70, 0, 0}, 20),
+                              build_mesh(fin), build_mesh(two), SkullMesh()};
+  for (const SkullMesh& mesh : meshes)
+    EXPECT_EQ(is_watertight(mesh), report_mesh(mesh).watertight) << mesh.n_faces();
+  EXPECT_TRUE(is_watertight(meshes[0]));
+  EXPECT_TRUE(is_watertight(meshes[3]));
+}
+
 }  // namespace
 }  // namespace cranioplan
 

@@ -50,4 +50,8 @@ std::vector<std::string> describe_openings(const MeshReport& report);
 /// reader split to keep OpenMesh manifold are still reported as non-manifold.
 MeshReport report_mesh(const SkullMesh& mesh);
 
+/// report_mesh(mesh).watertight alone (the same welding of identical positions), without the
+/// loops and pieces: for a flag on every implant built.
+bool is_watertight(const SkullMesh& mesh);
+
 }  // namespace cranioplan
