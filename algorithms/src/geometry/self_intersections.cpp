@@ -2,8 +2,11 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <array>
 #include <cmath>
-#include <unordered_map>
+#include <vector>
+
+#include "cranioplan/algorithms/geometry/parallel.h"
 
 namespace cranioplan {
 namespace {
@@ -40,48 +43,68 @@ long long count_self_intersections(const SkullMesh& mesh) {
     edge_sum += (soup.vertices[t[0]] - soup.vertices[t[1]]).norm();
   }
   const double cell = std::max(1e-6, 2.0 * edge_sum / static_cast<double>(n));
-  auto key = [](long long x, long long y, long long z) {
-    return static_cast<unsigned long long>((x * 73856093LL) ^ (y * 19349663LL) ^ (z * 83492791LL));
-  };
-  std::unordered_multimap<unsigned long long, int> cells;
   auto cell_of = [&](const Eigen::Vector3d& p) {
     return Eigen::Array3i((p / cell).array().floor().cast<int>());
   };
+  // Every (cell, triangle) its box meets, sorted by cell: the triangles sharing a cell are
+  // neighbours in the list.
+  struct Entry {
+    std::array<int, 3> cell;
+    int triangle;
+    bool operator<(const Entry& o) const {
+      return cell != o.cell ? cell < o.cell : triangle < o.triangle;
+    }
+  };
+  std::vector<Entry> entries;
+  entries.reserve(2 * n);
   for (size_t i = 0; i < n; ++i) {
     const Eigen::Array3i a = cell_of(lo[i]), b = cell_of(hi[i]);
     for (int x = a[0]; x <= b[0]; ++x)
       for (int y = a[1]; y <= b[1]; ++y)
-        for (int z = a[2]; z <= b[2]; ++z) cells.emplace(key(x, y, z), static_cast<int>(i));
+        for (int z = a[2]; z <= b[2]; ++z) entries.push_back({{x, y, z}, static_cast<int>(i)});
   }
-  long long count = 0;
-  for (size_t i = 0; i < n; ++i) {
-    const Eigen::Array3i a = cell_of(lo[i]), b = cell_of(hi[i]);
-    for (int x = a[0]; x <= b[0]; ++x)
-      for (int y = a[1]; y <= b[1]; ++y)
-        for (int z = a[2]; z <= b[2]; ++z) {
-          auto range = cells.equal_range(key(x, y, z));
-          for (auto it = range.first; it != range.second; ++it) {
-            const size_t j = static_cast<size_t>(it->second);
-            if (j <= i) continue;
-            // Test each pair once: in the cell holding the corner where their boxes start.
-            const Eigen::Array3i owner = cell_of(lo[i].cwiseMax(lo[j]));
-            if (owner[0] != x || owner[1] != y || owner[2] != z) continue;
-            if ((lo[i].array() > hi[j].array()).any() || (lo[j].array() > hi[i].array()).any())
-              continue;
-            const auto &ti = soup.triangles[i], &tj = soup.triangles[j];
-            bool shared = false;
-            for (int p = 0; p < 3; ++p)
-              for (int q = 0; q < 3; ++q) shared |= ti[p] == tj[q];
-            if (shared) continue;
-            const auto& V = soup.vertices;
-            bool cross = false;
-            for (int e = 0; e < 3 && !cross; ++e)
-              cross = segment_crosses(V[ti[e]], V[ti[(e + 1) % 3]], V[tj[0]], V[tj[1]], V[tj[2]]) ||
-                      segment_crosses(V[tj[e]], V[tj[(e + 1) % 3]], V[ti[0]], V[ti[1]], V[ti[2]]);
-            count += cross;
-          }
+  std::sort(entries.begin(), entries.end());
+  std::vector<size_t> starts;
+  for (size_t e = 0; e < entries.size(); ++e)
+    if (e == 0 || entries[e].cell != entries[e - 1].cell) starts.push_back(e);
+  starts.push_back(entries.size());
+  const size_t groups = starts.size() - 1;
+  // Each pair is tested once, in the cell holding the corner where their boxes start; the
+  // cells on all threads, each thread's count added in thread order (an integer: the same sum).
+  std::vector<long long> counts(groups, 0);
+  parallel_for(
+      groups,
+      [&](size_t first, size_t last) {
+        for (size_t g = first; g < last; ++g) {
+          long long count = 0;
+          for (size_t u = starts[g]; u < starts[g + 1]; ++u)
+            for (size_t w = u + 1; w < starts[g + 1]; ++w) {
+              const size_t i = static_cast<size_t>(entries[u].triangle),
+                           j = static_cast<size_t>(entries[w].triangle);
+              const Eigen::Array3i owner = cell_of(lo[i].cwiseMax(lo[j]));
+              const std::array<int, 3>& here = entries[u].cell;
+              if (owner[0] != here[0] || owner[1] != here[1] || owner[2] != here[2]) continue;
+              if ((lo[i].array() > hi[j].array()).any() || (lo[j].array() > hi[i].array()).any())
+                continue;
+              const auto &ti = soup.triangles[i], &tj = soup.triangles[j];
+              bool shared = false;
+              for (int p = 0; p < 3; ++p)
+                for (int q = 0; q < 3; ++q) shared |= ti[p] == tj[q];
+              if (shared) continue;
+              const auto& V = soup.vertices;
+              bool cross = false;
+              for (int e = 0; e < 3 && !cross; ++e)
+                cross =
+                    segment_crosses(V[ti[e]], V[ti[(e + 1) % 3]], V[tj[0]], V[tj[1]], V[tj[2]]) ||
+                    segment_crosses(V[tj[e]], V[tj[(e + 1) % 3]], V[ti[0]], V[ti[1]], V[ti[2]]);
+              count += cross;
+            }
+          counts[g] = count;
         }
-  }
+      },
+      64);
+  long long count = 0;
+  for (long long c : counts) count += c;
   return count;
 }
 

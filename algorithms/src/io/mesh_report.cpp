@@ -205,35 +205,57 @@ MeshReport report_mesh(const SkullMesh& mesh) {
   }
   r.volume_mm3 = signed_volume(soup);
 
-  // Weld identical positions, then count triangles per undirected edge.
-  std::map<std::array<double, 3>, int> weld;
-  std::vector<int> id(soup.vertices.size());
-  for (size_t i = 0; i < soup.vertices.size(); ++i) {
+  // Weld identical positions (ids in the order positions first appear), then count triangles
+  // per undirected edge.
+  const size_t nv = soup.vertices.size();
+  std::vector<int> order(nv);
+  std::iota(order.begin(), order.end(), 0);
+  auto key = [&](int i) {
     const auto& p = soup.vertices[i];
-    id[i] = weld.emplace(std::array<double, 3>{p.x(), p.y(), p.z()}, static_cast<int>(weld.size()))
-                .first->second;
+    return std::array<double, 3>{p.x(), p.y(), p.z()};
+  };
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
+  std::vector<int> first_of;  // each position's first vertex, in order of position
+  std::vector<int> group(nv);
+  for (size_t r = 0; r < nv; ++r) {
+    if (r == 0 || key(order[r]) != key(order[r - 1])) first_of.push_back(order[r]);
+    group[order[r]] = static_cast<int>(first_of.size()) - 1;
   }
-  std::unordered_map<unsigned long long, int> edge_count;
-  edge_count.reserve(soup.triangles.size() * 2);
+  std::vector<int> by_appearance(first_of.size());
+  std::iota(by_appearance.begin(), by_appearance.end(), 0);
+  std::sort(by_appearance.begin(), by_appearance.end(),
+            [&](int a, int b) { return first_of[a] < first_of[b]; });
+  std::vector<int> rank(first_of.size());
+  for (size_t k = 0; k < by_appearance.size(); ++k) rank[by_appearance[k]] = static_cast<int>(k);
+  std::vector<int> id(nv);
+  for (size_t i = 0; i < nv; ++i) id[i] = rank[group[i]];
+  std::vector<unsigned long long> edges;
+  edges.reserve(soup.triangles.size() * 3);
   for (auto& t : soup.triangles) {
     for (int k = 0; k < 3; ++k) t[k] = id[t[k]];
     for (int k = 0; k < 3; ++k) {
       const unsigned long long a = static_cast<unsigned>(t[k]),
                                b = static_cast<unsigned>(t[(k + 1) % 3]);
-      ++edge_count[std::min(a, b) << 32 | std::max(a, b)];
+      edges.push_back(std::min(a, b) << 32 | std::max(a, b));
     }
   }
+  std::sort(edges.begin(), edges.end());
   std::vector<std::pair<int, int>> boundary;
-  for (const auto& [edge, count] : edge_count) {
+  for (size_t e = 0; e < edges.size();) {
+    size_t count = 1;
+    while (e + count < edges.size() && edges[e + count] == edges[e]) ++count;
     if (count == 1) {
       ++r.boundary_edges;
-      boundary.emplace_back(static_cast<int>(edge >> 32), static_cast<int>(edge & 0xffffffffu));
+      boundary.emplace_back(static_cast<int>(edges[e] >> 32),
+                            static_cast<int>(edges[e] & 0xffffffffu));
     }
     if (count > 2) ++r.nonmanifold_edges;
+    e += count;
   }
-  soup.vertices.resize(weld.size());
-  for (const auto& [p, i] : weld) soup.vertices[i] = {p[0], p[1], p[2]};
-  // In the edges' order of the welded ids, not the hash map's: the same loops on any run.
+  std::vector<Eigen::Vector3d> welded(first_of.size());
+  for (size_t g = 0; g < first_of.size(); ++g) welded[rank[g]] = soup.vertices[first_of[g]];
+  soup.vertices = std::move(welded);
+  // In the order of the welded ids: the same loops on any run.
   std::sort(boundary.begin(), boundary.end());
   r.loops = boundary_loops(soup, boundary);
   r.pieces = static_cast<long long>(soup_components(soup).sizes.size());

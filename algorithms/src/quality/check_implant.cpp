@@ -9,6 +9,7 @@
 #include <memory>
 
 #include "cranioplan/algorithms/geometry/distance_transform.h"
+#include "cranioplan/algorithms/geometry/parallel.h"
 #include "cranioplan/algorithms/geometry/self_intersections.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
@@ -111,8 +112,8 @@ namespace {
 std::vector<double> thickness_samples(const SkullMesh& implant, const SurfaceLocator& self,
                                       const Eigen::Vector3d& axis, const std::vector<float>& depth,
                                       const VoxelGrid& grid, std::vector<int>& wall_vertices) {
-  std::vector<double> thickness;
   const size_t stride = std::max<size_t>(1, (implant.n_faces() + 59999) / 60000);
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> rays;  // from, inward normal
   for (auto fh : implant.faces()) {
     const bool measure = static_cast<size_t>(fh.idx()) % stride == 0;
     Eigen::Vector3d p[3];
@@ -129,12 +130,23 @@ std::vector<double> thickness_samples(const SkullMesh& implant, const SurfaceLoc
       // Where the plate curves, a normal can leave it at a grazing angle and run along it (on
       // the sample's frontal implant up to 27 mm through a plate 8 mm at its thickest): the
       // thickness there is at most the diameter of the deepest ball the ray passes.
-      const double t = thickness_through(self, (p[0] + p[1] + p[2]) / 3.0, n, depth, grid);
-      if (t > 0.0) thickness.push_back(t);
+      rays.emplace_back((p[0] + p[1] + p[2]) / 3.0, n);
     } else {
       wall_vertices.insert(wall_vertices.end(), ids, ids + 3);
     }
   }
+  // The rays on all threads, each thickness in its face's place.
+  std::vector<double> through(rays.size());
+  parallel_for(
+      rays.size(),
+      [&](size_t first, size_t last) {
+        for (size_t i = first; i < last; ++i)
+          through[i] = thickness_through(self, rays[i].first, rays[i].second, depth, grid);
+      },
+      256);
+  std::vector<double> thickness;
+  for (double t : through)
+    if (t > 0.0) thickness.push_back(t);
   return thickness;
 }
 
@@ -194,18 +206,22 @@ std::vector<float> measure_against_bone(const SkullMesh& implant, const SkullMes
   std::sort(wall_vertices.begin(), wall_vertices.end());
   wall_vertices.erase(std::unique(wall_vertices.begin(), wall_vertices.end()), wall_vertices.end());
   const Eigen::Vector3d e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
-  std::vector<double> angle, distance;
-  std::vector<Eigen::Vector3d> nearest;  // the bone point each wall vertex faces
-  angle.reserve(wall_vertices.size());
-  distance.reserve(wall_vertices.size());
-  nearest.reserve(wall_vertices.size());
-  for (int v : wall_vertices) {
-    const Eigen::Vector3d p = to_eigen(implant.point(SkullMesh::VertexHandle(v)));
-    angle.push_back(std::atan2((p - c).dot(e2), (p - c).dot(e1)));
-    const auto near = bone.closest(p);
-    distance.push_back(near.distance);
-    nearest.push_back(near.point);
-  }
+  const size_t walls = wall_vertices.size();
+  std::vector<double> angle(walls), distance(walls);
+  std::vector<Eigen::Vector3d> nearest(walls);  // the bone point each wall vertex faces
+  parallel_for(
+      walls,
+      [&](size_t first, size_t last) {
+        for (size_t i = first; i < last; ++i) {
+          const Eigen::Vector3d p =
+              to_eigen(implant.point(SkullMesh::VertexHandle(wall_vertices[i])));
+          angle[i] = std::atan2((p - c).dot(e2), (p - c).dot(e1));
+          const auto near = bone.closest(p);
+          distance[i] = near.distance;
+          nearest[i] = near.point;
+        }
+      },
+      256);
   q.rim_gap_mm = worst_arc_gap(angle, distance, M_PI / 36);
   if (params.edge_clearance_mm > 0.0 || !params.clearance_zones.empty()) {
     // The excess of each wall vertex's gap over the clearance asked at the bone it faces: the
