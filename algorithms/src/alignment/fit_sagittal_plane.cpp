@@ -310,12 +310,19 @@ Plane automatic_initial_plane(const SkullMesh& mesh) {
   // degrees off the midsagittal normal mirrors the far side of the head millimetres off and can
   // rank below a wrong plane through a round head until it is polished.
   const SymmetryScore score(all, centroid);
-  std::vector<Candidate> candidates;
-  for (const auto& n : normals) {
-    double sc;
-    const Plane p = score.best_offset(n, n.dot(centroid), 3.0, 2, &sc);
-    candidates.push_back({p, sc});
-  }
+  // The candidates and the basins' polishing on all threads, each result in its own place and
+  // compared in order afterwards.
+  std::vector<Candidate> candidates(normals.size());
+  parallel_for(
+      normals.size(),
+      [&](size_t first, size_t last) {
+        for (size_t i = first; i < last; ++i) {
+          double sc;
+          const Plane p = score.best_offset(normals[i], normals[i].dot(centroid), 3.0, 2, &sc);
+          candidates[i] = {p, sc};
+        }
+      },
+      8);
   std::sort(candidates.begin(), candidates.end(),
             [](const Candidate& a, const Candidate& b) { return a.score < b.score; });
   const double apart = std::cos(20.0 * M_PI / 180.0);
@@ -327,11 +334,16 @@ Plane automatic_initial_plane(const SkullMesh& mesh) {
     });
     if (new_basin) basins.push_back(c);
   }
+  std::vector<Candidate> polished(basins.size());
+  parallel_for(
+      basins.size(),
+      [&](size_t first, size_t last) {
+        for (size_t i = first; i < last; ++i) polished[i] = polish(score, basins[i]);
+      },
+      1);
   Candidate best{candidates.front().plane, std::numeric_limits<double>::infinity()};
-  for (const auto& b : basins) {
-    const Candidate c = polish(score, b);
+  for (const Candidate& c : polished)
     if (c.score < best.score) best = c;
-  }
   Plane plane = best.plane;
   // Orient the normal along the positive coordinate axis it is closest to, for stable output.
   int axis;
