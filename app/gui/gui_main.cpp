@@ -1,13 +1,16 @@
 // cranioplan [MESH|VOLUME|SESSION] [--sample] [--units U] [--step N] [--screenshot OUT.png]
-// [--thickness-map] [--mould] [--report OUT.html] [--quit]
+// [--thickness-map] [--mould] [--report OUT.html] [--pauses] [--quit]
 #include <QApplication>
 #include <QCheckBox>
 #include <QCommandLineParser>
 #include <QFileInfo>
+#include <QStatusBar>
 #include <QTimer>
 #include <cstdio>
+#include <memory>
 
 #include "main_window.h"
+#include "pause_meter.h"
 
 int main(int argc, char** argv) {
   cranioplan::gui::SkullView::set_default_surface_format();
@@ -38,8 +41,10 @@ int main(int argc, char** argv) {
       "mould", "in step 9, show the casting mould opened apart (3MF with a mould)");
   const QCommandLineOption report(
       "report", "write the design report (HTML, its pictures and a PDF beside it)", "OUT.html");
+  const QCommandLineOption pauses(
+      "pauses", "when quitting, print the window's longest pauses (the GUI thread held)");
   parser.addOptions({sample, units, step, screenshot, quit, view, layout, window_preset, thickness,
-                     mould, report});
+                     mould, report, pauses});
   parser.process(app);
 
   cranioplan::gui::MainWindow window;
@@ -58,6 +63,14 @@ int main(int argc, char** argv) {
                      failed = true;
                      std::fprintf(stderr, "cranioplan: %s\n", message.toLocal8Bit().constData());
                    });
+  std::unique_ptr<cranioplan::gui::PauseMeter> meter;
+  if (parser.isSet(pauses)) {
+    meter = std::make_unique<cranioplan::gui::PauseMeter>(
+        [&window] { return window.statusBar()->currentMessage(); });
+    QObject::connect(&app, &QCoreApplication::aboutToQuit, [&meter] {
+      std::printf("longest pauses of the window: %s\n", meter->summary().toLocal8Bit().constData());
+    });
+  }
   window.show();
 
   const QStringList files = parser.positionalArguments();

@@ -1013,11 +1013,33 @@ bool MainWindow::open_session(const QString& path) {
           QMessageBox::question(this, tr("Recover unsaved changes?"),
                                 tr("%1.\n\nRecover them?").arg(q(info.message))) ==
           QMessageBox::Yes;
+    // Opening replays the plan's commands (seconds for a fitted implant): on a worker thread,
+    // the window greyed out but painting, as a computation's wait is.
+    struct Opened {
+      std::shared_ptr<Session> session;
+      std::string error;
+    };
     QApplication::setOverrideCursor(Qt::WaitCursor);
-    Session s = Session::open(path.toStdString(), options);
+    show_message(tr("Opening %1…").arg(QFileInfo(path).fileName()), false);
+    setEnabled(false);
+    QFuture<Opened> opening = QtConcurrent::run([file = path.toStdString(), options] {
+      Opened o;
+      try {
+        o.session = std::make_shared<Session>(Session::open(file, options));
+      } catch (const Error& e) {
+        o.error = e.what();
+      } catch (const std::exception& e) {
+        o.error = file + ": unexpected error: " + e.what();
+      }
+      return o;
+    });
+    while (!opening.isFinished()) QApplication::processEvents(QEventLoop::AllEvents, 20);
+    setEnabled(true);
     QApplication::restoreOverrideCursor();
+    Opened opened = opening.result();
+    if (!opened.session) throw Error(opened.error);
     controller_->set_read_only(false);
-    controller_->set_session(std::move(s));
+    controller_->set_session(std::move(*opened.session));
     session_path_ = path;
     plan_tabs_->setTabVisible(2, false);
     add_recent(path);

@@ -349,12 +349,15 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
   d.interactor->AddObserver(vtkCommand::RenderEvent, on_render);
 
   // Depth peeling for the translucent mirror and plane: order-independent transparency
-  // (VTK's default without it) draws wrong colours under Mesa's llvmpipe.
+  // (VTK's default without it) draws wrong colours under Mesa's llvmpipe. Four peels, stopping
+  // once fewer than 5 % of the pixels change: on the sample's step 8, 8 of the view's 513,000
+  // pixels differ by more than 40 from six exact peels, and a frame takes 0.8–1.1 s instead of
+  // 2 s under llvmpipe (cranioplan --pauses).
   d.window->SetAlphaBitPlanes(1);
   d.window->SetMultiSamples(0);
   d.renderer->SetUseDepthPeeling(1);
-  d.renderer->SetMaximumNumberOfPeels(6);
-  d.renderer->SetOcclusionRatio(0.0);
+  d.renderer->SetMaximumNumberOfPeels(4);
+  d.renderer->SetOcclusionRatio(0.05);
   d.renderer->GradientBackgroundOn();
   d.renderer->SetBackground(0.10, 0.11, 0.14);
   d.renderer->SetBackground2(0.30, 0.33, 0.40);
