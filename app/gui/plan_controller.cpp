@@ -16,7 +16,14 @@ PlanController::~PlanController() {
   if (watcher_) watcher_->waitForFinished();
 }
 
+void PlanController::drop_work() {
+  if (busy()) cancelled_ = true;  // its result belongs to the plan being replaced
+  queue_.clear();
+  intent_.reset();
+}
+
 void PlanController::new_session(const SessionInfo& info, const QString& autosave_path) {
+  drop_work();
   session_ = std::make_unique<Session>(info);
   if (!autosave_path.isEmpty()) session_->set_autosave_path(autosave_path.toStdString());
   read_only_ = false;
@@ -24,6 +31,7 @@ void PlanController::new_session(const SessionInfo& info, const QString& autosav
 }
 
 void PlanController::set_session(Session session) {
+  drop_work();
   session_ = std::make_unique<Session>(std::move(session));
   emit stateChanged();
 }
@@ -84,6 +92,7 @@ bool PlanController::push(Command command) {
     emit refused(tr("This plan is open for audit only."));
     return false;
   }
+  if (editing()) wait();  // after the marker edits given so far, as a queued command would run
   if (busy()) {
     emit refused(tr("Wait for the running operation to finish (or cancel it)."));
     return false;

@@ -36,7 +36,8 @@ class PlanController : public QObject {
   bool read_only() const { return read_only_; }
   void set_read_only(bool read_only) { read_only_ = read_only; }
 
-  /// Runs a command now. Returns whether it was accepted; a refusal or a bad input is signalled.
+  /// Runs a command now (after the marker edits being computed, if any). Returns whether it was
+  /// accepted; a refusal or a bad input is signalled.
   bool push(Command command);
   /// Runs a long command off the GUI thread; `busyChanged` brackets it. While busy, other
   /// pushes are refused.
@@ -84,6 +85,8 @@ class PlanController : public QObject {
 
  private:
   void finish();
+  /// Cancels the running computation and drops the queue (the plan is being replaced).
+  void drop_work();
   void start(Command command, const QString& what);
   void start_queued();
   /// The previews of the running and queued edits, from the plan as it stands.

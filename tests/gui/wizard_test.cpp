@@ -842,7 +842,8 @@ TEST(WizardTabs, TabsAreDraggedRemovedAndAddedWithUndo) {
 // Markers dragged in a plan fitted to the bone (step 8): while dragged the view previews the
 // implant without the fit, no command is pushed; let go, the move is one command computed off
 // the GUI thread, and the next drags queue behind it instead of waiting; undo takes back the
-// last queued one. The plan ends as the same commands pushed one by one leave it.
+// last queued one. The plan ends as the same commands pushed one by one leave it. A command
+// pushed meanwhile runs after the drops; another plan opened drops them.
 TEST(WizardMarkers, DragsInAFittedPlanQueueOffTheGuiThread) {
   MainWindow w;
   open_planned_at_step(w, 8, QSize(1500, 950));
@@ -919,6 +920,27 @@ TEST(WizardMarkers, DragsInAFittedPlanQueueOffTheGuiThread) {
   ASSERT_TRUE(direct.push(commands::move_marker(b, dropped_b)).accepted);
   ASSERT_TRUE(direct.state().implant);
   EXPECT_EQ(direct.state().implant->stl_sha256(), plan.state().implant->stl_sha256());
+
+  // A command pushed while a drop is computed runs after it.
+  drag_view(w.view(), drags[2].from, drags[2].to);
+  ASSERT_TRUE(plan.editing());
+  EXPECT_TRUE(plan.push(commands::note("after the drag")));
+  ASSERT_EQ(plan.session().index(), index + 4);
+  EXPECT_EQ(plan.session().stack()[index + 2].type, CommandType::MoveMarker);
+  EXPECT_EQ(plan.session().stack()[index + 3].type, CommandType::Note);
+
+  // Another plan opened while drops are computed and queued: they belong to the plan replaced.
+  // (A and B dragged back from where they were dropped.)
+  drag_view(w.view(), drags[0].to, drags[0].from);
+  drag_view(w.view(), drags[1].to, drags[1].from);
+  ASSERT_TRUE(plan.editing());
+  ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
+  EXPECT_EQ(plan.queued(), 0u);
+  plan.wait();
+  EXPECT_EQ(plan.session().index(), plan.session().stack().size());
+  EXPECT_EQ(plan.session().stack().size(), direct.stack().size() - 3) << "the plan as saved";
+  EXPECT_LT((position(plan.state(), a) - drags[0].marker.position).norm(), 1e-9);
+  EXPECT_EQ(&plan.shown_state(), &plan.state());
 }
 
 // Step 9's "3MF with a casting mould": the mould the export would hold, made off the GUI thread
