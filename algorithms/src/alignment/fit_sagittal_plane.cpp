@@ -284,7 +284,10 @@ Candidate polish(const SymmetryScore& score, Candidate c) {
 }  // namespace
 
 Plane automatic_initial_plane(const SkullMesh& mesh) {
-  const SurfaceSamples all = all_vertex_samples(mesh);
+  return automatic_initial_plane(all_vertex_samples(mesh));
+}
+
+Plane automatic_initial_plane(const SurfaceSamples& all) {
   assert(!all.points.empty());
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (const auto& p : all.points) centroid += p;
@@ -353,7 +356,7 @@ Plane automatic_initial_plane(const SkullMesh& mesh) {
 }
 
 PlaneFit fit_sagittal_plane(const SkullMesh& mesh, const Landmarks& landmarks,
-                            const PlaneFitParams& params) {
+                            const PlaneFitParams& params, const VertexCloud* cloud) {
   const auto t0 = std::chrono::steady_clock::now();
   PlaneFit fit;
   if (mesh.n_vertices() < 10 && !landmarks.has_required()) {
@@ -363,20 +366,23 @@ PlaneFit fit_sagittal_plane(const SkullMesh& mesh, const Landmarks& landmarks,
   if (landmarks.has_required()) {
     fit.initial = initial_plane_from_landmarks(landmarks);
     fit.initial_method = "landmarks";
-  } else {
-    fit.initial = automatic_initial_plane(mesh);
+  }
+  const bool use_surface = params.use_surface_symmetry && mesh.n_vertices() >= 10;
+  std::unique_ptr<VertexCloud> own;
+  if (!cloud && (use_surface || !landmarks.has_required()))
+    cloud = (own = std::make_unique<VertexCloud>(mesh)).get();
+  if (!landmarks.has_required()) {
+    fit.initial = automatic_initial_plane(cloud->samples);
     fit.initial_method = "automatic";
   }
   fit.plane = fit.initial;
 
-  const bool use_surface = params.use_surface_symmetry && mesh.n_vertices() >= 10;
-  SurfaceSamples all, samples;
-  std::unique_ptr<PointIndex> index;
-  if (use_surface) {
-    all = all_vertex_samples(mesh);
+  const SurfaceSamples empty;
+  const SurfaceSamples& all = use_surface ? cloud->samples : empty;
+  const PointIndex* index = use_surface ? &cloud->index : nullptr;
+  SurfaceSamples samples;
+  if (use_surface)
     samples = subsample(all, static_cast<size_t>(std::clamp(params.sample_count, 100, 100000)));
-    index = std::make_unique<PointIndex>(all.points);
-  }
 
   fit.status = PlaneFit::Status::Converged;
   if (params.refine && (use_surface || landmarks.has_required())) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <memory>
 
 #include "cranioplan/algorithms/alignment/mirror_mesh.h"
 #include "cranioplan/algorithms/geometry/parallel.h"
@@ -44,7 +45,8 @@ RigidTransform small_motion(const Eigen::Matrix<double, 6, 1>& x, const Eigen::V
 }  // namespace
 
 RegisterResult register_icp(const SkullMesh& moving, const SkullMesh& fixed,
-                            const RegisterParams& params) {
+                            const RegisterParams& params, const VertexCloud* fixed_cloud,
+                            const VertexCloud* moving_cloud) {
   const auto t0 = std::chrono::steady_clock::now();
   RegisterResult result;
   result.transform = params.initial;
@@ -52,9 +54,14 @@ RegisterResult register_icp(const SkullMesh& moving, const SkullMesh& fixed,
     result.message = "both meshes need at least 6 vertices";
     return result;
   }
-  const SurfaceSamples fixed_samples = all_vertex_samples(fixed);
-  const PointIndex index(fixed_samples.points);
-  const SurfaceSamples moving_all = all_vertex_samples(moving);
+  std::unique_ptr<VertexCloud> own_fixed, own_moving;
+  if (!fixed_cloud) fixed_cloud = (own_fixed = std::make_unique<VertexCloud>(fixed)).get();
+  if (!moving_cloud)
+    moving_cloud = &moving == &fixed ? fixed_cloud
+                                     : (own_moving = std::make_unique<VertexCloud>(moving)).get();
+  const SurfaceSamples& fixed_samples = fixed_cloud->samples;
+  const PointIndex& index = fixed_cloud->index;
+  const SurfaceSamples& moving_all = moving_cloud->samples;
   SurfaceSamples source;
   if (params.roi) {
     for (size_t i = 0; i < moving_all.points.size(); ++i)
@@ -160,11 +167,11 @@ RegisterResult register_icp(const SkullMesh& moving, const SkullMesh& fixed,
 }
 
 RegisterResult register_mirror(const SkullMesh& skull, const Plane& plane,
-                               const RegisterParams& params) {
+                               const RegisterParams& params, const VertexCloud* cloud) {
   const RigidTransform reflection = reflection_across(plane);
   RegisterParams own = params;
   own.initial = params.initial * reflection;
-  RegisterResult result = register_icp(skull, skull, own);
+  RegisterResult result = register_icp(skull, skull, own, cloud, cloud);
   result.transform = result.transform * reflection;  // the reflection is its own inverse
   return result;
 }

@@ -27,7 +27,7 @@ PointIndex::PointIndex(std::vector<Eigen::Vector3d> points) : impl_(std::make_un
   impl_->adaptor.pts = &impl_->points;
   impl_->tree = std::make_unique<Impl::Tree>(3, impl_->adaptor,
                                              nanoflann::KDTreeSingleIndexAdaptorParams(12));
-  impl_->tree->buildIndex();
+  if (!impl_->points.empty()) impl_->tree->buildIndex();  // nanoflann refuses an empty set
 }
 
 PointIndex::~PointIndex() = default;
@@ -46,6 +46,7 @@ int PointIndex::nearest(const Eigen::Vector3d& query, double* squared_distance) 
 }
 
 std::vector<int> PointIndex::within_radius(const Eigen::Vector3d& query, double radius) const {
+  if (impl_->points.empty()) return {};
   std::vector<std::pair<int, double>> matches;
   nanoflann::SearchParams params;
   params.sorted = false;
@@ -71,5 +72,8 @@ std::vector<size_t> thin_points(const std::vector<Eigen::Vector3d>& points, doub
   }
   return kept;
 }
+
+VertexCloud::VertexCloud(const SkullMesh& mesh)
+    : samples(all_vertex_samples(mesh)), index(samples.points) {}
 
 }  // namespace cranioplan

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "cranioplan/algorithms/alignment/mirror_mesh.h"
+#include "cranioplan/algorithms/geometry/point_index.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/planning/detect_defect.h"
 #include "cranioplan/algorithms/planning/propose_markers.h"
@@ -28,8 +29,9 @@ class StageTimer {
 
 // From the detection on: `r` holds the plane and the global registration. `all_openings`: the
 // other openings are planned as well, and the messages say so.
-void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const AutoplanParams& params,
-                  bool all_openings, StageTimer& timer, AutoplanResult& r) {
+void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const VertexCloud& cloud,
+                  const AutoplanParams& params, bool all_openings, StageTimer& timer,
+                  AutoplanResult& r) {
   const RigidTransform reflection = reflection_across(r.plane.plane);
   r.defect = autoplan_stages::detect(skull, bone, r.plane.plane, params);
   if (all_openings) r.defect.message = r.defect.describe(true);
@@ -44,7 +46,8 @@ void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const Auto
     return;
   }
   const std::optional<autoplan_stages::LocalRegistration> local =
-      autoplan_stages::local_registration(skull, r.plane.plane, r.defect, r.registration, params);
+      autoplan_stages::local_registration(skull, r.plane.plane, r.defect, r.registration, params,
+                                          &cloud);
   if (local) {
     r.registration = autoplan_stages::registration_used(r.registration, local);
     timer.stage("local register");
@@ -81,14 +84,15 @@ void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const Auto
 
 // The plane and the global registration; false (and `r` says why) when the plane fails.
 bool plane_and_registration(const SkullMesh& skull, const Landmarks& landmarks,
-                            const AutoplanParams& params, StageTimer& timer, AutoplanResult& r) {
-  r.plane = autoplan_stages::plane(skull, landmarks, params);
+                            const VertexCloud& cloud, const AutoplanParams& params,
+                            StageTimer& timer, AutoplanResult& r) {
+  r.plane = autoplan_stages::plane(skull, landmarks, params, &cloud);
   timer.stage("plane");
   if (!r.plane.usable()) {
     r.message = "midsagittal plane: " + r.plane.message;
     return false;
   }
-  r.registration = autoplan_stages::registration(skull, r.plane.plane, params);
+  r.registration = autoplan_stages::registration(skull, r.plane.plane, params, &cloud);
   timer.stage("register");
   return true;
 }
@@ -97,13 +101,14 @@ bool plane_and_registration(const SkullMesh& skull, const Landmarks& landmarks,
 
 namespace autoplan_stages {
 
-PlaneFit plane(const SkullMesh& skull, const Landmarks& landmarks, const AutoplanParams& params) {
-  return fit_sagittal_plane(skull, landmarks, params.plane);
+PlaneFit plane(const SkullMesh& skull, const Landmarks& landmarks, const AutoplanParams& params,
+               const VertexCloud* cloud) {
+  return fit_sagittal_plane(skull, landmarks, params.plane, cloud);
 }
 
 RegisterResult registration(const SkullMesh& skull, const Plane& plane,
-                            const AutoplanParams& params) {
-  return register_mirror(skull, plane, params.registration);
+                            const AutoplanParams& params, const VertexCloud* cloud) {
+  return register_mirror(skull, plane, params.registration, cloud);
 }
 
 DefectRegion detect(const SkullMesh& skull, const SurfaceLocator& bone, const Plane& plane,
@@ -114,14 +119,15 @@ DefectRegion detect(const SkullMesh& skull, const SurfaceLocator& bone, const Pl
 std::optional<LocalRegistration> local_registration(const SkullMesh& skull, const Plane& plane,
                                                     const DefectRegion& defect,
                                                     const RegisterResult& global,
-                                                    const AutoplanParams& params) {
+                                                    const AutoplanParams& params,
+                                                    const VertexCloud* cloud) {
   if (params.local_registration_mm <= 0.0 || !defect.found() || !global.usable())
     return std::nullopt;
   LocalRegistration local;
   local.params = params.registration;
   local.params.initial = global.transform;
   local.params.roi = local_registration_region(defect, params.local_registration_mm);
-  local.result = register_mirror(skull, plane, local.params);
+  local.result = register_mirror(skull, plane, local.params, cloud);
   return local;
 }
 
@@ -153,9 +159,10 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
                         const AutoplanParams& params) {
   AutoplanResult r;
   StageTimer timer(r.stage_seconds);
-  if (!plane_and_registration(skull, landmarks, params, timer, r)) return r;
+  const VertexCloud cloud(skull);
+  if (!plane_and_registration(skull, landmarks, cloud, params, timer, r)) return r;
   const SurfaceLocator bone(skull);
-  plan_opening(skull, bone, params, false, timer, r);
+  plan_opening(skull, bone, cloud, params, false, timer, r);
   return r;
 }
 
@@ -164,12 +171,13 @@ std::vector<AutoplanResult> autoplan_all_openings(const SkullMesh& skull,
                                                   const AutoplanParams& params) {
   AutoplanResult first;
   StageTimer timer(first.stage_seconds);
-  if (!plane_and_registration(skull, landmarks, params, timer, first)) return {first};
+  const VertexCloud cloud(skull);
+  if (!plane_and_registration(skull, landmarks, cloud, params, timer, first)) return {first};
   AutoplanResult shared;  // the plane and the global registration, before the local one
   shared.plane = first.plane;
   shared.registration = first.registration;
   const SurfaceLocator bone(skull);
-  plan_opening(skull, bone, params, true, timer, first);
+  plan_opening(skull, bone, cloud, params, true, timer, first);
   std::vector<AutoplanResult> plans;
   plans.push_back(std::move(first));
   if (!plans.front().defect.found()) return plans;
@@ -179,7 +187,7 @@ std::vector<AutoplanResult> autoplan_all_openings(const SkullMesh& skull,
     each.propose.detect.near = point_towards_other_opening(first_opening, k);
     AutoplanResult r = shared;
     StageTimer each_timer(r.stage_seconds);
-    plan_opening(skull, bone, each, true, each_timer, r);
+    plan_opening(skull, bone, cloud, each, true, each_timer, r);
     plans.push_back(std::move(r));
   }
   return plans;

@@ -4,7 +4,9 @@
 
 #include <Eigen/Geometry>
 
+#include "cranioplan/algorithms/alignment/fit_sagittal_plane.h"
 #include "cranioplan/algorithms/alignment/mirror_mesh.h"
+#include "cranioplan/algorithms/geometry/point_index.h"
 #include "support/synthetic.h"
 
 namespace cranioplan {
@@ -104,6 +106,33 @@ TEST(RegisterIcp, MirrorRegisteredWithoutItsMeshIsTheMirrorMeshRegistered) {
     expect_transform_near(without.transform, with_mesh.transform, 1e-4, 1e-4, mirror);
     EXPECT_NEAR(without.rms_mm, with_mesh.rms_mm, 1e-9);
   }
+}
+
+// The skull's vertex cloud made once and shared gives the plane and the registrations exactly
+// as each stage making its own; an empty cloud is no error.
+TEST(RegisterIcp, ASharedVertexCloudGivesTheSameResults) {
+  const SkullMesh& skull = hole_pair().fixed;
+  const VertexCloud cloud(skull);
+  const PlaneFit own_fit = fit_sagittal_plane(skull, Landmarks{});
+  const PlaneFit shared_fit = fit_sagittal_plane(skull, Landmarks{}, PlaneFitParams{}, &cloud);
+  ASSERT_TRUE(own_fit.usable());
+  EXPECT_EQ(shared_fit.plane.normal, own_fit.plane.normal);
+  EXPECT_EQ(shared_fit.plane.offset, own_fit.plane.offset);
+  RegisterParams local;
+  local.roi = RegionOfInterest{};
+  local.roi->center = Eigen::Vector3d(-40, 20, 40);
+  local.roi->radius = 45.0;
+  for (const RegisterParams& params : {RegisterParams{}, local}) {
+    const RegisterResult own = register_mirror(skull, own_fit.plane, params);
+    const RegisterResult shared = register_mirror(skull, own_fit.plane, params, &cloud);
+    ASSERT_TRUE(own.usable()) << own.message;
+    EXPECT_EQ(shared.transform.rotation, own.transform.rotation);
+    EXPECT_EQ(shared.transform.translation, own.transform.translation);
+    EXPECT_EQ(shared.iterations, own.iterations);
+  }
+  const VertexCloud empty{SkullMesh()};
+  EXPECT_EQ(empty.index.size(), 0u);
+  EXPECT_TRUE(empty.index.within_radius(Eigen::Vector3d::Zero(), 5.0).empty());
 }
 
 TEST(RegisterIcp, RegionOfInterestRestrictsTheFit) {

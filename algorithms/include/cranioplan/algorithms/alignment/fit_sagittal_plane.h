@@ -9,6 +9,9 @@
 
 namespace cranioplan {
 
+struct SurfaceSamples;
+struct VertexCloud;
+
 struct PlaneFitParams {
   bool refine = true;                ///< run the Ceres refinement after the initial plane
   bool use_surface_symmetry = true;  ///< add the surface-symmetry residuals (needs a mesh)
@@ -55,11 +58,14 @@ Plane initial_plane_from_landmarks(const Landmarks& landmarks);
 /// each of up to six basins (20° apart) is polished by a pattern search on tilt and offset (down
 /// to 0.25° and 0.125 mm), and the best polished one wins.
 Plane automatic_initial_plane(const SkullMesh& mesh);
+/// The same from the mesh's vertex samples (all_vertex_samples) made beforehand.
+Plane automatic_initial_plane(const SurfaceSamples& all);
 
 /// Initial plane (landmarks when they hold the required three, otherwise automatic), then the
 /// Ceres refinement. With `params.refine == false` returns the initial plane with its
 /// symmetry measures.
+/// `cloud`, when given, is the mesh's VertexCloud made beforehand (the same fit).
 PlaneFit fit_sagittal_plane(const SkullMesh& mesh, const Landmarks& landmarks,
-                            const PlaneFitParams& params = {});
+                            const PlaneFitParams& params = {}, const VertexCloud* cloud = nullptr);
 
 }  // namespace cranioplan

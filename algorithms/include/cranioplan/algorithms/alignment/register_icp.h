@@ -43,15 +43,22 @@ struct RegisterResult {
   bool usable() const { return status != Status::Failed; }
 };
 
+struct VertexCloud;
+
+/// `fixed_cloud` and `moving_cloud`, when given, are the meshes' VertexCloud made beforehand
+/// (the same result, without making them again).
 RegisterResult register_icp(const SkullMesh& moving, const SkullMesh& fixed,
-                            const RegisterParams& params = {});
+                            const RegisterParams& params = {},
+                            const VertexCloud* fixed_cloud = nullptr,
+                            const VertexCloud* moving_cloud = nullptr);
 
 /// Registers the skull's mirror image across `plane` onto the skull without building the mirrored
 /// mesh (on a skull of two million triangles it is about 300 MB): the skull is registered onto
 /// itself starting from `params.initial` after the reflection. The result carries the mirror
 /// (mirror_mesh(skull, plane)) onto the skull, as register_icp(mirror, skull, params) does.
 RegisterResult register_mirror(const SkullMesh& skull, const Plane& plane,
-                               const RegisterParams& params = {});
+                               const RegisterParams& params = {},
+                               const VertexCloud* cloud = nullptr);
 
 /// A copy of the mesh with every vertex transformed.
 SkullMesh transform_mesh(const SkullMesh& mesh, const RigidTransform& transform);

@@ -4,6 +4,8 @@
 #include <memory>
 #include <vector>
 
+#include "cranioplan/algorithms/geometry/surface_samples.h"
+
 namespace cranioplan {
 
 class PointIndex {
@@ -28,5 +30,14 @@ class PointIndex {
 /// Greedy thinning: indices of the points kept, in the given order, each at least `spacing` mm
 /// from every point kept before it (earlier points win).
 std::vector<size_t> thin_points(const std::vector<Eigen::Vector3d>& points, double spacing);
+
+/// A mesh's vertices with their normals (all_vertex_samples) and a search tree over them, made
+/// once and shared by the stages that each need them (the plane fit, the registrations): on a
+/// SkullFix skull each costs about half a second to make.
+struct VertexCloud {
+  explicit VertexCloud(const SkullMesh& mesh);
+  SurfaceSamples samples;
+  PointIndex index;
+};
 
 }  // namespace cranioplan

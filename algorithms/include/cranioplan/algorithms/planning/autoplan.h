@@ -62,15 +62,19 @@ struct AutoplanResult {
 AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
                         const AutoplanParams& params = {});
 
-/// The stages of the automatic plan, in the order autoplan() runs them.
+struct VertexCloud;
+
+/// The stages of the automatic plan, in the order autoplan() runs them. `cloud`, when given, is
+/// the skull's VertexCloud, made once for the plane and the registrations (the same results).
 namespace autoplan_stages {
 
 /// The midsagittal plane (from the landmarks when they give one).
-PlaneFit plane(const SkullMesh& skull, const Landmarks& landmarks, const AutoplanParams& params);
+PlaneFit plane(const SkullMesh& skull, const Landmarks& landmarks, const AutoplanParams& params,
+               const VertexCloud* cloud = nullptr);
 /// The skull's mirror image across `plane` registered onto the skull (no mirrored mesh is built:
 /// on a skull of two million triangles a mesh and its locator are a few hundred megabytes each).
 RegisterResult registration(const SkullMesh& skull, const Plane& plane,
-                            const AutoplanParams& params);
+                            const AutoplanParams& params, const VertexCloud* cloud = nullptr);
 /// The opening to plan, seen from the skull's centroid on the plane (`params.propose.detect`:
 /// `near` chooses among several).
 DefectRegion detect(const SkullMesh& skull, const SurfaceLocator& bone, const Plane& plane,
@@ -86,7 +90,8 @@ struct LocalRegistration {
 std::optional<LocalRegistration> local_registration(const SkullMesh& skull, const Plane& plane,
                                                     const DefectRegion& defect,
                                                     const RegisterResult& global,
-                                                    const AutoplanParams& params);
+                                                    const AutoplanParams& params,
+                                                    const VertexCloud* cloud = nullptr);
 /// The registration a plan goes on with: the local one when it is usable, else the global one.
 const RegisterResult& registration_used(const RegisterResult& global,
                                         const std::optional<LocalRegistration>& local);
