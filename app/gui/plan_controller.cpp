@@ -132,7 +132,6 @@ void PlanController::push_async(Command command, const QString& what) {
   }
   cancelled_ = false;
   running_edit_ = is_marker_edit(running_.command);
-  if (running_edit_) intent_ = quick_apply(state(), running_.command, session_->context());
   watcher_ = new QFutureWatcher<Computed>(this);
   connect(watcher_, &QFutureWatcher<Computed>::finished, this, &PlanController::finish);
   std::shared_ptr<const PlanState> state = session_->shared_state();
@@ -149,6 +148,8 @@ void PlanController::push_async(Command command, const QString& what) {
     }
     return c;
   }));
+  // What the view shows meanwhile: this edit and those queued behind it, previewed.
+  update_intent();
   emit busyChanged(true, what);
 }
 

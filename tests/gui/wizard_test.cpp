@@ -895,15 +895,21 @@ TEST(WizardMarkers, DragsInAFittedPlanQueueOffTheGuiThread) {
   EXPECT_GT((dropped_a - drags[0].marker.position).norm(), 1.5) << "the view shows the drop";
   EXPECT_LT((position(plan.state(), a) - drags[0].marker.position).norm(), 1e-9);
 
-  // Two more while the first is computed: they queue; undo takes back the last.
+  // Two more while the first is computed: they queue; undo takes back the last queued.
   drag_view(w.view(), drags[1].from, drags[1].to);
   drag_view(w.view(), drags[2].from, drags[2].to);
   EXPECT_EQ(plan.queued(), 2u);
   const int b = drags[1].marker.id, c = drags[2].marker.id;
   const Eigen::Vector3d dropped_b = position(plan.shown_state(), b);
   EXPECT_GT((position(plan.shown_state(), c) - drags[2].marker.position).norm(), 1.5);
-  plan.undo();
+  // The first done, the second computed: the view still shows the third where it was dropped.
+  while (plan.session().index() == index) QApplication::processEvents(QEventLoop::AllEvents, 20);
+  ASSERT_TRUE(plan.editing());
   EXPECT_EQ(plan.queued(), 1u);
+  EXPECT_GT((position(plan.shown_state(), c) - drags[2].marker.position).norm(), 1.5);
+  EXPECT_LT((position(plan.shown_state(), b) - dropped_b).norm(), 1e-9);
+  plan.undo();
+  EXPECT_EQ(plan.queued(), 0u);
   EXPECT_LT((position(plan.shown_state(), c) - drags[2].marker.position).norm(), 1e-9);
   plan.wait();
 
