@@ -1037,7 +1037,10 @@ bool MainWindow::open_session(const QString& path) {
     setEnabled(true);
     QApplication::restoreOverrideCursor();
     Opened opened = opening.result();
-    if (!opened.session) throw Error(opened.error);
+    if (!opened.session) {
+      emit controller_->failed(QString::fromStdString(opened.error));
+      return false;
+    }
     controller_->set_read_only(false);
     controller_->set_session(std::move(*opened.session));
     session_path_ = path;
