@@ -1,6 +1,7 @@
 #include "cranioplan/algorithms/geometry/distance_transform.h"
 
 #include <algorithm>
+#include <cassert>
 #include <cmath>
 #include <limits>
 
@@ -184,7 +185,8 @@ float distance_value(const VoxelGrid& g, long long squared) {
 }  // namespace
 
 std::vector<uint8_t> within_steps(const std::vector<uint8_t>& in, const VoxelGrid& g, int steps) {
-  const uint8_t cap = static_cast<uint8_t>(std::min(steps + 1, 255));
+  assert(steps >= 0 && steps <= 254 && "within_steps counts steps in a byte");
+  const uint8_t cap = static_cast<uint8_t>(steps + 1);
   std::vector<uint8_t> d(in.size());
   for (size_t c = 0; c < in.size(); ++c) d[c] = in[c] ? 0 : cap;
   const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
