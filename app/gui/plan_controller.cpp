@@ -4,8 +4,8 @@
 #include <QFutureWatcher>
 #include <QtConcurrent/QtConcurrentRun>
 
-#include "cranioplan/algorithms/implant/build_implant.h"
 #include "cranioplan/model/error.h"
+#include "cranioplan/sessions/previews.h"
 
 namespace cranioplan::gui {
 
@@ -35,25 +35,6 @@ void PlanController::set_session(Session session) {
   session_ = std::make_unique<Session>(std::move(session));
   emit stateChanged();
 }
-
-namespace {
-
-// `command` applied to `base` with the implant rebuilt as its quick preview; none when the
-// command is refused there.
-std::shared_ptr<const PlanState> quick_apply(const PlanState& base, const Command& command,
-                                             const ApplyContext& context) {
-  PlanState copy = base;
-  if (copy.implant_params) copy.implant_params = live_preview_params(*copy.implant_params);
-  try {
-    ApplyOutcome out = apply_command(copy, command, context);
-    if (!out.accepted) return nullptr;
-    return std::make_shared<const PlanState>(std::move(out.state));
-  } catch (const Error&) {
-    return nullptr;
-  }
-}
-
-}  // namespace
 
 bool PlanController::is_marker_edit(const Command& c) {
   return c.type == CommandType::AddMarker || c.type == CommandType::MoveMarker ||
@@ -160,7 +141,7 @@ void PlanController::submit(Command command, const QString& what) {
   }
   if (editing()) {
     if (is_marker_edit(command))
-      if (auto next = quick_apply(shown_state(), command, session_->context()))
+      if (auto next = preview_command_quickly(shown_state(), command, session_->context()))
         intent_ = std::move(next);
     queue_.push_back({std::move(command), what});
     emit stateChanged();
@@ -191,7 +172,8 @@ void PlanController::update_intent() {
   std::shared_ptr<const PlanState> at;
   auto add = [&](const Command& c) {
     if (!is_marker_edit(c)) return;
-    if (auto next = quick_apply(at ? *at : state(), c, session_->context())) at = std::move(next);
+    if (auto next = preview_command_quickly(at ? *at : state(), c, session_->context()))
+      at = std::move(next);
   };
   if (!cancelled_) add(running_.command);
   for (const Queued& q : queue_) add(q.command);
@@ -203,7 +185,7 @@ const PlanState& PlanController::shown_state() const {
 }
 
 std::shared_ptr<const PlanState> PlanController::preview_edit(const Command& command) {
-  return quick_apply(shown_state(), command, session_->context());
+  return preview_command_quickly(shown_state(), command, session_->context());
 }
 
 void PlanController::finish() {
@@ -243,13 +225,7 @@ void PlanController::wait() {
 }
 
 std::shared_ptr<const PlanState> PlanController::preview(const Command& command) {
-  try {
-    ApplyOutcome out = apply_command(session_->state(), command, session_->context());
-    if (!out.accepted) return nullptr;
-    return std::make_shared<const PlanState>(std::move(out.state));
-  } catch (const Error&) {
-    return nullptr;
-  }
+  return preview_command(session_->state(), command, session_->context());
 }
 
 void PlanController::undo() {

@@ -28,6 +28,7 @@
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/algorithms/planning/autoplan.h"
 #include "cranioplan/sessions/autoplan_session.h"
+#include "cranioplan/sessions/previews.h"
 
 namespace cranioplan::cli {
 namespace {
@@ -197,13 +198,12 @@ Json run_bench(const BenchOptions& options) {
       // applied with the implant previewed without the fit (the fitted one is computed on a
       // worker once the marker is let go).
       if (session.state().implant_params) {
-        PlanState live = session.state();
-        live.implant_params = live_preview_params(*live.implant_params);
         int n = 0;
         out["drag_preview_s"] = median_seconds(runs, [&] {
           const Eigen::Vector3d to =
               surface.closest(m.position + Eigen::Vector3d(0, 0.2 * ++n, 0)).point;
-          apply_command(live, commands::move_marker(m.id, to), session.context());
+          preview_command_quickly(session.state(), commands::move_marker(m.id, to),
+                                  session.context());
         });
       }
       out["session_undo_s"] = median_seconds(runs,

@@ -266,35 +266,33 @@ bool LocalDistance::farther(size_t voxel) const {
 
 LocalOpening::LocalOpening(const std::vector<uint8_t>& mask, const VoxelGrid& grid, double radius)
     : mask_(mask),
-      need_(radius + 0.5 * grid.spacing),
-      depth_(grid, need_),
-      grow_(grid, radius + 0.5 * grid.spacing),
+      reach_(radius + 0.5 * grid.spacing),
+      offsets_(grid, reach_),
       centre_(mask.size(), -1) {}
 
 bool LocalOpening::is_centre(size_t v) {
   if (centre_[v] < 0) {
-    // ball_centres: depth_in_mask ≥ need, the depth being the distance to the nearest voxel
-    // outside the mask or on the grid's outermost layer.
-    const VoxelGrid& g = depth_.grid();
+    // ball_centres: depth_in_mask ≥ radius + ½ voxel, the depth being the distance to the
+    // nearest voxel outside the mask or on the grid's outermost layer.
+    const VoxelGrid& g = offsets_.grid();
     const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
-    const bool shallow = depth_.first(
+    const bool shallow = offsets_.first(
         v,
         [&](size_t u, int x, int y, int z) {
           return !mask_[u] || x == 0 || y == 0 || z == 0 || x == nx - 1 || y == ny - 1 ||
                  z == nz - 1;
         },
-        [&](float d) { return d < need_; });
+        [&](float d) { return d < reach_; });
     centre_[v] = !shallow;
   }
   return centre_[v] == 1;
 }
 
 bool LocalOpening::contains(size_t voxel) {
-  // open_by_ball: within radius + ½ voxel of a centre.
-  const double grow = need_;
-  return mask_[voxel] && grow_.first(
+  // open_by_ball: within radius + ½ voxel of a centre (the same reach as the centres' depth).
+  return mask_[voxel] && offsets_.first(
                              voxel, [&](size_t v, int, int, int) { return is_centre(v); },
-                             [&](float d) { return d <= grow; });
+                             [&](float d) { return d <= reach_; });
 }
 
 }  // namespace cranioplan

@@ -188,6 +188,60 @@ std::vector<std::string> describe_openings(const MeshReport& report) {
   return out;
 }
 
+namespace {
+
+// Identical positions as one vertex: each input vertex's id, ids in the order positions first
+// appear, and the positions by id.
+struct Welded {
+  std::vector<int> id;
+  std::vector<Eigen::Vector3d> positions;
+};
+
+Welded weld_positions(const std::vector<Eigen::Vector3d>& points) {
+  const size_t n = points.size();
+  std::vector<int> order(n);
+  std::iota(order.begin(), order.end(), 0);
+  auto key = [&](int i) {
+    return std::array<double, 3>{points[i].x(), points[i].y(), points[i].z()};
+  };
+  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
+  std::vector<int> first_of;  // each position's first vertex, in order of position
+  std::vector<int> group(n);
+  for (size_t r = 0; r < n; ++r) {
+    if (r == 0 || key(order[r]) != key(order[r - 1])) first_of.push_back(order[r]);
+    group[order[r]] = static_cast<int>(first_of.size()) - 1;
+  }
+  std::vector<int> by_appearance(first_of.size());
+  std::iota(by_appearance.begin(), by_appearance.end(), 0);
+  std::sort(by_appearance.begin(), by_appearance.end(),
+            [&](int a, int b) { return first_of[a] < first_of[b]; });
+  std::vector<int> rank(first_of.size());
+  for (size_t k = 0; k < by_appearance.size(); ++k) rank[by_appearance[k]] = static_cast<int>(k);
+  Welded w;
+  w.id.resize(n);
+  for (size_t i = 0; i < n; ++i) w.id[i] = rank[group[i]];
+  w.positions.resize(first_of.size());
+  for (size_t g = 0; g < first_of.size(); ++g) w.positions[rank[g]] = points[first_of[g]];
+  return w;
+}
+
+// Every triangle's three undirected edges as (smaller id << 32 | larger id), sorted: an edge's
+// triangles are a run.
+std::vector<unsigned long long> sorted_edges(const std::vector<Eigen::Vector3i>& triangles) {
+  std::vector<unsigned long long> edges;
+  edges.reserve(triangles.size() * 3);
+  for (const auto& t : triangles)
+    for (int k = 0; k < 3; ++k) {
+      const unsigned long long a = static_cast<unsigned>(t[k]),
+                               b = static_cast<unsigned>(t[(k + 1) % 3]);
+      edges.push_back(std::min(a, b) << 32 | std::max(a, b));
+    }
+  std::sort(edges.begin(), edges.end());
+  return edges;
+}
+
+}  // namespace
+
 MeshReport report_mesh(const SkullMesh& mesh) {
   MeshReport r;
   TriangleSoup soup = to_soup(mesh);
@@ -205,41 +259,12 @@ MeshReport report_mesh(const SkullMesh& mesh) {
   }
   r.volume_mm3 = signed_volume(soup);
 
-  // Weld identical positions (ids in the order positions first appear), then count triangles
-  // per undirected edge.
-  const size_t nv = soup.vertices.size();
-  std::vector<int> order(nv);
-  std::iota(order.begin(), order.end(), 0);
-  auto key = [&](int i) {
-    const auto& p = soup.vertices[i];
-    return std::array<double, 3>{p.x(), p.y(), p.z()};
-  };
-  std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
-  std::vector<int> first_of;  // each position's first vertex, in order of position
-  std::vector<int> group(nv);
-  for (size_t r = 0; r < nv; ++r) {
-    if (r == 0 || key(order[r]) != key(order[r - 1])) first_of.push_back(order[r]);
-    group[order[r]] = static_cast<int>(first_of.size()) - 1;
-  }
-  std::vector<int> by_appearance(first_of.size());
-  std::iota(by_appearance.begin(), by_appearance.end(), 0);
-  std::sort(by_appearance.begin(), by_appearance.end(),
-            [&](int a, int b) { return first_of[a] < first_of[b]; });
-  std::vector<int> rank(first_of.size());
-  for (size_t k = 0; k < by_appearance.size(); ++k) rank[by_appearance[k]] = static_cast<int>(k);
-  std::vector<int> id(nv);
-  for (size_t i = 0; i < nv; ++i) id[i] = rank[group[i]];
-  std::vector<unsigned long long> edges;
-  edges.reserve(soup.triangles.size() * 3);
-  for (auto& t : soup.triangles) {
-    for (int k = 0; k < 3; ++k) t[k] = id[t[k]];
-    for (int k = 0; k < 3; ++k) {
-      const unsigned long long a = static_cast<unsigned>(t[k]),
-                               b = static_cast<unsigned>(t[(k + 1) % 3]);
-      edges.push_back(std::min(a, b) << 32 | std::max(a, b));
-    }
-  }
-  std::sort(edges.begin(), edges.end());
+  // Weld identical positions, then count triangles per undirected edge.
+  Welded w = weld_positions(soup.vertices);
+  for (auto& t : soup.triangles)
+    for (int k = 0; k < 3; ++k) t[k] = w.id[t[k]];
+  soup.vertices = std::move(w.positions);
+  const std::vector<unsigned long long> edges = sorted_edges(soup.triangles);
   std::vector<std::pair<int, int>> boundary;
   for (size_t e = 0; e < edges.size();) {
     size_t count = 1;
@@ -252,9 +277,6 @@ MeshReport report_mesh(const SkullMesh& mesh) {
     if (count > 2) ++r.nonmanifold_edges;
     e += count;
   }
-  std::vector<Eigen::Vector3d> welded(first_of.size());
-  for (size_t g = 0; g < first_of.size(); ++g) welded[rank[g]] = soup.vertices[first_of[g]];
-  soup.vertices = std::move(welded);
   // In the order of the welded ids: the same loops on any run.
   std::sort(boundary.begin(), boundary.end());
   r.loops = boundary_loops(soup, boundary);
@@ -264,35 +286,13 @@ MeshReport report_mesh(const SkullMesh& mesh) {
 }
 
 bool is_watertight(const SkullMesh& mesh) {
-  const size_t n = mesh.n_vertices();
-  if (n == 0) return false;
-  // Weld: the vertices in order of position, equal positions one id.
-  std::vector<int> order(n);
-  for (size_t i = 0; i < n; ++i) order[i] = static_cast<int>(i);
-  auto key = [&](int i) {
-    const auto& p = mesh.point(OpenMesh::VertexHandle(i));
-    return std::array<double, 3>{p[0], p[1], p[2]};
-  };
-  std::sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
-  std::vector<unsigned> id(n);
-  unsigned next = 0;
-  for (size_t r = 0; r < n; ++r) {
-    if (r > 0 && key(order[r]) != key(order[r - 1])) ++next;
-    id[order[r]] = next;
-  }
+  TriangleSoup soup = to_soup(mesh);
+  if (soup.vertices.empty()) return false;
+  const Welded w = weld_positions(soup.vertices);
+  for (auto& t : soup.triangles)
+    for (int k = 0; k < 3; ++k) t[k] = w.id[t[k]];
   // Every undirected edge of the welded triangles twice: no boundary, nothing non-manifold.
-  std::vector<unsigned long long> edges;
-  edges.reserve(3 * mesh.n_faces());
-  for (auto fh : mesh.faces()) {
-    unsigned v[3];
-    int k = 0;
-    for (auto vh : mesh.fv_range(fh)) v[k++] = id[vh.idx()];
-    for (k = 0; k < 3; ++k) {
-      const unsigned long long a = v[k], b = v[(k + 1) % 3];
-      edges.push_back(std::min(a, b) << 32 | std::max(a, b));
-    }
-  }
-  std::sort(edges.begin(), edges.end());
+  const std::vector<unsigned long long> edges = sorted_edges(soup.triangles);
   for (size_t e = 0; e < edges.size();) {
     size_t run = 1;
     while (e + run < edges.size() && edges[e + run] == edges[e]) ++run;

@@ -92,8 +92,8 @@ class LocalOpening {
  private:
   bool is_centre(size_t voxel);
   const std::vector<uint8_t>& mask_;
-  double need_;
-  VoxelOffsets depth_, grow_;
+  double reach_;  ///< radius + ½ voxel: the centres' depth, and how far a ball reaches from one
+  VoxelOffsets offsets_;
   std::vector<int8_t> centre_;  ///< -1 not known yet
 };
 
