@@ -159,20 +159,24 @@ void add_edge_markers(const DefectRegion& defect, const DefectSurfaces& surfaces
   for (size_t i : along(defect.outer_rim, params.edge_spacing_mm)) {
     const Eigen::Vector3d& rim = defect.outer_rim[i];
     const auto fitted = surfaces.at(rim - c);
-    if (!bone_beyond(rim)) {
-      // Not where the rim's last bone lies below the fitted bone altogether, or, without a
-      // fitted surface there, more than one layer of bone below its neighbours on the rim: its
-      // ray met other bone past the vault's edge (an orbital roof, a sinus wall), and a marker
-      // there pulls the implant's outer surface down into a funnel (the sample: a rim point
-      // 18 mm below the surface; decimated, two 20-30 mm below their neighbours, rim gap 7 mm).
-      const double radius = (rim - c).norm();
-      if (fitted ? radius < (fitted->second - c).norm() - 1.0
-                 : radius < neighbours_radius(i) - params.detect.max_thickness_mm)
-        continue;
-      out.push_back({id++, MarkerType::OuterEdge, rim, MarkerSurface::Original});
-    } else if (const auto& p = fitted) {
-      out.push_back({id++, MarkerType::OuterEdge, p->first, MarkerSurface::Original});
+    if (fitted && bone_beyond(rim)) {
+      out.push_back({id++, MarkerType::OuterEdge, fitted->first, MarkerSurface::Original});
+      continue;
     }
+    // At the rim's last bone: where no intact bone continues beyond the rim, and where it does
+    // but no fitted surface says where (mirror-guided, the mirror has no bone there either: a
+    // rim point left out there left the outline to cut straight across that stretch, and an
+    // export of the sample smoothed as Slicer does lost one next to the frontal sinus). Not
+    // where that bone lies below the fitted bone altogether, or, without a fitted surface
+    // there, more than one layer of bone below its neighbours on the rim: its ray met other
+    // bone past the vault's edge (an orbital roof, a sinus wall), and a marker there pulls the
+    // implant's outer surface down into a funnel (the sample: a rim point 18 mm below the
+    // surface; decimated, two 20-30 mm below their neighbours, rim gap 7 mm).
+    const double radius = (rim - c).norm();
+    if (fitted ? radius < (fitted->second - c).norm() - 1.0
+               : radius < neighbours_radius(i) - params.detect.max_thickness_mm)
+      continue;
+    out.push_back({id++, MarkerType::OuterEdge, rim, MarkerSurface::Original});
   }
 }
 

@@ -2,7 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
+#include <vector>
 
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "support/synthetic.h"
@@ -36,6 +38,42 @@ TEST(ProposeMarkers, MarkersLieOnTheRimAndOnTheMissingBone) {
   EXPECT_GE(count[MarkerType::OuterEdge], 10);
   EXPECT_GE(count[MarkerType::OuterSurface], 10);
   EXPECT_GE(count[MarkerType::InnerSurface], 10);
+}
+
+// Mirror-guided where the mirror has no bone over part of the rim (its own opening, a sinus):
+// intact bone continues beyond the rim there, but no fitted surface says where. The rim's last
+// bone is still an edge marker, so the outline follows the rim there too instead of cutting
+// straight across.
+TEST(ProposeMarkers, TheRimKeepsEdgeMarkersWhereTheMirrorHasNoBone) {
+  const test::ThickHeadDefect& c = test::thick_head_defect();
+  ASSERT_TRUE(c.defect.found()) << c.defect.message;
+  ASSERT_GT(c.defect.outer_rim.size(), 8u);
+  const Eigen::Vector3d hole_at = c.defect.outer_rim.front();
+  const Eigen::Vector3d inward = (test::head_surface_point(c.defect.axis) - hole_at).normalized();
+  // The mirror's hole covers the rim there but not the intact bone 5-7 mm beyond it, where the
+  // proposal looks for bone that goes on.
+  const SkullMesh mirror_mesh = test::cut_hole(c.intact, hole_at + 8.0 * inward, 9.5);
+  const SurfaceLocator bone(c.defective), mirror(mirror_mesh);
+  ProposeParams params;
+  params.method = PlanMethod::Mirror;
+  const MarkerProposal p = propose_markers_for_defect(c.defect, bone, mirror, params);
+  ASSERT_TRUE(p.proposed()) << p.message;
+  std::vector<Eigen::Vector3d> edges;
+  for (const Marker& m : p.markers)
+    if (m.type == MarkerType::OuterEdge) edges.push_back(m.position);
+  ASSERT_FALSE(edges.empty());
+  // Every rim point has an edge marker within a marker spacing (4 mm); without the rim's last
+  // bone as markers there, the rim point under the mirror's hole had none within 7.6 mm.
+  int rim_in_hole = 0;
+  for (const Eigen::Vector3d& r : c.defect.outer_rim) {
+    double nearest = 1e9;
+    for (const Eigen::Vector3d& e : edges) nearest = std::min(nearest, (e - r).norm());
+    EXPECT_LT(nearest, params.edge_spacing_mm + 0.5) << r.transpose();
+    rim_in_hole += (r - hole_at).norm() < 8.0;
+  }
+  EXPECT_GE(rim_in_hole, 2) << "the mirror's hole lies over a stretch of the rim";
+  // Those edge markers lie on the skull's bone.
+  for (const Eigen::Vector3d& e : edges) EXPECT_LT(bone.closest(e).distance, 1.0);
 }
 
 TEST(ProposeMarkers, RimOnlyFittingIsUsedWhenAsked) {
