@@ -68,7 +68,8 @@ std::vector<size_t> along(const std::vector<Eigen::Vector3d>& loop, double spaci
 
 DefectRegion detect_defect_near_plane(const SkullMesh& skull, const SurfaceLocator& bone,
                                       const Plane& plane, const DetectDefectParams& params) {
-  const Eigen::Vector3d center = plane.project(vertex_centroid(skull));
+  const Eigen::Vector3d center =
+      params.center ? *params.center : plane.project(vertex_centroid(skull));
   DetectDefectParams framed = params;
   if (!framed.frame) framed.frame = skull_frame(skull, center, plane.normal);
   if (framed.scan_borders.empty() && has_boundary(skull))

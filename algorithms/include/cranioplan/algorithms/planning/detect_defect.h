@@ -46,6 +46,10 @@ struct DetectDefectParams {
   /// With several openings large enough, the one seen in the direction of this point (e.g. a
   /// click near the defect, mm) rather than the largest.
   std::optional<Eigen::Vector3d> near;
+  /// Where the rays start, a point inside the cranial cavity (detect_defect_near_plane; mm).
+  /// Unset: the skull's vertex centroid moved onto the midsagittal plane. Set, the plan's
+  /// dependence on its own rays can be measured (docs/AUTOPLAN.md).
+  std::optional<Eigen::Vector3d> center;
   /// The rays' lattice is turned by this rotation (columns: its axes in the skull's
   /// coordinates). With the skull's own frame (skull_frame) the rays meet the same anatomy
   /// whatever pose the file came in, and so the plan is the same.

@@ -57,7 +57,8 @@ struct MarkerProposal {
 /// or "rim-only fitting (…)".
 std::string describe_method(PlanMethod method, double mirror_coverage);
 
-/// The defect seen from the skull's centroid moved onto the midsagittal plane.
+/// The defect seen from the skull's centroid moved onto the midsagittal plane (or from
+/// DetectDefectParams::center).
 DefectRegion detect_defect_near_plane(const SkullMesh& skull, const SurfaceLocator& bone,
                                       const Plane& plane, const DetectDefectParams& params);
 
