@@ -4,6 +4,7 @@
 // the plan on the project's own import. The table it prints is docs/AUTOPLAN.md's.
 #include <gtest/gtest.h>
 #include <vtkCellArray.h>
+#include <vtkLinearSubdivisionFilter.h>
 #include <vtkNew.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
@@ -88,6 +89,16 @@ vtkSmartPointer<vtkPolyData> remeshed(vtkPolyData* in) {
   return t->GetOutput();
 }
 
+// Finer: every triangle split in four at its edges' midpoints (the same surface, edges halved,
+// four times the triangles), as a mesh exported at a finer resolution.
+vtkSmartPointer<vtkPolyData> subdivided(vtkPolyData* in) {
+  vtkNew<vtkLinearSubdivisionFilter> f;
+  f->SetInputData(in);
+  f->SetNumberOfSubdivisions(1);
+  f->Update();
+  return f->GetOutput();
+}
+
 // Written as a binary STL by VTK and read back as a user's file.
 SkullMesh exported(vtkPolyData* pd, const std::string& path) {
   vtkNew<vtkSTLWriter> w;
@@ -148,6 +159,7 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
       {"open, decimated to 50 %", [&] { return decimated(open300, 0.5); }, true, false},
       {"open, decimated to 25 %", [&] { return decimated(open300, 0.25); }, true, false},
       {"open, re-meshed (vertex clustering)", [&] { return remeshed(open300); }, true, false},
+      {"open, subdivided (edges halved)", [&] { return subdivided(open300); }, true, false},
       {"cropped above the orbits (z ≥ 60 mm)",
        [&] {
          const SkullMesh m = load_skull(path).mesh;
