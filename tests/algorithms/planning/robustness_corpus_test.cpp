@@ -235,7 +235,7 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
 // How much the plan moves with its own rays: the sample's own import planned again with the
 // rays' centre moved 1 mm along each axis, and with their lattice turned 3° either way about
 // the midsagittal plane's normal. Every export starts from this spread (docs/AUTOPLAN.md).
-TEST(RobustnessCorpus, ThePlanMovesLittleWithItsOwnRays) {
+TEST(RobustnessCorpus, HowFarThePlanMovesWithItsOwnRays) {
   const std::string path = sample_case_path();
   if (!std::filesystem::exists(path))
     GTEST_SKIP() << path << " not installed (scripts/install-deps)";
