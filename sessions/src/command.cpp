@@ -330,6 +330,9 @@ Json params_to_json(const ProposeParams& p) {
   j["method"] = to_string(p.method);
   j["detect"] = write_fields([](auto& v, auto& q) { detect_fields(v, q); }, p.detect);
   j["detect"]["near"] = p.detect.near ? to_json(*p.detect.near) : Json(nullptr);
+  // Written only when set (no plan made in the program sets it), so the commands of every
+  // other plan keep their bytes.
+  if (p.detect.center) j["detect"]["center"] = to_json(*p.detect.center);
   j["smooth"] = params_to_json(p.smooth);
   j["surfaces"] = write_fields([](auto& v, auto& q) { surface_fit_fields(v, q); }, p.surfaces);
   return j;
@@ -561,6 +564,8 @@ void params_from_json(const ParamReader& r, ProposeParams& p) {
   detect_fields(dv, p.detect);
   p.detect.near.reset();
   if (detect.has("near") && !detect.value("near").is_null()) p.detect.near = detect.vector3("near");
+  p.detect.center.reset();
+  if (detect.has("center")) p.detect.center = detect.vector3("center");
   params_from_json(ParamReader(r.value("smooth"), r.where() + " smooth"), p.smooth);
   // Version 1 (before the surfaces were fitted to the ring) has no "surfaces": the defaults.
   if (r.has("surfaces")) {

@@ -422,6 +422,16 @@ TEST(Commands, ProposeMarkersVersionTwoRoundTripsAndVersionOneGetsDefaults) {
   EXPECT_EQ(back.surfaces.smoothing, 0.07);
   ASSERT_TRUE(back.detect.near.has_value());
   EXPECT_EQ(*back.detect.near, *p.detect.near);
+  EXPECT_FALSE(j["params"]["params"]["detect"].contains("center")) << "unset: not written";
+  // Where the rays start, when a caller sets it, is recorded and read back.
+  ProposeParams moved;
+  moved.detect.center = Eigen::Vector3d(3.0, -1.25, 60.5);
+  ProposeParams moved_back;
+  params_from_json(
+      ParamReader(to_json(commands::propose_markers(moved))["params"]["params"], "test"),
+      moved_back);
+  ASSERT_TRUE(moved_back.detect.center.has_value());
+  EXPECT_EQ(*moved_back.detect.center, *moved.detect.center);
 
   Json v1 = j;
   v1["version"] = 1;

@@ -76,7 +76,7 @@ PlaneFit plane(const SkullMesh& skull, const Landmarks& landmarks, const Autopla
 RegisterResult registration(const SkullMesh& skull, const Plane& plane,
                             const AutoplanParams& params, const VertexCloud* cloud = nullptr);
 /// The opening to plan, seen from the skull's centroid on the plane (`params.propose.detect`:
-/// `near` chooses among several).
+/// `near` chooses among several, `center` starts the rays elsewhere).
 DefectRegion detect(const SkullMesh& skull, const SurfaceLocator& bone, const Plane& plane,
                     const AutoplanParams& params);
 
