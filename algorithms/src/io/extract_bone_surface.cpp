@@ -113,12 +113,16 @@ ExtractBoneSurfaceResult surface_of_field(std::vector<float> field, const VoxelG
 
 ExtractBoneSurfaceResult surface_of_signed_distance(std::vector<float> distance,
                                                     const VoxelGrid& grid) {
-  // From 0 (outside) to 1 (inside), ½ on the surface. A value exactly at the iso-level puts a
-  // vertex on a grid point, shared by triangles that then have no area: nudged off it.
+  // From 0 (outside) to 1 (inside), ½ on the surface. A value at or next to the iso-level puts
+  // a vertex on or next to a grid point, where the vertices of the edges meeting there fall
+  // together: triangles without area, whose neighbours then seem to cross. Values within
+  // kIsoGap of ½ are moved kIsoGap off it, on their side (the surface moves by at most a
+  // thousandth of a voxel).
+  constexpr float kIsoGap = 1e-3f;
   const double h = grid.spacing;
   for (float& v : distance) {
     v = static_cast<float>(std::clamp(0.5 + v / h, 0.0, 1.0));
-    if (v == 0.5f) v = 0.5f + 1e-4f;
+    if (std::abs(v - 0.5f) < kIsoGap) v = v < 0.5f ? 0.5f - kIsoGap : 0.5f + kIsoGap;
   }
   return surface_of_field(std::move(distance), grid);
 }

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include "cranioplan/algorithms/geometry/self_intersections.h"
+#include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/mesh_report.h"
 #include "support/synthetic.h"
 
@@ -59,6 +61,36 @@ TEST(ExtractBoneSurface, ThresholdOutsideTheDataGivesAStatusNotAnException) {
   const auto r = extract_bone_surface(v, p);
   EXPECT_FALSE(r.usable());
   EXPECT_NE(r.message.find("no surface"), std::string::npos);
+}
+
+// A solid whose surface passes within a millionth of a voxel of grid points (a slanted face
+// through a lattice of them, as a tab's or a drilled implant's distance field may): the vertices
+// of the edges meeting at such a point do not fall together into triangles without area.
+TEST(ExtractBoneSurface, ASurfaceThroughGridPointsGetsNoSliverTriangles) {
+  VoxelGrid g;
+  g.spacing = 0.2;
+  g.dims = {24, 24, 24};
+  const Eigen::Vector3d n = Eigen::Vector3d(1, 1, 1).normalized();
+  const Eigen::Vector3d centre = g.center(12, 12, 12);
+  // The half-space below the plane x + y + z = 36 (in voxels), a millionth of a voxel above it,
+  // cut to a ball so that the solid is closed.
+  const double offset = n.dot(g.center(12, 12, 12)) + 1e-6 * g.spacing;
+  std::vector<float> distance(g.size());
+  for (int k = 0; k < g.dims[2]; ++k)
+    for (int j = 0; j < g.dims[1]; ++j)
+      for (int i = 0; i < g.dims[0]; ++i) {
+        const Eigen::Vector3d p = g.center(i, j, k);
+        distance[g.index(i, j, k)] =
+            static_cast<float>(std::min(offset - n.dot(p), 2.0 - (p - centre).norm()));
+      }
+  const ExtractBoneSurfaceResult r = surface_of_signed_distance(std::move(distance), g);
+  ASSERT_TRUE(r.usable()) << r.message;
+  EXPECT_TRUE(report_mesh(r.mesh).watertight);
+  EXPECT_EQ(count_self_intersections(r.mesh), 0);
+  double shortest = std::numeric_limits<double>::infinity();
+  for (const auto e : r.mesh.edges())
+    shortest = std::min(shortest, static_cast<double>(r.mesh.calc_edge_length(e)));
+  EXPECT_GT(shortest, 1e-4 * g.spacing);
 }
 
 }  // namespace
