@@ -149,6 +149,12 @@ void split_complex_vertices(const OutgoingLists& lists, std::vector<int>& corner
 // added afterwards with add_face, split if need be; vertices where several fans of triangles
 // meet (complex vertices, as marching cubes makes) get one copy per extra fan.
 SkullMesh build_mesh(const TriangleSoup& soup, BuildMeshStats* stats) {
+  SkullMesh mesh;
+  build_mesh(soup, mesh, stats);
+  return mesh;
+}
+
+void build_mesh(const TriangleSoup& soup, SkullMesh& mesh, BuildMeshStats* stats) {
   // Complex faces are counted in the stats and reported by the callers in plain words;
   // OpenMesh's own log lines on stderr would only confuse.
   omerr().disable();
@@ -218,7 +224,7 @@ SkullMesh build_mesh(const TriangleSoup& soup, BuildMeshStats* stats) {
   int n_accepted = 0;
   for (char a : accepted) n_accepted += a;
 
-  SkullMesh mesh;
+  mesh.clear();
   mesh.resize(nv, ne, n_accepted);
   for (int v = 0; v < nv; ++v) mesh.set_point(VH(v), to_point(soup.vertices[source[v]]));
   std::vector<int> boundary_out(nv, -1), boundary_to(nv, -1);
@@ -258,7 +264,6 @@ SkullMesh build_mesh(const TriangleSoup& soup, BuildMeshStats* stats) {
     add_face_or_split(mesh, p, v, local);
   }
   if (stats) *stats = local;
-  return mesh;
 }
 
 TriangleSoup to_soup(const SkullMesh& mesh) {
@@ -309,7 +314,7 @@ double signed_volume(const TriangleSoup& soup, const Eigen::Vector3d& about) {
 void flip_orientation(SkullMesh& mesh) {
   TriangleSoup soup = to_soup(mesh);
   for (auto& t : soup.triangles) std::swap(t[1], t[2]);
-  mesh = build_mesh(soup);
+  mesh = build_mesh(soup);  // a fresh mesh: no property of the old one stays behind
 }
 
 }  // namespace cranioplan

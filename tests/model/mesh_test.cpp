@@ -54,6 +54,24 @@ TEST(Mesh, CanonicalFormDependsOnlyOnTheTriangles) {
       }));
 }
 
+// Built in place (OpenMesh meshes cannot be moved), a mesh is the one build_mesh returns,
+// whatever the mesh held before.
+TEST(Mesh, BuildingInPlaceGivesTheSameMeshWhateverItHeld) {
+  const TriangleSoup soup = to_soup(test::make_symmetric_head(2));
+  const SkullMesh fresh = build_mesh(soup);
+  SkullMesh reused = test::make_symmetric_head(3);
+  BuildMeshStats stats;
+  build_mesh(soup, reused, &stats);
+  EXPECT_EQ(stats.degenerate_dropped, 0);
+  const TriangleSoup a = to_soup(fresh), b = to_soup(reused);
+  EXPECT_EQ(a.vertices, b.vertices);
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_EQ(reused.n_edges(), fresh.n_edges());
+  for (auto he : reused.halfedges())
+    EXPECT_EQ(reused.to_vertex_handle(reused.next_halfedge_handle(he)),
+              fresh.to_vertex_handle(fresh.next_halfedge_handle(he)));
+}
+
 TEST(Mesh, SignedVolumeOfHeadIsPositiveAndFlipNegates) {
   SkullMesh head = test::make_symmetric_head(3);
   const double v = signed_volume(head);

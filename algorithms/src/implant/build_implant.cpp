@@ -405,7 +405,7 @@ class ShellBuilder {
     }
     if (signed_volume(soup_) < 0)  // inner surface above the outer one: markers swapped
       for (auto& t : soup_.triangles) std::swap(t[1], t[2]);
-    result_.mesh = build_mesh(soup_);
+    build_mesh(soup_, result_.mesh);
   }
 
   // How far the rims pass from their edge markers, and the verdict.
@@ -717,7 +717,7 @@ ImplantResult build_delaunay(const std::vector<Marker>& markers, const ImplantPa
   }
   if (signed_volume(soup) < 0)
     for (auto& t : soup.triangles) std::swap(t[1], t[2]);
-  result.mesh = build_mesh(soup);
+  build_mesh(soup, result.mesh);
   result.watertight = is_watertight(result.mesh);
   result.status = ImplantResult::Status::Built;
   result.message = result.watertight ? "Delaunay 3D surface (watertight)"

@@ -215,14 +215,13 @@ PerforateResult perforate(const SkullMesh& implant, const Eigen::Vector3d& insid
           v = static_cast<float>(smooth_min(v, off_axis - radius, kRimRoundMm));
         }
   }
-  ExtractBoneSurfaceResult s = surface_of_signed_distance(std::move(field), g);
+  ExtractBoneSurfaceResult s = surface_of_signed_distance(std::move(field), g, r.mesh);
   if (!s.usable()) {
     r.message = "drilling the holes: " + s.message;
     r.mesh = implant;
     r.holes.clear();
     return done(r);
   }
-  r.mesh = std::move(s.mesh);
   const SurfaceLocator drilled(r.mesh);
   int blocked = 0;
   for (const Hole& hole : r.holes) blocked += !hole_goes_through(drilled, hole);

@@ -399,14 +399,13 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
   Mask().swap(bone);
   // The implant as the meshing gives it: plans saved before meshes were made canonical replay
   // to their bytes.
-  ExtractBoneSurfaceResult s = surface_of_field(std::move(smooth), grid);
+  ExtractBoneSurfaceResult s = surface_of_field(std::move(smooth), grid, result.mesh);
   if (!s.usable()) {
     result.message = s.message;
     result.mesh = implant;
     result.seconds = elapsed();
     return result;
   }
-  result.mesh = std::move(s.mesh);
   result.status = TrimToBoneResult::Status::Trimmed;
   result.seconds = elapsed();
   return result;

@@ -18,10 +18,13 @@
 
 namespace cranioplan {
 
-ExtractBoneSurfaceResult extract_bone_surface(const Volume& volume,
-                                              const ExtractBoneSurfaceParams& params) {
+namespace {
+
+// The surface built in `mesh` (result.mesh or another), the rest of the result in `result`.
+void extract(const Volume& volume, const ExtractBoneSurfaceParams& params,
+             ExtractBoneSurfaceResult& result, SkullMesh& mesh) {
   const auto t0 = std::chrono::steady_clock::now();
-  ExtractBoneSurfaceResult result;
+  mesh.clear();
   const double threshold =
       std::isnan(params.threshold) ? volume.default_threshold() : params.threshold;
   result.threshold_used = threshold;
@@ -31,7 +34,7 @@ ExtractBoneSurfaceResult extract_bone_surface(const Volume& volume,
     result.message = "threshold " + std::to_string(threshold) + " is outside the volume's range [" +
                      std::to_string(volume.data.empty() ? 0.0 : *lo_it) + ", " +
                      std::to_string(volume.data.empty() ? 0.0 : *hi_it) + "]: no surface";
-    return result;
+    return;
   }
 
   // Pad by one sample below the threshold on every side so the surface is closed where bone
@@ -96,35 +99,78 @@ ExtractBoneSurfaceResult extract_bone_surface(const Volume& volume,
   if (signed_volume(soup) < 0)
     for (auto& t : soup.triangles) std::swap(t[1], t[2]);
   if (params.canonical) make_canonical(soup);
-  result.mesh = build_mesh(soup);
+  build_mesh(soup, mesh);
   result.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+ExtractBoneSurfaceResult extract_bone_surface(const Volume& volume,
+                                              const ExtractBoneSurfaceParams& params) {
+  ExtractBoneSurfaceResult result;
+  extract(volume, params, result, result.mesh);
   return result;
 }
 
-ExtractBoneSurfaceResult surface_of_field(std::vector<float> field, const VoxelGrid& grid) {
+ExtractBoneSurfaceResult extract_bone_surface(const Volume& volume,
+                                              const ExtractBoneSurfaceParams& params,
+                                              SkullMesh& mesh) {
+  ExtractBoneSurfaceResult result;
+  extract(volume, params, result, mesh);
+  return result;
+}
+
+namespace {
+
+// A field on a grid (0 outside, 1 inside) as a volume meshed at ½, largest piece, as meshed.
+Volume field_volume(std::vector<float> field, const VoxelGrid& grid) {
   Volume volume = mask_volume({}, grid);
   volume.data = std::move(field);
+  return volume;
+}
+
+ExtractBoneSurfaceParams field_surface() {
   ExtractBoneSurfaceParams surface;
   surface.threshold = 0.5;
   surface.largest_piece_only = true;
   surface.canonical = false;
-  return extract_bone_surface(volume, surface);
+  return surface;
 }
 
-ExtractBoneSurfaceResult surface_of_signed_distance(std::vector<float> distance,
-                                                    const VoxelGrid& grid) {
-  // From 0 (outside) to 1 (inside), ½ on the surface. A value at or next to the iso-level puts
-  // a vertex on or next to a grid point, where the vertices of the edges meeting there fall
-  // together: triangles without area, whose neighbours then seem to cross. Values within
-  // kIsoGap of ½ are moved kIsoGap off it, on their side (the surface moves by at most a
-  // thousandth of a voxel).
+// From 0 (outside) to 1 (inside), ½ on the surface. A value at or next to the iso-level puts a
+// vertex on or next to a grid point, where the vertices of the edges meeting there fall
+// together: triangles without area, whose neighbours then seem to cross. Values within kIsoGap
+// of ½ are moved kIsoGap off it, on their side (the surface moves by at most a thousandth of a
+// voxel).
+std::vector<float> unit_field(std::vector<float> distance, const VoxelGrid& grid) {
   constexpr float kIsoGap = 1e-3f;
   const double h = grid.spacing;
   for (float& v : distance) {
     v = static_cast<float>(std::clamp(0.5 + v / h, 0.0, 1.0));
     if (std::abs(v - 0.5f) < kIsoGap) v = v < 0.5f ? 0.5f - kIsoGap : 0.5f + kIsoGap;
   }
-  return surface_of_field(std::move(distance), grid);
+  return distance;
+}
+
+}  // namespace
+
+ExtractBoneSurfaceResult surface_of_field(std::vector<float> field, const VoxelGrid& grid) {
+  return extract_bone_surface(field_volume(std::move(field), grid), field_surface());
+}
+
+ExtractBoneSurfaceResult surface_of_field(std::vector<float> field, const VoxelGrid& grid,
+                                          SkullMesh& mesh) {
+  return extract_bone_surface(field_volume(std::move(field), grid), field_surface(), mesh);
+}
+
+ExtractBoneSurfaceResult surface_of_signed_distance(std::vector<float> distance,
+                                                    const VoxelGrid& grid) {
+  return surface_of_field(unit_field(std::move(distance), grid), grid);
+}
+
+ExtractBoneSurfaceResult surface_of_signed_distance(std::vector<float> distance,
+                                                    const VoxelGrid& grid, SkullMesh& mesh) {
+  return surface_of_field(unit_field(std::move(distance), grid), grid, mesh);
 }
 
 }  // namespace cranioplan

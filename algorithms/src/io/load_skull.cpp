@@ -30,11 +30,9 @@ LoadedSkull load(const std::string& path, const ExtractBoneSurfaceParams& import
     read.dicom_series = import.dicom_series;
     read.patient_frame = import.patient_frame;
     const Volume volume = read_volume(path, read);
-    out.surface = extract_bone_surface(volume, import);
+    // Built in place: OpenMesh meshes cannot be moved (assigning one copies it).
+    out.surface = extract_bone_surface(volume, import, out.mesh);
     if (!out.surface.usable()) throw InputError(path, out.surface.message);
-    // OpenMesh meshes cannot be moved (std::move copies), so the import's copy is cleared.
-    out.mesh = out.surface.mesh;
-    out.surface.mesh.clear();
     out.source_kind = "volume";
     out.description = volume.description;
     out.frame = volume.frame;
@@ -46,10 +44,8 @@ LoadedSkull load(const std::string& path, const ExtractBoneSurfaceParams& import
     read.orient_outward = as_skull && import.orient_outward;
     read.far_piece_mm = as_skull && import.drop_far_pieces ? kFarPieceMm : 0.0;
     {
-      // A copy (OpenMesh meshes cannot be moved): `file` goes before anything else is
-      // allocated, so that the skull is held twice only for the copy.
-      MeshFile file = read_mesh(path, read);
-      out.mesh = file.mesh;
+      // Built in place: OpenMesh meshes cannot be moved (assigning one copies it).
+      MeshFile file = read_mesh(path, read, out.mesh);
       out.description = file.format;
       out.warnings = std::move(file.warnings);
       out.pieces_dropped = file.pieces_dropped;

@@ -435,8 +435,11 @@ TriangleSoup read_mesh_soup(const std::string& path, std::string* format_out) {
   return soup;
 }
 
-MeshFile read_mesh(const std::string& path, const ReadMeshParams& params) {
-  MeshFile out;
+namespace {
+
+// The mesh built in `mesh` (out.mesh or another), the rest of what was read in `out`.
+void read_into(const std::string& path, const ReadMeshParams& params, MeshFile& out,
+               SkullMesh& mesh) {
   TriangleSoup soup = read_mesh_soup(path, &out.format);
   out.triangles_in_file = static_cast<long long>(soup.triangles.size());
   assert(params.unit_mm > 0.0 && std::isfinite(params.unit_mm) && "validated by the caller");
@@ -453,10 +456,10 @@ MeshFile read_mesh(const std::string& path, const ReadMeshParams& params) {
   if (params.canonical) make_canonical(soup);
 
   BuildMeshStats stats;
-  out.mesh = build_mesh(soup, &stats);
+  build_mesh(soup, mesh, &stats);
   out.degenerate_dropped = stats.degenerate_dropped;
   out.nonmanifold_split = stats.nonmanifold_split;
-  if (out.mesh.n_faces() == 0)
+  if (mesh.n_faces() == 0)
     fail(path, "all " + format_count(out.triangles_in_file) +
                    " triangles have zero area; there is no surface to use");
   if (stats.degenerate_dropped > 0) {
@@ -470,6 +473,19 @@ MeshFile read_mesh(const std::string& path, const ReadMeshParams& params) {
     out.warnings.push_back(path + ": " + format_count(stats.nonmanifold_split) +
                            " triangles share an edge with two or more others (non-manifold); "
                            "they were kept on separate vertices");
+}
+
+}  // namespace
+
+MeshFile read_mesh(const std::string& path, const ReadMeshParams& params) {
+  MeshFile out;
+  read_into(path, params, out, out.mesh);
+  return out;
+}
+
+MeshFile read_mesh(const std::string& path, const ReadMeshParams& params, SkullMesh& mesh) {
+  MeshFile out;
+  read_into(path, params, out, mesh);
   return out;
 }
 

@@ -64,15 +64,26 @@ struct ExtractBoneSurfaceResult {
 
 ExtractBoneSurfaceResult extract_bone_surface(const Volume& volume,
                                               const ExtractBoneSurfaceParams& params = {});
+/// The same, the surface built in `mesh` and the result's own mesh left empty (OpenMesh meshes
+/// cannot be moved: assigning one copies it).
+ExtractBoneSurfaceResult extract_bone_surface(const Volume& volume,
+                                              const ExtractBoneSurfaceParams& params,
+                                              SkullMesh& mesh);
 
 struct VoxelGrid;
 /// A solid given as a field on a grid (0 outside, 1 inside, ½ on its surface) meshed at ½: its
 /// largest piece, in the order the meshing gives (not canonical: an implant fitted to the bone
 /// or drilled follows from the canonical skull and the markers already).
 ExtractBoneSurfaceResult surface_of_field(std::vector<float> field, const VoxelGrid& grid);
+/// The same, the surface built in `mesh` (the result's own mesh left empty).
+ExtractBoneSurfaceResult surface_of_field(std::vector<float> field, const VoxelGrid& grid,
+                                          SkullMesh& mesh);
 /// A solid given by its signed distance (mm, positive inside) meshed at 0: the field is mapped
 /// to surface_of_field's 0..1 over one voxel on either side of the surface.
 ExtractBoneSurfaceResult surface_of_signed_distance(std::vector<float> distance,
                                                     const VoxelGrid& grid);
+/// The same, the surface built in `mesh` (the result's own mesh left empty).
+ExtractBoneSurfaceResult surface_of_signed_distance(std::vector<float> distance,
+                                                    const VoxelGrid& grid, SkullMesh& mesh);
 
 }  // namespace cranioplan

@@ -49,5 +49,8 @@ TriangleSoup read_mesh_soup(const std::string& path, std::string* format = nullp
 /// Throws InputError naming the file and the problem: missing, empty, truncated, garbage,
 /// NaN/Inf coordinates, no usable triangle, unknown format.
 MeshFile read_mesh(const std::string& path, const ReadMeshParams& params = {});
+/// The same, the mesh built in `mesh` and the file's own mesh left empty (OpenMesh meshes
+/// cannot be moved: assigning one copies it).
+MeshFile read_mesh(const std::string& path, const ReadMeshParams& params, SkullMesh& mesh);
 
 }  // namespace cranioplan
