@@ -9,10 +9,12 @@
 #include <cstdio>
 #include <memory>
 
+#include "cranioplan/algorithms/geometry/huge_pages.h"
 #include "main_window.h"
 #include "pause_meter.h"
 
 int main(int argc, char** argv) {
+  cranioplan::start_with_huge_pages(argv);
   cranioplan::gui::SkullView::set_default_surface_format();
 
   QApplication app(argc, argv);

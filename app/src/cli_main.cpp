@@ -10,6 +10,7 @@
 #include "cli_mesh_commands.h"
 #include "cli_output.h"
 #include "cli_session_commands.h"
+#include "cranioplan/algorithms/geometry/huge_pages.h"
 #include "cranioplan/model/error.h"
 
 namespace cranioplan::cli {
@@ -68,4 +69,7 @@ int run(int argc, char** argv) {
 
 }  // namespace cranioplan::cli
 
-int main(int argc, char** argv) { return cranioplan::cli::run(argc, argv); }
+int main(int argc, char** argv) {
+  cranioplan::start_with_huge_pages(argv);
+  return cranioplan::cli::run(argc, argv);
+}

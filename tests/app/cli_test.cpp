@@ -54,6 +54,29 @@ TEST(Cli, InfoPlaneMirrorRegisterOnASyntheticHead) {
   EXPECT_LT(reg["rms_mm"].get<double>(), 0.1);
 }
 
+// The programs start themselves again with malloc in transparent huge pages (huge_pages.h);
+// that changes the allocations, not the arithmetic: a CT's surface and a fitted implant are the
+// same bytes with it (the default) and without (CRANIOPLAN_HUGE_PAGES=0), and a user's own
+// GLIBC_TUNABLES is kept.
+TEST(Cli, HugePagesChangeNoByte) {
+  test::TempDir dir;
+  test::write_nrrd(test::oblique_ball_volume({-5, 12, 40}), dir.path("ct.nrrd"), true);
+  const std::vector<std::pair<std::string, std::string>> runs = {
+      {"", "default.stl"},
+      {"env CRANIOPLAN_HUGE_PAGES=0 ", "off.stl"},
+      {"env GLIBC_TUNABLES=glibc.malloc.hugetlb=0 ", "own.stl"}};
+  std::string out;
+  for (const auto& [env, name] : runs)
+    ASSERT_EQ(test::run_command(
+                  env + kCli + " import-ct " + dir.path("ct.nrrd") + " -o " + dir.path(name), &out),
+              0)
+        << env << out;
+  const std::string with = test::read_bytes(dir.path("default.stl"));
+  EXPECT_GT(with.size(), 1000u);
+  EXPECT_EQ(with, test::read_bytes(dir.path("off.stl")));
+  EXPECT_EQ(with, test::read_bytes(dir.path("own.stl")));
+}
+
 // An implant mesh as a Slicer segmentation on a volume's grid, read back as the same volume.
 TEST(Cli, LabelmapWritesTheImplantOnTheReferenceGrid) {
   test::TempDir dir;

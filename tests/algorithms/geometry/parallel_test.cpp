@@ -4,6 +4,7 @@
 
 #include <atomic>
 
+#include "cranioplan/algorithms/geometry/huge_pages.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/algorithms/planning/autoplan.h"
 #include "support/synthetic.h"
@@ -16,6 +17,18 @@ struct ThreadCount {
   explicit ThreadCount(int n) { set_thread_count(n); }
   ~ThreadCount() { set_thread_count(0); }
 };
+
+// The tunable the programs start again with: added to the user's own tunables, never twice,
+// and not at all when the user sets it or turns it off.
+TEST(HugePages, TheTunableIsAddedOnceAndTheUsersChoiceKept) {
+  EXPECT_EQ(huge_page_tunables(nullptr, nullptr), "glibc.malloc.hugetlb=1");
+  EXPECT_EQ(huge_page_tunables("", nullptr), "glibc.malloc.hugetlb=1");
+  EXPECT_EQ(huge_page_tunables("glibc.malloc.check=3", "1"),
+            "glibc.malloc.check=3:glibc.malloc.hugetlb=1");
+  EXPECT_FALSE(huge_page_tunables("glibc.malloc.hugetlb=1", nullptr));
+  EXPECT_FALSE(huge_page_tunables("glibc.malloc.check=3:glibc.malloc.hugetlb=0", nullptr));
+  EXPECT_FALSE(huge_page_tunables(nullptr, "0"));
+}
 
 TEST(Parallel, EveryItemIsVisitedOnceWhateverTheThreads) {
   for (int threads : {1, 2, 3, 8}) {

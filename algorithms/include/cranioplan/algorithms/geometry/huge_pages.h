@@ -1,0 +1,27 @@
+#pragma once
+// Memory in transparent huge pages. The planning allocates large arrays (a SkullFix CT as
+// floats, its surface, grids of millions of voxels) and touches each page once: with 4 KB pages
+// the kernel serves a page fault per 4 KB, and on virtual machines those are dear (a third of a
+// SkullFix import's time). glibc's malloc asks for transparent huge pages (2 MB) when its
+// tunable glibc.malloc.hugetlb=1 is set; tunables are read when a process starts, so the
+// programs start themselves once more with it. The allocations change, not the arithmetic: the
+// same implant bytes either way (tested).
+#include <optional>
+#include <string>
+
+namespace cranioplan {
+
+/// The GLIBC_TUNABLES value to start again with, given the present one (null when unset) and
+/// CRANIOPLAN_HUGE_PAGES's (null when unset): the present one with glibc.malloc.hugetlb=1
+/// added; nothing when it names that tunable already (the second start, or the user's own
+/// choice) or when CRANIOPLAN_HUGE_PAGES is "0".
+std::optional<std::string> huge_page_tunables(const char* glibc_tunables,
+                                              const char* cranioplan_huge_pages);
+
+/// Starts this program again (same arguments and environment) with huge_page_tunables's value
+/// of GLIBC_TUNABLES, when it gives one and the kernel offers transparent huge pages; returns
+/// (and the program goes on as it is) when not, or when starting again fails. Call it first
+/// thing in main, before any thread or file is opened.
+void start_with_huge_pages(char** argv);
+
+}  // namespace cranioplan
