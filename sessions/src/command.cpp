@@ -230,7 +230,10 @@ int current_version(CommandType type) {
   // clearance ("clearance_zones") and the holes drilled ("perforations"); version 5 is read
   // without them.
   // build_implant 7: fixation tabs ("tabs"); version 6 is read without them.
-  if (type == CommandType::BuildImplant) return 7;
+  // build_implant 8 and export_implant 2: tabs, holes and a mould meshed with field values kept
+  // 1e-3 off the iso-level (no sliver triangles); earlier versions are meshed as they were.
+  if (type == CommandType::BuildImplant) return 8;
+  if (type == CommandType::ExportImplant) return 2;
   if (type == CommandType::ProposeMarkers) return 3;
   // load_skull 4: volumes in the patient's frame ("import.patient_frame"), a DICOM folder's
   // series ("import.dicom_series"), a mesh's far pieces dropped ("import.drop_far_pieces");

@@ -755,6 +755,8 @@ void apply_build(PlanState& s, const ParamReader& r, int version) {
     recorded["fit_to_bone_mm"] = 0.0;
   ImplantParams params;
   params_from_json(ParamReader(recorded, r.where() + " params"), params);
+  // Before version 8, tabs and holes were meshed without the iso-level gap.
+  params.tabs.iso_gap = params.perforations.iso_gap = version >= 8;
   s.implant_params = params;
   unacknowledge(s, 8, "the implant was built again");
   rebuild_implant(s);
@@ -792,7 +794,7 @@ std::string export_bytes(const PlanState& s, const ExportSpec& spec, std::string
 
 namespace {
 
-void apply_export(PlanState& s, const ParamReader& r) {
+void apply_export(PlanState& s, const ParamReader& r, int version) {
   if (!s.implant) throw Refusal{"there is no implant to export: build it first"};
   ExportRecord e;
   e.path = r.string("path");
@@ -803,8 +805,10 @@ void apply_export(PlanState& s, const ParamReader& r) {
   ExportSpec spec;
   spec.format = e.format;
   if (r.has("plan_sha256")) spec.plan_sha256 = r.string("plan_sha256");
-  if (r.has("mould"))
+  if (r.has("mould")) {
     spec.mould = mould_from_json(ParamReader(r.value("mould"), r.where() + " mould"));
+    spec.mould->iso_gap = version >= 2;  // version 1 meshed the mould without the gap
+  }
   std::string why;
   const std::string bytes = export_bytes(s, spec, &why);
   if (!why.empty()) throw Refusal{why};
@@ -932,7 +936,7 @@ ApplyOutcome apply_command(const PlanState& before, const Command& command,
         apply_build(s, r, command.version);
         break;
       case CommandType::ExportImplant:
-        apply_export(s, r);
+        apply_export(s, r, command.version);
         break;
       case CommandType::GoToStep:
       case CommandType::CompleteStep:

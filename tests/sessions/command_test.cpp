@@ -82,7 +82,7 @@ TEST(Commands, EveryTypeRoundTripsThroughJson) {
 // read as recorded, built without the fit.
 TEST(Commands, BuildImplantVersionOneIsReadByItsOwnRules) {
   Json v1 = to_json(commands::build_implant());
-  EXPECT_EQ(v1["version"], 7);
+  EXPECT_EQ(v1["version"], 8);
   v1["version"] = 1;
   v1["params"]["params"].erase("trim");
   v1["params"]["params"].erase("fit_to_bone_mm");
@@ -129,7 +129,7 @@ TEST(Commands, OlderPlansReadTheSkullAndFitTheBoneAsTheyWereMade) {
   p.trim.min_feature_mm = 1.7;
   p.trim.bridge_mm = 0.8;
   const Json build = to_json(commands::build_implant(p));
-  EXPECT_EQ(build["version"], 7);
+  EXPECT_EQ(build["version"], 8);
   ImplantParams back;
   params_from_json(ParamReader(build["params"]["params"], "test"), back);
   EXPECT_EQ(back.trim.min_feature_mm, 1.7);
@@ -175,7 +175,7 @@ TEST(Commands, TheBuildRecordsItsMaterialAndClearanceZones) {
   p.perforations.added = {Eigen::Vector3d(4, 5, 6)};
   p.perforations.removed = {Eigen::Vector3d(7, 8, 9)};
   const Json build = to_json(commands::build_implant(p));
-  EXPECT_EQ(build["version"], 7);
+  EXPECT_EQ(build["version"], 8);
   const Json& recorded = build["params"]["params"];
   EXPECT_EQ(recorded["material"]["name"], "PMMA");
   EXPECT_TRUE(recorded["material"]["thickness_mm"].is_null()) << "follows the bone";
@@ -369,6 +369,22 @@ TEST(Commands, TheLoadRecordsWhatTheSkullHeldAndAReplaySaysWhenItDiffers) {
 // build_implant 4 holds the implant a set clearance off the bone's surface and removes thin
 // fills; a version-3 command ("trim" without either) is read as it was fitted then, and a bad
 // clearance is named.
+// Tabs and holes of plans saved before build_implant 8 are meshed as they were (without the
+// gap kept around the iso-level), today's with it; so is a mould exported before export 2.
+TEST(Commands, OlderBuildsMeshTheirTabsAndHolesAsTheyWereMade) {
+  const Session planned = Session::open(test::planned_defect_case().session_path);
+  const Json today = to_json(commands::build_implant(ImplantParams{}));
+  Json older = today;
+  older["version"] = 7;
+  for (const auto& [json, gap] : {std::pair{today, true}, std::pair{older, false}}) {
+    const ApplyOutcome out = apply_command(planned.state(), command_from_json(json, "test"));
+    ASSERT_TRUE(out.state.implant_params.has_value()) << out.message;
+    EXPECT_EQ(out.state.implant_params->tabs.iso_gap, gap);
+    EXPECT_EQ(out.state.implant_params->perforations.iso_gap, gap);
+  }
+  EXPECT_EQ(current_version(CommandType::ExportImplant), 2);
+}
+
 TEST(Commands, BuildImplant3FitsTheBoneAsItWasMadeTo) {
   ImplantParams p;
   p.trim.clearance_mm = 0.25;

@@ -347,8 +347,8 @@ MouldResult make_casting_mould(const SkullMesh& implant, const Eigen::Vector3d& 
       inner[cc] = static_cast<float>(n);
     }
   });
-  ExtractBoneSurfaceResult mo = surface_of_signed_distance(std::move(outer), g);
-  ExtractBoneSurfaceResult mi = surface_of_signed_distance(std::move(inner), g);
+  ExtractBoneSurfaceResult mo = surface_of_signed_distance(std::move(outer), g, p.iso_gap);
+  ExtractBoneSurfaceResult mi = surface_of_signed_distance(std::move(inner), g, p.iso_gap);
   if (!mo.usable() || !mi.usable()) {
     r.message = "meshing the mould: " + (mo.usable() ? mi.message : mo.message);
     return done();

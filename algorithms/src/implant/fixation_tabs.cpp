@@ -661,7 +661,8 @@ TabResult add_fixation_tabs(const SkullMesh& implant, const SurfaceLocator& bone
             f = std::min(f, static_cast<float>(off_axis - open));
           }
     }
-  const ExtractBoneSurfaceResult mesh = surface_of_signed_distance(std::move(field), g, r.mesh);
+  const ExtractBoneSurfaceResult mesh =
+      surface_of_signed_distance(std::move(field), g, r.mesh, p.iso_gap);
   if (!mesh.usable()) return fail("joining the tabs to the implant: " + mesh.message);
   for (Candidate& c : placed) r.tabs.push_back(std::move(c.tab));
   r.status = TabResult::Status::Added;

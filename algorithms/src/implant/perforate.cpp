@@ -215,7 +215,7 @@ PerforateResult perforate(const SkullMesh& implant, const Eigen::Vector3d& insid
           v = static_cast<float>(smooth_min(v, off_axis - radius, kRimRoundMm));
         }
   }
-  ExtractBoneSurfaceResult s = surface_of_signed_distance(std::move(field), g, r.mesh);
+  ExtractBoneSurfaceResult s = surface_of_signed_distance(std::move(field), g, r.mesh, p.iso_gap);
   if (!s.usable()) {
     r.message = "drilling the holes: " + s.message;
     r.mesh = implant;

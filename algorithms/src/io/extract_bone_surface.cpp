@@ -141,13 +141,17 @@ ExtractBoneSurfaceParams field_surface() {
 // vertex on or next to a grid point, where the vertices of the edges meeting there fall
 // together: triangles without area, whose neighbours then seem to cross. Values within kIsoGap
 // of ½ are moved kIsoGap off it, on their side (the surface moves by at most a thousandth of a
-// voxel).
-std::vector<float> unit_field(std::vector<float> distance, const VoxelGrid& grid) {
+// voxel). Without `iso_gap`, only a value exactly at ½ is moved, 1e-4 up (plans saved before).
+std::vector<float> unit_field(std::vector<float> distance, const VoxelGrid& grid, bool iso_gap) {
   constexpr float kIsoGap = 1e-3f;
   const double h = grid.spacing;
   for (float& v : distance) {
     v = static_cast<float>(std::clamp(0.5 + v / h, 0.0, 1.0));
-    if (std::abs(v - 0.5f) < kIsoGap) v = v < 0.5f ? 0.5f - kIsoGap : 0.5f + kIsoGap;
+    if (!iso_gap) {
+      if (v == 0.5f) v = 0.5f + 1e-4f;
+    } else if (std::abs(v - 0.5f) < kIsoGap) {
+      v = v < 0.5f ? 0.5f - kIsoGap : 0.5f + kIsoGap;
+    }
   }
   return distance;
 }
@@ -164,13 +168,14 @@ ExtractBoneSurfaceResult surface_of_field(std::vector<float> field, const VoxelG
 }
 
 ExtractBoneSurfaceResult surface_of_signed_distance(std::vector<float> distance,
-                                                    const VoxelGrid& grid) {
-  return surface_of_field(unit_field(std::move(distance), grid), grid);
+                                                    const VoxelGrid& grid, bool iso_gap) {
+  return surface_of_field(unit_field(std::move(distance), grid, iso_gap), grid);
 }
 
 ExtractBoneSurfaceResult surface_of_signed_distance(std::vector<float> distance,
-                                                    const VoxelGrid& grid, SkullMesh& mesh) {
-  return surface_of_field(unit_field(std::move(distance), grid), grid, mesh);
+                                                    const VoxelGrid& grid, SkullMesh& mesh,
+                                                    bool iso_gap) {
+  return surface_of_field(unit_field(std::move(distance), grid, iso_gap), grid, mesh);
 }
 
 }  // namespace cranioplan

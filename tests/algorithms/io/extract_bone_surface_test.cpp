@@ -83,6 +83,7 @@ TEST(ExtractBoneSurface, ASurfaceThroughGridPointsGetsNoSliverTriangles) {
         distance[g.index(i, j, k)] =
             static_cast<float>(std::min(offset - n.dot(p), 2.0 - (p - centre).norm()));
       }
+  std::vector<float> before = distance;
   const ExtractBoneSurfaceResult r = surface_of_signed_distance(std::move(distance), g);
   ASSERT_TRUE(r.usable()) << r.message;
   EXPECT_TRUE(report_mesh(r.mesh).watertight);
@@ -91,6 +92,13 @@ TEST(ExtractBoneSurface, ASurfaceThroughGridPointsGetsNoSliverTriangles) {
   for (const auto e : r.mesh.edges())
     shortest = std::min(shortest, static_cast<double>(r.mesh.calc_edge_length(e)));
   EXPECT_GT(shortest, 1e-4 * g.spacing);
+  // Without the gap (plans saved before it are meshed so), the slivers are there.
+  const ExtractBoneSurfaceResult old = surface_of_signed_distance(std::move(before), g, false);
+  ASSERT_TRUE(old.usable()) << old.message;
+  double old_shortest = std::numeric_limits<double>::infinity();
+  for (const auto e : old.mesh.edges())
+    old_shortest = std::min(old_shortest, static_cast<double>(old.mesh.calc_edge_length(e)));
+  EXPECT_LT(old_shortest, 1e-4 * g.spacing);
 }
 
 }  // namespace

@@ -18,6 +18,10 @@ struct MouldParams {
   double vent_diameter_mm = 2.0;     ///< the air vent, mm (1..6)
   double voxel_mm = 0.2;             ///< grid of the halves, mm (0.05..1)
   double max_voxels = 3e7;           ///< a large mould's grid is coarsened to this many voxels
+  /// Field values within 1e-3 of the meshing's iso-level are moved that far off it (no sliver
+  /// triangles); false: only a value exactly at it, as plans saved before this were meshed (set
+  /// from the session command's version, not recorded).
+  bool iso_gap = true;
 };
 /// Why the parameters cannot be used (a value out of its range), or empty.
 std::string mould_problem(const MouldParams& p);

@@ -29,6 +29,10 @@ struct PerforationParams {
   std::vector<Eigen::Vector3d> removed;
   double voxel_mm = 0.2;      ///< grid of the drilling, mm (0.05..1; at most a quarter diameter)
   double max_voxels = 1.2e7;  ///< a large implant's grid is coarsened to this many voxels
+  /// Field values within 1e-3 of the meshing's iso-level are moved that far off it (no sliver
+  /// triangles); false: only a value exactly at it, as plans saved before this were meshed (set
+  /// from the session command's version, not recorded).
+  bool iso_gap = true;
   bool any() const { return pattern || !added.empty(); }
 };
 /// Why the parameters cannot be used (a value out of its range), or empty.

@@ -79,11 +79,14 @@ ExtractBoneSurfaceResult surface_of_field(std::vector<float> field, const VoxelG
 ExtractBoneSurfaceResult surface_of_field(std::vector<float> field, const VoxelGrid& grid,
                                           SkullMesh& mesh);
 /// A solid given by its signed distance (mm, positive inside) meshed at 0: the field is mapped
-/// to surface_of_field's 0..1 over one voxel on either side of the surface.
+/// to surface_of_field's 0..1 over one voxel on either side of the surface. Values within 1e-3
+/// of ½ are moved that far off it, so that no vertices fall together into sliver triangles;
+/// `iso_gap` false: only a value exactly at ½ (as plans saved before were meshed).
 ExtractBoneSurfaceResult surface_of_signed_distance(std::vector<float> distance,
-                                                    const VoxelGrid& grid);
+                                                    const VoxelGrid& grid, bool iso_gap = true);
 /// The same, the surface built in `mesh` (the result's own mesh left empty).
 ExtractBoneSurfaceResult surface_of_signed_distance(std::vector<float> distance,
-                                                    const VoxelGrid& grid, SkullMesh& mesh);
+                                                    const VoxelGrid& grid, SkullMesh& mesh,
+                                                    bool iso_gap = true);
 
 }  // namespace cranioplan
