@@ -55,9 +55,8 @@ TEST(Cli, InfoPlaneMirrorRegisterOnASyntheticHead) {
 }
 
 // The programs start themselves again with malloc in transparent huge pages (huge_pages.h);
-// that changes the allocations, not the arithmetic: a CT's surface and a fitted implant are the
-// same bytes with it (the default) and without (CRANIOPLAN_HUGE_PAGES=0), and a user's own
-// GLIBC_TUNABLES is kept.
+// that changes the allocations, not the arithmetic: a CT's surface is the same bytes with it
+// (the default), without it (CRANIOPLAN_HUGE_PAGES=0) and with a user's own GLIBC_TUNABLES.
 TEST(Cli, HugePagesChangeNoByte) {
   test::TempDir dir;
   test::write_nrrd(test::oblique_ball_volume({-5, 12, 40}), dir.path("ct.nrrd"), true);

@@ -10,6 +10,7 @@
 #include "cranioplan/model/error.h"
 #include "cranioplan/sessions/session.h"
 #include "cranioplan/sessions/session_error.h"
+#include "cranioplan/sessions/sha256.h"
 #include "support/session_cases.h"
 #include "support/synthetic.h"
 #include "support/test_files.h"
@@ -366,11 +367,8 @@ TEST(Commands, TheLoadRecordsWhatTheSkullHeldAndAReplaySaysWhenItDiffers) {
       << t.state().message;
 }
 
-// build_implant 4 holds the implant a set clearance off the bone's surface and removes thin
-// fills; a version-3 command ("trim" without either) is read as it was fitted then, and a bad
-// clearance is named.
 // Tabs and holes of plans saved before build_implant 8 are meshed as they were (without the
-// gap kept around the iso-level), today's with it; so is a mould exported before export 2.
+// gap kept around the iso-level), today's with it.
 TEST(Commands, OlderBuildsMeshTheirTabsAndHolesAsTheyWereMade) {
   const Session planned = Session::open(test::planned_defect_case().session_path);
   const Json today = to_json(commands::build_implant(ImplantParams{}));
@@ -382,9 +380,37 @@ TEST(Commands, OlderBuildsMeshTheirTabsAndHolesAsTheyWereMade) {
     EXPECT_EQ(out.state.implant_params->tabs.iso_gap, gap);
     EXPECT_EQ(out.state.implant_params->perforations.iso_gap, gap);
   }
-  EXPECT_EQ(current_version(CommandType::ExportImplant), 2);
 }
 
+// A mould exported before export_implant 2 is made again as it was meshed then (without the
+// gap), today's with it: the replayed bytes are those of each meshing.
+TEST(Commands, AnOlderMouldExportIsMadeAsItWasMeshed) {
+  const Session planned = Session::open(test::planned_defect_case().session_path);
+  MouldParams mould;
+  mould.voxel_mm = 0.4;  // coarser than the default, for the test's time
+  const Json today = to_json(commands::export_implant(test::scratch_path("m.3mf"), "", mould));
+  EXPECT_EQ(today["version"], 2);
+  Json older = today;
+  older["version"] = 1;
+  std::string replayed[2];
+  for (int v : {1, 2}) {
+    const ApplyOutcome out =
+        apply_command(planned.state(), command_from_json(v == 1 ? older : today, "test"));
+    ASSERT_TRUE(out.accepted) << out.message;
+    replayed[v - 1] = out.state.exports.back().replayed_sha256;
+  }
+  ExportSpec spec;
+  spec.format = "3mf";
+  spec.mould = mould;
+  spec.mould->iso_gap = false;
+  std::string why;
+  EXPECT_EQ(replayed[0], sha256_hex(export_bytes(planned.state(), spec, &why))) << why;
+  EXPECT_NE(replayed[0], replayed[1]) << "the meshing without the gap differs on this mould";
+}
+
+// build_implant 4 holds the implant a set clearance off the bone's surface and removes thin
+// fills; a version-3 command ("trim" without either) is read as it was fitted then, and a bad
+// clearance is named.
 TEST(Commands, BuildImplant3FitsTheBoneAsItWasMadeTo) {
   ImplantParams p;
   p.trim.clearance_mm = 0.25;

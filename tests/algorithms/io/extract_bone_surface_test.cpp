@@ -83,22 +83,21 @@ TEST(ExtractBoneSurface, ASurfaceThroughGridPointsGetsNoSliverTriangles) {
         distance[g.index(i, j, k)] =
             static_cast<float>(std::min(offset - n.dot(p), 2.0 - (p - centre).norm()));
       }
-  std::vector<float> before = distance;
-  const ExtractBoneSurfaceResult r = surface_of_signed_distance(std::move(distance), g);
+  auto shortest_edge = [](const SkullMesh& mesh) {
+    double shortest = std::numeric_limits<double>::infinity();
+    for (const auto e : mesh.edges())
+      shortest = std::min(shortest, static_cast<double>(mesh.calc_edge_length(e)));
+    return shortest;
+  };
+  const ExtractBoneSurfaceResult r = surface_of_signed_distance(distance, g);
   ASSERT_TRUE(r.usable()) << r.message;
   EXPECT_TRUE(report_mesh(r.mesh).watertight);
   EXPECT_EQ(count_self_intersections(r.mesh), 0);
-  double shortest = std::numeric_limits<double>::infinity();
-  for (const auto e : r.mesh.edges())
-    shortest = std::min(shortest, static_cast<double>(r.mesh.calc_edge_length(e)));
-  EXPECT_GT(shortest, 1e-4 * g.spacing);
+  EXPECT_GT(shortest_edge(r.mesh), 1e-4 * g.spacing);
   // Without the gap (plans saved before it are meshed so), the slivers are there.
-  const ExtractBoneSurfaceResult old = surface_of_signed_distance(std::move(before), g, false);
+  const ExtractBoneSurfaceResult old = surface_of_signed_distance(std::move(distance), g, false);
   ASSERT_TRUE(old.usable()) << old.message;
-  double old_shortest = std::numeric_limits<double>::infinity();
-  for (const auto e : old.mesh.edges())
-    old_shortest = std::min(old_shortest, static_cast<double>(old.mesh.calc_edge_length(e)));
-  EXPECT_LT(old_shortest, 1e-4 * g.spacing);
+  EXPECT_LT(shortest_edge(old.mesh), 1e-4 * g.spacing);
 }
 
 }  // namespace
