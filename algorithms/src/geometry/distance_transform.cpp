@@ -140,7 +140,83 @@ std::vector<float> distance_to_mask(const std::vector<uint8_t>& mask, const Voxe
                                    : distance_in<double>(mask, grid);
 }
 
-std::vector<float> depth_in_mask(const std::vector<uint8_t>& mask, const VoxelGrid& grid) {
+namespace {
+
+// The squared distances (voxel units) within `reach` voxels, exact, by windows instead of
+// envelopes: along x the nearest site on the line (capped at reach + 1), then along y and z the
+// smallest of the 2·reach + 1 neighbours' values plus the squared step. A squared distance of at
+// most reach² is made of steps of at most `reach` along each axis, so the window holds it; a
+// larger one comes out larger than reach² (no term is ever below the true value). The same
+// integers as the envelope, as floats, where they are at most reach²; +infinity beyond.
+std::vector<float> distance_within(const std::vector<uint8_t>& mask, const VoxelGrid& grid,
+                                   int reach) {
+  const int nx = grid.dims[0], ny = grid.dims[1], nz = grid.dims[2];
+  const size_t sy = static_cast<size_t>(nx), sz = sy * ny;
+  const float capped = static_cast<float>(reach + 1) * static_cast<float>(reach + 1);
+  std::vector<float> sq(mask.size());
+  // Along x, and along y within each slice (slices on all threads).
+  parallel_for(
+      static_cast<size_t>(nz),
+      [&](size_t first, size_t last) {
+        std::vector<float> slice(sz);
+        for (size_t k = first; k < last; ++k) {
+          for (int j = 0; j < ny; ++j) {
+            const uint8_t* in = &mask[k * sz + j * sy];
+            float* out = &slice[j * sy];
+            int gap = reach + 1;
+            for (int i = 0; i < nx; ++i) {
+              gap = in[i] ? 0 : std::min(gap + 1, reach + 1);
+              out[i] = static_cast<float>(gap);
+            }
+            gap = reach + 1;
+            for (int i = nx - 1; i >= 0; --i) {
+              gap = in[i] ? 0 : std::min(gap + 1, reach + 1);
+              const float g = std::min(out[i], static_cast<float>(gap));
+              out[i] = g * g;
+            }
+          }
+          for (int j = 0; j < ny; ++j) {
+            float* out = &sq[k * sz + j * sy];
+            std::fill(out, out + nx, capped);
+            for (int t = std::max(-reach, -j); t <= std::min(reach, ny - 1 - j); ++t) {
+              const float step = static_cast<float>(t * t);
+              const float* in = &slice[(j + t) * sy];
+              for (int i = 0; i < nx; ++i) out[i] = std::min(out[i], in[i] + step);
+            }
+          }
+        }
+      },
+      2);
+  // Along z (slices on all threads), and the distance in mm.
+  std::vector<float> d(mask.size());
+  const float limit = static_cast<float>(reach) * static_cast<float>(reach);
+  parallel_for(
+      static_cast<size_t>(nz),
+      [&](size_t first, size_t last) {
+        std::vector<float> row(sy);
+        for (size_t k = first; k < last; ++k)
+          for (int j = 0; j < ny; ++j) {
+            std::fill(row.begin(), row.end(), capped);
+            const int z = static_cast<int>(k);
+            for (int t = std::max(-reach, -z); t <= std::min(reach, nz - 1 - z); ++t) {
+              const float step = static_cast<float>(t * t);
+              const float* in = &sq[static_cast<size_t>(z + t) * sz + j * sy];
+              for (int i = 0; i < nx; ++i) row[i] = std::min(row[i], in[i] + step);
+            }
+            float* out = &d[k * sz + j * sy];
+            for (int i = 0; i < nx; ++i)
+              out[i] =
+                  row[i] <= limit
+                      ? static_cast<float>(grid.spacing * std::sqrt(static_cast<double>(row[i])))
+                      : std::numeric_limits<float>::infinity();
+          }
+      },
+      2);
+  return d;
+}
+
+// The border layer of the grid and the voxels outside the mask: what depth_in_mask measures to.
+std::vector<uint8_t> outside_of(const std::vector<uint8_t>& mask, const VoxelGrid& grid) {
   std::vector<uint8_t> out(mask.size());
   for (size_t c = 0; c < mask.size(); ++c) out[c] = !mask[c];
   // The grid's outermost layer stands for the outside beyond it.
@@ -150,7 +226,24 @@ std::vector<float> depth_in_mask(const std::vector<uint8_t>& mask, const VoxelGr
       for (int i = 0; i < nx; ++i)
         if (i == 0 || j == 0 || k == 0 || i == nx - 1 || j == ny - 1 || k == nz - 1)
           out[grid.index(i, j, k)] = 1;
-  return distance_to_mask(out, grid);
+  return out;
+}
+
+}  // namespace
+
+std::vector<float> distance_to_mask(const std::vector<uint8_t>& mask, const VoxelGrid& grid,
+                                    double within_mm) {
+  // Steps of up to `reach` voxels along an axis make every distance up to within_mm, and one
+  // more keeps the float tests at within_mm exact (the next squared integer lies far from it).
+  const double steps = std::floor(std::max(0.0, within_mm) / grid.spacing) + 1.0;
+  const int longest = std::max({grid.dims[0], grid.dims[1], grid.dims[2]});
+  // A window as long as the grid costs more than the envelope.
+  if (steps * 4.0 > longest || steps > 1000.0) return distance_to_mask(mask, grid);
+  return distance_within(mask, grid, static_cast<int>(steps));
+}
+
+std::vector<float> depth_in_mask(const std::vector<uint8_t>& mask, const VoxelGrid& grid) {
+  return distance_to_mask(outside_of(mask, grid), grid);
 }
 
 std::vector<uint8_t> ball_centres(const std::vector<float>& depth, const VoxelGrid& grid,
@@ -163,15 +256,18 @@ std::vector<uint8_t> ball_centres(const std::vector<float>& depth, const VoxelGr
 
 std::vector<uint8_t> ball_centres(const std::vector<uint8_t>& mask, const VoxelGrid& grid,
                                   double radius) {
-  return ball_centres(depth_in_mask(mask, grid), grid, radius);
+  // Only depths up to the centres' decide.
+  const double need = radius + 0.5 * grid.spacing;
+  return ball_centres(distance_to_mask(outside_of(mask, grid), grid, need), grid, radius);
 }
 
 std::vector<uint8_t> open_by_ball(const std::vector<uint8_t>& mask, const VoxelGrid& grid,
                                   double radius) {
-  const std::vector<float> to_centre = distance_to_mask(ball_centres(mask, grid, radius), grid);
+  const double reach = radius + 0.5 * grid.spacing;
+  const std::vector<float> to_centre =
+      distance_to_mask(ball_centres(mask, grid, radius), grid, reach);
   std::vector<uint8_t> out(mask.size());
-  for (size_t c = 0; c < mask.size(); ++c)
-    out[c] = mask[c] && to_centre[c] <= radius + 0.5 * grid.spacing;
+  for (size_t c = 0; c < mask.size(); ++c) out[c] = mask[c] && to_centre[c] <= reach;
   return out;
 }
 

@@ -227,10 +227,15 @@ SurfaceLocator SurfaceLocator::moved(const RigidTransform& motion) const {
 }
 
 SurfaceLocator::Closest SurfaceLocator::closest(const Eigen::Vector3d& world_query) const {
+  return *closest_within(world_query, std::numeric_limits<double>::infinity());
+}
+
+std::optional<SurfaceLocator::Closest> SurfaceLocator::closest_within(
+    const Eigen::Vector3d& world_query, double radius) const {
   const Tree& t = *tree_;
   const Eigen::Vector3d query = moved_ ? motion_.inverse().apply(world_query) : world_query;
   Closest best;
-  double best_d2 = std::numeric_limits<double>::infinity();
+  double best_d2 = radius * radius;
   t.walk([&](const Node& node) { return node.box.squared_distance(query) >= best_d2; },
          [&](int index, const Node& node, const auto& push) {
            const int left = index + 1, right = node.first;
@@ -255,6 +260,7 @@ SurfaceLocator::Closest SurfaceLocator::closest(const Eigen::Vector3d& world_que
              best.face = f;
            }
          });
+  if (best.face < 0 && !std::isinf(radius)) return std::nullopt;
   best.distance = std::sqrt(best_d2);
   if (moved_) best.point = motion_.apply(best.point);
   return best;

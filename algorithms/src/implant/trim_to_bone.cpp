@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
 #include <memory>
 #include <numeric>
 #include <vector>
@@ -269,10 +270,18 @@ std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const Vo
       for (int i = 0; i < g.dims[0]; ++i) {
         const size_t c = g.index(i, j, k);
         if (field[c] <= 0.0f || !near_bone[c]) continue;
-        const auto near = locator->closest(g.center(i, j, k));
-        const double d = near.distance * (bone[c] ? -1.0 : 1.0);
-        const double want = zones.empty() ? clearance : clearance_at(near.point, clearance, zones);
-        const double cap = std::clamp(0.5 + (d - want) / h, 0.0, 1.0);
+        // Without zones only a surface nearer than the clearance and a voxel makes the cap
+        // other than 1 outside the bone and 0 inside it.
+        const auto near = locator->closest_within(
+            g.center(i, j, k),
+            zones.empty() ? clearance + h : std::numeric_limits<double>::infinity());
+        double cap = bone[c] ? 0.0 : 1.0;
+        if (near) {
+          const double d = near->distance * (bone[c] ? -1.0 : 1.0);
+          const double want =
+              zones.empty() ? clearance : clearance_at(near->point, clearance, zones);
+          cap = std::clamp(0.5 + (d - want) / h, 0.0, 1.0);
+        }
         field[c] = std::min(field[c], static_cast<float>(cap));
       }
   });

@@ -113,6 +113,52 @@ TEST(DistanceTransform, WithinStepsIsRepeatedDilation) {
             std::vector<uint8_t>(g.size(), 0));
 }
 
+// Bounded to a distance, the transform gives the whole transform's float wherever that is at
+// most the bound and a larger value elsewhere, so every test against the bound agrees; the
+// opening by a ball, which uses it, is the union of the balls the whole transforms find.
+TEST(DistanceTransform, BoundedAgreesWithTheWholeTransformUpToItsBound) {
+  for (const double spacing : {0.25, 0.4}) {
+    SCOPED_TRACE(spacing);
+    const VoxelGrid g = test_grid(spacing);
+    const std::vector<uint8_t> mask = random_blobs(g, 17);
+    const std::vector<float> full = distance_to_mask(mask, g);
+    size_t cut = 0;
+    for (const double bound : {0.0, 0.3, 0.75, 1.0, 1.6, 100.0}) {
+      const std::vector<float> bounded = distance_to_mask(mask, g, bound);
+      size_t near = 0, far = 0;
+      for (size_t c = 0; c < g.size(); ++c) {
+        if (full[c] <= bound) {
+          ASSERT_EQ(bounded[c], full[c]) << c << " within " << bound;
+          ++near;
+        } else {
+          ASSERT_GT(bounded[c], bound) << c << " within " << bound;
+          ++far;
+          cut += std::isinf(bounded[c]);
+        }
+      }
+      EXPECT_GT(near, 0u);
+      if (bound < 10.0) {
+        EXPECT_GT(far, 0u);
+      }
+    }
+    EXPECT_GT(cut, 0u) << "the windows were used";
+    EXPECT_TRUE(std::isinf(distance_to_mask(std::vector<uint8_t>(g.size(), 0), g, 1.0)[0]));
+    for (const double radius : {0.5, 0.9}) {
+      const std::vector<uint8_t> centres =
+          ball_centres(depth_in_mask(mask, g), g, radius);  // the whole transforms
+      const std::vector<float> to_centre = distance_to_mask(centres, g);
+      const std::vector<uint8_t> opened = open_by_ball(mask, g, radius);
+      EXPECT_EQ(ball_centres(mask, g, radius), centres) << radius;
+      size_t removed = 0;
+      for (size_t c = 0; c < g.size(); ++c) {
+        ASSERT_EQ(opened[c] != 0, mask[c] && to_centre[c] <= radius + 0.5 * spacing) << c;
+        removed += mask[c] && !opened[c];
+      }
+      EXPECT_GT(removed, 0u);
+    }
+  }
+}
+
 // The local tests agree with the whole-grid transforms on every voxel, at several distances
 // and spacings (the fit to the bone asks them of the few voxels a bridging fill adds).
 TEST(DistanceTransform, LocalTestsAgreeWithTheWholeGrid) {

@@ -60,6 +60,44 @@ std::optional<double> segment_hit(const Eigen::Vector3d& o, const Eigen::Vector3
   return s_t;
 }
 
+// A search bounded by a radius gives the unbounded search's distance when the surface is
+// nearer, and nothing when it is not (queries near the surface, inside and out, of a moved
+// locator too).
+TEST(SurfaceLocator, ClosestWithinARadiusAgreesWithTheUnboundedSearch) {
+  const SkullMesh head = test::cut_hole(test::make_symmetric_head(3), {40, 20, 50}, 30);
+  const SurfaceLocator plain(head);
+  const SurfaceLocator moved = plain.moved(RigidTransform{
+      Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix(),
+      Eigen::Vector3d(5, -2, 7)});
+  std::mt19937 rng(11);
+  std::uniform_int_distribution<int> vertex(0, static_cast<int>(head.n_vertices()) - 1);
+  std::uniform_real_distribution<double> u(-3.0, 3.0);
+  int within = 0, beyond = 0;
+  for (const SurfaceLocator* locator : {&plain, &moved}) {
+    for (int i = 0; i < 600; ++i) {
+      const Eigen::Vector3d on = to_eigen(head.point(SkullMesh::VertexHandle(vertex(rng))));
+      const Eigen::Vector3d q = (locator == &plain ? on : moved.closest(on).point) +
+                                Eigen::Vector3d(u(rng), u(rng), u(rng));
+      const double radius = 0.5 + 0.25 * (i % 9);
+      const SurfaceLocator::Closest all = locator->closest(q);
+      const auto near = locator->closest_within(q, radius);
+      ASSERT_EQ(near.has_value(), all.distance < radius) << i;
+      if (!near) {
+        ++beyond;
+        continue;
+      }
+      ++within;
+      EXPECT_EQ(near->distance, all.distance) << i;
+      EXPECT_NEAR((near->point - all.point).norm(), 0.0, 1e-9) << i;
+    }
+  }
+  EXPECT_GT(within, 200);
+  EXPECT_GT(beyond, 200);
+  EXPECT_EQ(plain.closest_within(Eigen::Vector3d(0, 0, 0), std::numeric_limits<double>::infinity())
+                ->distance,
+            plain.closest(Eigen::Vector3d(0, 0, 0)).distance);
+}
+
 // Closest points and first hits agree with brute force over every face of an open head (a hole
 // cut, so that segments leave through it too) for random queries inside, on and around it.
 TEST(SurfaceLocator, AgreesWithBruteForce) {

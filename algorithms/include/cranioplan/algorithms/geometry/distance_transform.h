@@ -13,6 +13,12 @@ namespace cranioplan {
 /// For every voxel, the distance (mm) from its centre to the centre of the nearest voxel whose
 /// mask value is non-zero: 0 on the mask itself, +infinity everywhere when the mask is empty.
 std::vector<float> distance_to_mask(const std::vector<uint8_t>& mask, const VoxelGrid& grid);
+/// The same where it is at most `within_mm` (the same floats); elsewhere a value larger than
+/// `within_mm` (+infinity, or the distance itself). Tests of a distance against a limit of at
+/// most `within_mm` give what they give on the whole transform, at a fraction of its cost when
+/// the limit is a few voxels (windows of that many voxels along y and z instead of envelopes).
+std::vector<float> distance_to_mask(const std::vector<uint8_t>& mask, const VoxelGrid& grid,
+                                    double within_mm);
 
 /// For every voxel of `mask`, the distance (mm) from its centre to the centre of the nearest
 /// voxel outside it; 0 outside. The grid's outermost layer counts as outside (it stands for what

@@ -33,6 +33,10 @@ class SurfaceLocator {
   };
   /// Closest point on the surface. Requires a mesh with at least one face.
   Closest closest(const Eigen::Vector3d& query) const;
+  /// The same when the surface comes nearer than `radius` mm, else nothing: the same distance
+  /// (and, but among points exactly as near, the same point), found faster when the surface is
+  /// mostly farther.
+  std::optional<Closest> closest_within(const Eigen::Vector3d& query, double radius) const;
 
   struct Hit {
     Eigen::Vector3d point;
