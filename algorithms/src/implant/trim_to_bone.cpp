@@ -1,6 +1,7 @@
 #include "cranioplan/algorithms/implant/trim_to_bone.h"
 
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -236,7 +237,8 @@ SkullMesh faces_in_box(const SkullMesh& mesh, const Eigen::Vector3d& lo,
 // outside the skull's surface, from the distance to its triangles. The surface then follows the
 // bone's own surface rather than its voxels. The clearance is `clearance` mm, or a zone's where
 // the nearest bone lies in one. `locator`: the skull's triangles near the grid (none: no
-// surface there). `to_bone`: distance_to_mask(bone), needed for a clearance wider than a voxel.
+// surface there). `to_bone`: distance_to_mask(bone) up to that band, needed for a clearance wider
+// than a voxel.
 std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const VoxelGrid& g,
                                     const SurfaceLocator* locator, double sigma_voxels,
                                     double clearance, const std::vector<ClearanceZone>& zones,
@@ -292,10 +294,13 @@ std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const Vo
 
 }  // namespace
 
-TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
-                              const TrimToBoneParams& params) {
+namespace {
+
+// trim_to_bone, meshed in `into` (the result's own mesh, or the caller's).
+void trim_into(const SkullMesh& implant, const SkullMesh& skull, const TrimToBoneParams& params,
+               TrimToBoneResult& result, SkullMesh& into) {
+  assert(&into != &implant && "the fit is meshed into another mesh than the implant");
   const auto t0 = std::chrono::steady_clock::now();
-  TrimToBoneResult result;
   const auto [lo, hi] = mesh_bounds(implant);
   const VoxelGrid grid = VoxelGrid::covering_at_most(lo, hi, std::clamp(params.voxel_mm, 0.1, 1.0),
                                                      std::max(1e5, params.max_voxels), 4);
@@ -327,7 +332,8 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
   // implant reaching between two pieces of bone narrows by the clearance from both sides.
   std::vector<float> to_bone;  // the distance to the bone's voxels, when a clearance needs it
   if (locator && widest > h) {
-    to_bone = distance_to_mask(bone, grid);
+    // Asked against the clearances, the band beyond them and the fills' millimetre only.
+    to_bone = distance_to_mask(bone, grid, std::max(widest + 2.0 * h, 1.0));
     for (int k = 0; k < grid.dims[2]; ++k)
       for (int j = 0; j < grid.dims[1]; ++j)
         for (int i = 0; i < grid.dims[0]; ++i) {
@@ -384,9 +390,9 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
   };
   if (after == 0) {
     result.message = "nothing of the implant lies outside the bone";
-    result.mesh = implant;
+    into = implant;
     result.seconds = elapsed();
-    return result;
+    return;
   }
   std::vector<float> smooth;
   if (params.clearance_mm) {
@@ -408,15 +414,30 @@ TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
   Mask().swap(bone);
   // The implant as the meshing gives it: plans saved before meshes were made canonical replay
   // to their bytes.
-  ExtractBoneSurfaceResult s = surface_of_field(std::move(smooth), grid, result.mesh);
+  ExtractBoneSurfaceResult s = surface_of_field(std::move(smooth), grid, into);
   if (!s.usable()) {
     result.message = s.message;
-    result.mesh = implant;
+    into = implant;
     result.seconds = elapsed();
-    return result;
+    return;
   }
   result.status = TrimToBoneResult::Status::Trimmed;
   result.seconds = elapsed();
+}
+
+}  // namespace
+
+TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
+                              const TrimToBoneParams& params) {
+  TrimToBoneResult result;
+  trim_into(implant, skull, params, result, result.mesh);
+  return result;
+}
+
+TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
+                              const TrimToBoneParams& params, SkullMesh& into) {
+  TrimToBoneResult result;
+  trim_into(implant, skull, params, result, into);
   return result;
 }
 

@@ -30,6 +30,15 @@ std::string fmt1(const char* f, double a) {
   std::snprintf(buf, sizeof(buf), f, a);
   return buf;
 }
+// How near the bone thin material counts as the tapered edge of an implant resting on it, mm:
+// its own thinness, a voxel and a half, and the widest clearance asked.
+double on_bone_mm(const QualityParams& params, double h) {
+  double clearance = params.edge_clearance_mm;
+  for (const ClearanceZone& z : params.clearance_zones)
+    clearance = std::max(clearance, z.clearance_mm);
+  return params.min_thickness_mm + 1.5 * h + std::max(0.0, clearance);
+}
+
 // Material thinner than the minimum: the solid minus its opening by a ball of that diameter
 // (the union of the balls that fit inside). Where it lies within its own thinness of the bone
 // (and the clearance asked) it is the tapered edge of an implant resting on the bone; how far
@@ -45,10 +54,7 @@ void measure_thin_material(const std::vector<uint8_t>& solid, const std::vector<
   }
   const std::vector<float> to_core = distance_to_mask(centres, grid);
   // An edge held a clearance off the bone tapers that much further from it.
-  double clearance = params.edge_clearance_mm;
-  for (const ClearanceZone& z : params.clearance_zones)
-    clearance = std::max(clearance, z.clearance_mm);
-  const double on_bone = params.min_thickness_mm + 1.5 * h + std::max(0.0, clearance);
+  const double on_bone = on_bone_mm(params, h);
   size_t thin = 0, off_bone = 0;
   for (size_t c = 0; c < solid.size(); ++c) {
     if (!solid[c] || to_core[c] <= r + h) continue;  // within a ball that fits (one voxel slack)
@@ -244,7 +250,8 @@ std::vector<float> measure_against_bone(const SkullMesh& implant, const SkullMes
   long long both = 0;
   for (size_t i = 0; i < solid.size(); ++i) both += solid[i] && b[i];
   q.penetration_mm3 = static_cast<double>(both) * grid.voxel_volume();
-  return distance_to_mask(b, grid);
+  // Only whether thin material lies within on_bone_mm of the bone is asked of it.
+  return distance_to_mask(b, grid, on_bone_mm(params, grid.spacing));
 }
 
 // Why the implant is not printable, from what was measured.

@@ -86,28 +86,32 @@ TEST(DistanceTransform, IsExactOnGridsWiderThanItsTiles) {
       }
 }
 
-// The sweeps give what `steps` 6-neighbour dilations give.
+// The sweeps give what `steps` 6-neighbour dilations give, of blobs and of three single voxels
+// (which grow for all of the 20 steps tried).
 TEST(DistanceTransform, WithinStepsIsRepeatedDilation) {
   const VoxelGrid g = test_grid(0.25);
-  const std::vector<uint8_t> mask = random_blobs(g, 7);
-  auto dilate = [&](const std::vector<uint8_t>& in) {
-    std::vector<uint8_t> out(in);
-    for (int k = 0; k < g.dims[2]; ++k)
-      for (int j = 0; j < g.dims[1]; ++j)
-        for (int i = 0; i < g.dims[0]; ++i) {
-          const int nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k},
-                                {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
-          for (const auto& n : nb)
-            if (n[0] >= 0 && n[1] >= 0 && n[2] >= 0 && n[0] < g.dims[0] && n[1] < g.dims[1] &&
-                n[2] < g.dims[2] && in[g.index(n[0], n[1], n[2])])
-              out[g.index(i, j, k)] = 1;
-        }
-    return out;
-  };
-  std::vector<uint8_t> grown = mask;
-  for (int steps = 0; steps <= 6; ++steps) {
-    EXPECT_EQ(within_steps(mask, g, steps), grown) << steps << " steps";
-    grown = dilate(grown);
+  std::vector<uint8_t> specks(g.size(), 0);
+  specks[g.index(0, 0, 0)] = specks[g.index(30, 20, 3)] = specks[g.index(9, 15, 17)] = 1;
+  for (const std::vector<uint8_t>& mask : {random_blobs(g, 7), specks}) {
+    auto dilate = [&](const std::vector<uint8_t>& in) {
+      std::vector<uint8_t> out(in);
+      for (int k = 0; k < g.dims[2]; ++k)
+        for (int j = 0; j < g.dims[1]; ++j)
+          for (int i = 0; i < g.dims[0]; ++i) {
+            const int nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k},
+                                  {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
+            for (const auto& n : nb)
+              if (n[0] >= 0 && n[1] >= 0 && n[2] >= 0 && n[0] < g.dims[0] && n[1] < g.dims[1] &&
+                  n[2] < g.dims[2] && in[g.index(n[0], n[1], n[2])])
+                out[g.index(i, j, k)] = 1;
+          }
+      return out;
+    };
+    std::vector<uint8_t> grown = mask;
+    for (int steps = 0; steps <= 20; ++steps) {
+      EXPECT_EQ(within_steps(mask, g, steps), grown) << steps << " steps";
+      grown = dilate(grown);
+    }
   }
   EXPECT_EQ(within_steps(std::vector<uint8_t>(g.size(), 0), g, 3),
             std::vector<uint8_t>(g.size(), 0));

@@ -69,6 +69,29 @@ TEST(TrimToBone, FillsTheGapFlushWithTheCutFaces) {
   EXPECT_EQ(q.penetration_mm3, 0.0);
 }
 
+// Meshed into a mesh the caller gives (one that held something else), the fit is the mesh the
+// result would hold, and the result's own mesh stays empty; when nothing is left, the given
+// mesh holds the implant as it came.
+TEST(TrimToBone, MeshedIntoAGivenMeshAsItWouldBeReturned) {
+  const SkullMesh bone = merge(box({0, 0, 0}, {20, 20, 5}), box({30, 0, 0}, {50, 20, 5}));
+  const SkullMesh implant = build_mesh(box({17, 2, 0}, {33, 18, 5.3}));
+  const TrimToBoneResult returned = trim_to_bone(implant, bone);
+  SkullMesh into = build_mesh(box({-5, -5, -5}, {5, 5, 5}));
+  const TrimToBoneResult given = trim_to_bone(implant, bone, {}, into);
+  ASSERT_TRUE(given.usable()) << given.message;
+  EXPECT_EQ(given.mesh.n_vertices(), 0u);
+  EXPECT_EQ(given.volume_mm3, returned.volume_mm3);
+  EXPECT_EQ(given.removed_mm3, returned.removed_mm3);
+  const TriangleSoup a = to_soup(returned.mesh), b = to_soup(into);
+  EXPECT_EQ(a.vertices, b.vertices);
+  EXPECT_EQ(a.triangles, b.triangles);
+
+  const SkullMesh buried = build_mesh(box({2, 2, 1}, {8, 8, 4}));
+  const TrimToBoneResult nothing = trim_to_bone(buried, bone, {}, into);
+  EXPECT_FALSE(nothing.usable());
+  EXPECT_EQ(to_soup(into).triangles, to_soup(buried).triangles);
+}
+
 // An implant that stops 1.2 mm short of a cut face (ragged bone it was not extended to) is
 // bridged onto it; without the bridge the crack stays.
 TEST(TrimToBone, BridgesANarrowGapToTheBone) {

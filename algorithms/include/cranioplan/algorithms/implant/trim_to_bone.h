@@ -64,5 +64,9 @@ struct TrimToBoneResult {
 /// keeps `clearance_mm` off the skull's surface (unset: a fraction of a voxel off its voxels).
 TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
                               const TrimToBoneParams& params = {});
+/// The same with the result meshed in `into` (whatever it held is replaced; the result's own
+/// mesh stays empty): a mesh cannot be moved, only copied. `into` must not be `implant`.
+TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
+                              const TrimToBoneParams& params, SkullMesh& into);
 
 }  // namespace cranioplan
