@@ -7,7 +7,10 @@
 #include <cmath>
 #include <limits>
 #include <numeric>
+#include <thread>
 #include <vector>
+
+#include "cranioplan/algorithms/geometry/parallel.h"
 
 namespace cranioplan {
 
@@ -15,6 +18,8 @@ namespace {
 
 constexpr int kLeafFaces = 4;
 constexpr int kMaxDepth = 64;
+// Trees over more faces are built on two threads.
+constexpr int kParallelFaces = 20000;
 
 // A box in float, rounded outward so that it still contains the double-precision geometry.
 struct Box {
@@ -126,8 +131,11 @@ struct SurfaceLocator::Tree {
 
   const Eigen::Vector3d& corner(int face, int k) const { return points[faces[face][k]]; }
 
-  // Builds the subtree over order[first, first + count); returns its node index.
-  int build(int first, int count, const std::vector<Eigen::Vector3f>& centroids, int depth) {
+  // Builds the subtree over order[first, first + count) at the end of `nodes`; returns its node
+  // index. A large tree's two halves are built on two threads (their own ranges of `order`),
+  // the right one's nodes then appended after the left's as one thread would have made them.
+  int build(std::vector<Node>& nodes, int first, int count,
+            const std::vector<Eigen::Vector3f>& centroids, int depth) {
     const int index = static_cast<int>(nodes.size());
     nodes.emplace_back();
     if (count <= kLeafFaces || depth >= kMaxDepth - 2) {
@@ -151,8 +159,23 @@ struct SurfaceLocator::Tree {
     std::nth_element(order.begin() + first, order.begin() + first + half,
                      order.begin() + first + count,
                      [&](int a, int b) { return centroids[a][axis] < centroids[b][axis]; });
-    const int left = build(first, half, centroids, depth + 1);
-    const int right = build(first + half, count - half, centroids, depth + 1);
+    int left = 0, right = 0;
+    if (depth == 0 && count >= kParallelFaces && thread_count() > 1) {
+      std::vector<Node> right_nodes;
+      right_nodes.reserve(nodes.capacity() / 2);
+      std::thread other(
+          [&] { build(right_nodes, first + half, count - half, centroids, depth + 1); });
+      left = build(nodes, first, half, centroids, depth + 1);
+      other.join();
+      right = static_cast<int>(nodes.size());
+      for (Node n : right_nodes) {
+        if (n.count == 0) n.first += right;  // an inner node's right child
+        nodes.push_back(n);
+      }
+    } else {
+      left = build(nodes, first, half, centroids, depth + 1);
+      right = build(nodes, first + half, count - half, centroids, depth + 1);
+    }
     Box box = nodes[left].box;
     box.add(nodes[right].box);
     nodes[index].box = box;
@@ -187,27 +210,40 @@ struct SurfaceLocator::Tree {
 SurfaceLocator::SurfaceLocator(const SkullMesh& mesh) {
   assert(mesh.n_faces() > 0 && "SurfaceLocator needs a mesh with faces");
   auto tree = std::make_shared<Tree>();
+  // The mesh's points and faces, and the faces' centroids (both threads, each entry once).
   tree->points.resize(mesh.n_vertices(), Eigen::Vector3d::Zero());
-  for (auto vh : mesh.vertices()) tree->points[vh.idx()] = to_eigen(mesh.point(vh));
-  tree->faces.reserve(mesh.n_faces());
-  for (auto fh : mesh.faces()) {
-    std::array<int, 3> f{};
-    int k = 0;
-    for (auto vh : mesh.fv_range(fh)) {
-      if (k == 3) break;
-      f[k++] = vh.idx();
+  parallel_for(mesh.n_vertices(), [&](size_t first, size_t last) {
+    for (size_t v = first; v < last; ++v)
+      tree->points[v] = to_eigen(mesh.point(SkullMesh::VertexHandle(static_cast<int>(v))));
+  });
+  // Faces are numbered as the mesh's face range gives them, which skips deleted ones.
+  std::vector<int> handle;
+  for (auto fh : mesh.all_faces())
+    if (mesh.status(fh).deleted()) {
+      for (auto kept : mesh.faces()) handle.push_back(kept.idx());
+      break;
     }
-    tree->faces.push_back(f);
-  }
-  const int n = static_cast<int>(tree->faces.size());
+  const int n = static_cast<int>(handle.empty() ? mesh.n_faces() : handle.size());
+  tree->faces.resize(static_cast<size_t>(n));
   std::vector<Eigen::Vector3f> centroids(n);
-  for (int f = 0; f < n; ++f)
-    centroids[f] =
-        ((tree->corner(f, 0) + tree->corner(f, 1) + tree->corner(f, 2)) / 3.0).cast<float>();
+  parallel_for(static_cast<size_t>(n), [&](size_t first, size_t last) {
+    for (size_t i = first; i < last; ++i) {
+      std::array<int, 3>& f = tree->faces[i];
+      int k = 0;
+      const int fh = handle.empty() ? static_cast<int>(i) : handle[i];
+      for (auto vh : mesh.fv_range(SkullMesh::FaceHandle(fh))) {
+        if (k == 3) break;
+        f[k++] = vh.idx();
+      }
+      const int face = static_cast<int>(i);
+      centroids[i] = ((tree->corner(face, 0) + tree->corner(face, 1) + tree->corner(face, 2)) / 3.0)
+                         .cast<float>();
+    }
+  });
   tree->order.resize(n);
   std::iota(tree->order.begin(), tree->order.end(), 0);
   tree->nodes.reserve(static_cast<size_t>(2 * n / kLeafFaces + 2));
-  if (n > 0) tree->build(0, n, centroids, 0);
+  if (n > 0) tree->build(tree->nodes, 0, n, centroids, 0);
   tree->nodes.shrink_to_fit();
   tree_ = std::move(tree);
 }

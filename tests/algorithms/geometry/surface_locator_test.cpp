@@ -8,6 +8,7 @@
 
 #include "cranioplan/algorithms/alignment/mirror_mesh.h"
 #include "cranioplan/algorithms/alignment/register_icp.h"
+#include "cranioplan/algorithms/geometry/parallel.h"
 #include "support/synthetic.h"
 
 namespace cranioplan {
@@ -96,6 +97,52 @@ TEST(SurfaceLocator, ClosestWithinARadiusAgreesWithTheUnboundedSearch) {
   EXPECT_EQ(plain.closest_within(Eigen::Vector3d(0, 0, 0), std::numeric_limits<double>::infinity())
                 ->distance,
             plain.closest(Eigen::Vector3d(0, 0, 0)).distance);
+}
+
+// A tree large enough to be built on two threads is the tree one thread builds: the same
+// faces found for the same queries (ties included), the same bytes.
+TEST(SurfaceLocator, TheTreeDoesNotDependOnTheThreads) {
+  const SkullMesh head = test::make_symmetric_head(5);
+  ASSERT_GT(head.n_faces(), 20000u);
+  set_thread_count(1);
+  const SurfaceLocator one(head);
+  set_thread_count(2);
+  const SurfaceLocator two(head);
+  set_thread_count(0);
+  EXPECT_EQ(one.memory_bytes(), two.memory_bytes());
+  std::mt19937 rng(5);
+  std::uniform_real_distribution<double> u(-120.0, 120.0);
+  for (int i = 0; i < 2000; ++i) {
+    const Eigen::Vector3d q(u(rng), u(rng), u(rng)), to(u(rng), u(rng), u(rng));
+    const SurfaceLocator::Closest a = one.closest(q), b = two.closest(q);
+    ASSERT_EQ(a.face, b.face) << i;
+    ASSERT_EQ(a.distance, b.distance) << i;
+    const auto ha = one.first_hit(q, to), hb = two.first_hit(q, to);
+    ASSERT_EQ(ha.has_value(), hb.has_value()) << i;
+    if (ha) {
+      ASSERT_EQ(ha->face, hb->face) << i;
+    }
+  }
+}
+
+// Faces deleted but not yet collected are not found; the others are numbered in the order of
+// the mesh's face range (which skips deleted ones).
+TEST(SurfaceLocator, SkipsDeletedFaces) {
+  SkullMesh head = test::make_symmetric_head(4);
+  for (int f = 0; f < static_cast<int>(head.n_faces()); f += 3)
+    head.delete_face(SkullMesh::FaceHandle(f), false);
+  const SurfaceLocator locator(head);
+  const std::vector<Triangle> kept = triangles(head);  // the face range's order
+  std::mt19937 rng(9);
+  std::uniform_real_distribution<double> u(-120.0, 120.0);
+  for (int i = 0; i < 300; ++i) {
+    const Eigen::Vector3d q(u(rng), u(rng), u(rng));
+    double best = std::numeric_limits<double>::infinity();
+    for (const auto& t : kept) best = std::min(best, distance_to_triangle(q, t));
+    const SurfaceLocator::Closest c = locator.closest(q);
+    ASSERT_NEAR(c.distance, best, 1e-9) << i;
+    ASSERT_NEAR(distance_to_triangle(c.point, kept[c.face]), 0.0, 1e-9) << i;
+  }
 }
 
 // Closest points and first hits agree with brute force over every face of an open head (a hole
