@@ -44,7 +44,9 @@ int main(int argc, char** argv) {
   const QCommandLineOption report(
       "report", "write the design report (HTML, its pictures and a PDF beside it)", "OUT.html");
   const QCommandLineOption pauses(
-      "pauses", "when quitting, print the window's longest pauses (the GUI thread held)");
+      "pauses",
+      "when quitting, print the window's longest pauses (the GUI thread held) and when the "
+      "first picture of the skull was drawn");
   parser.addOptions({sample, units, step, screenshot, quit, view, layout, window_preset, thickness,
                      mould, report, pauses});
   parser.process(app);
@@ -66,11 +68,18 @@ int main(int argc, char** argv) {
                      std::fprintf(stderr, "cranioplan: %s\n", message.toLocal8Bit().constData());
                    });
   std::unique_ptr<cranioplan::gui::PauseMeter> meter;
+  double first_picture_s = -1.0;  // when the first frame with the skull was drawn
   if (parser.isSet(pauses)) {
     meter = std::make_unique<cranioplan::gui::PauseMeter>(
         [&window] { return window.statusBar()->currentMessage(); });
-    QObject::connect(&app, &QCoreApplication::aboutToQuit, [&meter] {
+    QObject::connect(
+        &window.view(), &cranioplan::gui::SkullView::skullFirstDrawn,
+        [&first_picture_s] { first_picture_s = cranioplan::gui::seconds_since_start(); });
+    QObject::connect(&app, &QCoreApplication::aboutToQuit, [&meter, &first_picture_s] {
       std::printf("longest pauses of the window: %s\n", meter->summary().toLocal8Bit().constData());
+      if (first_picture_s >= 0.0)
+        std::printf("first picture of the skull: %.2f s after the program started\n",
+                    first_picture_s);
     });
   }
   window.show();

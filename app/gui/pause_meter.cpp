@@ -1,9 +1,32 @@
 #include "pause_meter.h"
 
+#include <unistd.h>
+
 #include <QTimer>
 #include <algorithm>
+#include <cmath>
+#include <fstream>
+#include <sstream>
+#include <string>
 
 namespace cranioplan::gui {
+
+double seconds_since_start() {
+  // /proc/self/stat's 22nd field is the start in clock ticks after boot; /proc/uptime the
+  // seconds since boot. The command (field 2) is in parentheses and may hold spaces.
+  std::ifstream stat("/proc/self/stat"), uptime("/proc/uptime");
+  std::string line;
+  double up = 0.0;
+  const long ticks = sysconf(_SC_CLK_TCK);
+  if (!std::getline(stat, line) || !(uptime >> up) || ticks <= 0) return std::nan("");
+  const size_t close = line.rfind(')');
+  if (close == std::string::npos) return std::nan("");
+  std::istringstream rest(line.substr(close + 1));
+  std::string field;
+  for (int k = 3; k <= 22 && rest >> field; ++k)
+    if (k == 22) return up - std::stod(field) / static_cast<double>(ticks);
+  return std::nan("");
+}
 
 namespace {
 constexpr int kIntervalMs = 10;

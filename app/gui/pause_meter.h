@@ -11,6 +11,10 @@ class QTimer;
 
 namespace cranioplan::gui {
 
+/// Seconds since this process started, as the kernel records its start (a program that
+/// starts itself again in place keeps it); NaN where /proc cannot tell.
+double seconds_since_start();
+
 class PauseMeter : public QObject {
   Q_OBJECT
 

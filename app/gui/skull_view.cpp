@@ -313,6 +313,7 @@ struct SkullView::Impl {
   std::optional<Eigen::Vector3d> handle_at;  // where it has been dragged to
   QPoint press_pos;
   bool moved = false;
+  bool skull_drawn = false;  // a frame with the skull has been drawn
   Eigen::Vector3d center = Eigen::Vector3d::Zero();
   double radius = 100.0;
 
@@ -494,6 +495,10 @@ void SkullView::paintGL() {
   d.window->Render();
   for (vtkActor* a : hidden) a->SetVisibility(true);
   d.window->SetReadyForRendering(false);
+  if (!d.skull_drawn && d.skull.visible()) {
+    d.skull_drawn = true;
+    emit skullFirstDrawn();
+  }
 }
 
 void SkullView::show_state(const PlanState& s) {

@@ -95,6 +95,8 @@ class SkullView : public QOpenGLWidget {
   /// A marker dragged and let go at `point`: one move.
   void markerDragged(int id, const Eigen::Vector3d& point);
   void handleDropped(int id, const Eigen::Vector3d& point);
+  /// The first frame that shows a skull has been drawn (once per view).
+  void skullFirstDrawn();
 
  protected:
   void initializeGL() override;

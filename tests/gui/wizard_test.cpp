@@ -20,6 +20,7 @@
 #include <QTimer>
 #include <QWheelEvent>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <filesystem>
 #include <thread>
@@ -593,6 +594,36 @@ TEST(WizardAbout, TheAboutBoxShowsTheVersion) {
 // it shows the anterior face's letter (green A), from the patient's left the left face's (red L),
 // from above the superior face's (blue S); the letters are checked against baselines (an L where
 // a reflected cube would show an R). Needs no sample case.
+// The view says when it first draws a skull, once: `cranioplan --pauses` prints that time
+// from the program's start (the first picture, whose target is 3 s for the sample).
+TEST(WizardFirstPicture, TheViewSaysOnceWhenItFirstDrawsTheSkull) {
+  const double age = seconds_since_start();
+  ASSERT_TRUE(std::isfinite(age));
+  EXPECT_GT(age, 0.0);
+  test::TempDir tmp;
+  const std::string path = tmp.path("head.stl");
+  write_mesh(test::make_symmetric_head(3), path);
+  MainWindow w;
+  w.set_interactive(false);
+  w.resize(1280, 800);
+  w.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&w));
+  int drawn = 0;
+  QObject::connect(&w.view(), &SkullView::skullFirstDrawn, [&drawn] { ++drawn; });
+  w.view().update();
+  QTest::qWait(100);
+  EXPECT_EQ(drawn, 0) << "frames without a skull";
+  w.open_input(QString::fromStdString(path));
+  w.controller().wait();
+  for (int i = 0; i < 100 && drawn == 0; ++i) QTest::qWait(50);
+  EXPECT_EQ(drawn, 1);
+  w.view().set_standard_view(SkullView::StandardView::Left);
+  w.view().update();
+  QTest::qWait(100);
+  EXPECT_EQ(drawn, 1) << "once";
+  EXPECT_GT(seconds_since_start(), age);
+}
+
 TEST(WizardOrientation, TheCubeShowsTheFaceTheCameraLooksAt) {
   test::TempDir tmp;
   const std::string path = tmp.path("head.stl");
