@@ -31,9 +31,15 @@ SharedSurface::SharedSurface(const std::string& path, const ExtractBoneSurfacePa
 ImplantData::ImplantData(ImplantResult result, std::shared_ptr<const SkullInput> skull,
                          QualityParams quality_params)
     : result_(std::move(result)),
-      stl_sha256_(sha256_hex(encode_mesh(result_.mesh, MeshFormat::BinarySTL))),
       skull_(std::move(skull)),
       quality_params_(std::move(quality_params)) {}
+
+const std::string& ImplantData::stl_sha256() const {
+  std::call_once(sha_once_, [this] {
+    stl_sha256_ = sha256_hex(encode_mesh(result_.mesh, MeshFormat::BinarySTL));
+  });
+  return stl_sha256_;
+}
 
 const QualityReport& ImplantData::quality() const {
   std::call_once(quality_once_, [this] {
@@ -290,16 +296,19 @@ void rebuild_implant(PlanState& s) {
   if (!s.implant_params) return;
   ImplantParams p = *s.implant_params;
   if (!p.radial_center && s.defect_center) p.radial_center = s.defect_center;
-  ImplantResult r =
-      build_implant(s.markers, &s.skull->surface->mesh, &s.skull->surface->locator, p);
+  auto built = std::make_shared<const ImplantData>(
+      [&] {
+        return build_implant(s.markers, &s.skull->surface->mesh, &s.skull->surface->locator, p);
+      },
+      [&](const ImplantResult& r) { return quality_params_for(p, r); }, s.skull);
+  const ImplantResult& r = built->result();
   if (r.usable()) {
     char buf[160];
     std::snprintf(buf, sizeof(buf), "implant built: %s triangles, %s",
                   format_count(static_cast<long long>(r.mesh.n_faces())).c_str(),
                   r.watertight ? "watertight" : "not watertight");
     s.message = buf;
-    QualityParams checks = quality_params_for(p, r);
-    s.implant = std::make_shared<const ImplantData>(std::move(r), s.skull, std::move(checks));
+    s.implant = std::move(built);
   } else {
     s.message = "implant not built: " + r.message;
     s.implant.reset();

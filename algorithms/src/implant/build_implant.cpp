@@ -738,6 +738,13 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
 
 namespace {
 
+// A result that was not built, and why.
+ImplantResult refused(const std::string& why) {
+  ImplantResult r;
+  r.message = why;
+  return r;
+}
+
 // Why the material or the clearance zones cannot be applied, or empty.
 std::string finishing_problem(const ImplantParams& params, const SkullMesh* skull) {
   if (params.material) {
@@ -783,11 +790,7 @@ std::string finishing_problem(const ImplantParams& params, const SkullMesh* skul
 ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh* skull,
                             const SurfaceLocator* skull_locator, const ImplantParams& given) {
   const auto t0 = std::chrono::steady_clock::now();
-  if (const std::string problem = finishing_problem(given, skull); !problem.empty()) {
-    ImplantResult r;
-    r.message = problem;
-    return r;
-  }
+  const std::string problem = finishing_problem(given, skull);
   // The material's thickness replaces the plan's inner surface; its clearance is the fit's.
   ImplantParams params = given;
   std::vector<Marker> outer_only;
@@ -813,7 +816,10 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
   const bool fitted = params.method == ImplantMethod::Shell && params.fit_to_bone_mm > 0.0 &&
                       skull && skull->n_faces() > 0;
   SkullMesh shell;
-  ImplantResult r = params.method == ImplantMethod::Shell
+  // One result, made where it is returned: a function that returns one of two named results
+  // copies the one it returns, and a mesh is copied, not moved.
+  ImplantResult r = !problem.empty() ? refused(problem)
+                    : params.method == ImplantMethod::Shell
                         ? build_shell(used, skull, skull_locator, params, fitted ? &shell : nullptr)
                         : build_delaunay(used, params);
   if (r.usable() && fitted) {

@@ -64,15 +64,22 @@ class ImplantData {
  public:
   ImplantData(ImplantResult result, std::shared_ptr<const SkullInput> skull,
               QualityParams quality_params = {});
+  /// The implant `build()` returns, kept where it is made (the result's mesh cannot be moved:
+  /// taking a built result in copies it), and the quality checks `checks(result)` names.
+  template <class Build, class Checks>
+  ImplantData(Build&& build, Checks&& checks, std::shared_ptr<const SkullInput> skull)
+      : result_(build()), skull_(std::move(skull)), quality_params_(checks(result_)) {}
   const QualityParams& quality_params() const { return quality_params_; }
   const ImplantResult& result() const { return result_; }
-  /// SHA-256 of the binary STL bytes of the implant (what an .stl export writes).
-  const std::string& stl_sha256() const { return stl_sha256_; }
+  /// SHA-256 of the binary STL bytes of the implant (what an .stl export writes), computed on
+  /// first use (an export, an approval, the audit): a marker edit does not wait for it.
+  const std::string& stl_sha256() const;
   const QualityReport& quality() const;
 
  private:
   ImplantResult result_;
-  std::string stl_sha256_;
+  mutable std::once_flag sha_once_;
+  mutable std::string stl_sha256_;
   std::shared_ptr<const SkullInput> skull_;
   QualityParams quality_params_;
   mutable std::once_flag quality_once_;
