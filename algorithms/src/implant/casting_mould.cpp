@@ -193,17 +193,20 @@ MouldResult make_casting_mould(const SkullMesh& implant, const Eigen::Vector3d& 
                                const MouldParams& p) {
   const auto t0 = std::chrono::steady_clock::now();
   MouldResult r;
-  auto done = [&]() -> MouldResult& {
+  // Every return is of `r` itself, so that it is made where it is returned (a function that
+  // returns anything else copies it, and the mould's halves with it).
+  auto done = [&] {
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return r;
   };
   if (const std::string problem = mould_problem(p); !problem.empty()) {
     r.message = problem;
-    return done();
+    done();
+    return r;
   }
   if (implant.n_faces() == 0) {
     r.message = "the implant has no triangles";
-    return done();
+    done();
+    return r;
   }
   // The pull: of the implant's thinnest principal axis (pointing away from the skull's inside)
   // and the directions 10° and 20° around it, the one whose parting traps the least of the
@@ -235,7 +238,8 @@ MouldResult make_casting_mould(const SkullMesh& implant, const Eigen::Vector3d& 
   }
   if (best.part.nu == 0) {
     r.message = "no line across the implant meets it";
-    return done();
+    done();
+    return r;
   }
   const Eigen::Vector3d axis = best.axis, e1 = best.e1, e2 = best.e2;
   const Parting& part = best.part;
@@ -347,14 +351,16 @@ MouldResult make_casting_mould(const SkullMesh& implant, const Eigen::Vector3d& 
       inner[cc] = static_cast<float>(n);
     }
   });
-  ExtractBoneSurfaceResult mo = surface_of_signed_distance(std::move(outer), g, p.iso_gap);
-  ExtractBoneSurfaceResult mi = surface_of_signed_distance(std::move(inner), g, p.iso_gap);
+  // The halves meshed where the result keeps them.
+  ExtractBoneSurfaceResult mo = surface_of_signed_distance(std::move(outer), g, r.outer, p.iso_gap);
+  ExtractBoneSurfaceResult mi = surface_of_signed_distance(std::move(inner), g, r.inner, p.iso_gap);
   if (!mo.usable() || !mi.usable()) {
     r.message = "meshing the mould: " + (mo.usable() ? mi.message : mo.message);
-    return done();
+    r.outer.clear();
+    r.inner.clear();
+    done();
+    return r;
   }
-  r.outer = std::move(mo.mesh);
-  r.inner = std::move(mi.mesh);
 
   // The cavity against the implant: each implant vertex's distance to the nearer half, away
   // from the openings (where the cavity is open to the top).
@@ -396,7 +402,8 @@ MouldResult make_casting_mould(const SkullMesh& implant, const Eigen::Vector3d& 
                   r.undercut_mm2, r.trapped_mm2);
     r.message += buf;
   }
-  return done();
+  done();
+  return r;
 }
 
 }  // namespace cranioplan

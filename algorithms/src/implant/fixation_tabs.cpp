@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -513,17 +514,20 @@ double tab_gap(const SurfaceLocator& self, const SurfaceLocator& bone, const Tab
   return any ? worst : std::numeric_limits<double>::quiet_NaN();
 }
 
-TabResult add_fixation_tabs(const SkullMesh& implant, const SurfaceLocator& bone,
-                            const Eigen::Vector3d& inside, const TabParams& p) {
+namespace {
+
+// add_fixation_tabs, the implant with its tabs meshed in `into` (the result's own mesh, or the
+// caller's).
+void tabs_into(const SkullMesh& implant, const SurfaceLocator& bone, const Eigen::Vector3d& inside,
+               const TabParams& p, TabResult& r, SkullMesh& into) {
+  assert(&into != &implant && "the tabs are meshed into another mesh than the implant");
   const auto t0 = std::chrono::steady_clock::now();
-  TabResult r;
   auto fail = [&](const std::string& message) {
     r.status = TabResult::Status::Failed;
     r.message = message;
-    r.mesh = implant;
+    into = implant;
     r.tabs.clear();
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return r;
   };
   if (const std::string problem = tab_problem(p); !problem.empty()) return fail(problem);
   if (std::isnan(p.width_mm) || std::isnan(p.thickness_mm))
@@ -662,7 +666,7 @@ TabResult add_fixation_tabs(const SkullMesh& implant, const SurfaceLocator& bone
           }
     }
   const ExtractBoneSurfaceResult mesh =
-      surface_of_signed_distance(std::move(field), g, r.mesh, p.iso_gap);
+      surface_of_signed_distance(std::move(field), g, into, p.iso_gap);
   if (!mesh.usable()) return fail("joining the tabs to the implant: " + mesh.message);
   for (Candidate& c : placed) r.tabs.push_back(std::move(c.tab));
   r.status = TabResult::Status::Added;
@@ -671,6 +675,22 @@ TabResult add_fixation_tabs(const SkullMesh& implant, const SurfaceLocator& bone
                 r.tabs.size() * static_cast<size_t>(p.screws), p.screw_diameter_mm);
   r.message += buf;
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+}
+
+}  // namespace
+
+TabResult add_fixation_tabs(const SkullMesh& implant, const SurfaceLocator& bone,
+                            const Eigen::Vector3d& inside, const TabParams& params) {
+  TabResult r;
+  tabs_into(implant, bone, inside, params, r, r.mesh);
+  return r;
+}
+
+TabResult add_fixation_tabs(const SkullMesh& implant, const SurfaceLocator& bone,
+                            const Eigen::Vector3d& inside, const TabParams& params,
+                            SkullMesh& into) {
+  TabResult r;
+  tabs_into(implant, bone, inside, params, r, into);
   return r;
 }
 

@@ -2,6 +2,7 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
+#include <cassert>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -129,23 +130,25 @@ bool hole_goes_through(const SurfaceLocator& locator, const Hole& hole) {
   return !locator.first_hit(hole.center + 15.0 * hole.axis, hole.center - 15.0 * hole.axis);
 }
 
-PerforateResult perforate(const SkullMesh& implant, const Eigen::Vector3d& inside,
-                          const PerforationParams& p) {
+namespace {
+
+// perforate, the drilled implant meshed in `into` (the result's own mesh, or the caller's).
+void perforate_into(const SkullMesh& implant, const Eigen::Vector3d& inside,
+                    const PerforationParams& p, PerforateResult& r, SkullMesh& into) {
+  assert(&into != &implant && "the holes are meshed into another mesh than the implant");
   const auto t0 = std::chrono::steady_clock::now();
-  PerforateResult r;
   auto done = [&](PerforateResult& out) {
     out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    return out;
   };
   if (const std::string problem = perforation_problem(p); !problem.empty()) {
     r.message = problem;
-    r.mesh = implant;
+    into = implant;
     return done(r);
   }
   const Faces faces = classify(implant, inside);
   if (faces.outer_centres.empty()) {
     r.message = "the implant has no outer surface facing away from the skull's inside";
-    r.mesh = implant;
+    into = implant;
     return done(r);
   }
   const SurfaceLocator self(implant);
@@ -163,7 +166,7 @@ PerforateResult perforate(const SkullMesh& implant, const Eigen::Vector3d& insid
       if ((r.holes[i].center - r.holes[j].center).norm() < p.diameter_mm + 1.0) {
         r.message = "holes " + std::to_string(i + 1) + " and " + std::to_string(j + 1) +
                     " are less than 1 mm apart: move or remove one";
-        r.mesh = implant;
+        into = implant;
         r.holes.clear();
         return done(r);
       }
@@ -175,7 +178,7 @@ PerforateResult perforate(const SkullMesh& implant, const Eigen::Vector3d& insid
       if (keep) r.holes.push_back({c, normal_near(faces, outer, c, inside), false});
     }
   if (r.holes.empty()) {  // nothing to drill: the implant as it is
-    r.mesh = implant;
+    into = implant;
     r.status = PerforateResult::Status::Drilled;
     r.message = "no hole fits: the implant is smaller than the pattern's distance from its edge";
     return done(r);
@@ -215,14 +218,14 @@ PerforateResult perforate(const SkullMesh& implant, const Eigen::Vector3d& insid
           v = static_cast<float>(smooth_min(v, off_axis - radius, kRimRoundMm));
         }
   }
-  ExtractBoneSurfaceResult s = surface_of_signed_distance(std::move(field), g, r.mesh, p.iso_gap);
+  ExtractBoneSurfaceResult s = surface_of_signed_distance(std::move(field), g, into, p.iso_gap);
   if (!s.usable()) {
     r.message = "drilling the holes: " + s.message;
-    r.mesh = implant;
+    into = implant;
     r.holes.clear();
     return done(r);
   }
-  const SurfaceLocator drilled(r.mesh);
+  const SurfaceLocator drilled(into);
   int blocked = 0;
   for (const Hole& hole : r.holes) blocked += !hole_goes_through(drilled, hole);
   r.status = PerforateResult::Status::Drilled;
@@ -231,6 +234,22 @@ PerforateResult perforate(const SkullMesh& implant, const Eigen::Vector3d& insid
   r.message = buf;
   if (blocked > 0) r.message += " (" + std::to_string(blocked) + " do not go through)";
   return done(r);
+}
+
+}  // namespace
+
+PerforateResult perforate(const SkullMesh& implant, const Eigen::Vector3d& inside,
+                          const PerforationParams& params) {
+  PerforateResult r;
+  perforate_into(implant, inside, params, r, r.mesh);
+  return r;
+}
+
+PerforateResult perforate(const SkullMesh& implant, const Eigen::Vector3d& inside,
+                          const PerforationParams& params, SkullMesh& into) {
+  PerforateResult r;
+  perforate_into(implant, inside, params, r, into);
+  return r;
 }
 
 }  // namespace cranioplan

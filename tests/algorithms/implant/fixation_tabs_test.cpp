@@ -135,6 +135,27 @@ TEST(FixationTabs, NoPlaceOnBoneThinnerThanAskedIsRefused) {
   EXPECT_EQ(r.mesh.n_faces(), implant.n_faces());
 }
 
+// Meshed into a mesh the caller gives, the tabs are what the result would hold (the result's
+// own mesh empty); refused, the given mesh holds the implant as it came.
+TEST(FixationTabs, MeshedIntoAGivenMeshAsTheyWouldBeReturned) {
+  const SkullMesh skull = bone(), implant = plug();
+  const SurfaceLocator on_bone(skull);
+  TabParams p = resolved(TabParams{}, std::nan(""));
+  p.automatic = true;
+  const TabResult returned = add_fixation_tabs(implant, on_bone, kInside, p);
+  ASSERT_TRUE(returned.usable()) << returned.message;
+  SkullMesh into = plug();
+  const TabResult given = add_fixation_tabs(implant, on_bone, kInside, p, into);
+  ASSERT_TRUE(given.usable()) << given.message;
+  EXPECT_EQ(given.mesh.n_faces(), 0u);
+  EXPECT_EQ(given.tabs.size(), returned.tabs.size());
+  EXPECT_EQ(to_soup(into).vertices, to_soup(returned.mesh).vertices);
+  EXPECT_EQ(to_soup(into).triangles, to_soup(returned.mesh).triangles);
+  p.min_bone_mm = 7.0;
+  EXPECT_FALSE(add_fixation_tabs(implant, on_bone, kInside, p, into).usable());
+  EXPECT_EQ(to_soup(into).triangles, to_soup(implant).triangles);
+}
+
 // A tab the user puts: at the rim point nearest the point given, reaching away from the
 // implant there.
 TEST(FixationTabs, AUsersTabGoesToTheNearestRimPoint) {

@@ -61,6 +61,23 @@ TEST(Perforate, APatternOnAPlateGoesThroughEveryHole) {
 
 // A single hole added where the user clicks (moved onto the surface), the pattern's holes near
 // it giving way; a pattern hole taken away; two added holes that would merge are refused.
+// Meshed into a mesh the caller gives, the drilled plate is what the result would hold (the
+// result's own mesh empty).
+TEST(Perforate, MeshedIntoAGivenMeshAsItWouldBeReturned) {
+  const SkullMesh p = plate();
+  PerforationParams params;
+  params.pattern = true;
+  const PerforateResult returned = perforate(p, kInside, params);
+  ASSERT_TRUE(returned.usable()) << returned.message;
+  SkullMesh into = plate();
+  const PerforateResult given = perforate(p, kInside, params, into);
+  ASSERT_TRUE(given.usable()) << given.message;
+  EXPECT_EQ(given.mesh.n_faces(), 0u);
+  EXPECT_EQ(given.holes.size(), returned.holes.size());
+  EXPECT_EQ(to_soup(into).vertices, to_soup(returned.mesh).vertices);
+  EXPECT_EQ(to_soup(into).triangles, to_soup(returned.mesh).triangles);
+}
+
 TEST(Perforate, HolesAreAddedAndTakenAway) {
   const SkullMesh p = plate();
   PerforationParams params;

@@ -86,6 +86,12 @@ struct TabResult {
 /// thickness set (resolved()).
 TabResult add_fixation_tabs(const SkullMesh& implant, const SurfaceLocator& bone,
                             const Eigen::Vector3d& inside, const TabParams& params);
+/// The same with the implant and its tabs meshed in `into` (the implant as it came when the
+/// tabs cannot be added; the result's own mesh stays empty): a mesh cannot be moved, only
+/// copied. `into` must not be `implant`.
+TabResult add_fixation_tabs(const SkullMesh& implant, const SurfaceLocator& bone,
+                            const Eigen::Vector3d& inside, const TabParams& params,
+                            SkullMesh& into);
 
 /// The largest gap between a tab's underside and the bone over the part of it that lies on the
 /// bone (beyond its edge's groove, away from the screw holes), mm; negative where the tab enters

@@ -59,6 +59,10 @@ struct PerforateResult {
 /// skull, which tells the implant's outer surface (facing away from it) from its inner one.
 PerforateResult perforate(const SkullMesh& implant, const Eigen::Vector3d& inside,
                           const PerforationParams& params);
+/// The same with the drilled implant meshed in `into` (the implant as it came when nothing is
+/// drilled; the result's own mesh stays empty). `into` must not be `implant`.
+PerforateResult perforate(const SkullMesh& implant, const Eigen::Vector3d& inside,
+                          const PerforationParams& params, SkullMesh& into);
 
 /// Whether a hole goes through `implant` (located by `locator`): its axis line, 15 mm to either
 /// side of its centre, meets no surface (a plate is at most 15 mm thick).
