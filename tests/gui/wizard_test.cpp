@@ -151,13 +151,18 @@ class Wizard : public ::testing::Test {
   }
 };
 
+// The window as the tests drive it: no dialogs, `size`, shown and exposed.
+bool shown(MainWindow& w, const QSize& size) {
+  w.set_interactive(false);
+  w.resize(size);
+  w.show();
+  return QTest::qWaitForWindowExposed(&w);
+}
+
 TEST_F(Wizard, AllNineStepsOnTheSampleReplayToTheSameImplant) {
   test::TempDir tmp;
   MainWindow w;
-  w.set_interactive(false);
-  w.resize(1500, 950);
-  w.show();
-  ASSERT_TRUE(QTest::qWaitForWindowExposed(&w));
+  ASSERT_TRUE(shown(w, QSize(1500, 950)));
   PlanController& plan = w.controller();
   SkullView& view = w.view();
 
@@ -432,10 +437,7 @@ TEST_F(Wizard, CtSlicesShowTheImplantWhereTheGeometrySays) {
     a.session.save(session);
   }
   MainWindow w;
-  w.set_interactive(false);
-  w.resize(1500, 950);
-  w.show();
-  ASSERT_TRUE(QTest::qWaitForWindowExposed(&w));
+  ASSERT_TRUE(shown(w, QSize(1500, 950)));
   ASSERT_TRUE(w.open_session(QString::fromStdString(session)));
   w.set_layout(MainWindow::Layout::Slices);
   w.slices().wait_loaded();
@@ -604,10 +606,7 @@ TEST(WizardFirstPicture, TheViewSaysOnceWhenItFirstDrawsTheSkull) {
   const std::string path = tmp.path("head.stl");
   write_mesh(test::make_symmetric_head(3), path);
   MainWindow w;
-  w.set_interactive(false);
-  w.resize(1280, 800);
-  w.show();
-  ASSERT_TRUE(QTest::qWaitForWindowExposed(&w));
+  ASSERT_TRUE(shown(w, QSize(1280, 800)));
   int drawn = 0;
   QObject::connect(&w.view(), &SkullView::skullFirstDrawn, [&drawn] { ++drawn; });
   w.view().update();
@@ -629,10 +628,7 @@ TEST(WizardOrientation, TheCubeShowsTheFaceTheCameraLooksAt) {
   const std::string path = tmp.path("head.stl");
   write_mesh(test::make_symmetric_head(3), path);
   MainWindow w;
-  w.set_interactive(false);
-  w.resize(1280, 800);
-  w.show();
-  ASSERT_TRUE(QTest::qWaitForWindowExposed(&w));
+  ASSERT_TRUE(shown(w, QSize(1280, 800)));
   w.open_input(QString::fromStdString(path));
   w.controller().wait();
   ASSERT_TRUE(w.controller().state().skull);
@@ -674,10 +670,7 @@ TEST(WizardOrientation, TheCubeShowsTheFaceTheCameraLooksAt) {
 // thickness and the skull around it by its gap, with legends; off again, the plain colours.
 TEST(WizardThickness, TheThicknessMapColoursTheImplantAndTheBoneAroundIt) {
   MainWindow w;
-  w.set_interactive(false);
-  w.resize(1280, 800);
-  w.show();
-  ASSERT_TRUE(QTest::qWaitForWindowExposed(&w));
+  ASSERT_TRUE(shown(w, QSize(1280, 800)));
   ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
   w.controller().wait();
   ASSERT_TRUE(w.plan().implant);
@@ -706,10 +699,7 @@ TEST(WizardThickness, TheThicknessMapColoursTheImplantAndTheBoneAroundIt) {
 
 // A window showing the planned sample case at `step`, for the tests that edit its implant.
 void open_planned_at_step(MainWindow& w, int step, const QSize& size) {
-  w.set_interactive(false);
-  w.resize(size);
-  w.show();
-  ASSERT_TRUE(QTest::qWaitForWindowExposed(&w));
+  ASSERT_TRUE(shown(w, size));
   ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
   w.controller().push(commands::go_to_step(step));
   w.controller().wait();
