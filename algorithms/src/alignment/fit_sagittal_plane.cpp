@@ -9,7 +9,7 @@
 #include <chrono>
 #include <cmath>
 
-#include "cranioplan/algorithms/geometry/parallel.h"
+#include "cranioplan/model/parallel.h"
 #include "cranioplan/algorithms/geometry/point_index.h"
 #include "cranioplan/algorithms/geometry/surface_samples.h"
 

@@ -7,7 +7,7 @@
 #include <memory>
 
 #include "cranioplan/algorithms/alignment/mirror_mesh.h"
-#include "cranioplan/algorithms/geometry/parallel.h"
+#include "cranioplan/model/parallel.h"
 #include "cranioplan/algorithms/geometry/point_index.h"
 #include "cranioplan/algorithms/geometry/surface_samples.h"
 

@@ -5,7 +5,7 @@
 #include <cmath>
 #include <limits>
 
-#include "cranioplan/algorithms/geometry/parallel.h"
+#include "cranioplan/model/parallel.h"
 
 namespace cranioplan {
 

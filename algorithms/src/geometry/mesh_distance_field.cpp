@@ -3,7 +3,7 @@
 #include <algorithm>
 #include <cmath>
 
-#include "cranioplan/algorithms/geometry/parallel.h"
+#include "cranioplan/model/parallel.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 

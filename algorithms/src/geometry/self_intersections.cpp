@@ -6,7 +6,7 @@
 #include <cmath>
 #include <vector>
 
-#include "cranioplan/algorithms/geometry/parallel.h"
+#include "cranioplan/model/parallel.h"
 
 namespace cranioplan {
 namespace {

@@ -10,7 +10,7 @@
 #include <thread>
 #include <vector>
 
-#include "cranioplan/algorithms/geometry/parallel.h"
+#include "cranioplan/model/parallel.h"
 
 namespace cranioplan {
 

@@ -10,7 +10,7 @@
 #include <vector>
 
 #include "cranioplan/algorithms/geometry/distance_transform.h"
-#include "cranioplan/algorithms/geometry/parallel.h"
+#include "cranioplan/model/parallel.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/extract_bone_surface.h"

@@ -6,7 +6,7 @@
 #include <limits>
 
 #include "cranioplan/algorithms/geometry/distance_transform.h"
-#include "cranioplan/algorithms/geometry/parallel.h"
+#include "cranioplan/model/parallel.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 

@@ -8,7 +8,7 @@
 
 #include "cranioplan/algorithms/alignment/mirror_mesh.h"
 #include "cranioplan/algorithms/alignment/register_icp.h"
-#include "cranioplan/algorithms/geometry/parallel.h"
+#include "cranioplan/model/parallel.h"
 #include "support/synthetic.h"
 
 namespace cranioplan {

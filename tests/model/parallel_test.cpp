@@ -1,4 +1,4 @@
-#include "cranioplan/algorithms/geometry/parallel.h"
+#include "cranioplan/model/parallel.h"
 
 #include <gtest/gtest.h>
 
