@@ -6,8 +6,11 @@
 #include <array>
 #include <cassert>
 #include <cmath>
+#include <cstdint>
+#include <cstring>
 #include <memory>
-#include <numeric>
+
+#include "cranioplan/model/parallel.h"
 
 namespace cranioplan {
 
@@ -58,46 +61,92 @@ void add_face_or_split(SkullMesh& mesh, const std::array<Eigen::Vector3d, 3>& p,
   ++stats.nonmanifold_split;
 }
 
-// x rounded to the nearest single-precision value (ties to even, as a float conversion rounds),
-// by its mantissa: GCC 12's SLP vectorizer at -O2/-O3 drops the round trip
-// static_cast<double>(static_cast<float>(x)) over Eigen vectors (measured on this machine: the
-// coordinates came back unrounded).
+// x rounded to 24 significant bits, ties to even (as a conversion to float rounds, without its
+// range limits), by clearing the low 29 of the 52 stored mantissa bits: a carry into the
+// exponent is the next power of two, as it should be. Zeros, subnormals, infinities and NaNs
+// (none reach here from a file: the readers refuse non-finite coordinates) go through frexp.
+// Not static_cast<double>(static_cast<float>(x)): GCC 12's SLP vectorizer at -O2/-O3 drops
+// that round trip over Eigen vectors (measured on this machine: the coordinates came back
+// unrounded).
 double round_to_single(double x) {
-  int exponent = 0;
-  const double mantissa = std::frexp(x, &exponent);
-  const double rounded = std::ldexp(std::nearbyint(std::ldexp(mantissa, 24)), exponent - 24);
-  return rounded == 0.0 ? 0.0 : rounded;  // −0 is +0: equal positions are one vertex, bit for bit
+  uint64_t bits = 0;
+  std::memcpy(&bits, &x, sizeof bits);
+  const uint64_t exponent = (bits >> 52) & 0x7ff;
+  if (exponent == 0 || exponent == 0x7ff) {
+    int e = 0;
+    const double mantissa = std::frexp(x, &e);
+    const double rounded = std::ldexp(std::nearbyint(std::ldexp(mantissa, 24)), e - 24);
+    return rounded == 0.0 ? 0.0 : rounded;  // −0 is +0: equal positions are one vertex
+  }
+  constexpr uint64_t kDropped = (uint64_t{1} << 29) - 1, kHalf = uint64_t{1} << 28;
+  const uint64_t low = bits & kDropped;
+  bits &= ~kDropped;
+  if (low > kHalf || (low == kHalf && (bits & (kDropped + 1)) != 0)) bits += kDropped + 1;
+  std::memcpy(&x, &bits, sizeof x);
+  return x;
 }
 
 }  // namespace
 
 void make_canonical(TriangleSoup& soup) {
-  for (auto& v : soup.vertices)
-    for (int k = 0; k < 3; ++k) v[k] = round_to_single(v[k]);
-  auto less = [](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-    return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
+  // Vertices sorted as values (position and input index side by side) rather than through an
+  // index array: the comparisons read contiguous memory.
+  struct Keyed {
+    double x, y, z;
+    int index;
   };
-  std::vector<int> order(soup.vertices.size());
-  std::iota(order.begin(), order.end(), 0);
-  std::sort(order.begin(), order.end(),
-            [&](int a, int b) { return less(soup.vertices[a], soup.vertices[b]); });
+  std::vector<Keyed> keyed(soup.vertices.size());
+  for (size_t i = 0; i < keyed.size(); ++i) {
+    const Eigen::Vector3d& v = soup.vertices[i];
+    keyed[i] = {round_to_single(v.x()), round_to_single(v.y()), round_to_single(v.z()),
+                static_cast<int>(i)};
+  }
+  auto less = [](const Keyed& a, const Keyed& b) {
+    return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
+  };
+  // Halves sorted on two threads and merged. Equal positions may come out in either order;
+  // they become one vertex, so the result does not depend on it (nor on the thread count).
+  const size_t half = keyed.size() / 2;
+  parallel_for(
+      2,
+      [&](size_t begin, size_t end) {
+        for (size_t part = begin; part < end; ++part)
+          std::sort(keyed.begin() + (part == 0 ? 0 : half),
+                    part == 0 ? keyed.begin() + half : keyed.end(), less);
+      },
+      keyed.size() > 50000 ? 1 : 2);
+  std::inplace_merge(keyed.begin(), keyed.begin() + half, keyed.end(), less);
   std::vector<int> id(soup.vertices.size());
   std::vector<Eigen::Vector3d> vertices;
   vertices.reserve(soup.vertices.size());
-  for (int i : order) {
-    if (vertices.empty() || vertices.back() != soup.vertices[i])
-      vertices.push_back(soup.vertices[i]);
-    id[i] = static_cast<int>(vertices.size()) - 1;
+  for (const Keyed& k : keyed) {
+    const Eigen::Vector3d p(k.x, k.y, k.z);
+    if (vertices.empty() || vertices.back() != p) vertices.push_back(p);
+    id[k.index] = static_cast<int>(vertices.size()) - 1;
   }
+  // Triangles from their smallest corner, in lexicographic order: counted out by that corner
+  // (a bucket per vertex, a few triangles each), then each bucket sorted by the other two.
+  const size_t nv = vertices.size();
+  std::vector<int> start(nv + 1, 0);
   for (auto& t : soup.triangles) {
-    Eigen::Vector3i u(id[t[0]], id[t[1]], id[t[2]]);
+    const Eigen::Vector3i u(id[t[0]], id[t[1]], id[t[2]]);
     const int first = u[0] <= u[1] && u[0] <= u[2] ? 0 : u[1] <= u[2] ? 1 : 2;
     t = Eigen::Vector3i(u[first], u[(first + 1) % 3], u[(first + 2) % 3]);
+    ++start[t[0] + 1];
   }
-  std::sort(soup.triangles.begin(), soup.triangles.end(),
-            [](const Eigen::Vector3i& a, const Eigen::Vector3i& b) {
-              return std::lexicographical_compare(a.data(), a.data() + 3, b.data(), b.data() + 3);
-            });
+  for (size_t v = 0; v < nv; ++v) start[v + 1] += start[v];
+  std::vector<Eigen::Vector3i> sorted(soup.triangles.size());
+  {
+    std::vector<int> fill(start.begin(), start.end() - 1);
+    for (const auto& t : soup.triangles) sorted[fill[t[0]]++] = t;
+  }
+  auto later = [](const Eigen::Vector3i& a, const Eigen::Vector3i& b) {
+    return a[1] != b[1] ? a[1] < b[1] : a[2] < b[2];
+  };
+  for (size_t v = 0; v < nv; ++v)
+    if (start[v + 1] - start[v] > 1)
+      std::sort(sorted.begin() + start[v], sorted.begin() + start[v + 1], later);
+  soup.triangles = std::move(sorted);
   soup.vertices = std::move(vertices);
 }
 
@@ -106,30 +155,61 @@ namespace {
 // Each fan of triangles around a vertex beyond the first (faces joined through shared edges)
 // gets its own copy of the vertex: `corner` is renumbered to the copies, `nv` and `source` (the
 // input vertex of each mesh vertex) grow with them.
+// Whether the triangles around v fall into more than one fan (faces joined through shared
+// edges). Leaves each outgoing halfedge's fan (a root in `parent`) for the caller; `ends` is
+// scratch for the two other corners of each face.
+bool fans_around(const OutgoingLists& lists, const std::vector<int>& corner, int v,
+                 std::vector<int>& parent, std::vector<std::array<int, 2>>& ends) {
+  const int a = lists.start[v], n = lists.start[v + 1] - a;
+  if (n < 2) return false;
+  parent.resize(n);
+  ends.resize(n);
+  for (int i = 0; i < n; ++i) {
+    const size_t h = static_cast<size_t>(lists.out[a + i]);
+    parent[i] = i;
+    ends[i] = {corner[next_corner(h)], corner[prev_corner(h)]};  // face i: v → w, x → v
+  }
+  auto root = [&](int x) {
+    while (parent[x] != x) x = parent[x] = parent[parent[x]];
+    return x;
+  };
+  for (int i = 0; i < n; ++i)
+    for (int j = 0; j < n; ++j)
+      // Face i leaves v towards w and face j arrives at v from w: they share edge v–w.
+      if (i != j && ends[i][0] == ends[j][1]) parent[root(i)] = root(j);
+  bool several = false;
+  for (int i = 0; i < n; ++i) {
+    parent[i] = root(i);
+    several = several || parent[i] != parent[0];
+  }
+  return several;
+}
+
+// Each fan of triangles around a vertex beyond the first gets its own copy of the vertex:
+// `corner` is renumbered to the copies, `nv` and `source` (the input vertex of each mesh vertex)
+// grow with them. Which vertices have several fans is found on all threads (a split never
+// changes another vertex's fans: two faces sharing an edge u–v share it at both ends); the
+// copies are made in vertex order.
 void split_complex_vertices(const OutgoingLists& lists, std::vector<int>& corner, int& nv,
                             std::vector<int>& source, BuildMeshStats& stats) {
   const int original_count = nv;
+  std::vector<char> complex(static_cast<size_t>(original_count), 0);
+  parallel_for(static_cast<size_t>(original_count), [&](size_t begin, size_t end) {
+    std::vector<int> parent;
+    std::vector<std::array<int, 2>> ends;
+    for (size_t v = begin; v < end; ++v)
+      complex[v] = fans_around(lists, corner, static_cast<int>(v), parent, ends) ? 1 : 0;
+  });
   std::vector<int> parent, copy;
+  std::vector<std::array<int, 2>> ends;
   for (int v = 0; v < original_count; ++v) {
+    if (!complex[v]) continue;
+    fans_around(lists, corner, v, parent, ends);
     const int a = lists.start[v], n = lists.start[v + 1] - a;
-    if (n < 2) continue;
-    parent.resize(n);
-    for (int i = 0; i < n; ++i) parent[i] = i;
-    auto root = [&](int x) {
-      while (parent[x] != x) x = parent[x] = parent[parent[x]];
-      return x;
-    };
-    for (int i = 0; i < n; ++i)
-      for (int j = 0; j < n; ++j) {
-        // Face i leaves v towards w and face j arrives at v from w: they share edge v–w.
-        const size_t hi = static_cast<size_t>(lists.out[a + i]);
-        const size_t hj = static_cast<size_t>(lists.out[a + j]);
-        if (i != j && corner[next_corner(hi)] == corner[prev_corner(hj)]) parent[root(i)] = root(j);
-      }
     copy.assign(n, -1);
-    const int keep = root(0);
+    const int keep = parent[0];
     for (int i = 0; i < n; ++i) {
-      const int r = root(i);
+      const int r = parent[i];
       if (r == keep) continue;
       if (copy[r] < 0) {
         copy[r] = nv++;
@@ -147,7 +227,10 @@ void split_complex_vertices(const OutgoingLists& lists, std::vector<int>& corner
 // halfedges from per-vertex outgoing lists, instead of add_vertex/add_face with their per-element
 // checks. Faces that would reuse a directed edge (non-manifold edges, flipped neighbours) are
 // added afterwards with add_face, split if need be; vertices where several fans of triangles
-// meet (complex vertices, as marching cubes makes) get one copy per extra fan.
+// meet (complex vertices, as marching cubes makes) get one copy per extra fan. The searches
+// run on all threads; whatever depends on order (which of two faces claiming one directed
+// edge comes first, the numbering of copies and edges) is decided in input order, so the mesh
+// does not depend on the thread count.
 SkullMesh build_mesh(const TriangleSoup& soup, BuildMeshStats* stats) {
   SkullMesh mesh;
   build_mesh(soup, mesh, stats);
@@ -162,18 +245,24 @@ void build_mesh(const TriangleSoup& soup, SkullMesh& mesh, BuildMeshStats* stats
   const int n_in = static_cast<int>(soup.vertices.size());
 
   // Non-degenerate faces and the vertices they use, renumbered in input order.
+  std::vector<char> degenerate(soup.triangles.size());
+  parallel_for(soup.triangles.size(), [&](size_t begin, size_t end) {
+    for (size_t i = begin; i < end; ++i) {
+      const auto& t = soup.triangles[i];
+      assert(t.minCoeff() >= 0 && t.maxCoeff() < n_in && "triangle index out of range");
+      degenerate[i] = is_degenerate(soup, t) ? 1 : 0;
+    }
+  });
   std::vector<int> faces;
   faces.reserve(soup.triangles.size());
   std::vector<int> id(n_in, -1);
   for (size_t i = 0; i < soup.triangles.size(); ++i) {
-    const auto& t = soup.triangles[i];
-    assert(t.minCoeff() >= 0 && t.maxCoeff() < n_in && "triangle index out of range");
-    if (is_degenerate(soup, t)) {
+    if (degenerate[i]) {
       ++local.degenerate_dropped;
       continue;
     }
     faces.push_back(static_cast<int>(i));
-    for (int k = 0; k < 3; ++k) id[t[k]] = 0;
+    for (int k = 0; k < 3; ++k) id[soup.triangles[i][k]] = 0;
   }
   std::vector<int> source;  // input vertex of each mesh vertex
   source.reserve(n_in);
@@ -185,14 +274,34 @@ void build_mesh(const TriangleSoup& soup, SkullMesh& mesh, BuildMeshStats* stats
   int nv = static_cast<int>(source.size());
   const size_t nf = faces.size(), nh = nf * 3;
   std::vector<int> corner(nh);
-  for (size_t he = 0; he < nh; ++he)
-    corner[he] = id[soup.triangles[faces[he / 3]][static_cast<int>(he % 3)]];
+  parallel_for(nf, [&](size_t begin, size_t end) {
+    for (size_t f = begin; f < end; ++f)
+      for (int k = 0; k < 3; ++k) corner[f * 3 + k] = id[soup.triangles[faces[f]][k]];
+  });
 
   // 1. Accept faces in order unless one of their directed edges is taken by an accepted face.
-  std::vector<char> accepted(nf, 0);
+  // A face none of whose directed edges another face repeats is accepted in any order; only
+  // the faces with a repeated directed edge (found on all threads) are decided in order.
+  std::vector<char> accepted(nf, 1);
+  auto lists = std::make_unique<OutgoingLists>(corner, nv, accepted);
+  std::vector<char> repeated(nh, 0);  // per halfedge: another face has the same directed edge
+  parallel_for(static_cast<size_t>(nv), [&](size_t begin, size_t end) {
+    for (size_t u = begin; u < end; ++u)
+      for (int i = lists->start[u]; i < lists->start[u + 1]; ++i)
+        for (int j = i + 1; j < lists->start[u + 1]; ++j) {
+          const size_t hi = static_cast<size_t>(lists->out[i]);
+          const size_t hj = static_cast<size_t>(lists->out[j]);
+          if (corner[next_corner(hi)] == corner[next_corner(hj)]) repeated[hi] = repeated[hj] = 1;
+        }
+  });
   std::vector<int> deferred;
-  auto lists = std::make_unique<OutgoingLists>(corner, nv, std::vector<char>(nf, 1));
-  for (size_t f = 0; f < nf; ++f) {
+  std::vector<size_t> contested;
+  for (size_t f = 0; f < nf; ++f)
+    if (repeated[f * 3] || repeated[f * 3 + 1] || repeated[f * 3 + 2]) {
+      contested.push_back(f);
+      accepted[f] = 0;
+    }
+  for (size_t f : contested) {
     bool ok = true;
     for (size_t he = f * 3; he < f * 3 + 3 && ok; ++he) {
       const int u = corner[he], v = corner[next_corner(he)];
@@ -213,40 +322,62 @@ void build_mesh(const TriangleSoup& soup, SkullMesh& mesh, BuildMeshStats* stats
   split_complex_vertices(*lists, corner, nv, source, local);
   if (nv != original_count) lists = std::make_unique<OutgoingLists>(corner, nv, accepted);
 
-  // 3. Edges: the first halfedge of a pair creates the edge; its twin reuses it.
+  // 3. Twins, then edges: the first halfedge of a pair creates the edge; its twin reuses it.
+  std::vector<int> twin(nh, -1);
+  parallel_for(nh, [&](size_t begin, size_t end) {
+    for (size_t he = begin; he < end; ++he)
+      if (accepted[he / 3]) twin[he] = lists->find(corner, corner[next_corner(he)], corner[he]);
+  });
   std::vector<int> halfedge(nh, -1);  // mesh halfedge index of each accepted face halfedge
-  int ne = 0;
+  std::vector<int> face_index(nf, -1);
+  int ne = 0, n_accepted = 0;
   for (size_t he = 0; he < nh; ++he) {
     if (!accepted[he / 3]) continue;
-    const int opp = lists->find(corner, corner[next_corner(he)], corner[he]);
+    const int opp = twin[he];
     halfedge[he] = opp >= 0 && static_cast<size_t>(opp) < he ? (halfedge[opp] ^ 1) : 2 * ne++;
+    if (he % 3 == 0) face_index[he / 3] = n_accepted++;
   }
-  int n_accepted = 0;
-  for (char a : accepted) n_accepted += a;
 
   mesh.clear();
+  // Room for the deferred faces too (each may bring three vertices and three edges of its
+  // own): OpenMesh grows its arrays and every property one element at a time otherwise, and
+  // the first deferred face would copy the whole mesh.
+  const size_t extra = 3 * deferred.size();
+  mesh.reserve(nv + extra, ne + extra, n_accepted + deferred.size());
   mesh.resize(nv, ne, n_accepted);
-  for (int v = 0; v < nv; ++v) mesh.set_point(VH(v), to_point(soup.vertices[source[v]]));
-  std::vector<int> boundary_out(nv, -1), boundary_to(nv, -1);
-  int fi = 0;
-  for (size_t f = 0; f < nf; ++f) {
-    if (!accepted[f]) continue;
-    const SkullMesh::FaceHandle fh(fi++);
-    mesh.set_halfedge_handle(fh, HH(halfedge[f * 3]));
-    for (size_t he = f * 3; he < f * 3 + 3; ++he) {
-      const HH h(halfedge[he]);
-      const int u = corner[he], v = corner[next_corner(he)];
-      mesh.set_vertex_handle(h, VH(v));
-      mesh.set_vertex_handle(mesh.opposite_halfedge_handle(h), VH(u));
-      mesh.set_next_halfedge_handle(h, HH(halfedge[next_corner(he)]));
-      mesh.set_face_handle(h, fh);
-      mesh.set_halfedge_handle(VH(u), h);
-      if (lists->find(corner, v, u) < 0) {  // no face on the other side: a boundary v → u
-        boundary_out[v] = halfedge[he] ^ 1;
-        boundary_to[v] = u;
+  // Each face sets its own halfedges (and the twin of a halfedge on the border, which has no
+  // face to set it); each vertex starts on its last outgoing halfedge in input order, or on
+  // the border halfedge that leaves it.
+  parallel_for(nf, [&](size_t begin, size_t end) {
+    for (size_t f = begin; f < end; ++f) {
+      if (!accepted[f]) continue;
+      const SkullMesh::FaceHandle fh(face_index[f]);
+      mesh.set_halfedge_handle(fh, HH(halfedge[f * 3]));
+      for (size_t he = f * 3; he < f * 3 + 3; ++he) {
+        const HH h(halfedge[he]);
+        mesh.set_vertex_handle(h, VH(corner[next_corner(he)]));
+        if (twin[he] < 0) mesh.set_vertex_handle(mesh.opposite_halfedge_handle(h), VH(corner[he]));
+        mesh.set_next_halfedge_handle(h, HH(halfedge[next_corner(he)]));
+        mesh.set_face_handle(h, fh);
       }
     }
-  }
+  });
+  std::vector<int> boundary_out(nv, -1), boundary_to(nv, -1);
+  parallel_for(static_cast<size_t>(nv), [&](size_t begin, size_t end) {
+    for (size_t v = begin; v < end; ++v) {
+      mesh.set_point(VH(static_cast<int>(v)), to_point(soup.vertices[source[v]]));
+      const int a = lists->start[v], b = lists->start[v + 1];
+      if (a == b) continue;
+      mesh.set_halfedge_handle(VH(static_cast<int>(v)), HH(halfedge[lists->out[b - 1]]));
+      for (int i = a; i < b; ++i) {
+        // The face's halfedge arriving at v; with no twin, the border leaves v along it.
+        const size_t in = prev_corner(static_cast<size_t>(lists->out[i]));
+        if (twin[in] >= 0) continue;
+        boundary_out[v] = halfedge[in] ^ 1;
+        boundary_to[v] = corner[in];
+      }
+    }
+  });
   for (int v = 0; v < nv; ++v) {
     if (boundary_out[v] < 0) continue;
     mesh.set_next_halfedge_handle(HH(boundary_out[v]), HH(boundary_out[boundary_to[v]]));

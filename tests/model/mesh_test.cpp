@@ -3,7 +3,10 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cmath>
+#include <random>
 
+#include "cranioplan/model/parallel.h"
 #include "support/synthetic.h"
 
 namespace cranioplan {
@@ -78,6 +81,121 @@ TEST(Mesh, SignedVolumeOfHeadIsPositiveAndFlipNegates) {
   EXPECT_GT(v, 0.0);
   flip_orientation(head);
   EXPECT_NEAR(signed_volume(head), -v, 1e-6 * v);
+}
+
+// Coordinates are rounded as a conversion to float rounds (to nearest, ties to even), also at
+// exact ties, where a carry reaches the next power of two, for negative numbers and zeros.
+TEST(Mesh, CanonicalCoordinatesAreRoundedAsAFloatConversionRounds) {
+  std::mt19937_64 rng(7);
+  std::uniform_real_distribution<double> coordinate(-400.0, 400.0);
+  std::vector<double> xs = {0.0, -0.0, 1.0, -1.0, std::nextafter(2.0, 0.0), 0.1, -0.1};
+  for (int i = 0; i < 3000; ++i) {
+    const double x = coordinate(rng);
+    const float f = static_cast<float>(x);
+    const double mid = (static_cast<double>(f) + std::nextafter(f, 1e9f)) / 2.0;  // a tie
+    xs.insert(xs.end(), {x, mid, -mid, std::nextafter(mid, 1e9), std::nextafter(mid, -1e9)});
+  }
+  TriangleSoup soup;
+  for (double x : xs) {
+    soup.vertices.push_back({x, 1.0, 2.0});
+    soup.vertices.push_back({x, 3.0, 2.0});
+    soup.vertices.push_back({x, 1.0, 5.0});
+    const int n = static_cast<int>(soup.vertices.size());
+    soup.triangles.push_back({n - 3, n - 2, n - 1});
+  }
+  std::vector<double> expected;
+  for (double x : xs) {
+    volatile float f = static_cast<float>(x);  // volatile: the round trip is not optimised away
+    expected.push_back(static_cast<double>(f) == 0.0 ? 0.0 : static_cast<double>(f));
+  }
+  std::sort(expected.begin(), expected.end());
+  expected.erase(std::unique(expected.begin(), expected.end()), expected.end());
+  make_canonical(soup);
+  std::vector<double> got;
+  for (const Eigen::Vector3d& v : soup.vertices)
+    if (got.empty() || got.back() != v.x()) got.push_back(v.x());
+  ASSERT_EQ(got.size(), expected.size());
+  for (size_t i = 0; i < got.size(); ++i) {
+    EXPECT_EQ(got[i], expected[i]) << i;
+    EXPECT_FALSE(std::signbit(got[i]) && got[i] == 0.0);  // −0 is +0
+  }
+}
+
+// A soup as files give them, damaged: triangles flipped against their neighbours, given
+// twice, fins on an edge (three faces on it), two surfaces touching at one vertex, zero-area
+// triangles. build_mesh keeps every triangle with area and gives the same halfedges on one
+// thread and on two.
+TEST(Mesh, ADamagedSoupIsBuiltTheSameOnOneThreadAndOnTwo) {
+  TriangleSoup soup = to_soup(test::make_symmetric_head(3));
+  const int nv = static_cast<int>(soup.vertices.size());
+  const size_t nt = soup.triangles.size();
+  std::mt19937 rng(3);
+  size_t degenerate = 0;
+  for (size_t i = 0; i < nt; ++i) {
+    Eigen::Vector3i t = soup.triangles[i];
+    switch (rng() % 50) {
+      case 0:
+        std::swap(soup.triangles[i][1], soup.triangles[i][2]);
+        break;
+      case 1:
+        soup.triangles.push_back(t);
+        break;
+      case 2:
+        t[2] = static_cast<int>(rng() % static_cast<unsigned>(nv));
+        soup.triangles.push_back(t);
+        break;
+      case 3:
+        t[1] = t[0];
+        soup.triangles.push_back(t);
+        ++degenerate;
+        break;
+      default:
+        break;
+    }
+  }
+  // A second copy of the head, moved so that its vertex 0 lies on the first one's vertex 0.
+  const size_t first_faces = soup.triangles.size();
+  for (size_t i = 0; i < nt; ++i) {
+    Eigen::Vector3i t = soup.triangles[i];
+    for (int k = 0; k < 3; ++k) t[k] = t[k] == 0 ? 0 : t[k] + nv;
+    soup.triangles.push_back(t);
+  }
+  for (int v = 0; v < nv; ++v)
+    soup.vertices.push_back(soup.vertices[v] + 2.0 * (soup.vertices[v] - soup.vertices[0]));
+  std::shuffle(soup.triangles.begin(), soup.triangles.end(), rng);
+
+  SkullMesh built[2];
+  BuildMeshStats stats[2];
+  for (int threads : {1, 2}) {
+    set_thread_count(threads);
+    build_mesh(soup, built[threads - 1], &stats[threads - 1]);
+  }
+  set_thread_count(0);
+  const SkullMesh &a = built[0], &b = built[1];
+  // (A fin's random corner may repeat one of its others: one more without area.)
+  EXPECT_GE(stats[0].degenerate_dropped, static_cast<long long>(degenerate));
+  EXPECT_GT(stats[0].nonmanifold_split, 0);
+  EXPECT_EQ(stats[0].degenerate_dropped, stats[1].degenerate_dropped);
+  EXPECT_EQ(stats[0].nonmanifold_split, stats[1].nonmanifold_split);
+  EXPECT_EQ(a.n_faces(), soup.triangles.size() - static_cast<size_t>(stats[0].degenerate_dropped));
+  EXPECT_GT(soup.triangles.size(), first_faces);
+  ASSERT_EQ(a.n_vertices(), b.n_vertices());
+  ASSERT_EQ(a.n_edges(), b.n_edges());
+  ASSERT_EQ(a.n_faces(), b.n_faces());
+  for (auto v : a.vertices()) {
+    ASSERT_EQ(a.point(v), b.point(v)) << v.idx();
+    ASSERT_EQ(a.halfedge_handle(v), b.halfedge_handle(v)) << v.idx();
+  }
+  for (auto h : a.halfedges()) {
+    ASSERT_EQ(a.to_vertex_handle(h), b.to_vertex_handle(h)) << h.idx();
+    ASSERT_EQ(a.next_halfedge_handle(h), b.next_halfedge_handle(h)) << h.idx();
+    ASSERT_EQ(a.prev_halfedge_handle(h), b.prev_halfedge_handle(h)) << h.idx();
+    ASSERT_EQ(a.face_handle(h), b.face_handle(h)) << h.idx();
+    // A consistent halfedge structure: next and prev invert each other, twins run back.
+    ASSERT_EQ(a.prev_halfedge_handle(a.next_halfedge_handle(h)), h) << h.idx();
+    ASSERT_EQ(a.from_vertex_handle(a.opposite_halfedge_handle(h)), a.to_vertex_handle(h));
+  }
+  for (auto f : a.faces()) ASSERT_EQ(a.halfedge_handle(f), b.halfedge_handle(f)) << f.idx();
 }
 
 }  // namespace
