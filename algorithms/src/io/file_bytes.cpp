@@ -99,6 +99,30 @@ size_t sample_size(SampleType t) {
   return 1;
 }
 
+FileReader::FileReader(const std::string& path) : path_(path), file_(nullptr, &std::fclose) {
+  std::error_code ec;
+  const fs::file_status st = fs::status(path, ec);
+  if (ec || !fs::exists(st)) throw InputError(path, "file not found");
+  if (fs::is_directory(st)) throw InputError(path, "is a folder, not a file");
+  file_.reset(std::fopen(path.c_str(), "rb"));
+  if (!file_) throw InputError(path, std::string("cannot open file: ") + std::strerror(errno));
+  if (std::fseek(file_.get(), 0, SEEK_END) != 0)
+    throw InputError(path, "cannot determine the file size");
+  const long size = std::ftell(file_.get());
+  if (size < 0 || std::fseek(file_.get(), 0, SEEK_SET) != 0)
+    throw InputError(path, "cannot determine the file size");
+  size_ = static_cast<size_t>(size);
+  if (size_ == 0) throw InputError(path, "file is empty");
+}
+
+void FileReader::read(char* into, size_t n) {
+  const size_t got = n == 0 ? 0 : std::fread(into, 1, n, file_.get());
+  done_ += got;
+  if (got != n)
+    throw InputError(path_,
+                     "read error after " + format_count(static_cast<long long>(done_)) + " bytes");
+}
+
 }  // namespace cranioplan::detail
 
 namespace cranioplan {
@@ -106,21 +130,10 @@ namespace cranioplan {
 namespace fs = std::filesystem;
 
 std::string read_file_bytes(const std::string& path) {
-  std::error_code ec;
-  const fs::file_status st = fs::status(path, ec);
-  if (ec || !fs::exists(st)) throw InputError(path, "file not found");
-  if (fs::is_directory(st)) throw InputError(path, "is a folder, not a file");
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path, std::string("cannot open file: ") + std::strerror(errno));
+  detail::FileReader file(path);
   std::string bytes;
-  in.seekg(0, std::ios::end);
-  const std::streamoff size = in.tellg();
-  if (size < 0) throw InputError(path, "cannot determine the file size");
-  in.seekg(0, std::ios::beg);
-  bytes.resize(static_cast<size_t>(size));
-  if (size > 0 && !in.read(bytes.data(), size))
-    throw InputError(path, "read error after " + format_count(in.gcount()) + " bytes");
-  if (bytes.empty()) throw InputError(path, "file is empty");
+  bytes.resize(file.size());
+  file.read(bytes.data(), bytes.size());
   return bytes;
 }
 

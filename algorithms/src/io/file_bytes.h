@@ -1,9 +1,27 @@
 #pragma once
 // Private helpers of the readers: gzip inflation, extensions and binary sample types.
 #include <cstddef>
+#include <cstdio>
+#include <memory>
 #include <string>
 
 namespace cranioplan::detail {
+
+/// A file read in pieces, front to back, with read_file_bytes's messages: the constructor
+/// throws InputError for a missing file, a folder, an unreadable or empty file; read() for a
+/// file that ends (or fails) early, saying after how many bytes.
+class FileReader {
+ public:
+  explicit FileReader(const std::string& path);
+  size_t size() const { return size_; }
+  /// The next n bytes.
+  void read(char* into, size_t n);
+
+ private:
+  std::string path_;
+  std::unique_ptr<std::FILE, int (*)(std::FILE*)> file_;
+  size_t size_ = 0, done_ = 0;
+};
 
 /// Inflates gzip (or zlib) data. `expected_size` (when > 0) bounds the output: more data than
 /// that is an error, which stops a corrupt stream from filling memory.

@@ -115,20 +115,39 @@ bool looks_like_text(const std::string& bytes) {
   return bytes.compare(i, 5, "solid") == 0;
 }
 
-TriangleSoup parse_binary_stl(const std::string& path, const std::string& bytes, uint32_t n) {
+// A binary STL's n triangles, read from the file in blocks of about half a megabyte after the
+// `head` already read (the 84-byte header and what follows it): the file is never held whole.
+TriangleSoup parse_binary_stl(const std::string& path, detail::FileReader& file,
+                              const std::string& head, uint32_t n) {
   FloatWelder welder(static_cast<size_t>(n) / 2 + 16);
   TriangleSoup soup;
   soup.triangles.resize(n);
-  const char* p = bytes.data() + 84;
-  for (uint32_t t = 0; t < n; ++t, p += 50) {
-    float xyz[9];
-    std::memcpy(xyz, p + 12, 36);
-    for (int c = 0; c < 9; ++c)
-      if (!std::isfinite(xyz[c]))
-        fail(path, "triangle " + format_count(t + 1LL) +
-                       " has a coordinate that is not a number (NaN or Inf)");
-    for (int v = 0; v < 3; ++v) soup.triangles[t][v] = welder.insert(xyz + 3 * v);
+  constexpr size_t kBlock = 50 * 10000;
+  std::vector<char> buffer(kBlock + 50);
+  const size_t all = 50 * static_cast<size_t>(n);
+  size_t have = std::min(head.size() - 84, all);  // bytes of triangles in the buffer
+  std::memcpy(buffer.data(), head.data() + 84, have);
+  size_t to_read = all - have;
+  uint32_t t = 0;
+  while (true) {
+    const char* p = buffer.data();
+    for (; have >= 50; ++t, p += 50, have -= 50) {
+      float xyz[9];
+      std::memcpy(xyz, p + 12, 36);
+      for (int c = 0; c < 9; ++c)
+        if (!std::isfinite(xyz[c]))
+          fail(path, "triangle " + format_count(t + 1LL) +
+                         " has a coordinate that is not a number (NaN or Inf)");
+      for (int v = 0; v < 3; ++v) soup.triangles[t][v] = welder.insert(xyz + 3 * v);
+    }
+    std::memmove(buffer.data(), p, have);  // a triangle split between two blocks
+    if (to_read == 0) break;
+    const size_t block = std::min(to_read, kBlock);
+    file.read(buffer.data() + have, block);
+    have += block;
+    to_read -= block;
   }
+  assert(t == n && have == 0);
   soup.vertices = welder.points();
   return soup;
 }
@@ -216,17 +235,24 @@ TriangleSoup parse_ascii_stl(const std::string& path, const std::string& bytes) 
   return soup;
 }
 
-TriangleSoup read_stl(const std::string& path, const std::string& bytes, std::string& format) {
-  const size_t size = bytes.size();
+TriangleSoup read_stl(const std::string& path, std::string& format) {
+  detail::FileReader file(path);
+  const size_t size = file.size();
+  std::string bytes(std::min<size_t>(size, 1024), '\0');  // enough to tell binary from text
+  file.read(bytes.data(), bytes.size());
   uint32_t n = 0;
   if (size >= 84) std::memcpy(&n, bytes.data() + 80, 4);
   const unsigned long long expected = 84ull + 50ull * n;
+  // (A binary STL that declares no triangle has at most 133 bytes, all of them read here.)
   if (size >= 84 && size >= expected && size - expected < 50 &&
       !(n == 0 && looks_like_text(bytes))) {
     if (n == 0) fail(path, "binary STL declares 0 triangles");
     format = "binary STL";
-    return parse_binary_stl(path, bytes, n);
+    return parse_binary_stl(path, file, bytes, n);
   }
+  const size_t head = bytes.size();
+  bytes.resize(size);
+  file.read(bytes.data() + head, size - head);
   if (looks_like_text(bytes)) {
     format = "ASCII STL";
     return parse_ascii_stl(path, bytes);
@@ -403,12 +429,13 @@ void drop_far_pieces(const std::string& path, double far_mm, TriangleSoup& soup,
 }  // namespace
 
 TriangleSoup read_mesh_soup(const std::string& path, std::string* format_out) {
-  const std::string bytes = read_file_bytes(path);
   const std::string ext = detail::lower_extension(path);
   std::string format;
   TriangleSoup soup;
+  // A binary STL is parsed as it is read; the other formats from the whole file.
+  const std::string bytes = ext == ".stl" ? std::string() : read_file_bytes(path);
   if (ext == ".stl") {
-    soup = read_stl(path, bytes, format);
+    soup = read_stl(path, format);
   } else if (ext == ".off") {
     format = "OFF";
     soup = read_off(path, bytes);

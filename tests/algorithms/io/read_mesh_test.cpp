@@ -174,6 +174,34 @@ TEST(ReadMesh, SomeZeroAreaTrianglesAreDroppedWithAWarningOrRefusedWhenStrict) {
   EXPECT_THROW(read_mesh(p, strict), InputError);
 }
 
+// A binary STL is read in blocks: a file of several blocks, whose triangles straddle the
+// blocks' ends, with a few bytes after the last triangle (as some exporters pad), gives every
+// triangle as written; a file cut short or with a NaN in a later block gives its message.
+TEST(ReadMesh, ABinaryStlOfSeveralReadBlocksIsReadWhole) {
+  test::TempDir dir;
+  std::vector<std::array<float, 9>> tris;
+  for (int t = 0; t < 25013; ++t) {
+    const float x = static_cast<float>(t % 211) * 0.5f, y = static_cast<float>(t / 211) * 0.5f;
+    tris.push_back({x, y, 0, x + 0.5f, y, 0.25f, x, y + 0.5f, 0.125f});
+  }
+  std::string bytes = binary_stl(tris, static_cast<uint32_t>(tris.size()));
+  test::write_bytes(dir.path("big.stl"), bytes + std::string(17, '\x01'));
+  const TriangleSoup soup = read_mesh_soup(dir.path("big.stl"));
+  ASSERT_EQ(soup.triangles.size(), tris.size());
+  for (size_t t = 0; t < tris.size(); ++t)
+    for (int v = 0; v < 3; ++v)
+      for (int c = 0; c < 3; ++c)
+        ASSERT_EQ(soup.vertices[soup.triangles[t][v]][c], tris[t][3 * v + c]) << t;
+
+  test::write_bytes(dir.path("short.stl"), bytes.substr(0, bytes.size() - 70));
+  expect_bad(dir.path("short.stl"), "file ends after 25,011 of 25,013 triangles");
+  std::string nan = bytes;
+  const float bad = std::numeric_limits<float>::quiet_NaN();
+  std::memcpy(nan.data() + 84 + 50 * 20000 + 12 + 4 * 4, &bad, 4);
+  test::write_bytes(dir.path("nan.stl"), nan);
+  expect_bad(dir.path("nan.stl"), "triangle 20,001 has a coordinate that is not a number");
+}
+
 }  // namespace
 }  // namespace cranioplan
 
