@@ -10,6 +10,8 @@
 #include <cstring>
 #include <filesystem>
 #include <fstream>
+#include <functional>
+#include <memory>
 
 #include "cranioplan/algorithms/io/file_io.h"
 #include "cranioplan/model/error.h"
@@ -18,42 +20,45 @@ namespace cranioplan::detail {
 
 namespace fs = std::filesystem;
 
-std::string gunzip(const std::string& path, const char* data, size_t size, size_t expected_size) {
+size_t gunzip_each(const std::string& path, const char* data, size_t size, size_t expected_size,
+                   const std::function<void(const char*, size_t)>& consume) {
   z_stream zs{};
   // 15 + 32: accept both gzip and zlib headers.
   if (inflateInit2(&zs, 15 + 32) != Z_OK) throw InputError(path, "cannot start decompression");
-  // Grown as the data comes, up to the size the header announces: a header may announce
-  // terabytes over a few bytes of data (a fuzzed NRRD asked for 600 GB at once).
-  const size_t guess = std::max<size_t>(size * 4, 1 << 16);
-  std::string out;
-  out.resize(expected_size > 0 ? std::min(expected_size, guess) : guess);
+  constexpr size_t kBlock = size_t{1} << 20;
+  std::unique_ptr<char[]> block(new char[kBlock]);
   zs.next_in = reinterpret_cast<Bytef*>(const_cast<char*>(data));
   zs.avail_in = static_cast<uInt>(std::min<size_t>(size, 0x7fffffff));
   size_t produced = 0;
-  int rc = Z_OK;
   while (true) {
-    if (produced == out.size()) {
-      if (expected_size > 0 && out.size() == expected_size) {
-        // The stream must end exactly here; one probe byte tells whether more data follows.
-        char probe;
-        zs.next_out = reinterpret_cast<Bytef*>(&probe);
-        zs.avail_out = 1;
-        rc = inflate(&zs, Z_NO_FLUSH);
-        if (zs.avail_out == 0) {
-          inflateEnd(&zs);
-          throw InputError(path, "compressed data holds more than the " +
-                                     format_count(static_cast<long long>(expected_size)) +
-                                     " bytes the header announces");
-        }
-        break;
+    const size_t room = expected_size > 0 ? std::min(kBlock, expected_size - produced) : kBlock;
+    if (room == 0) {
+      // The stream must end exactly here; one probe byte tells whether more data follows.
+      char probe;
+      zs.next_out = reinterpret_cast<Bytef*>(&probe);
+      zs.avail_out = 1;
+      inflate(&zs, Z_NO_FLUSH);
+      if (zs.avail_out == 0) {
+        inflateEnd(&zs);
+        throw InputError(path, "compressed data holds more than the " +
+                                   format_count(static_cast<long long>(expected_size)) +
+                                   " bytes the header announces");
       }
-      out.resize(expected_size > 0 ? std::min(expected_size, out.size() * 2) : out.size() * 2);
+      break;
     }
-    zs.next_out = reinterpret_cast<Bytef*>(out.data() + produced);
-    zs.avail_out = static_cast<uInt>(std::min<size_t>(out.size() - produced, 0x7fffffff));
-    const uInt before = zs.avail_out;
-    rc = inflate(&zs, Z_NO_FLUSH);
-    produced += before - zs.avail_out;
+    zs.next_out = reinterpret_cast<Bytef*>(block.get());
+    zs.avail_out = static_cast<uInt>(room);
+    const int rc = inflate(&zs, Z_NO_FLUSH);
+    const size_t got = room - zs.avail_out;
+    if (got > 0) {
+      try {
+        consume(block.get(), got);
+      } catch (...) {
+        inflateEnd(&zs);
+        throw;
+      }
+    }
+    produced += got;
     if (rc == Z_STREAM_END) break;
     if (rc != Z_OK) {
       inflateEnd(&zs);
@@ -65,7 +70,19 @@ std::string gunzip(const std::string& path, const char* data, size_t size, size_
     }
   }
   inflateEnd(&zs);
-  out.resize(produced);
+  return produced;
+}
+
+std::string gunzip(const std::string& path, const char* data, size_t size, size_t expected_size) {
+  // Deflate expands at most 1032 times (a 258-byte match in two bits): room for the size the
+  // header announces is made at once when the data can hold it, and a header announcing
+  // terabytes over a few bytes of data (a fuzzed NRRD asked for 600 GB) gets only what the
+  // data could give.
+  std::string out;
+  out.reserve(expected_size > 0 ? std::min(expected_size, size * 1032 + (1 << 16))
+                                : std::max<size_t>(size * 4, 1 << 16));
+  gunzip_each(path, data, size, expected_size,
+              [&](const char* chunk, size_t n) { out.append(chunk, n); });
   return out;
 }
 

@@ -2,6 +2,7 @@
 // Private helpers of the readers: gzip inflation, extensions and binary sample types.
 #include <cstddef>
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <string>
 
@@ -27,6 +28,10 @@ class FileReader {
 /// that is an error, which stops a corrupt stream from filling memory.
 std::string gunzip(const std::string& path, const char* data, size_t size,
                    size_t expected_size = 0);
+/// The same, the output handed to `consume` in order, a megabyte or less at a time, and never
+/// held whole; returns how many bytes it gave.
+size_t gunzip_each(const std::string& path, const char* data, size_t size, size_t expected_size,
+                   const std::function<void(const char*, size_t)>& consume);
 
 /// The binary number types of volume and mesh files (NRRD, NIfTI, PLY...).
 enum class SampleType { Int8, UInt8, Int16, UInt16, Int32, UInt32, Float32, Float64 };

@@ -7,6 +7,7 @@
 #include <filesystem>
 
 #include "cranioplan/model/error.h"
+#include "cranioplan/model/parallel.h"
 #include "file_bytes.h"
 #include "volume_formats.h"
 
@@ -14,9 +15,9 @@ namespace cranioplan {
 namespace detail {
 
 namespace {
+
 template <class T>
-void convert_typed(const char* data, size_t count, bool swap, std::vector<float>& out) {
-  out.resize(count);
+void convert_typed(const char* data, size_t count, bool swap, float* out) {
   for (size_t i = 0; i < count; ++i) {
     unsigned char b[sizeof(T)];
     std::memcpy(b, data + i * sizeof(T), sizeof(T));
@@ -27,47 +28,90 @@ void convert_typed(const char* data, size_t count, bool swap, std::vector<float>
     out[i] = static_cast<float>(v);
   }
 }
-}  // namespace
 
-void convert_samples(const std::string& path, const char* data, size_t available, size_t count,
-                     SampleType type, bool big_endian, std::vector<float>& out) {
-  const size_t need = count * sample_size(type);
-  if (available < need)
-    throw InputError(path, "the header announces " + format_count(static_cast<long long>(count)) +
-                               " samples (" + format_count(static_cast<long long>(need)) +
-                               " bytes) but the data holds only " +
-                               format_count(static_cast<long long>(available)) + " bytes");
+// `count` samples of `type` at `data` as floats in `out`.
+void convert_range(SampleType type, bool big_endian, const char* data, size_t count, float* out) {
   const bool swap = big_endian;  // this program runs on little-endian machines
   switch (type) {
     case SampleType::Int8:
-      convert_typed<int8_t>(data, count, false, out);
-      break;
+      return convert_typed<int8_t>(data, count, false, out);
     case SampleType::UInt8:
-      convert_typed<uint8_t>(data, count, false, out);
-      break;
+      return convert_typed<uint8_t>(data, count, false, out);
     case SampleType::Int16:
-      convert_typed<int16_t>(data, count, swap, out);
-      break;
+      return convert_typed<int16_t>(data, count, swap, out);
     case SampleType::UInt16:
-      convert_typed<uint16_t>(data, count, swap, out);
-      break;
+      return convert_typed<uint16_t>(data, count, swap, out);
     case SampleType::Int32:
-      convert_typed<int32_t>(data, count, swap, out);
-      break;
+      return convert_typed<int32_t>(data, count, swap, out);
     case SampleType::UInt32:
-      convert_typed<uint32_t>(data, count, swap, out);
-      break;
+      return convert_typed<uint32_t>(data, count, swap, out);
     case SampleType::Float32:
-      convert_typed<float>(data, count, swap, out);
-      break;
+      return convert_typed<float>(data, count, swap, out);
     case SampleType::Float64:
-      convert_typed<double>(data, count, swap, out);
-      break;
+      return convert_typed<double>(data, count, swap, out);
   }
+}
+
+[[noreturn]] void too_few_bytes(const std::string& path, size_t count, size_t need,
+                                size_t available) {
+  throw InputError(path, "the header announces " + format_count(static_cast<long long>(count)) +
+                             " samples (" + format_count(static_cast<long long>(need)) +
+                             " bytes) but the data holds only " +
+                             format_count(static_cast<long long>(available)) + " bytes");
+}
+
+// Integers are finite; floats are checked.
+void check_finite(const std::string& path, SampleType type, const std::vector<float>& out) {
+  if (type != SampleType::Float32 && type != SampleType::Float64) return;
   for (size_t i = 0; i < out.size(); ++i)
     if (!std::isfinite(out[i]))
       throw InputError(path, "sample " + format_count(static_cast<long long>(i)) +
                                  " is not a number (NaN or Inf)");
+}
+
+}  // namespace
+
+void convert_samples(const std::string& path, const char* data, size_t available, size_t count,
+                     SampleType type, bool big_endian, std::vector<float>& out) {
+  const size_t size = sample_size(type), need = count * size;
+  if (available < need) too_few_bytes(path, count, need, available);
+  out.resize(count);
+  parallel_for(count, [&](size_t begin, size_t end) {
+    convert_range(type, big_endian, data + begin * size, end - begin, out.data() + begin);
+  });
+  check_finite(path, type, out);
+}
+
+SampleStream::SampleStream(std::string path, size_t count, SampleType type, bool big_endian,
+                           std::vector<float>& out)
+    : path_(std::move(path)), count_(count), type_(type), big_endian_(big_endian), out_(out) {
+  out_.resize(count);
+}
+
+void SampleStream::add(const char* data, size_t n) {
+  const size_t size = sample_size(type_);
+  received_ += n;
+  if (partial_ > 0) {  // the rest of a sample the last piece began
+    const size_t take = std::min(n, size - partial_);
+    std::memcpy(carry_ + partial_, data, take);
+    partial_ += take;
+    data += take;
+    n -= take;
+    if (partial_ < size) return;
+    if (done_ < count_) convert_range(type_, big_endian_, carry_, 1, out_.data() + done_++);
+    partial_ = 0;
+  }
+  const size_t whole = n / size, usable = std::min(whole, count_ - done_);
+  convert_range(type_, big_endian_, data, usable, out_.data() + done_);
+  done_ += usable;
+  partial_ = n - whole * size;
+  std::memcpy(carry_, data + whole * size, partial_);
+}
+
+void SampleStream::finish() {
+  const size_t need = count_ * sample_size(type_);
+  if (received_ < need) too_few_bytes(path_, count_, need, received_);
+  check_finite(path_, type_, out_);
 }
 
 void flip_axes(Volume& v, const Eigen::Vector3d& signs) {

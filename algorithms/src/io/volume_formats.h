@@ -12,6 +12,27 @@ namespace cranioplan::detail {
 void convert_samples(const std::string& path, const char* data, size_t available, size_t count,
                      SampleType type, bool big_endian, std::vector<float>& out);
 
+/// The same for samples whose bytes come in pieces (a stream being decompressed): each piece's
+/// whole samples are converted as it comes, a sample split between two pieces when its rest
+/// comes. Bytes beyond the samples are ignored.
+class SampleStream {
+ public:
+  SampleStream(std::string path, size_t count, SampleType type, bool big_endian,
+               std::vector<float>& out);
+  void add(const char* data, size_t n);
+  /// Throws InputError, as convert_samples does, when fewer bytes came than the samples need.
+  void finish();
+
+ private:
+  std::string path_;
+  size_t count_;
+  SampleType type_;
+  bool big_endian_;
+  std::vector<float>& out_;
+  size_t received_ = 0, done_ = 0, partial_ = 0;
+  char carry_[8] = {};
+};
+
 /// Marks the volume as a mask when all samples are 0 or 1.
 void classify_kind(Volume& v);
 

@@ -269,11 +269,13 @@ Volume read_nrrd(const std::string& path, bool patient_frame) {
     available = bytes.size() - std::min(pos, bytes.size());
   }
   const size_t need = v.size() * sample_size(type);
-  std::string inflated;
   if (encoding == "gzip" || encoding == "gz") {
-    inflated = gunzip(path, data, available, need);
-    data = inflated.data();
-    available = inflated.size();
+    // Converted as it is inflated: the inflated samples are never held whole (a SkullFix mask
+    // of int32 is 250 MB of them).
+    SampleStream samples(path, v.size(), type, big_endian, v.data);
+    gunzip_each(path, data, available, need,
+                [&](const char* piece, size_t n) { samples.add(piece, n); });
+    samples.finish();
   } else if (encoding == "raw") {
     // "byte skip: -1" means the data is the last `need` bytes; otherwise sizes must agree.
     if (field("byte skip") == "-1" && available > need) {
@@ -284,10 +286,10 @@ Volume read_nrrd(const std::string& path, bool patient_frame) {
                                  " bytes of samples but the data holds " +
                                  format_count(static_cast<long long>(available)));
     }
+    convert_samples(path, data, available, v.size(), type, big_endian, v.data);
   } else {
     throw InputError(path, "NRRD encoding '" + encoding + "' is not supported (use raw or gzip)");
   }
-  convert_samples(path, data, available, v.size(), type, big_endian, v.data);
   std::ostringstream d;
   d << "NRRD " << v.dims[0] << "×" << v.dims[1] << "×" << v.dims[2] << " " << field("type");
   v.description = d.str();

@@ -7,6 +7,7 @@
 
 #include "cranioplan/algorithms/io/file_io.h"
 #include "cranioplan/model/error.h"
+#include "io/volume_formats.h"
 #include "support/test_files.h"
 
 namespace cranioplan {
@@ -49,6 +50,67 @@ TEST(FileBytes, TheAnnouncedSizeIsHeldToBothWays) {
   const std::string noise(64, '\x17');
   EXPECT_EQ(error_of([&] { gunzip("noise.gz", noise.data(), noise.size()); }).rfind("noise.gz", 0),
             0u);
+}
+
+// Inflated in pieces of at most a megabyte, in order: the pieces make the whole, also when the
+// output is a few bytes over a megabyte; the announced size still bounds it.
+TEST(FileBytes, InflatedPiecesMakeTheWhole) {
+  std::string text;
+  for (int i = 0; i < (1 << 20) + 4099; ++i) text += static_cast<char>((i * 131) % 251);
+  const std::string gz = test::gzip(text);
+  std::string joined;
+  size_t pieces = 0, largest = 0;
+  const size_t n = detail::gunzip_each("x.gz", gz.data(), gz.size(), text.size(),
+                                       [&](const char* piece, size_t size) {
+                                         joined.append(piece, size);
+                                         ++pieces;
+                                         largest = std::max(largest, size);
+                                       });
+  EXPECT_EQ(n, text.size());
+  EXPECT_EQ(joined, text);
+  EXPECT_GE(pieces, 2u);
+  EXPECT_LE(largest, size_t{1} << 20);
+  EXPECT_NE(error_of([&] {
+              detail::gunzip_each("big.nrrd", gz.data(), gz.size(), 5000,
+                                  [](const char*, size_t) {});
+            }).find("big.nrrd: compressed data holds more than the 5,000 bytes"),
+            std::string::npos);
+}
+
+// Samples whose bytes come in pieces that split them (three bytes at a time for 16-bit samples,
+// big-endian) are the samples convert_samples gives from the whole; too few bytes give its
+// message.
+TEST(FileBytes, SamplesConvertedAsTheirBytesComeAreTheSamplesOfTheWhole) {
+  std::string bytes;
+  for (int i = 0; i < 1001; ++i) {
+    const int16_t v = static_cast<int16_t>(i * 37 - 15000);
+    bytes += static_cast<char>((v >> 8) & 0xff);
+    bytes += static_cast<char>(v & 0xff);
+  }
+  std::vector<float> whole, pieces;
+  detail::convert_samples("v.nrrd", bytes.data(), bytes.size(), 1001, detail::SampleType::Int16,
+                          true, whole);
+  detail::SampleStream stream("v.nrrd", 1001, detail::SampleType::Int16, true, pieces);
+  for (size_t at = 0; at < bytes.size(); at += 3)
+    stream.add(bytes.data() + at, std::min<size_t>(3, bytes.size() - at));
+  stream.finish();
+  EXPECT_EQ(pieces, whole);
+  EXPECT_EQ(whole[1000], 1000.0f * 37 - 15000);
+
+  const std::string expected = error_of([&] {
+    std::vector<float> out;
+    detail::convert_samples("v.nrrd", bytes.data(), 2001, 1001, detail::SampleType::Int16, true,
+                            out);
+  });
+  EXPECT_NE(expected.find("but the data holds only 2,001 bytes"), std::string::npos) << expected;
+  EXPECT_EQ(error_of([&] {
+              std::vector<float> out;
+              detail::SampleStream cut("v.nrrd", 1001, detail::SampleType::Int16, true, out);
+              cut.add(bytes.data(), 1000);
+              cut.add(bytes.data() + 1000, 1001);
+              cut.finish();
+            }),
+            expected);
 }
 
 TEST(FileBytes, ExtensionsAndSampleSizes) {
