@@ -7,18 +7,98 @@
 #include <vtkPointData.h>
 #include <vtkPolyData.h>
 #include <vtkQuadricDecimation.h>
+#include <vtkShortArray.h>
+#include <vtkSignedCharArray.h>
 
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <mutex>
 
 #include "cranioplan/algorithms/geometry/mesh_components.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
+#include "cranioplan/model/parallel.h"
 #include "soup_building.h"
 
 namespace cranioplan {
 
 namespace {
+
+struct SampleRange {
+  float lo = 0.0f, hi = 0.0f;
+  bool whole = true;  // every sample a whole number (CT values in HU, masks)
+};
+
+// The samples' range, and whether they are all whole numbers, on all threads.
+SampleRange sample_range(const std::vector<float>& data) {
+  SampleRange all;
+  if (data.empty()) return all;
+  all.lo = all.hi = data[0];
+  std::mutex m;
+  parallel_for(data.size(), [&](size_t begin, size_t end) {
+    SampleRange part{data[begin], data[begin], true};
+    for (size_t i = begin; i < end; ++i) {
+      const float v = data[i];
+      part.lo = std::min(part.lo, v);
+      part.hi = std::max(part.hi, v);
+      part.whole = part.whole && v == std::nearbyint(v);
+    }
+    const std::lock_guard<std::mutex> lock(m);  // min, max and "and" do not depend on order
+    all.lo = std::min(all.lo, part.lo);
+    all.hi = std::max(all.hi, part.hi);
+    all.whole = all.whole && part.whole;
+  });
+  return all;
+}
+
+struct PaddedScalars {
+  vtkSmartPointer<vtkDataArray> scalars;
+  double scale = 1.0;  // the samples' factor in `scalars` (the threshold's too)
+};
+
+template <class Array, class T>
+vtkSmartPointer<vtkDataArray> fill_padded(const Volume& volume, float pad, float scale) {
+  const int nx = volume.dims[0] + 2, ny = volume.dims[1] + 2, nz = volume.dims[2] + 2;
+  auto array = vtkSmartPointer<Array>::New();
+  array->SetNumberOfTuples(static_cast<vtkIdType>(nx) * ny * nz);
+  T* dst = array->GetPointer(0);
+  const T padding = static_cast<T>(scale * pad);
+  const size_t slice = static_cast<size_t>(nx) * ny;
+  // Slice by slice on all threads: the copy's pages (240 MB as floats for a SkullFix volume)
+  // are first touched here, and faulting them in costs more than copying.
+  parallel_for(
+      static_cast<size_t>(nz),
+      [&](size_t begin, size_t end) {
+        for (size_t k = begin; k < end; ++k) {
+          T* out = dst + k * slice;
+          std::fill(out, out + slice, padding);
+          if (k == 0 || k + 1 == static_cast<size_t>(nz)) continue;
+          for (int j = 0; j < volume.dims[1]; ++j) {
+            const float* in = &volume.data[volume.index(0, j, static_cast<int>(k) - 1)];
+            T* row = out + (static_cast<size_t>(j) + 1) * nx + 1;
+            for (int i = 0; i < volume.dims[0]; ++i) row[i] = static_cast<T>(scale * in[i]);
+          }
+        }
+      },
+      1);
+  return array;
+}
+
+// The padded volume as flying edges reads it. Samples that are whole numbers (CT values,
+// masks) are stored doubled as 8- or 16-bit integers when they, the padding and the
+// threshold's double fit: doubling is exact in binary floating point, so every comparison with
+// the threshold and every interpolation t = (threshold − s0) / (s1 − s0) gives the very same
+// double as on the floats (the same surface, bit for bit), from a half or a quarter of the
+// memory. Anything else stays float.
+PaddedScalars padded_scalars(const Volume& volume, const SampleRange& range, float pad) {
+  const double lo = 2.0 * std::min(range.lo, pad), hi = 2.0 * range.hi;
+  const bool whole = range.whole && 2.0 * pad == std::nearbyint(2.0 * pad);
+  if (whole && lo >= -128.0 && hi <= 127.0)
+    return {fill_padded<vtkSignedCharArray, signed char>(volume, pad, 2.0f), 2.0};
+  if (whole && lo >= -32768.0 && hi <= 32767.0)
+    return {fill_padded<vtkShortArray, short>(volume, pad, 2.0f), 2.0};
+  return {fill_padded<vtkFloatArray, float>(volume, pad, 1.0f), 1.0};
+}
 
 // The surface built in `mesh` (result.mesh or another), the rest of the result in `result`.
 void extract(const Volume& volume, const ExtractBoneSurfaceParams& params,
@@ -28,12 +108,12 @@ void extract(const Volume& volume, const ExtractBoneSurfaceParams& params,
   const double threshold =
       std::isnan(params.threshold) ? volume.default_threshold() : params.threshold;
   result.threshold_used = threshold;
-  const auto [lo_it, hi_it] = std::minmax_element(volume.data.begin(), volume.data.end());
-  if (volume.data.empty() || *hi_it < threshold || *lo_it >= threshold) {
+  const SampleRange range = sample_range(volume.data);
+  if (volume.data.empty() || range.hi < threshold || range.lo >= threshold) {
     result.status = ExtractBoneSurfaceResult::Status::NoSurface;
     result.message = "threshold " + std::to_string(threshold) + " is outside the volume's range [" +
-                     std::to_string(volume.data.empty() ? 0.0 : *lo_it) + ", " +
-                     std::to_string(volume.data.empty() ? 0.0 : *hi_it) + "]: no surface";
+                     std::to_string(volume.data.empty() ? 0.0 : range.lo) + ", " +
+                     std::to_string(volume.data.empty() ? 0.0 : range.hi) + "]: no surface";
     return;
   }
 
@@ -43,25 +123,17 @@ void extract(const Volume& volume, const ExtractBoneSurfaceParams& params,
   // (a SkullFix volume is 240 MB as floats): they are not needed while the mesh is built.
   TriangleSoup soup;
   {
-    const int nx = volume.dims[0] + 2, ny = volume.dims[1] + 2, nz = volume.dims[2] + 2;
-    const float pad = static_cast<float>(std::min<double>(*lo_it, threshold - 1.0));
-    vtkNew<vtkFloatArray> scalars;
-    scalars->SetNumberOfTuples(static_cast<vtkIdType>(nx) * ny * nz);
-    float* dst = scalars->GetPointer(0);
-    std::fill(dst, dst + static_cast<size_t>(nx) * ny * nz, pad);
-    for (int k = 0; k < volume.dims[2]; ++k)
-      for (int j = 0; j < volume.dims[1]; ++j)
-        std::copy_n(&volume.data[volume.index(0, j, k)], volume.dims[0],
-                    dst + ((static_cast<size_t>(k) + 1) * ny + j + 1) * nx + 1);
+    const float pad = static_cast<float>(std::min<double>(range.lo, threshold - 1.0));
+    const PaddedScalars padded = padded_scalars(volume, range, pad);
     vtkNew<vtkImageData> image;
-    image->SetDimensions(nx, ny, nz);
+    image->SetDimensions(volume.dims[0] + 2, volume.dims[1] + 2, volume.dims[2] + 2);
     image->SetOrigin(-1, -1, -1);
     image->SetSpacing(1, 1, 1);
-    image->GetPointData()->SetScalars(scalars);
+    image->GetPointData()->SetScalars(padded.scalars);
 
     vtkNew<vtkFlyingEdges3D> fe;
     fe->SetInputData(image);
-    fe->SetValue(0, threshold);
+    fe->SetValue(0, padded.scale * threshold);
     fe->ComputeNormalsOff();
     fe->ComputeGradientsOff();
     fe->ComputeScalarsOff();

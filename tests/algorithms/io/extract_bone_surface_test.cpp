@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+
 #include "cranioplan/algorithms/geometry/self_intersections.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/mesh_report.h"
@@ -19,6 +22,38 @@ TEST(ExtractBoneSurface, BallGivesClosedOutwardSurfaceOfTheRightVolume) {
   EXPECT_TRUE(rep.watertight);
   EXPECT_EQ(rep.pieces, 1);
   EXPECT_NEAR(rep.volume_mm3, 4.0 / 3.0 * M_PI * 12 * 12 * 12, 0.05 * 7238.2);
+}
+
+// Whole-numbered samples are meshed as small integers (doubled, with the threshold) and other
+// samples as floats; doubling is exact, so both give the same surface to the last bit. One
+// sample far below every other, away from the bone, sends the same data down the other path
+// (its double no longer fits): the surface must not change.
+TEST(ExtractBoneSurface, SmallIntegerSamplesGiveTheSurfaceOfTheirFloats) {
+  for (const bool ct : {true, false}) {
+    Volume v = test::make_ball_volume({1, 2, 3}, 9.0, 30, 0.9, ct);
+    if (ct)  // values that vary across the surface, whole numbers of HU
+      for (int k = 0; k < 30; ++k)
+        for (int j = 0; j < 30; ++j)
+          for (int i = 0; i < 30; ++i) {
+            const double r = (v.world(Eigen::Vector3d(i, j, k)) - Eigen::Vector3d(1, 2, 3)).norm();
+            v.data[v.index(i, j, k)] = static_cast<float>(
+                std::clamp(std::round(1000.0 - 400.0 * (r - 9.0)), -1000.0, 2000.0));
+          }
+    for (const float low : {-100.0f, -40000.0f}) {
+      if (ct && low == -100.0f) continue;  // a CT's samples already lie below −100
+      Volume other = v;
+      other.data[0] = low;  // a corner, far from the ball
+      ExtractBoneSurfaceParams params;
+      params.threshold = v.default_threshold() + 0.25;  // between samples, never on one
+      const SkullMesh a = extract_bone_surface(v, params).mesh;
+      const SkullMesh b = extract_bone_surface(other, params).mesh;
+      ASSERT_EQ(a.n_vertices(), b.n_vertices()) << ct << " " << low;
+      ASSERT_GT(a.n_faces(), 500u);
+      for (auto vh : a.vertices()) ASSERT_EQ(a.point(vh), b.point(vh)) << ct << " " << low;
+      const TriangleSoup sa = to_soup(a), sb = to_soup(b);
+      EXPECT_EQ(sa.triangles, sb.triangles);
+    }
+  }
 }
 
 TEST(ExtractBoneSurface, BallTouchingTheScanEdgeIsStillClosed) {
