@@ -104,18 +104,9 @@ void make_canonical(TriangleSoup& soup) {
   auto less = [](const Keyed& a, const Keyed& b) {
     return a.x != b.x ? a.x < b.x : a.y != b.y ? a.y < b.y : a.z < b.z;
   };
-  // Halves sorted on two threads and merged. Equal positions may come out in either order;
-  // they become one vertex, so the result does not depend on it (nor on the thread count).
-  const size_t half = keyed.size() / 2;
-  parallel_for(
-      2,
-      [&](size_t begin, size_t end) {
-        for (size_t part = begin; part < end; ++part)
-          std::sort(keyed.begin() + (part == 0 ? 0 : half),
-                    part == 0 ? keyed.begin() + half : keyed.end(), less);
-      },
-      keyed.size() > 50000 ? 1 : 2);
-  std::inplace_merge(keyed.begin(), keyed.begin() + half, keyed.end(), less);
+  // Equal positions may come out in either order; they become one vertex, so the result does
+  // not depend on it (nor on the thread count).
+  parallel_sort(keyed.begin(), keyed.end(), less);
   std::vector<int> id(soup.vertices.size());
   std::vector<Eigen::Vector3d> vertices;
   vertices.reserve(soup.vertices.size());

@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "cranioplan/algorithms/geometry/mesh_components.h"
+#include "cranioplan/model/parallel.h"
 
 namespace cranioplan {
 namespace {
@@ -199,11 +200,22 @@ struct Welded {
 
 Welded weld_positions(const std::vector<Eigen::Vector3d>& points) {
   const size_t n = points.size();
-  std::vector<int> order(n);
-  std::iota(order.begin(), order.end(), 0);
-  auto key = [&](int i) {
+  auto key = [&](size_t i) {
     return std::array<double, 3>{points[i].x(), points[i].y(), points[i].z()};
   };
+  Welded w;
+  // A mesh in canonical form (every skull read or imported) has its positions distinct and in
+  // order already: each vertex is its own.
+  bool ascending = true;
+  for (size_t i = 1; i < n && ascending; ++i) ascending = key(i - 1) < key(i);
+  if (ascending) {
+    w.id.resize(n);
+    std::iota(w.id.begin(), w.id.end(), 0);
+    w.positions = points;
+    return w;
+  }
+  std::vector<int> order(n);
+  std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return key(a) < key(b); });
   std::vector<int> first_of;  // each position's first vertex, in order of position
   std::vector<int> group(n);
@@ -217,7 +229,6 @@ Welded weld_positions(const std::vector<Eigen::Vector3d>& points) {
             [&](int a, int b) { return first_of[a] < first_of[b]; });
   std::vector<int> rank(first_of.size());
   for (size_t k = 0; k < by_appearance.size(); ++k) rank[by_appearance[k]] = static_cast<int>(k);
-  Welded w;
   w.id.resize(n);
   for (size_t i = 0; i < n; ++i) w.id[i] = rank[group[i]];
   w.positions.resize(first_of.size());
@@ -236,7 +247,7 @@ std::vector<unsigned long long> sorted_edges(const std::vector<Eigen::Vector3i>&
                                b = static_cast<unsigned>(t[(k + 1) % 3]);
       edges.push_back(std::min(a, b) << 32 | std::max(a, b));
     }
-  std::sort(edges.begin(), edges.end());
+  parallel_sort(edges.begin(), edges.end(), std::less<>());
   return edges;
 }
 

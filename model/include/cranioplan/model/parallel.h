@@ -36,4 +36,21 @@ void parallel_for(size_t n, F&& f, size_t min_items = 256) {
   for (std::thread& t : pool) t.join();
 }
 
+/// Sorts [first, last) by `less`: two halves on two threads (when the count allows), then
+/// merged. The same sequence as std::sort wherever elements that compare equal are alike (keys,
+/// positions that become one vertex); otherwise equal elements may come in another order.
+template <class It, class Less>
+void parallel_sort(It first, It last, Less less) {
+  const size_t n = static_cast<size_t>(last - first);
+  const It middle = first + static_cast<std::ptrdiff_t>(n / 2);
+  parallel_for(
+      2,
+      [&](size_t begin, size_t end) {
+        for (size_t half = begin; half < end; ++half)
+          std::sort(half == 0 ? first : middle, half == 0 ? middle : last, less);
+      },
+      n >= 50000 ? 1 : 2);
+  std::inplace_merge(first, middle, last, less);
+}
+
 }  // namespace cranioplan
