@@ -2,6 +2,7 @@
 
 #include <chrono>
 #include <cstdio>
+#include <future>
 
 #include "cranioplan/algorithms/alignment/mirror_mesh.h"
 #include "cranioplan/algorithms/geometry/point_index.h"
@@ -82,6 +83,13 @@ void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const Vert
               r.surfaces_message;
 }
 
+// The skull's search tree, built on a thread of its own while the plane and the registration
+// are found: they do not use it (the detection is the first stage that does), and for most of
+// their time they keep one core of two busy. The tree does not depend on the threads.
+std::future<SurfaceLocator> locator_meanwhile(const SkullMesh& skull) {
+  return std::async(std::launch::async, [&skull] { return SurfaceLocator(skull); });
+}
+
 // The plane and the global registration; false (and `r` says why) when the plane fails.
 bool plane_and_registration(const SkullMesh& skull, const Landmarks& landmarks,
                             const VertexCloud& cloud, const AutoplanParams& params,
@@ -159,10 +167,10 @@ AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
                         const AutoplanParams& params) {
   AutoplanResult r;
   StageTimer timer(r.stage_seconds);
+  std::future<SurfaceLocator> bone = locator_meanwhile(skull);
   const VertexCloud cloud(skull);
   if (!plane_and_registration(skull, landmarks, cloud, params, timer, r)) return r;
-  const SurfaceLocator bone(skull);
-  plan_opening(skull, bone, cloud, params, false, timer, r);
+  plan_opening(skull, bone.get(), cloud, params, false, timer, r);
   return r;
 }
 
@@ -171,12 +179,13 @@ std::vector<AutoplanResult> autoplan_all_openings(const SkullMesh& skull,
                                                   const AutoplanParams& params) {
   AutoplanResult first;
   StageTimer timer(first.stage_seconds);
+  std::future<SurfaceLocator> building = locator_meanwhile(skull);
   const VertexCloud cloud(skull);
   if (!plane_and_registration(skull, landmarks, cloud, params, timer, first)) return {first};
   AutoplanResult shared;  // the plane and the global registration, before the local one
   shared.plane = first.plane;
   shared.registration = first.registration;
-  const SurfaceLocator bone(skull);
+  const SurfaceLocator bone = building.get();
   plan_opening(skull, bone, cloud, params, true, timer, first);
   std::vector<AutoplanResult> plans;
   plans.push_back(std::move(first));
