@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <vector>
 
 #include "cranioplan/model/parallel.h"
@@ -42,18 +43,29 @@ long long count_self_intersections(const SkullMesh& mesh) {
     hi[i] = soup.vertices[t[0]].cwiseMax(soup.vertices[t[1]]).cwiseMax(soup.vertices[t[2]]);
     edge_sum += (soup.vertices[t[0]] - soup.vertices[t[1]]).norm();
   }
-  const double cell = std::max(1e-6, 2.0 * edge_sum / static_cast<double>(n));
+  // Cells of about two edge lengths, numbered from the mesh's lowest corner and packed 21 bits
+  // an axis into one key (larger cells if the mesh spans more than 2²¹ of them: the count does
+  // not depend on the cell size, only the time does).
+  Eigen::Vector3d low = lo[0], high = hi[0];
+  for (size_t i = 1; i < n; ++i) {
+    low = low.cwiseMin(lo[i]);
+    high = high.cwiseMax(hi[i]);
+  }
+  constexpr double kCells = double(1 << 21) - 2.0;
+  const double cell =
+      std::max({1e-6, 2.0 * edge_sum / static_cast<double>(n), (high - low).maxCoeff() / kCells});
   auto cell_of = [&](const Eigen::Vector3d& p) {
-    return Eigen::Array3i((p / cell).array().floor().cast<int>());
+    return Eigen::Array3i(((p - low) / cell).array().floor().cast<int>());
+  };
+  auto key_of = [](int x, int y, int z) {
+    return static_cast<uint64_t>(x) << 42 | static_cast<uint64_t>(y) << 21 |
+           static_cast<uint64_t>(z);
   };
   // Every (cell, triangle) its box meets, sorted by cell: the triangles sharing a cell are
   // neighbours in the list.
   struct Entry {
-    std::array<int, 3> cell;
+    uint64_t cell;
     int triangle;
-    bool operator<(const Entry& o) const {
-      return cell != o.cell ? cell < o.cell : triangle < o.triangle;
-    }
   };
   std::vector<Entry> entries;
   entries.reserve(2 * n);
@@ -61,9 +73,12 @@ long long count_self_intersections(const SkullMesh& mesh) {
     const Eigen::Array3i a = cell_of(lo[i]), b = cell_of(hi[i]);
     for (int x = a[0]; x <= b[0]; ++x)
       for (int y = a[1]; y <= b[1]; ++y)
-        for (int z = a[2]; z <= b[2]; ++z) entries.push_back({{x, y, z}, static_cast<int>(i)});
+        for (int z = a[2]; z <= b[2]; ++z)
+          entries.push_back({key_of(x, y, z), static_cast<int>(i)});
   }
-  std::sort(entries.begin(), entries.end());
+  parallel_sort(entries.begin(), entries.end(), [](const Entry& a, const Entry& b) {
+    return a.cell != b.cell ? a.cell < b.cell : a.triangle < b.triangle;  // entries are distinct
+  });
   std::vector<size_t> starts;
   for (size_t e = 0; e < entries.size(); ++e)
     if (e == 0 || entries[e].cell != entries[e - 1].cell) starts.push_back(e);
@@ -82,8 +97,7 @@ long long count_self_intersections(const SkullMesh& mesh) {
               const size_t i = static_cast<size_t>(entries[u].triangle),
                            j = static_cast<size_t>(entries[w].triangle);
               const Eigen::Array3i owner = cell_of(lo[i].cwiseMax(lo[j]));
-              const std::array<int, 3>& here = entries[u].cell;
-              if (owner[0] != here[0] || owner[1] != here[1] || owner[2] != here[2]) continue;
+              if (key_of(owner[0], owner[1], owner[2]) != entries[u].cell) continue;
               if ((lo[i].array() > hi[j].array()).any() || (lo[j].array() > hi[i].array()).any())
                 continue;
               const auto &ti = soup.triangles[i], &tj = soup.triangles[j];
