@@ -283,10 +283,22 @@ float distance_value(const VoxelGrid& g, long long squared) {
 std::vector<uint8_t> within_steps(const std::vector<uint8_t>& in, const VoxelGrid& g, int steps) {
   assert(steps >= 0 && steps <= 254 && "within_steps counts steps in a byte");
   const uint8_t cap = static_cast<uint8_t>(steps + 1);
-  std::vector<uint8_t> d(in.size());
-  for (size_t c = 0; c < in.size(); ++c) d[c] = in[c] ? 0 : cap;
   const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
   const size_t sy = static_cast<size_t>(nx), sz = sy * ny;
+  // Rows (along x) that may hold a distance below the cap: a row relaxed from a row without one
+  // cannot change (cap + 1 is clipped to the cap), so those sweeps are skipped and the sums are
+  // those of the whole sweep. A mask fills a shell of its grid; most rows stay at the cap.
+  std::vector<uint8_t> d(in.size()), held(static_cast<size_t>(ny) * nz);
+  parallel_for(held.size(), [&](size_t first, size_t last) {
+    for (size_t row = first; row < last; ++row) {
+      bool any = false;
+      for (size_t c = row * sy; c < (row + 1) * sy; ++c) {
+        d[c] = in[c] ? 0 : cap;
+        any |= in[c] != 0;
+      }
+      held[row] = any;
+    }
+  });
   auto relax = [cap](uint8_t& to, uint8_t from) {
     const uint8_t v = static_cast<uint8_t>(std::min<int>(from + 1, cap));
     if (v < to) to = v;
@@ -297,15 +309,23 @@ std::vector<uint8_t> within_steps(const std::vector<uint8_t>& in, const VoxelGri
       [&](size_t first, size_t last) {
         for (size_t k = first; k < last; ++k) {
           uint8_t* slice = &d[k * sz];
+          uint8_t* rows = &held[k * static_cast<size_t>(ny)];
           for (int j = 0; j < ny; ++j) {
+            if (!rows[j]) continue;
             uint8_t* row = slice + j * sy;
             for (int i = 1; i < nx; ++i) relax(row[i], row[i - 1]);
             for (int i = nx - 2; i >= 0; --i) relax(row[i], row[i + 1]);
           }
-          for (int j = 1; j < ny; ++j)
+          for (int j = 1; j < ny; ++j) {
+            if (!rows[j - 1]) continue;
             for (int i = 0; i < nx; ++i) relax(slice[j * sy + i], slice[(j - 1) * sy + i]);
-          for (int j = ny - 2; j >= 0; --j)
+            rows[j] = 1;
+          }
+          for (int j = ny - 2; j >= 0; --j) {
+            if (!rows[j + 1]) continue;
             for (int i = 0; i < nx; ++i) relax(slice[j * sy + i], slice[(j + 1) * sy + i]);
+            rows[j] = 1;
+          }
         }
       },
       2);
@@ -314,17 +334,27 @@ std::vector<uint8_t> within_steps(const std::vector<uint8_t>& in, const VoxelGri
       static_cast<size_t>(ny),
       [&](size_t first, size_t last) {
         for (size_t j = first; j < last; ++j) {
-          for (int k = 1; k < nz; ++k)
+          auto row_held = [&](int k) -> uint8_t& { return held[k * static_cast<size_t>(ny) + j]; };
+          for (int k = 1; k < nz; ++k) {
+            if (!row_held(k - 1)) continue;
             for (int i = 0; i < nx; ++i)
               relax(d[k * sz + j * sy + i], d[(k - 1) * sz + j * sy + i]);
-          for (int k = nz - 2; k >= 0; --k)
+            row_held(k) = 1;
+          }
+          for (int k = nz - 2; k >= 0; --k) {
+            if (!row_held(k + 1)) continue;
             for (int i = 0; i < nx; ++i)
               relax(d[k * sz + j * sy + i], d[(k + 1) * sz + j * sy + i]);
+            row_held(k) = 1;
+          }
         }
       },
       2);
   std::vector<uint8_t> out(in.size());
-  for (size_t c = 0; c < in.size(); ++c) out[c] = d[c] <= steps;
+  parallel_for(held.size(), [&](size_t first, size_t last) {
+    for (size_t row = first; row < last; ++row)
+      for (size_t c = row * sy; c < (row + 1) * sy; ++c) out[c] = held[row] && d[c] <= steps;
+  });
   return out;
 }
 

@@ -10,10 +10,10 @@
 #include <vector>
 
 #include "cranioplan/algorithms/geometry/distance_transform.h"
-#include "cranioplan/model/parallel.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
+#include "cranioplan/model/parallel.h"
 
 namespace cranioplan {
 
@@ -148,7 +148,10 @@ Mask bridge_cracks(const Mask& implant, const Mask& bone, const VoxelGrid& g, in
   return out;
 }
 
-// Separable Gaussian blur of a 0/1 mask along the three axes.
+// Separable Gaussian blur of a 0/1 mask along the three axes. Rows (along x) that are zero in
+// a pass's input and in every row its taps reach are zero in its output and are not summed: a
+// zero adds nothing to a sum of non-negative terms, so the floats are those of the whole sum,
+// and the implant fills only a shell of its grid.
 std::vector<float> blur(const Mask& in, const VoxelGrid& g, double sigma_voxels) {
   std::vector<float> a(in.begin(), in.end());
   if (sigma_voxels <= 0.05) return a;
@@ -162,7 +165,29 @@ std::vector<float> blur(const Mask& in, const VoxelGrid& g, double sigma_voxels)
   const int dims[3] = {g.dims[0], g.dims[1], g.dims[2]};
   const size_t stride[3] = {1, static_cast<size_t>(dims[0]),
                             static_cast<size_t>(dims[0]) * dims[1]};
+  // Which rows (j, k) of the current input hold anything.
+  const size_t rows = static_cast<size_t>(dims[1]) * dims[2];
+  std::vector<uint8_t> held(rows), next(rows);
+  parallel_for(rows, [&](size_t first, size_t last) {
+    for (size_t row = first; row < last; ++row) {
+      const uint8_t* at = &in[row * stride[1]];
+      held[row] = std::any_of(at, at + dims[0], [](uint8_t v) { return v != 0; });
+    }
+  });
   for (int axis = 0; axis < 3; ++axis) {
+    // The output's rows: along x the input's; along y and z those a tap reaches from a held row.
+    if (axis == 0) next = held;
+    for (int k = 0; k < dims[2] && axis > 0; ++k)
+      for (int j = 0; j < dims[1]; ++j) {
+        const int pos = axis == 1 ? j : k;
+        bool any = false;
+        for (int t = -r; t <= r && !any; ++t) {
+          if (pos + t < 0 || pos + t >= dims[axis]) continue;
+          any = held[static_cast<size_t>(axis == 1 ? j + t : j) +
+                     static_cast<size_t>(axis == 2 ? k + t : k) * dims[1]];
+        }
+        next[static_cast<size_t>(j) + static_cast<size_t>(k) * dims[1]] = any;
+      }
     // Slices on all threads; each voxel's sum is taken over the taps in order (the same
     // float operations however the loops run) and written once. Along y and z a whole row in
     // x has the same taps: it is summed tap by tap.
@@ -173,6 +198,10 @@ std::vector<float> blur(const Mask& in, const VoxelGrid& g, double sigma_voxels)
             for (int j = 0; j < dims[1]; ++j) {
               const size_t row = g.index(0, j, k);
               float* out = &b[row];
+              if (!next[static_cast<size_t>(j) + static_cast<size_t>(k) * dims[1]]) {
+                std::fill(out, out + dims[0], 0.0f);
+                continue;
+              }
               if (axis == 0) {
                 for (int i = 0; i < dims[0]; ++i) {
                   const float* at = &a[row + i];
@@ -191,6 +220,9 @@ std::vector<float> blur(const Mask& in, const VoxelGrid& g, double sigma_voxels)
               std::fill(out, out + dims[0], 0.0f);
               for (int t = -r; t <= r; ++t) {
                 if (pos + t < 0 || pos + t >= dims[axis]) continue;
+                if (!held[static_cast<size_t>(axis == 1 ? j + t : j) +
+                          static_cast<size_t>(axis == 2 ? k + t : k) * dims[1]])
+                  continue;
                 const float wt = w[t + r];
                 const float* in = &a[row + static_cast<std::ptrdiff_t>(t) *
                                                static_cast<std::ptrdiff_t>(stride[axis])];
@@ -200,6 +232,7 @@ std::vector<float> blur(const Mask& in, const VoxelGrid& g, double sigma_voxels)
         },
         2);
     a.swap(b);
+    held.swap(next);
   }
   return a;
 }

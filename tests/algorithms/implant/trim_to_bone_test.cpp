@@ -69,6 +69,20 @@ TEST(TrimToBone, FillsTheGapFlushWithTheCutFaces) {
   EXPECT_EQ(q.penetration_mm3, 0.0);
 }
 
+// The same scene with x and z exchanged: the grid is then thin along x and long along z (more
+// slices than voxels in a row), and the fit fills the gap just the same (a guard on the blur's
+// bookkeeping of empty rows, which must not mix one axis's length with another's).
+TEST(TrimToBone, FillsTheGapOnAGridLongerAlongZThanAlongX) {
+  const SkullMesh bone = merge(box({0, 0, 0}, {5, 20, 20}), box({0, 0, 30}, {5, 20, 50}));
+  const SkullMesh implant = build_mesh(box({0, 2, 17}, {5.3, 18, 33}));
+  const TrimToBoneResult r = trim_to_bone(implant, bone);
+  ASSERT_TRUE(r.usable()) << r.message;
+  EXPECT_TRUE(report_mesh(r.mesh).watertight);
+  EXPECT_GE(r.volume_mm3, 0.95 * 848.0);
+  EXPECT_LE(r.volume_mm3, 1.05 * 848.0);
+  EXPECT_NEAR(signed_volume(to_soup(r.mesh)), 848.0, 0.06 * 848.0);
+}
+
 // Meshed into a mesh the caller gives (one that held something else), the fit is the mesh the
 // result would hold, and the result's own mesh stays empty; when nothing is left, the given
 // mesh holds the implant as it came.
