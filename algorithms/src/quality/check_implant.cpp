@@ -6,16 +6,18 @@
 #include <cmath>
 #include <cstdio>
 #include <deque>
+#include <future>
 #include <memory>
+#include <utility>
 
 #include "cranioplan/algorithms/geometry/distance_transform.h"
-#include "cranioplan/model/parallel.h"
 #include "cranioplan/algorithms/geometry/self_intersections.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/implant/build_implant.h"
 #include "cranioplan/algorithms/io/mesh_report.h"
 #include "cranioplan/algorithms/quality/thickness_map.h"
+#include "cranioplan/model/parallel.h"
 #include "cranioplan/model/plane.h"
 
 namespace cranioplan {
@@ -341,17 +343,27 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
 QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
                             const SurfaceLocator* skull_locator, const QualityParams& params) {
   QualityReport q;
-  const MeshReport rep = report_mesh(implant);
-  q.watertight = rep.watertight;
-  q.manifold = rep.nonmanifold_edges == 0;
-  q.volume_mm3 = rep.volume_mm3;
-  q.area_mm2 = rep.area_mm2;
-  q.outward = rep.volume_mm3 > 0;
-  q.pieces = rep.pieces;
-  q.self_intersections = count_self_intersections(implant);
+  // The mesh's own checks (its report and its self-intersections, partly on one thread) run
+  // beside the checks on the grid; neither uses the other's results.
+  std::future<std::pair<MeshReport, long long>> own_checks =
+      std::async(std::launch::async, [&implant] {
+        return std::make_pair(report_mesh(implant), count_self_intersections(implant));
+      });
+  auto take_own_checks = [&] {
+    const auto [rep, self_intersections] = own_checks.get();
+    q.watertight = rep.watertight;
+    q.manifold = rep.nonmanifold_edges == 0;
+    q.volume_mm3 = rep.volume_mm3;
+    q.area_mm2 = rep.area_mm2;
+    q.outward = rep.volume_mm3 > 0;
+    q.pieces = rep.pieces;
+    q.self_intersections = self_intersections;
+    if (params.density_g_cm3 > 0.0) q.mass_g = rep.volume_mm3 * 1e-3 * params.density_g_cm3;
+    return rep;
+  };
   q.material_name = params.material_name;
-  if (params.density_g_cm3 > 0.0) q.mass_g = rep.volume_mm3 * 1e-3 * params.density_g_cm3;
   if (implant.n_faces() == 0) {
+    take_own_checks();
     q.reasons.push_back("the implant has no triangles");
     return q;
   }
@@ -397,6 +409,7 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
                                          solid, grid, params, q);
   }
   measure_thin_material(solid, depth, grid, bone_distance, params, q);
+  const MeshReport rep = take_own_checks();
   add_reasons(rep, params, !bone_distance.empty(), q);
   measure_tabs(self, bone, params, q);
   q.printable = q.reasons.empty();
