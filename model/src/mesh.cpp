@@ -143,9 +143,6 @@ void make_canonical(TriangleSoup& soup) {
 
 namespace {
 
-// Each fan of triangles around a vertex beyond the first (faces joined through shared edges)
-// gets its own copy of the vertex: `corner` is renumbered to the copies, `nv` and `source` (the
-// input vertex of each mesh vertex) grow with them.
 // Whether the triangles around v fall into more than one fan (faces joined through shared
 // edges). Leaves each outgoing halfedge's fan (a root in `parent`) for the caller; `ends` is
 // scratch for the two other corners of each face.

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstring>
 #include <filesystem>
+#include <new>
 
 #include "cranioplan/model/error.h"
 #include "cranioplan/model/parallel.h"
@@ -85,7 +86,15 @@ void convert_samples(const std::string& path, const char* data, size_t available
 SampleStream::SampleStream(std::string path, size_t count, SampleType type, bool big_endian,
                            std::vector<float>& out)
     : path_(std::move(path)), count_(count), type_(type), big_endian_(big_endian), out_(out) {
-  out_.resize(count);
+  // Room for every sample, but filled only as the bytes come: a header that announces more
+  // than its data holds costs no more memory than the data.
+  out_.clear();
+  try {
+    out_.reserve(count);
+  } catch (const std::bad_alloc&) {
+    throw InputError(path_, "the header announces " + format_count(static_cast<long long>(count)) +
+                                " samples, more than this computer's memory holds as floats");
+  }
 }
 
 void SampleStream::add(const char* data, size_t n) {
@@ -98,10 +107,14 @@ void SampleStream::add(const char* data, size_t n) {
     data += take;
     n -= take;
     if (partial_ < size) return;
-    if (done_ < count_) convert_range(type_, big_endian_, carry_, 1, out_.data() + done_++);
+    if (done_ < count_) {
+      out_.resize(done_ + 1);
+      convert_range(type_, big_endian_, carry_, 1, out_.data() + done_++);
+    }
     partial_ = 0;
   }
   const size_t whole = n / size, usable = std::min(whole, count_ - done_);
+  out_.resize(done_ + usable);
   convert_range(type_, big_endian_, data, usable, out_.data() + done_);
   done_ += usable;
   partial_ = n - whole * size;

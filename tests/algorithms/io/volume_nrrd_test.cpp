@@ -64,5 +64,24 @@ TEST(VolumeNrrd, HeaderThatDisagreesWithDataIsAnError) {
   EXPECT_THROW(read_volume(dir.path("gzcut.nrrd")), InputError);
 }
 
+// A gzipped NRRD whose header announces far more samples than its data could inflate to
+// (deflate expands at most 1032 times) is refused with the count it announces and what the
+// data holds, and nothing the size of the announced volume is allocated.
+TEST(VolumeNrrd, AGzipHeaderAnnouncingMoreThanItsDataCanHoldIsRefused) {
+  test::TempDir dir;
+  const std::string data = test::gzip(std::string(4000, '\0'));
+  test::write_bytes(dir.path("huge.nrrd"),
+                    "NRRD0004\ntype: int32\ndimension: 3\nsizes: 90000 90000 90000\n"
+                    "encoding: gzip\n\n" +
+                        data);
+  try {
+    read_volume(dir.path("huge.nrrd"));
+    FAIL();
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("but the data holds only 4,000 bytes"), std::string::npos) << msg;
+  }
+}
+
 }  // namespace
 }  // namespace cranioplan
