@@ -29,24 +29,64 @@ bool is_degenerate(const TriangleSoup& soup, const Eigen::Vector3i& t) {
 inline size_t next_corner(size_t he) { return he - he % 3 + (he + 1) % 3; }
 inline size_t prev_corner(size_t he) { return he - he % 3 + (he + 2) % 3; }
 
-// Outgoing halfedges per vertex, as compressed lists, for the faces marked in `keep`.
+// Vertices with more outgoing halfedges than this (a pole, a cap triangulated as a fan) are
+// searched by sorting instead of pair by pair, which would take seconds from valences of tens
+// of thousands.
+constexpr int kLongList = 64;
+
+// Outgoing halfedges per vertex, as compressed lists, for the faces marked in `keep`. Long
+// lists also in order of destination (`by_dest`, the same range), for finding a halfedge by
+// bisection.
 struct OutgoingLists {
-  std::vector<int> start, out;
+  std::vector<int> start, out, by_dest;
   OutgoingLists(const std::vector<int>& corner, int nv, const std::vector<char>& keep)
       : start(static_cast<size_t>(nv) + 1, 0) {
     for (size_t he = 0; he < corner.size(); ++he)
       if (keep[he / 3]) ++start[corner[he] + 1];
-    for (int v = 0; v < nv; ++v) start[v + 1] += start[v];
+    bool any_long = false;
+    for (int v = 0; v < nv; ++v) {
+      any_long = any_long || start[v + 1] > kLongList;
+      start[v + 1] += start[v];
+    }
     out.resize(start[nv]);
     std::vector<int> fill(start.begin(), start.end() - 1);
     for (size_t he = 0; he < corner.size(); ++he)
       if (keep[he / 3]) out[fill[corner[he]]++] = static_cast<int>(he);
+    if (!any_long) return;
+    by_dest.resize(out.size());
+    for (int v = 0; v < nv; ++v) {
+      if (start[v + 1] - start[v] <= kLongList) continue;
+      const auto first = by_dest.begin() + start[v], last = by_dest.begin() + start[v + 1];
+      std::copy(out.begin() + start[v], out.begin() + start[v + 1], first);
+      std::sort(first, last, [&](int a, int b) {  // by destination, then in list order
+        const int da = corner[next_corner(static_cast<size_t>(a))];
+        const int db = corner[next_corner(static_cast<size_t>(b))];
+        return da != db ? da < db : a < b;
+      });
+    }
   }
-  // The halfedge u → v, or -1.
+  bool is_long(int u) const { return start[u + 1] - start[u] > kLongList; }
+  // Calls f(he) for every halfedge u → v.
+  template <class F>
+  void each_to(const std::vector<int>& corner, int u, int v, F&& f) const {
+    auto dest = [&](int he) { return corner[next_corner(static_cast<size_t>(he))]; };
+    if (!is_long(u)) {
+      for (int i = start[u]; i < start[u + 1]; ++i)
+        if (dest(out[i]) == v) f(static_cast<size_t>(out[i]));
+      return;
+    }
+    const auto last = by_dest.begin() + start[u + 1];
+    auto it = std::lower_bound(by_dest.begin() + start[u], last, v,
+                               [&](int he, int d) { return dest(he) < d; });
+    for (; it != last && dest(*it) == v; ++it) f(static_cast<size_t>(*it));
+  }
+  // The halfedge u → v (the first in list order), or -1.
   int find(const std::vector<int>& corner, int u, int v) const {
-    for (int i = start[u]; i < start[u + 1]; ++i)
-      if (corner[next_corner(static_cast<size_t>(out[i]))] == v) return out[i];
-    return -1;
+    int first = -1;
+    each_to(corner, u, v, [&](size_t he) {
+      if (first < 0) first = static_cast<int>(he);
+    });
+    return first;
   }
 };
 
@@ -161,10 +201,24 @@ bool fans_around(const OutgoingLists& lists, const std::vector<int>& corner, int
     while (parent[x] != x) x = parent[x] = parent[parent[x]];
     return x;
   };
-  for (int i = 0; i < n; ++i)
-    for (int j = 0; j < n; ++j)
-      // Face i leaves v towards w and face j arrives at v from w: they share edge v–w.
-      if (i != j && ends[i][0] == ends[j][1]) parent[root(i)] = root(j);
+  // Face i leaves v towards w and face j arrives at v from w: they share edge v–w. (The fans
+  // are the same whatever order the faces are joined in.)
+  if (n <= kLongList) {
+    for (int i = 0; i < n; ++i)
+      for (int j = 0; j < n; ++j)
+        if (i != j && ends[i][0] == ends[j][1]) parent[root(i)] = root(j);
+  } else {
+    std::vector<int> by_from(n);  // faces in order of the corner they arrive from
+    for (int j = 0; j < n; ++j) by_from[j] = j;
+    std::sort(by_from.begin(), by_from.end(),
+              [&](int a, int b) { return ends[a][1] < ends[b][1]; });
+    for (int i = 0; i < n; ++i) {
+      auto it = std::lower_bound(by_from.begin(), by_from.end(), ends[i][0],
+                                 [&](int j, int w) { return ends[j][1] < w; });
+      for (; it != by_from.end() && ends[*it][1] == ends[i][0]; ++it)
+        if (*it != i) parent[root(i)] = root(*it);
+    }
+  }
   bool several = false;
   for (int i = 0; i < n; ++i) {
     parent[i] = root(i);
@@ -274,13 +328,20 @@ void build_mesh(const TriangleSoup& soup, SkullMesh& mesh, BuildMeshStats* stats
   auto lists = std::make_unique<OutgoingLists>(corner, nv, accepted);
   std::vector<char> repeated(nh, 0);  // per halfedge: another face has the same directed edge
   parallel_for(static_cast<size_t>(nv), [&](size_t begin, size_t end) {
-    for (size_t u = begin; u < end; ++u)
-      for (int i = lists->start[u]; i < lists->start[u + 1]; ++i)
-        for (int j = i + 1; j < lists->start[u + 1]; ++j) {
-          const size_t hi = static_cast<size_t>(lists->out[i]);
-          const size_t hj = static_cast<size_t>(lists->out[j]);
-          if (corner[next_corner(hi)] == corner[next_corner(hj)]) repeated[hi] = repeated[hj] = 1;
-        }
+    for (size_t u = begin; u < end; ++u) {
+      const int a = lists->start[u], b = lists->start[u + 1];
+      auto dest = [&](int he) { return corner[next_corner(static_cast<size_t>(he))]; };
+      if (lists->is_long(static_cast<int>(u))) {  // runs of one destination, in `by_dest`
+        for (int i = a; i + 1 < b; ++i)
+          if (dest(lists->by_dest[i]) == dest(lists->by_dest[i + 1]))
+            repeated[lists->by_dest[i]] = repeated[lists->by_dest[i + 1]] = 1;
+        continue;
+      }
+      for (int i = a; i < b; ++i)
+        for (int j = i + 1; j < b; ++j)
+          if (dest(lists->out[i]) == dest(lists->out[j]))
+            repeated[lists->out[i]] = repeated[lists->out[j]] = 1;
+    }
   });
   std::vector<int> deferred;
   std::vector<size_t> contested;
@@ -293,10 +354,8 @@ void build_mesh(const TriangleSoup& soup, SkullMesh& mesh, BuildMeshStats* stats
     bool ok = true;
     for (size_t he = f * 3; he < f * 3 + 3 && ok; ++he) {
       const int u = corner[he], v = corner[next_corner(he)];
-      for (int i = lists->start[u]; i < lists->start[u + 1] && ok; ++i) {
-        const size_t other = static_cast<size_t>(lists->out[i]);
-        ok = !(other / 3 != f && accepted[other / 3] && corner[next_corner(other)] == v);
-      }
+      lists->each_to(corner, u, v,
+                     [&](size_t other) { ok = ok && !(other / 3 != f && accepted[other / 3]); });
     }
     if (ok)
       accepted[f] = 1;

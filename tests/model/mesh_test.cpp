@@ -198,5 +198,60 @@ TEST(Mesh, ADamagedSoupIsBuiltTheSameOnOneThreadAndOnTwo) {
   for (auto f : a.faces()) ASSERT_EQ(a.halfedge_handle(f), b.halfedge_handle(f)) << f.idx();
 }
 
+// Vertices of very high valence (a pole, a cap triangulated as a fan) are searched by sorting:
+// a closed cone of 500 sides (two poles of 500 triangles) is built closed and manifold; two
+// such cones touching at one pole give that pole a copy; a third of the triangles given twice
+// are kept on their own vertices, one split each.
+TEST(Mesh, PolesOfHundredsOfTrianglesAreBuiltWhole) {
+  const int n = 500;
+  auto cone = [&](TriangleSoup& s, const Eigen::Vector3d& apex, double z) {
+    const int a = static_cast<int>(s.vertices.size());
+    s.vertices.push_back(apex);
+    s.vertices.push_back({0, 0, z});
+    for (int i = 0; i < n; ++i) {
+      const double t = 2 * M_PI * i / n;
+      s.vertices.push_back({40 * std::cos(t), 40 * std::sin(t), z + 0.3 * std::sin(5 * t)});
+    }
+    for (int i = 0; i < n; ++i) {
+      const int p = a + 2 + i, q = a + 2 + (i + 1) % n;
+      s.triangles.push_back({a, p, q});
+      s.triangles.push_back({a + 1, q, p});
+    }
+  };
+  TriangleSoup one;
+  cone(one, {0, 0, 30}, 0);
+  const SkullMesh m = build_mesh(one);
+  EXPECT_EQ(m.n_faces(), 2u * n);
+  EXPECT_EQ(m.n_vertices(), static_cast<size_t>(n) + 2);
+  EXPECT_EQ(m.n_edges(), 3u * n);
+  for (auto h : m.halfedges()) EXPECT_FALSE(m.is_boundary(h));
+
+  TriangleSoup two = one;  // a second cone, upside down, its apex on the first one's
+  cone(two, {0, 0, 30}, 60);
+  const int second = static_cast<int>(one.vertices.size());
+  for (size_t t = one.triangles.size(); t < two.triangles.size(); ++t) {
+    for (int k = 0; k < 3; ++k)
+      if (two.triangles[t][k] == second) two.triangles[t][k] = 0;
+    std::swap(two.triangles[t][1], two.triangles[t][2]);  // outward on the upside-down cone
+  }
+  TriangleSoup twice = two;
+  for (size_t t = 0; t < one.triangles.size(); t += 3) twice.triangles.push_back(one.triangles[t]);
+  for (int threads : {1, 2}) {
+    set_thread_count(threads);
+    BuildMeshStats stats;
+    const SkullMesh touching = build_mesh(two, &stats);
+    EXPECT_EQ(stats.nonmanifold_split, 1) << "the shared pole, once";
+    EXPECT_EQ(touching.n_faces(), 4u * n);
+    for (auto h : touching.halfedges()) EXPECT_FALSE(touching.is_boundary(h));
+    BuildMeshStats more;
+    const SkullMesh doubled = build_mesh(twice, &more);
+    const long long repeated =
+        static_cast<long long>(twice.triangles.size() - two.triangles.size());
+    EXPECT_EQ(doubled.n_faces(), twice.triangles.size());
+    EXPECT_EQ(more.nonmanifold_split, 1 + repeated);
+  }
+  set_thread_count(0);
+}
+
 }  // namespace
 }  // namespace cranioplan
