@@ -9,6 +9,7 @@
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/planning/detect_defect.h"
 #include "cranioplan/algorithms/planning/propose_markers.h"
+#include "cranioplan/model/parallel.h"
 
 namespace cranioplan {
 
@@ -87,7 +88,7 @@ void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const Vert
 // are found: they do not use it (the detection is the first stage that does), and for most of
 // their time they keep one core of two busy. The tree does not depend on the threads.
 std::future<SurfaceLocator> locator_meanwhile(const SkullMesh& skull) {
-  return std::async(std::launch::async, [&skull] { return SurfaceLocator(skull); });
+  return std::async(beside(), [&skull] { return SurfaceLocator(skull); });
 }
 
 // The plane and the global registration; false (and `r` says why) when the plane fails.

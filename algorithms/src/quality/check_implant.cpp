@@ -345,10 +345,9 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
   QualityReport q;
   // The mesh's own checks (its report and its self-intersections, partly on one thread) run
   // beside the checks on the grid; neither uses the other's results.
-  std::future<std::pair<MeshReport, long long>> own_checks =
-      std::async(std::launch::async, [&implant] {
-        return std::make_pair(report_mesh(implant), count_self_intersections(implant));
-      });
+  std::future<std::pair<MeshReport, long long>> own_checks = std::async(beside(), [&implant] {
+    return std::make_pair(report_mesh(implant), count_self_intersections(implant));
+  });
   auto take_own_checks = [&] {
     const auto [rep, self_intersections] = own_checks.get();
     q.watertight = rep.watertight;

@@ -4,6 +4,7 @@
 // threads (tested: the same implant bytes with 1 and 2 threads).
 #include <algorithm>
 #include <cstddef>
+#include <future>
 #include <thread>
 #include <vector>
 
@@ -34,6 +35,12 @@ void parallel_for(size_t n, F&& f, size_t min_items = 256) {
   }
   f(size_t{0}, std::min(n, chunk));
   for (std::thread& t : pool) t.join();
+}
+
+/// How a task that may run beside the caller's work is launched: on a thread of its own when
+/// more than one thread is allowed, else when its result is asked for, on the caller's thread.
+inline std::launch beside() {
+  return thread_count() > 1 ? std::launch::async : std::launch::deferred;
 }
 
 /// Sorts [first, last) by `less`: two halves on two threads (when the count allows), then
