@@ -74,13 +74,11 @@ size_t gunzip_each(const std::string& path, const char* data, size_t size, size_
 }
 
 std::string gunzip(const std::string& path, const char* data, size_t size, size_t expected_size) {
-  // Deflate expands at most 1032 times (a 258-byte match in two bits): room for the size the
-  // header announces is made at once when the data can hold it, and a header announcing
-  // terabytes over a few bytes of data (a fuzzed NRRD asked for 600 GB) gets only what the
-  // data could give.
+  // Grown as the data comes, from four times its size (or the announced size, if smaller): a
+  // header may announce terabytes over a few bytes of data (a fuzzed NRRD asked for 600 GB).
+  const size_t guess = std::max<size_t>(size * 4, 1 << 16);
   std::string out;
-  out.reserve(expected_size > 0 ? std::min(expected_size, size * 1032 + (1 << 16))
-                                : std::max<size_t>(size * 4, 1 << 16));
+  out.reserve(expected_size > 0 ? std::min(expected_size, guess) : guess);
   gunzip_each(path, data, size, expected_size,
               [&](const char* chunk, size_t n) { out.append(chunk, n); });
   return out;
