@@ -9,9 +9,9 @@
 #include <chrono>
 #include <cmath>
 
-#include "cranioplan/model/parallel.h"
 #include "cranioplan/algorithms/geometry/point_index.h"
 #include "cranioplan/algorithms/geometry/surface_samples.h"
+#include "cranioplan/model/parallel.h"
 
 namespace cranioplan {
 namespace {

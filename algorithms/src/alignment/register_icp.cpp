@@ -7,9 +7,9 @@
 #include <memory>
 
 #include "cranioplan/algorithms/alignment/mirror_mesh.h"
-#include "cranioplan/model/parallel.h"
 #include "cranioplan/algorithms/geometry/point_index.h"
 #include "cranioplan/algorithms/geometry/surface_samples.h"
+#include "cranioplan/model/parallel.h"
 
 namespace cranioplan {
 

@@ -3,9 +3,9 @@
 #include <algorithm>
 #include <cmath>
 
-#include "cranioplan/model/parallel.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
+#include "cranioplan/model/parallel.h"
 
 namespace cranioplan {
 

@@ -9,10 +9,10 @@
 #include <optional>
 
 #include "cranioplan/algorithms/geometry/mesh_distance_field.h"
-#include "cranioplan/model/parallel.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
+#include "cranioplan/model/parallel.h"
 #include "param_ranges.h"
 
 namespace cranioplan {

@@ -6,9 +6,9 @@
 #include <limits>
 
 #include "cranioplan/algorithms/geometry/distance_transform.h"
-#include "cranioplan/model/parallel.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
+#include "cranioplan/model/parallel.h"
 
 namespace cranioplan {
 
