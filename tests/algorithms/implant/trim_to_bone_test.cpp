@@ -26,6 +26,20 @@ SkullMesh merge(const TriangleSoup& a, const TriangleSoup& b) {
   return build_mesh(s);
 }
 
+// The plates most tests stand on: 5 mm thick, 20 mm wide, a 10 mm gap (the defect) between
+// them along x; with `exchange_xz` the same scene with x and z exchanged.
+SkullMesh gap_plates(bool exchange_xz = false) {
+  auto p = [&](double x, double y, double z) {
+    return exchange_xz ? Eigen::Vector3d(z, y, x) : Eigen::Vector3d(x, y, z);
+  };
+  return merge(box(p(0, 0, 0), p(20, 20, 5)), box(p(30, 0, 0), p(50, 20, 5)));
+}
+
+// An implant over the gap, 3 mm wider on both sides and 0.3 mm proud of the plates' tops.
+TriangleSoup gap_implant(bool exchange_xz = false) {
+  return exchange_xz ? box({0, 2, 17}, {5.3, 18, 33}) : box({17, 2, 0}, {33, 18, 5.3});
+}
+
 // The largest coordinate `axis` of the mesh's vertices.
 double highest(const SkullMesh& m, int axis) {
   double x = -1e9;
@@ -33,12 +47,12 @@ double highest(const SkullMesh& m, int axis) {
   return x;
 }
 
-// Bone: two plates 5 mm thick with a 10 mm wide gap (the defect) between them. The implant is
-// built 3 mm wider on both sides and 0.3 mm proud of the bone: trimmed, it fills the gap —
-// against both cut faces, no overlap, and no sliver left on top of the bone.
+// Bone: the two plates with their 10 mm gap; the implant 3 mm wider on both sides and 0.3 mm
+// proud of the bone (gap_implant): trimmed, it fills the gap — against both cut faces, no
+// overlap, and no sliver left on top of the bone.
 TEST(TrimToBone, FillsTheGapFlushWithTheCutFaces) {
-  const SkullMesh bone = merge(box({0, 0, 0}, {20, 20, 5}), box({30, 0, 0}, {50, 20, 5}));
-  const SkullMesh implant = build_mesh(box({17, 2, 0}, {33, 18, 5.3}));
+  const SkullMesh bone = gap_plates();
+  const SkullMesh implant = build_mesh(gap_implant());
   const TrimToBoneResult r = trim_to_bone(implant, bone);
   ASSERT_TRUE(r.usable()) << r.message;
   EXPECT_TRUE(report_mesh(r.mesh).watertight);
@@ -73,8 +87,8 @@ TEST(TrimToBone, FillsTheGapFlushWithTheCutFaces) {
 // slices than voxels in a row), and the fit fills the gap just the same (a guard on the blur's
 // bookkeeping of empty rows, which must not mix one axis's length with another's).
 TEST(TrimToBone, FillsTheGapOnAGridLongerAlongZThanAlongX) {
-  const SkullMesh bone = merge(box({0, 0, 0}, {5, 20, 20}), box({0, 0, 30}, {5, 20, 50}));
-  const SkullMesh implant = build_mesh(box({0, 2, 17}, {5.3, 18, 33}));
+  const SkullMesh bone = gap_plates(true);
+  const SkullMesh implant = build_mesh(gap_implant(true));
   const TrimToBoneResult r = trim_to_bone(implant, bone);
   ASSERT_TRUE(r.usable()) << r.message;
   EXPECT_TRUE(report_mesh(r.mesh).watertight);
@@ -87,8 +101,8 @@ TEST(TrimToBone, FillsTheGapOnAGridLongerAlongZThanAlongX) {
 // result would hold, and the result's own mesh stays empty; when nothing is left, the given
 // mesh holds the implant as it came.
 TEST(TrimToBone, MeshedIntoAGivenMeshAsItWouldBeReturned) {
-  const SkullMesh bone = merge(box({0, 0, 0}, {20, 20, 5}), box({30, 0, 0}, {50, 20, 5}));
-  const SkullMesh implant = build_mesh(box({17, 2, 0}, {33, 18, 5.3}));
+  const SkullMesh bone = gap_plates();
+  const SkullMesh implant = build_mesh(gap_implant());
   const TrimToBoneResult returned = trim_to_bone(implant, bone);
   SkullMesh into = build_mesh(box({-5, -5, -5}, {5, 5, 5}));
   const TrimToBoneResult given = trim_to_bone(implant, bone, {}, into);
@@ -109,7 +123,7 @@ TEST(TrimToBone, MeshedIntoAGivenMeshAsItWouldBeReturned) {
 // An implant that stops 1.2 mm short of a cut face (ragged bone it was not extended to) is
 // bridged onto it; without the bridge the crack stays.
 TEST(TrimToBone, BridgesANarrowGapToTheBone) {
-  const SkullMesh bone = merge(box({0, 0, 0}, {20, 20, 5}), box({30, 0, 0}, {50, 20, 5}));
+  const SkullMesh bone = gap_plates();
   const SkullMesh implant = build_mesh(box({17, 2, 0.5}, {28.8, 18, 4.5}));
   const TrimToBoneResult bridged = trim_to_bone(implant, bone);
   TrimToBoneParams off;
@@ -152,9 +166,8 @@ std::vector<double> wall_distances(const SkullMesh& implant, const SkullMesh& bo
 TEST(TrimToBone, HoldsTheClearanceOffObliqueCutFacesOnACoarseGrid) {
   const Eigen::Matrix3d r =
       (Eigen::AngleAxisd(0.5, Eigen::Vector3d(1, 2, 3).normalized())).toRotationMatrix();
-  const SkullMesh bone =
-      turned(merge(box({0, 0, 0}, {20, 20, 5}), box({30, 0, 0}, {50, 20, 5})), r);
-  const SkullMesh implant = turned(build_mesh(box({17, 2, 0}, {33, 18, 5.3})), r);
+  const SkullMesh bone = turned(gap_plates(), r);
+  const SkullMesh implant = turned(build_mesh(gap_implant()), r);
   TrimToBoneParams coarse;
   coarse.max_voxels = 1e5;  // about 0.45 mm over this implant
   TrimToBoneParams then = coarse;
@@ -181,10 +194,9 @@ TEST(TrimToBone, HoldsTheClearanceOffObliqueCutFacesOnACoarseGrid) {
 // widens the trim's grid to hold the fragment; being apart, it goes as well.)
 TEST(TrimToBone, ARodOfFillToAFragmentGoes) {
   const SkullMesh bone = [&] {
-    const SkullMesh two = merge(box({0, 0, 0}, {20, 20, 5}), box({30, 0, 0}, {50, 20, 5}));
-    return merge(to_soup(two), box({24.5, 9.5, 7.8}, {25.5, 10.5, 8.8}));
+    return merge(to_soup(gap_plates()), box({24.5, 9.5, 7.8}, {25.5, 10.5, 8.8}));
   }();
-  const SkullMesh implant = merge(box({17, 2, 0}, {33, 18, 5.3}), box({17, 2, 11}, {18, 3, 12}));
+  const SkullMesh implant = merge(gap_implant(), box({17, 2, 11}, {18, 3, 12}));
   TrimToBoneParams wide;
   wide.bridge_mm = 3.0;
   TrimToBoneParams kept = wide;
