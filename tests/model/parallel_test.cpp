@@ -2,7 +2,10 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <atomic>
+#include <functional>
+#include <random>
 
 #include "cranioplan/algorithms/geometry/huge_pages.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
@@ -47,6 +50,22 @@ TEST(Parallel, EveryItemIsVisitedOnceWhateverTheThreads) {
   }
   set_thread_count(0);
   EXPECT_GE(thread_count(), 1);
+}
+
+// Sorted in two halves and merged, keys come out as std::sort gives them, on one thread and on
+// two, below and above the size where the halves go to two threads, duplicates included.
+TEST(Parallel, ParallelSortGivesWhatStdSortGives) {
+  std::mt19937_64 rng(11);
+  for (size_t n : {size_t{0}, size_t{1}, size_t{7}, size_t{1000}, size_t{120001}})
+    for (int threads : {1, 2}) {
+      const ThreadCount count(threads);
+      std::vector<unsigned long long> keys(n);
+      for (auto& k : keys) k = rng() % (n / 3 + 1);  // many repeats
+      std::vector<unsigned long long> expected = keys;
+      std::sort(expected.begin(), expected.end());
+      parallel_sort(keys.begin(), keys.end(), std::less<>());
+      EXPECT_EQ(keys, expected) << n << " keys, " << threads << " threads";
+    }
 }
 
 // The plan (plane, registrations, distance fields, the implant) is the same to the byte on one
