@@ -210,33 +210,46 @@ class SymmetryScore {
         index_(sparse_.points),
         centroid_(centroid) {}
 
-  double operator()(const Plane& plane) const {
+  // The score, or infinity as soon as it is sure to exceed `bound`: when more probes than the
+  // top fifth lie further than `bound`, the 80th percentile does too. A caller that keeps a
+  // plane only when its score is below the best so far (never on a tie: a score equal to the
+  // bound is computed in full) chooses the same planes with or without the bound, and gives
+  // up on a poor plane long before its last probe.
+  double operator()(const Plane& plane,
+                    double bound = std::numeric_limits<double>::infinity()) const {
+    const size_t n = probe_.points.size();
+    const size_t rank = static_cast<size_t>(0.8 * static_cast<double>(n));
+    const size_t above_needed = n - rank;  // probes beyond `bound` that put the score there
+    size_t above = 0;
     std::vector<double> d;
-    d.reserve(probe_.points.size());
-    for (size_t i = 0; i < probe_.points.size(); ++i) {
+    d.reserve(n);
+    for (size_t i = 0; i < n; ++i) {
       const MirrorMatch mm =
           mirror_match(probe_.points[i], probe_.normals[i], plane, index_, sparse_.normals);
       double dist = std::sqrt(mm.d2);
       if (dist < kTangentReach && mm.facing)
         dist = std::abs(sparse_.normals[mm.c].dot(mm.q - sparse_.points[mm.c]));
       d.push_back(dist);
+      if (dist > bound && ++above == above_needed) return std::numeric_limits<double>::infinity();
     }
-    const auto at = d.begin() + static_cast<std::ptrdiff_t>(0.8 * static_cast<double>(d.size()));
+    const auto at = d.begin() + static_cast<std::ptrdiff_t>(rank);
     std::nth_element(d.begin(), at, d.end());
     return *at;
   }
 
-  // The best plane with normal `n` among offsets `centre` ± k·step, k = 0..count.
-  Plane best_offset(const Eigen::Vector3d& n, double centre, double step, int count,
-                    double* score) const {
-    Plane best{n, centre};
-    *score = std::numeric_limits<double>::infinity();
+  // The best plane with normal `n` among offsets `centre` + k·step, k = −count..count (on equal
+  // scores the lowest k). The centre first: it is most often the best, and bounds the others.
+  // `*score` is infinity when every offset scores above `bound`.
+  Plane best_offset(const Eigen::Vector3d& n, double centre, double step, int count, double* score,
+                    double bound = std::numeric_limits<double>::infinity()) const {
+    int best_k = 0;
+    *score = (*this)(Plane{n, centre}, bound);
     for (int k = -count; k <= count; ++k) {
-      const Plane p{n, centre + k * step};
-      const double sc = (*this)(p);
-      if (sc < *score) *score = sc, best = p;
+      if (k == 0) continue;
+      const double sc = (*this)(Plane{n, centre + k * step}, std::min(bound, *score));
+      if (sc < *score || (sc == *score && k < best_k)) *score = sc, best_k = k;
     }
-    return best;
+    return Plane{n, centre + best_k * step};
   }
 
   const Eigen::Vector3d& centroid() const { return centroid_; }
@@ -264,7 +277,7 @@ Candidate polish(const SymmetryScore& score, Candidate c) {
       const Eigen::Vector3d e1 = c.plane.normal.unitOrthogonal(), e2 = c.plane.normal.cross(e1);
       Candidate next = c;
       auto consider = [&](const Plane& p) {
-        const double sc = score(p);
+        const double sc = score(p, next.score);
         if (sc < next.score) next = {p, sc};
       };
       for (int a = 0; a < 8; ++a) {
@@ -315,27 +328,62 @@ Plane automatic_initial_plane(const SurfaceSamples& all) {
   const SymmetryScore score(all, centroid);
   // The candidates and the basins' polishing on all threads, each result in its own place and
   // compared in order afterwards.
+  //
+  // Only the candidates up to the sixth basin's matter. A quarter of them (and the axes) are
+  // scored first; their sixth basin's score bounds the rest, whose scores are given up as soon
+  // as they are sure to exceed it (SymmetryScore). When the six basins of all the candidates
+  // then lie within the bound, they are the basins every candidate scored in full gives (no
+  // given-up candidate can rank before them); otherwise the given-up ones are scored in full.
   std::vector<Candidate> candidates(normals.size());
-  parallel_for(
-      normals.size(),
-      [&](size_t first, size_t last) {
-        for (size_t i = first; i < last; ++i) {
-          double sc;
-          const Plane p = score.best_offset(normals[i], normals[i].dot(centroid), 3.0, 2, &sc);
-          candidates[i] = {p, sc};
-        }
-      },
-      8);
-  std::sort(candidates.begin(), candidates.end(),
-            [](const Candidate& a, const Candidate& b) { return a.score < b.score; });
+  auto score_candidates = [&](const std::vector<size_t>& which, double bound) {
+    parallel_for(
+        which.size(),
+        [&](size_t first, size_t last) {
+          for (size_t w = first; w < last; ++w) {
+            const size_t i = which[w];
+            double sc;
+            const Plane p =
+                score.best_offset(normals[i], normals[i].dot(centroid), 3.0, 2, &sc, bound);
+            candidates[i] = {p, sc};
+          }
+        },
+        8);
+  };
   const double apart = std::cos(20.0 * M_PI / 180.0);
-  std::vector<Candidate> basins;
-  for (const auto& c : candidates) {
-    if (basins.size() == 6) break;
-    const bool new_basin = std::none_of(basins.begin(), basins.end(), [&](const Candidate& b) {
-      return std::abs(b.plane.normal.dot(c.plane.normal)) > apart;
+  // The best candidate of each basin, up to six, best first (on equal scores the first normal).
+  auto basins_of = [&](std::vector<size_t> which) {
+    std::sort(which.begin(), which.end(), [&](size_t a, size_t b) {
+      return candidates[a].score < candidates[b].score ||
+             (candidates[a].score == candidates[b].score && a < b);
     });
-    if (new_basin) basins.push_back(c);
+    std::vector<Candidate> basins;
+    for (size_t i : which) {
+      const Candidate& c = candidates[i];
+      if (basins.size() == 6) break;
+      const bool new_basin = std::none_of(basins.begin(), basins.end(), [&](const Candidate& b) {
+        return std::abs(b.plane.normal.dot(c.plane.normal)) > apart;
+      });
+      if (new_basin) basins.push_back(c);
+    }
+    return basins;
+  };
+  std::vector<size_t> first_pass, rest, all_candidates(normals.size());
+  for (size_t i = 0; i < normals.size(); ++i) {
+    all_candidates[i] = i;
+    (i % 4 == 0 || i >= static_cast<size_t>(kSpread) ? first_pass : rest).push_back(i);
+  }
+  score_candidates(first_pass, std::numeric_limits<double>::infinity());
+  const std::vector<Candidate> first_basins = basins_of(first_pass);
+  const double bound = first_basins.size() == 6 ? first_basins.back().score
+                                                : std::numeric_limits<double>::infinity();
+  score_candidates(rest, bound);
+  std::vector<Candidate> basins = basins_of(all_candidates);
+  if (basins.size() < 6 || basins.back().score > bound) {
+    std::vector<size_t> given_up;
+    for (size_t i : rest)
+      if (candidates[i].score == std::numeric_limits<double>::infinity()) given_up.push_back(i);
+    score_candidates(given_up, std::numeric_limits<double>::infinity());
+    basins = basins_of(all_candidates);
   }
   std::vector<Candidate> polished(basins.size());
   parallel_for(
@@ -344,7 +392,8 @@ Plane automatic_initial_plane(const SurfaceSamples& all) {
         for (size_t i = first; i < last; ++i) polished[i] = polish(score, basins[i]);
       },
       1);
-  Candidate best{candidates.front().plane, std::numeric_limits<double>::infinity()};
+  // (The first candidate in order always opens a basin.)
+  Candidate best{basins.front().plane, std::numeric_limits<double>::infinity()};
   for (const Candidate& c : polished)
     if (c.score < best.score) best = c;
   Plane plane = best.plane;
