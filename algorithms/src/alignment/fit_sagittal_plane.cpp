@@ -301,7 +301,13 @@ Plane automatic_initial_plane(const SkullMesh& mesh) {
 }
 
 Plane automatic_initial_plane(const SurfaceSamples& all) {
+  return automatic_initial_plane(all, InitialPlaneParams{}).plane;
+}
+
+InitialPlaneResult automatic_initial_plane(const SurfaceSamples& all,
+                                           const InitialPlaneParams& params) {
   assert(!all.points.empty());
+  assert(params.first_pass_stride >= 1);
   Eigen::Vector3d centroid = Eigen::Vector3d::Zero();
   for (const auto& p : all.points) centroid += p;
   centroid /= static_cast<double>(all.points.size());
@@ -329,11 +335,12 @@ Plane automatic_initial_plane(const SurfaceSamples& all) {
   // The candidates and the basins' polishing on all threads, each result in its own place and
   // compared in order afterwards.
   //
-  // Only the candidates up to the sixth basin's matter. A quarter of them (and the axes) are
-  // scored first; their sixth basin's score bounds the rest, whose scores are given up as soon
-  // as they are sure to exceed it (SymmetryScore). When the six basins of all the candidates
-  // then lie within the bound, they are the basins every candidate scored in full gives (no
-  // given-up candidate can rank before them); otherwise the given-up ones are scored in full.
+  // Only the candidates up to the sixth basin's matter. A quarter of them (every
+  // params.first_pass_stride-th, and the axes) are scored first; their sixth basin's score bounds
+  // the rest, whose scores are given up as soon as they are sure to exceed it (SymmetryScore). When
+  // the six basins of all the candidates then lie within the bound, they are the basins every
+  // candidate scored in full gives (no given-up candidate can rank before them); otherwise the
+  // given-up ones are scored in full.
   std::vector<Candidate> candidates(normals.size());
   auto score_candidates = [&](const std::vector<size_t>& which, double bound) {
     parallel_for(
@@ -367,22 +374,27 @@ Plane automatic_initial_plane(const SurfaceSamples& all) {
     }
     return basins;
   };
+  InitialPlaneResult result;
+  result.candidates = normals.size();
+  const size_t stride = static_cast<size_t>(params.first_pass_stride);
   std::vector<size_t> first_pass, rest, all_candidates(normals.size());
   for (size_t i = 0; i < normals.size(); ++i) {
     all_candidates[i] = i;
-    (i % 4 == 0 || i >= static_cast<size_t>(kSpread) ? first_pass : rest).push_back(i);
+    (i % stride == 0 || i >= static_cast<size_t>(kSpread) ? first_pass : rest).push_back(i);
   }
   score_candidates(first_pass, std::numeric_limits<double>::infinity());
   const std::vector<Candidate> first_basins = basins_of(first_pass);
   const double bound = first_basins.size() == 6 ? first_basins.back().score
                                                 : std::numeric_limits<double>::infinity();
   score_candidates(rest, bound);
+  std::vector<size_t> given_up;
+  for (size_t i : rest)
+    if (candidates[i].score == std::numeric_limits<double>::infinity()) given_up.push_back(i);
+  result.given_up = given_up.size();
   std::vector<Candidate> basins = basins_of(all_candidates);
   if (basins.size() < 6 || basins.back().score > bound) {
-    std::vector<size_t> given_up;
-    for (size_t i : rest)
-      if (candidates[i].score == std::numeric_limits<double>::infinity()) given_up.push_back(i);
     score_candidates(given_up, std::numeric_limits<double>::infinity());
+    result.rescored = given_up.size();
     basins = basins_of(all_candidates);
   }
   std::vector<Candidate> polished(basins.size());
@@ -401,7 +413,8 @@ Plane automatic_initial_plane(const SurfaceSamples& all) {
   int axis;
   plane.normal.cwiseAbs().maxCoeff(&axis);
   if (plane.normal[axis] < 0) plane = plane.flipped();
-  return plane;
+  result.plane = plane;
+  return result;
 }
 
 PlaneFit fit_sagittal_plane(const SkullMesh& mesh, const Landmarks& landmarks,

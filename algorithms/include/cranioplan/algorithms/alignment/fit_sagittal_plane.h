@@ -61,6 +61,25 @@ Plane automatic_initial_plane(const SkullMesh& mesh);
 /// The same from the mesh's vertex samples (all_vertex_samples) made beforehand.
 Plane automatic_initial_plane(const SurfaceSamples& all);
 
+/// How the automatic initial plane scores its candidates. Only the candidates up to the sixth
+/// basin matter: every `first_pass_stride`-th spread normal (and the axes) is scored in full
+/// first, and the first pass's sixth basin's score bounds the rest, which are given up as soon
+/// as they are sure to score above it. The plane does not depend on the stride (1 scores every
+/// candidate in full); only the time does.
+struct InitialPlaneParams {
+  int first_pass_stride = 4;
+};
+struct InitialPlaneResult {
+  Plane plane;
+  size_t candidates = 0;  ///< candidate normals scored
+  size_t given_up = 0;    ///< candidates given up in the second pass
+  /// Given-up candidates scored in full afterwards because the six basins of all candidates did
+  /// not lie within the first pass's bound (so one of them could have opened a basin).
+  size_t rescored = 0;
+};
+InitialPlaneResult automatic_initial_plane(const SurfaceSamples& all,
+                                           const InitialPlaneParams& params);
+
 /// Initial plane (landmarks when they hold the required three, otherwise automatic), then the
 /// Ceres refinement. With `params.refine == false` returns the initial plane with its
 /// symmetry measures.
