@@ -234,7 +234,9 @@ int current_version(CommandType type) {
   // 1e-3 off the iso-level (no sliver triangles); earlier versions are meshed as they were.
   if (type == CommandType::BuildImplant) return 8;
   if (type == CommandType::ExportImplant) return 2;
-  if (type == CommandType::ProposeMarkers) return 3;
+  // propose_markers 4: support markers only where the fitted surface describes the ring's bone
+  // ("max_support_off_fit_mm"; versions 1 to 3 are read with 0, every ring point of the band).
+  if (type == CommandType::ProposeMarkers) return 4;
   // load_skull 4: volumes in the patient's frame ("import.patient_frame"), a DICOM folder's
   // series ("import.dicom_series"), a mesh's far pieces dropped ("import.drop_far_pieces");
   // absent, as version 3 read them.
@@ -338,6 +340,7 @@ Json params_to_json(const ProposeParams& p) {
   if (p.detect.center) j["detect"]["center"] = to_json(*p.detect.center);
   j["smooth"] = params_to_json(p.smooth);
   j["surfaces"] = write_fields([](auto& v, auto& q) { surface_fit_fields(v, q); }, p.surfaces);
+  j["max_support_off_fit_mm"] = p.max_support_off_fit_mm;
   return j;
 }
 
@@ -576,6 +579,9 @@ void params_from_json(const ParamReader& r, ProposeParams& p) {
     Reader sv{surfaces};
     surface_fit_fields(sv, p.surfaces);
   }
+  // Versions 1 to 3 have none: support markers on every ring point of the band (0: off).
+  p.max_support_off_fit_mm =
+      r.has("max_support_off_fit_mm") ? r.number("max_support_off_fit_mm") : 0.0;
 }
 
 void params_from_json(const ParamReader& r, ImplantParams& p) {

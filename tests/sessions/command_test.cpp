@@ -450,18 +450,21 @@ TEST(Commands, BuildImplant3FitsTheBoneAsItWasMadeTo) {
 }
 
 // propose_markers 2 records how the surfaces are fitted and which opening was asked for; a
-// version-1 command (neither) is read with their defaults.
+// version-1 command (neither) is read with their defaults. Version 4 records how far support
+// markers may lie from the fitted surfaces; older ones are read without that rule.
 TEST(Commands, ProposeMarkersVersionTwoRoundTripsAndVersionOneGetsDefaults) {
   ProposeParams p;
   p.surfaces.ring_width_mm = 31.0;
   p.surfaces.smoothing = 0.07;
   p.detect.near = Eigen::Vector3d(1.5, -2.0, 70.25);
+  p.max_support_off_fit_mm = 2.25;
   const Json j = to_json(commands::propose_markers(p));
-  EXPECT_EQ(j["version"], 3);
+  EXPECT_EQ(j["version"], 4);
   ProposeParams back;
   params_from_json(ParamReader(j["params"]["params"], "test"), back);
   EXPECT_EQ(back.surfaces.ring_width_mm, 31.0);
   EXPECT_EQ(back.surfaces.smoothing, 0.07);
+  EXPECT_EQ(back.max_support_off_fit_mm, 2.25);
   ASSERT_TRUE(back.detect.near.has_value());
   EXPECT_EQ(*back.detect.near, *p.detect.near);
   EXPECT_FALSE(j["params"]["params"]["detect"].contains("center")) << "unset: not written";
@@ -479,12 +482,15 @@ TEST(Commands, ProposeMarkersVersionTwoRoundTripsAndVersionOneGetsDefaults) {
   v1["version"] = 1;
   v1["params"]["params"].erase("surfaces");
   v1["params"]["params"]["detect"].erase("near");
+  v1["params"]["params"].erase("max_support_off_fit_mm");
   const Command c = command_from_json(v1, "old plan");
   EXPECT_EQ(c.version, 1);
   ProposeParams old;
   params_from_json(ParamReader(c.params["params"], "test"), old);
   EXPECT_FALSE(old.detect.near.has_value());
   EXPECT_EQ(old.surfaces.ring_width_mm, DefectSurfaceParams{}.ring_width_mm);
+  // Before version 4 support markers stood on every ring point of the band.
+  EXPECT_EQ(old.max_support_off_fit_mm, 0.0);
 }
 
 TEST(Commands, UnknownTypeVersionAndMissingParameterAreNamed) {

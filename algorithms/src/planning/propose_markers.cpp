@@ -189,16 +189,24 @@ void add_edge_markers(const DefectRegion& defect, const DefectSurfaces& surfaces
 // Not where the first bone is a cut face met side-on: it lies above where the inner table
 // goes on, and the implant's inner surface would rise to it and leave the wedge of bone under
 // the cut empty (SkullFix: median Dice 0.904 -> 0.910, boundary Dice 0.901 -> 0.924).
-void add_support_markers(const DefectSurfaces& surfaces, const ProposeParams& params, int& id,
-                         std::vector<Marker>& out) {
+void add_support_markers(const DefectRegion& defect, const DefectSurfaces& surfaces,
+                         const ProposeParams& params, int& id, std::vector<Marker>& out) {
   std::vector<Eigen::Vector3d> support_outer, support_inner;
   const double band = params.surfaces.rim_clearance_mm + params.detect.support_width_mm;
   const double min_facing =
       std::cos(std::clamp(params.max_support_inner_tilt_deg, 0.0, 90.0) * M_PI / 180.0) - 1e-12;
+  const double max_off = params.max_support_off_fit_mm;
   for (size_t i = 0; i < surfaces.ring_outer.size(); ++i)
     if (surfaces.ring_distance_mm[i] <= band) {
-      support_outer.push_back(surfaces.ring_outer[i]);
-      if (surfaces.ring_inner_facing[i] >= min_facing)
+      const auto fitted = max_off > 0.0
+                              ? surfaces.at((surfaces.ring_outer[i] - defect.center).normalized())
+                              : std::nullopt;
+      const bool outer_on_fit =
+          max_off <= 0.0 || (fitted && (fitted->first - surfaces.ring_outer[i]).norm() <= max_off);
+      const bool inner_on_fit =
+          max_off <= 0.0 || (fitted && (fitted->second - surfaces.ring_inner[i]).norm() <= max_off);
+      if (outer_on_fit) support_outer.push_back(surfaces.ring_outer[i]);
+      if (inner_on_fit && surfaces.ring_inner_facing[i] >= min_facing)
         support_inner.push_back(surfaces.ring_inner[i]);
     }
   for (size_t i : thin_points(support_outer, params.surface_spacing_mm))
@@ -265,7 +273,7 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
   r.ring_rms_mm = surfaces.outer_rms_mm;
   int id = first_id;
   add_edge_markers(defect, surfaces, params, id, r.markers);
-  add_support_markers(surfaces, params, id, r.markers);
+  add_support_markers(defect, surfaces, params, id, r.markers);
   add_surface_markers(defect, surfaces, guided ? MarkerSurface::Mirrored : MarkerSurface::Original,
                       params, id, r.markers);
   r.status = MarkerProposal::Status::Proposed;

@@ -118,5 +118,48 @@ TEST(ProposeMarkers, MethodsHaveNamesAndTheRegionReachesPastTheRim) {
   for (const Eigen::Vector3d& p : d.outer_rim) EXPECT_LE((p - roi.center).norm(), roi.radius - 20);
 }
 
+// A bone chip lying on the outer table just beyond the rim (a fragment, like those below a
+// frontal sinus): the rays through it meet it as their last bone, millimetres above the
+// table. Support markers stand only on bone the fitted surface describes: none on the chip,
+// where one would pull the implant's outer surface up to it, and whether a ray near the chip's
+// edge counts would decide the implant's shape there. With the rule off, the chip gets some.
+TEST(ProposeMarkers, SupportMarkersStayOffBoneTheFittedSurfaceDoesNotDescribe) {
+  const test::ThickHeadDefect& c = test::thick_head_defect();
+  ASSERT_TRUE(c.defect.found()) << c.defect.message;
+  const Eigen::Vector3d rim = c.defect.outer_rim.front();
+  Eigen::Vector3d out = rim - rim.dot(c.defect.axis) * c.defect.axis;  // away from the axis
+  const Eigen::Vector3d d = (rim + 8.0 * out.normalized()).normalized();
+  const Eigen::Vector3d chip_centre = test::head_surface_point(d) + 5.0 * d;
+  const TriangleSoup chip = test::box_soup(chip_centre - Eigen::Vector3d::Constant(2.0),
+                                           chip_centre + Eigen::Vector3d::Constant(2.0));
+  TriangleSoup soup = to_soup(c.defective);
+  const int first = static_cast<int>(soup.vertices.size());
+  soup.vertices.insert(soup.vertices.end(), chip.vertices.begin(), chip.vertices.end());
+  for (const Eigen::Vector3i& t : chip.triangles)
+    soup.triangles.push_back(t + Eigen::Vector3i::Constant(first));
+  const SkullMesh skull = build_mesh(soup);
+  const SurfaceLocator bone(skull), truth(c.intact);
+  const SurfaceLocator chip_bone(build_mesh(chip));
+  const DefectRegion defect = detect_defect(skull, bone, Eigen::Vector3d::Zero());
+  ASSERT_TRUE(defect.found()) << defect.message;
+
+  auto on_chip = [&](const ProposeParams& params) {
+    const MarkerProposal p = propose_markers_for_defect(defect, bone, truth, params);
+    EXPECT_TRUE(p.proposed()) << p.message;
+    int n = 0, support = 0;
+    for (const Marker& m : p.markers) {
+      if (is_edge(m.type) || m.surface != MarkerSurface::Original) continue;
+      ++support;
+      n += chip_bone.closest(m.position).distance < 0.5;
+    }
+    EXPECT_GE(support, 20);
+    return n;
+  };
+  EXPECT_EQ(on_chip(ProposeParams{}), 0);
+  ProposeParams off;
+  off.max_support_off_fit_mm = 0.0;
+  EXPECT_GE(on_chip(off), 1) << "the chip lies where the ring's rays meet it";
+}
+
 }  // namespace
 }  // namespace cranioplan

@@ -153,13 +153,13 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
       {"open, 300 HU", [&] { return open300; }, true, true},
       {"open, 400 HU", [&] { return open(400.0); }, true, false},
       {"open, 450 HU", [&] { return open(450.0); }, true, false},
-      {"open, sinc pass band 0.1", [&] { return sinc_smoothed(open300, 0.1); }, false, false},
+      {"open, sinc pass band 0.1", [&] { return sinc_smoothed(open300, 0.1); }, true, true},
       {"open, sinc pass band 0.01", [&] { return sinc_smoothed(open300, 0.01); }, true, false},
       {"open, sinc pass band 0.001", [&] { return sinc_smoothed(open300, 0.001); }, true, false},
-      {"open, decimated to 50 %", [&] { return decimated(open300, 0.5); }, true, false},
+      {"open, decimated to 50 %", [&] { return decimated(open300, 0.5); }, true, true},
       {"open, decimated to 25 %", [&] { return decimated(open300, 0.25); }, true, false},
       {"open, re-meshed (vertex clustering)", [&] { return remeshed(open300); }, true, false},
-      {"open, subdivided (edges halved)", [&] { return subdivided(open300); }, true, false},
+      {"open, subdivided (edges halved)", [&] { return subdivided(open300); }, true, true},
       {"cropped above the orbits (z ≥ 60 mm)",
        [&] {
          const SkullMesh m = load_skull(path).mesh;
@@ -271,7 +271,7 @@ TEST(RobustnessCorpus, HowFarThePlanMovesWithItsOwnRays) {
     std::printf("| %s | %.3f | %.2f | %s |\n", m.name.c_str(), dice, r.quality.rim_gap_mm,
                 r.quality.printable ? "yes" : "no");
     EXPECT_TRUE(r.quality.printable) << (r.quality.reasons.empty() ? "" : r.quality.reasons[0]);
-    // Measured 0.914-0.937: a floor below it, so that a change that makes the plan follow its
+    // Measured 0.906-0.957: a floor below it, so that a change that makes the plan follow its
     // rays more fails here.
     EXPECT_GE(dice, 0.89);
   }

@@ -78,8 +78,9 @@ TEST(SampleCase, AutoplanFillsTheRealDefect) {
   // The target on the sample's real defect, from autoplan alone: a watertight shell
   // with a rim gap of at most 0.5 mm and no penetration into the skull (the shell is fitted to
   // the bone: built 4 mm over it and trimmed by it), and printable by the quality report (its
-  // edge on the bone tapers over 1.5 mm; docs/IMPLANT.md). Measured 0.09 mm over the worst 5°
-  // arc of the rim (the STL of scripts/run-sample is read as this very mesh).
+  // edge on the bone tapers over 1.5 mm; docs/IMPLANT.md). Measured 0.28 mm over the worst 5°
+  // arc of the rim, where the rim runs into the orbit's roof unseen by the rays (the STL of
+  // scripts/run-sample is read as this very mesh).
   EXPECT_TRUE(r.quality.watertight);
   EXPECT_TRUE(r.quality.manifold);
   EXPECT_EQ(r.quality.self_intersections, 0);
@@ -93,7 +94,9 @@ TEST(SampleCase, AutoplanFillsTheRealDefect) {
   // defect: planned with fills kept as made, the implant has a rod from its edge to a fragment
   // by the orbit that the quality report rejects (a corner reaching 0.85 mm past 1 mm thick,
   // measured); with a one-voxel keep-out instead of the clearance it stands further off the
-  // bone (rim gap 0.16 mm against 0.09 mm, measured).
+  // bone: rim gap 0.16 mm against 0.09 mm, measured with support markers on every ring point
+  // of the band (the worst arc then lies on bone both rules meet; with today's support markers
+  // it lies where the rim runs unseen into the orbit's roof, the same under both rules).
   {
     AutoplanParams kept;
     kept.implant.trim.thin_fills_removed = false;
@@ -101,12 +104,16 @@ TEST(SampleCase, AutoplanFillsTheRealDefect) {
     ASSERT_TRUE(rod.planned()) << rod.message;
     EXPECT_GT(rod.quality.corner_reach_mm, 0.8) << "the case has the rod the rule removes";
     EXPECT_FALSE(rod.quality.printable);
-    AutoplanParams voxel_rule;
+    AutoplanParams every_ring;
+    every_ring.propose.max_support_off_fit_mm = 0.0;
+    const AutoplanResult clearance = autoplan(skull.mesh, Landmarks{}, every_ring);
+    ASSERT_TRUE(clearance.planned()) << clearance.message;
+    AutoplanParams voxel_rule = every_ring;
     voxel_rule.implant.trim.clearance_mm.reset();
     voxel_rule.implant.trim.thin_fills_removed = false;
     const AutoplanResult off = autoplan(skull.mesh, Landmarks{}, voxel_rule);
     ASSERT_TRUE(off.planned()) << off.message;
-    EXPECT_GT(off.quality.rim_gap_mm, r.quality.rim_gap_mm + 0.03);
+    EXPECT_GT(off.quality.rim_gap_mm, clearance.quality.rim_gap_mm + 0.03);
   }
   RecordProperty("rim_gap_mm", std::to_string(r.quality.rim_gap_mm));
   RecordProperty("penetration_mm3", std::to_string(r.quality.penetration_mm3));

@@ -36,6 +36,10 @@ struct ProposeParams {
   /// centre first meets the face, above where the inner table would go on, and a marker there
   /// lifts the implant's inner surface off the missing wedge of bone.
   double max_support_inner_tilt_deg = 45.0;
+  /// Support markers lie on the ring's bone only where the fitted surface describes it: bone
+  /// further than this from the fitted table along its ray is not where the table goes on (a
+  /// fragment below a sinus, an orbital roof, bone across the opening), mm (0: off).
+  double max_support_off_fit_mm = 1.5;
   SmoothParams smooth{10.0, 2.0, 1};  ///< applied to surface markers (put back after)
   DefectSurfaceParams surfaces;       ///< fitting the surfaces to the intact ring
 };
