@@ -335,12 +335,12 @@ InitialPlaneResult automatic_initial_plane(const SurfaceSamples& all,
   // The candidates and the basins' polishing on all threads, each result in its own place and
   // compared in order afterwards.
   //
-  // Only the candidates up to the sixth basin's matter. A quarter of them (every
-  // params.first_pass_stride-th, and the axes) are scored first; their sixth basin's score bounds
-  // the rest, whose scores are given up as soon as they are sure to exceed it (SymmetryScore). When
-  // the six basins of all the candidates then lie within the bound, they are the basins every
-  // candidate scored in full gives (no given-up candidate can rank before them); otherwise the
-  // given-up ones are scored in full.
+  // Only the candidates up to the sixth basin's matter. Every params.first_pass_stride-th of
+  // them (a quarter by default) and the axes are scored first; their sixth basin's score bounds
+  // the rest, whose scores are given up as soon as they are sure to exceed it (SymmetryScore).
+  // When the six basins of all the candidates then lie within the bound, they are the basins
+  // every candidate scored in full gives (no given-up candidate can rank before them); otherwise
+  // the given-up ones are scored in full.
   std::vector<Candidate> candidates(normals.size());
   auto score_candidates = [&](const std::vector<size_t>& which, double bound) {
     parallel_for(

@@ -198,13 +198,15 @@ void add_support_markers(const DefectRegion& defect, const DefectSurfaces& surfa
   const double max_off = params.max_support_off_fit_mm;
   for (size_t i = 0; i < surfaces.ring_outer.size(); ++i)
     if (surfaces.ring_distance_mm[i] <= band) {
+      // A ring point the fitted surfaces do not reach (outside their cap) is kept: nothing
+      // tells it from the table.
       const auto fitted = max_off > 0.0
                               ? surfaces.at((surfaces.ring_outer[i] - defect.center).normalized())
                               : std::nullopt;
       const bool outer_on_fit =
-          max_off <= 0.0 || (fitted && (fitted->first - surfaces.ring_outer[i]).norm() <= max_off);
+          !fitted || (fitted->first - surfaces.ring_outer[i]).norm() <= max_off;
       const bool inner_on_fit =
-          max_off <= 0.0 || (fitted && (fitted->second - surfaces.ring_inner[i]).norm() <= max_off);
+          !fitted || (fitted->second - surfaces.ring_inner[i]).norm() <= max_off;
       if (outer_on_fit) support_outer.push_back(surfaces.ring_outer[i]);
       if (inner_on_fit && surfaces.ring_inner_facing[i] >= min_facing)
         support_inner.push_back(surfaces.ring_inner[i]);
