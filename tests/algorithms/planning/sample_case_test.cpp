@@ -78,7 +78,7 @@ TEST(SampleCase, AutoplanFillsTheRealDefect) {
   // The target on the sample's real defect, from autoplan alone: a watertight shell
   // with a rim gap of at most 0.5 mm and no penetration into the skull (the shell is fitted to
   // the bone: built 4 mm over it and trimmed by it), and printable by the quality report (its
-  // edge on the bone tapers over 1.5 mm; docs/IMPLANT.md). Measured 0.28 mm over the worst 5°
+  // edge on the bone tapers over 1.5 mm; docs/IMPLANT.md). Measured 0.25 mm over the worst 5°
   // arc of the rim, where the rim runs into the orbit's roof unseen by the rays (the STL of
   // scripts/run-sample is read as this very mesh).
   EXPECT_TRUE(r.quality.watertight);
