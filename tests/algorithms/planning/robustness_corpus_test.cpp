@@ -24,6 +24,8 @@
 #include <string>
 #include <vector>
 
+#include "cranioplan/algorithms/geometry/distance_transform.h"
+#include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/load_skull.h"
 #include "cranioplan/algorithms/io/mesh_report.h"
 #include "cranioplan/algorithms/planning/autoplan.h"
@@ -109,10 +111,33 @@ SkullMesh exported(vtkPolyData* pd, const std::string& path) {
   return load_skull(path).mesh;
 }
 
+// How far two skulls' bone agrees where an implant sits: the Dice of their inside (0.3 mm
+// voxels) within `reach` mm of the implant. An export of the same surface gives 1; another
+// threshold or a smoothing moves the tables, and an implant fitted to them moves with them.
+double bone_agreement(const SkullMesh& a, const SkullMesh& b, const SkullMesh& implant,
+                      double reach = 10.0) {
+  const auto [lo, hi] = mesh_bounds(implant);
+  const Eigen::Vector3d pad = Eigen::Vector3d::Constant(reach + 1.0);
+  const VoxelGrid grid = VoxelGrid::covering(lo - pad, hi + pad, 0.3);
+  const std::vector<uint8_t> in_a = voxelize_mesh(a, grid), in_b = voxelize_mesh(b, grid);
+  const std::vector<float> to_implant =
+      distance_to_mask(voxelize_mesh(implant, grid), grid, reach + 1.0);
+  size_t na = 0, nb = 0, both = 0;
+  for (size_t c = 0; c < in_a.size(); ++c)
+    if (to_implant[c] <= reach) {
+      na += in_a[c];
+      nb += in_b[c];
+      both += in_a[c] && in_b[c];
+    }
+  return na + nb > 0 ? 2.0 * static_cast<double>(both) / static_cast<double>(na + nb) : 1.0;
+}
+
 struct Row {
   std::string name;
   bool planned = false, printable = false;
   double rim_gap_mm = -1, overlap_mm3 = -1, dice = 0;
+  double bone = 0, same_rays_dice = 0;  // bone_agreement; Dice planned with the own rays
+  double centre_moved_mm = -1;          // the rays' centre from the own import's
   std::string message, why;
 };
 
@@ -120,6 +145,10 @@ struct Row {
 constexpr double kMaxRimGapMm = 0.5, kMaxOverlapMm3 = 5.0, kTargetDice = 0.90;
 // The same defect planned (a plan of another opening has Dice 0 against it).
 constexpr double kSameDefectDice = 0.8;
+// The own import's bone where the implant sits (bone_agreement): measured 0.980-1.000 on the
+// exports of its surface (re-meshed on 0.8 mm cells the lowest), 0.904-0.971 on other
+// thresholds and smoothings.
+constexpr double kSameBone = 0.975;
 
 TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
   const std::string path = sample_case_path();
@@ -129,6 +158,11 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
   const LoadedSkull own = load_skull(path);
   const AutoplanResult reference = autoplan(own.mesh, Landmarks{});
   ASSERT_TRUE(reference.planned()) << reference.message;
+  // Each export planned a second time with the rays where the own import's plan cast them
+  // (its centre and frame): what the surface changes once the rays start alike.
+  AutoplanParams own_rays;
+  own_rays.propose.detect.center = reference.defect.center;
+  own_rays.propose.detect.frame = reference.defect.frame;
 
   // The scan's lowest slice is at z = 0; the padding closed the import below it.
   auto open = [&](double threshold) {
@@ -146,27 +180,33 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
     // defect the own import's plan found (Dice ≥ kSameDefectDice; planning another opening
     // gives 0). Meets the Dice target too. As measured; the table shows the rest.
     bool on_bone, meets_dice;
+    // The own import's bone where the implant sits (bone_agreement ≥ kSameBone): planned with
+    // the own plan's rays it meets the Dice target — what follows where the rays start depends
+    // on the bone, not on its triangles (measured 0.929-0.988).
+    bool same_bone;
   };
   const std::vector<Case> cases = {
-      {"open, 200 HU", [&] { return open(200.0); }, true, false},
-      {"open, 226 HU (InVesalius bone)", [&] { return open(226.0); }, true, false},
-      {"open, 300 HU", [&] { return open300; }, true, true},
-      {"open, 400 HU", [&] { return open(400.0); }, true, false},
-      {"open, 450 HU", [&] { return open(450.0); }, true, false},
-      {"open, sinc pass band 0.1", [&] { return sinc_smoothed(open300, 0.1); }, true, true},
-      {"open, sinc pass band 0.01", [&] { return sinc_smoothed(open300, 0.01); }, true, false},
-      {"open, sinc pass band 0.001", [&] { return sinc_smoothed(open300, 0.001); }, true, false},
-      {"open, decimated to 50 %", [&] { return decimated(open300, 0.5); }, true, true},
-      {"open, decimated to 25 %", [&] { return decimated(open300, 0.25); }, true, false},
-      {"open, re-meshed (vertex clustering)", [&] { return remeshed(open300); }, true, false},
-      {"open, subdivided (edges halved)", [&] { return subdivided(open300); }, true, true},
+      {"open, 200 HU", [&] { return open(200.0); }, true, false, false},
+      {"open, 226 HU (InVesalius bone)", [&] { return open(226.0); }, true, false, false},
+      {"open, 300 HU", [&] { return open300; }, true, true, true},
+      {"open, 400 HU", [&] { return open(400.0); }, true, false, false},
+      {"open, 450 HU", [&] { return open(450.0); }, true, false, false},
+      {"open, sinc pass band 0.1", [&] { return sinc_smoothed(open300, 0.1); }, true, true, false},
+      {"open, sinc pass band 0.01", [&] { return sinc_smoothed(open300, 0.01); }, true, false,
+       false},
+      {"open, sinc pass band 0.001", [&] { return sinc_smoothed(open300, 0.001); }, true, false,
+       false},
+      {"open, decimated to 50 %", [&] { return decimated(open300, 0.5); }, true, true, true},
+      {"open, decimated to 25 %", [&] { return decimated(open300, 0.25); }, true, false, true},
+      {"open, re-meshed (vertex clustering)", [&] { return remeshed(open300); }, true, false, true},
+      {"open, subdivided (edges halved)", [&] { return subdivided(open300); }, true, true, true},
       {"cropped above the orbits (z ≥ 60 mm)",
        [&] {
          const SkullMesh m = load_skull(path).mesh;
          return to_polydata(
              test::cut_open(m, Eigen::Vector3d(0, 0, 60.0), Eigen::Vector3d::UnitZ()));
        },
-       true, false},
+       true, false, true},
       // A gantry tilted 20° (or a skull cropped obliquely by an exporter): the cut rises
       // towards the back, through the orbits at the front, in no axis's plane.
       {"cropped along a plane tilted 20° (gantry tilt)",
@@ -178,7 +218,7 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
              m, Eigen::Vector3d(0, 0.5 * (box.bbox_min.y() + box.bbox_max.y()), 60.0),
              Eigen::Vector3d(0, -std::sin(tilt), std::cos(tilt))));
        },
-       true, false},
+       true, false, true},
   };
   std::vector<Row> rows;
   for (size_t i = 0; i < cases.size(); ++i) {
@@ -199,7 +239,16 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
       row.rim_gap_mm = r.quality.rim_gap_mm;
       row.overlap_mm3 = r.quality.penetration_mm3;
       row.dice = compare_implants(r.implant.mesh, reference.implant.mesh).dice;
+      row.centre_moved_mm = (r.defect.center - reference.defect.center).norm();
       if (!r.quality.reasons.empty()) row.why = r.quality.reasons[0];
+    }
+    row.bone = bone_agreement(own.mesh, skull, reference.implant.mesh);
+    const AutoplanResult same_rays = autoplan(skull, Landmarks{}, own_rays);
+    if (same_rays.planned())
+      row.same_rays_dice = compare_implants(same_rays.implant.mesh, reference.implant.mesh).dice;
+    if (c.same_bone) {
+      EXPECT_GE(row.bone, kSameBone);
+      EXPECT_GE(row.same_rays_dice, kTargetDice);
     }
     // Every export ends in a plan or in a message that says why not.
     EXPECT_TRUE(r.planned() || !r.message.empty());
@@ -217,18 +266,21 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
   }
   std::printf(
       "\n| export of Cranium.inv3 | planned | printable | rim gap (mm) | overlap (mm³) | "
-      "Dice vs own import | all met |\n|---|---|---|---|---|---|---|\n");
+      "Dice vs own import | all met | bone near the implant vs own import (Dice) | Dice with "
+      "the own plan's rays | rays' centre moved (mm) "
+      "|\n|---|---|---|---|---|---|---|---|---|---|\n");
   for (const Row& row : rows) {
     const bool all = row.planned && row.printable && row.rim_gap_mm <= kMaxRimGapMm &&
                      row.overlap_mm3 <= kMaxOverlapMm3 && row.dice >= kTargetDice;
     if (row.planned)
-      std::printf("| %s | yes | %s | %.2f | %.1f | %.3f | %s |\n", row.name.c_str(),
-                  row.printable ? "yes" : "no", row.rim_gap_mm, row.overlap_mm3, row.dice,
-                  all ? "yes" : "no");
+      std::printf("| %s | yes | %s | %.2f | %.1f | %.3f | %s | %.3f | %.3f | %.1f |\n",
+                  row.name.c_str(), row.printable ? "yes" : "no", row.rim_gap_mm, row.overlap_mm3,
+                  row.dice, all ? "yes" : "no", row.bone, row.same_rays_dice, row.centre_moved_mm);
     else
-      std::printf("| %s | no: %.120s | | | | | no |\n", row.name.c_str(), row.message.c_str());
+      std::printf("| %s | no: %.120s | | | | | no | %.3f | %.3f | |\n", row.name.c_str(),
+                  row.message.c_str(), row.bone, row.same_rays_dice);
     if (row.planned && !row.printable)
-      std::printf("|  | not printable: %.160s | | | | | |\n", row.why.c_str());
+      std::printf("|  | not printable: %.160s | | | | | | | | |\n", row.why.c_str());
   }
 }
 
