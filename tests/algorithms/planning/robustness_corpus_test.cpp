@@ -181,8 +181,8 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
     // gives 0). Meets the Dice target too. As measured; the table shows the rest.
     bool on_bone, meets_dice;
     // The own import's bone where the implant sits (bone_agreement ≥ kSameBone): planned with
-    // the own plan's rays it meets the Dice target — what follows where the rays start depends
-    // on the bone, not on its triangles (measured 0.929-0.988).
+    // the own plan's rays it meets the Dice target — all but where the rays start depends on
+    // the bone, not on its triangles (measured 0.929-0.988).
     bool same_bone;
   };
   const std::vector<Case> cases = {
