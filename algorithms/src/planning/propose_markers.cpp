@@ -108,6 +108,11 @@ double mirror_coverage(const DefectRegion& defect, const SurfaceLocator& mirror,
              : static_cast<double>(covered) / defect.hole_directions.size();
 }
 
+// How far from the opening the ring's bone carries support markers, mm.
+double support_band_mm(const ProposeParams& params) {
+  return params.surfaces.rim_clearance_mm + params.detect.support_width_mm;
+}
+
 // The fitted surfaces along each ring ray within `reach` of the opening (none further out, or
 // where the fit does not reach): the edge and the support markers both judge the ring's bone
 // by them, and mirror-guided each is a ray cast through the mirror.
@@ -210,7 +215,7 @@ void add_edge_markers(const DefectRegion& defect, const DefectSurfaces& surfaces
 void add_support_markers(const DefectSurfaces& surfaces, const std::vector<FittedPoints>& ring_fit,
                          const ProposeParams& params, int& id, std::vector<Marker>& out) {
   std::vector<Eigen::Vector3d> support_outer, support_inner;
-  const double band = params.surfaces.rim_clearance_mm + params.detect.support_width_mm;
+  const double band = support_band_mm(params);
   const double min_facing =
       std::cos(std::clamp(params.max_support_inner_tilt_deg, 0.0, 90.0) * M_PI / 180.0) - 1e-12;
   const double max_off = params.max_support_off_fit_mm;
@@ -291,9 +296,9 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
   }
   r.ring_rms_mm = surfaces.outer_rms_mm;
   int id = first_id;
-  const double support_band = params.surfaces.rim_clearance_mm + params.detect.support_width_mm;
   const std::vector<FittedPoints> ring_fit = fitted_along_ring(
-      defect, surfaces, std::max(params.surfaces.rim_clearance_mm + kEdgeRingReach, support_band));
+      defect, surfaces,
+      std::max(params.surfaces.rim_clearance_mm + kEdgeRingReach, support_band_mm(params)));
   add_edge_markers(defect, surfaces, ring_fit, params, id, r.markers);
   add_support_markers(surfaces, ring_fit, params, id, r.markers);
   add_surface_markers(defect, surfaces, guided ? MarkerSurface::Mirrored : MarkerSurface::Original,
