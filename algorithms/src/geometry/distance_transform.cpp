@@ -106,6 +106,11 @@ std::vector<float> distance_in(const std::vector<uint8_t>& mask, const VoxelGrid
               }
               for (int t = 0; t < w; ++t) {
                 T* l = &tile[t * static_cast<size_t>(n)];
+                // A line all of sites stays 0 and a line without one stays far (most lines of
+                // a grid around a thin implant): only the others need their envelope.
+                if (std::all_of(l, l + n, [&](T x) { return x == l[0]; }) &&
+                    (l[0] == T(0) || l[0] == far))
+                  continue;
                 for (int q = 0; q < n; ++q) line[q] = l[q];
                 lower_envelope(line.data(), out.data(), n, v, z);
                 for (int q = 0; q < n; ++q) l[q] = static_cast<T>(out[q]);
@@ -153,12 +158,26 @@ std::vector<float> distance_within(const std::vector<uint8_t>& mask, const Voxel
   const int nx = grid.dims[0], ny = grid.dims[1], nz = grid.dims[2];
   const size_t sy = static_cast<size_t>(nx), sz = sy * ny;
   const float capped = static_cast<float>(reach + 1) * static_cast<float>(reach + 1);
+  // What each row (along x) holds after a pass: kFull rows are all 0 (every voxel in the mask)
+  // and stay so, kEmpty rows are all capped; a window of kEmpty rows gives a capped row. Only
+  // the other rows, near the mask's surface, are summed: the same values as summing them all.
+  enum : uint8_t { kEmpty = 0, kFull = 1, kMixed = 2 };
+  auto kind_of = [capped](const float* row, int n) -> uint8_t {
+    bool zero = true, empty = true;
+    for (int i = 0; i < n; ++i) {
+      zero &= row[i] == 0.0f;
+      empty &= row[i] == capped;
+    }
+    return zero ? kFull : empty ? kEmpty : kMixed;
+  };
   std::vector<float> sq(mask.size());
+  std::vector<uint8_t> kind(static_cast<size_t>(ny) * nz);
   // Along x, and along y within each slice (slices on all threads).
   parallel_for(
       static_cast<size_t>(nz),
       [&](size_t first, size_t last) {
         std::vector<float> slice(sz);
+        std::vector<uint8_t> row_kind(static_cast<size_t>(ny));
         for (size_t k = first; k < last; ++k) {
           for (int j = 0; j < ny; ++j) {
             const uint8_t* in = &mask[k * sz + j * sy];
@@ -174,15 +193,25 @@ std::vector<float> distance_within(const std::vector<uint8_t>& mask, const Voxel
               const float g = std::min(out[i], static_cast<float>(gap));
               out[i] = g * g;
             }
+            row_kind[j] = kind_of(out, nx);
           }
           for (int j = 0; j < ny; ++j) {
             float* out = &sq[k * sz + j * sy];
-            std::fill(out, out + nx, capped);
-            for (int t = std::max(-reach, -j); t <= std::min(reach, ny - 1 - j); ++t) {
-              const float step = static_cast<float>(t * t);
-              const float* in = &slice[(j + t) * sy];
-              for (int i = 0; i < nx; ++i) out[i] = std::min(out[i], in[i] + step);
+            const int lo = std::max(-reach, -j), hi = std::min(reach, ny - 1 - j);
+            if (row_kind[j] == kFull) {
+              std::fill(out, out + nx, 0.0f);
+            } else if (std::all_of(&row_kind[j + lo], &row_kind[j + hi] + 1,
+                                   [](uint8_t r) { return r == kEmpty; })) {
+              std::fill(out, out + nx, capped);
+            } else {
+              std::fill(out, out + nx, capped);
+              for (int t = lo; t <= hi; ++t) {
+                const float step = static_cast<float>(t * t);
+                const float* in = &slice[(j + t) * sy];
+                for (int i = 0; i < nx; ++i) out[i] = std::min(out[i], in[i] + step);
+              }
             }
+            kind[k * static_cast<size_t>(ny) + j] = kind_of(out, nx);
           }
         }
       },
@@ -196,14 +225,26 @@ std::vector<float> distance_within(const std::vector<uint8_t>& mask, const Voxel
         std::vector<float> row(sy);
         for (size_t k = first; k < last; ++k)
           for (int j = 0; j < ny; ++j) {
-            std::fill(row.begin(), row.end(), capped);
+            float* out = &d[k * sz + j * sy];
             const int z = static_cast<int>(k);
-            for (int t = std::max(-reach, -z); t <= std::min(reach, nz - 1 - z); ++t) {
+            const int lo = std::max(-reach, -z), hi = std::min(reach, nz - 1 - z);
+            auto kind_at = [&](int t) { return kind[static_cast<size_t>(z + t) * ny + j]; };
+            if (kind_at(0) == kFull) {
+              std::fill(out, out + nx, static_cast<float>(grid.spacing * std::sqrt(0.0)));
+              continue;
+            }
+            bool empty = true;
+            for (int t = lo; t <= hi && empty; ++t) empty = kind_at(t) == kEmpty;
+            if (empty) {
+              std::fill(out, out + nx, std::numeric_limits<float>::infinity());
+              continue;
+            }
+            std::fill(row.begin(), row.end(), capped);
+            for (int t = lo; t <= hi; ++t) {
               const float step = static_cast<float>(t * t);
               const float* in = &sq[static_cast<size_t>(z + t) * sz + j * sy];
               for (int i = 0; i < nx; ++i) row[i] = std::min(row[i], in[i] + step);
             }
-            float* out = &d[k * sz + j * sy];
             for (int i = 0; i < nx; ++i)
               out[i] =
                   row[i] <= limit
@@ -222,10 +263,14 @@ std::vector<uint8_t> outside_of(const std::vector<uint8_t>& mask, const VoxelGri
   // The grid's outermost layer stands for the outside beyond it.
   const int nx = grid.dims[0], ny = grid.dims[1], nz = grid.dims[2];
   for (int k = 0; k < nz; ++k)
-    for (int j = 0; j < ny; ++j)
-      for (int i = 0; i < nx; ++i)
-        if (i == 0 || j == 0 || k == 0 || i == nx - 1 || j == ny - 1 || k == nz - 1)
-          out[grid.index(i, j, k)] = 1;
+    for (int j = 0; j < ny; ++j) {
+      uint8_t* row = &out[grid.index(0, j, k)];
+      if (k == 0 || j == 0 || k == nz - 1 || j == ny - 1) {
+        std::fill(row, row + nx, uint8_t{1});
+      } else {
+        row[0] = row[nx - 1] = 1;
+      }
+    }
   return out;
 }
 
@@ -299,9 +344,17 @@ std::vector<uint8_t> within_steps(const std::vector<uint8_t>& in, const VoxelGri
       held[row] = any;
     }
   });
-  auto relax = [cap](uint8_t& to, uint8_t from) {
-    const uint8_t v = static_cast<uint8_t>(std::min<int>(from + 1, cap));
-    if (v < to) to = v;
+  // Relaxes row `to` from its neighbour `from`; whether `to` now holds a value below the cap.
+  // A row is held only then: a row relaxed from a held row whose values all stayed at the cap
+  // holds nothing either, so the sweeps keep to the rows near the mask.
+  auto relax_row = [cap](uint8_t* to, const uint8_t* from, int n) -> uint8_t {
+    uint8_t low = cap;
+    for (int i = 0; i < n; ++i) {
+      const uint8_t v = static_cast<uint8_t>(std::min<int>(from[i] + 1, cap));
+      to[i] = std::min(to[i], v);
+      low = std::min(low, to[i]);
+    }
+    return low < cap;
   };
   // Along x: each row by itself; along y: row by row within a slice (slices on all threads).
   parallel_for(
@@ -313,19 +366,15 @@ std::vector<uint8_t> within_steps(const std::vector<uint8_t>& in, const VoxelGri
           for (int j = 0; j < ny; ++j) {
             if (!rows[j]) continue;
             uint8_t* row = slice + j * sy;
-            for (int i = 1; i < nx; ++i) relax(row[i], row[i - 1]);
-            for (int i = nx - 2; i >= 0; --i) relax(row[i], row[i + 1]);
+            for (int i = 1; i < nx; ++i)
+              row[i] = std::min(row[i], static_cast<uint8_t>(std::min<int>(row[i - 1] + 1, cap)));
+            for (int i = nx - 2; i >= 0; --i)
+              row[i] = std::min(row[i], static_cast<uint8_t>(std::min<int>(row[i + 1] + 1, cap)));
           }
-          for (int j = 1; j < ny; ++j) {
-            if (!rows[j - 1]) continue;
-            for (int i = 0; i < nx; ++i) relax(slice[j * sy + i], slice[(j - 1) * sy + i]);
-            rows[j] = 1;
-          }
-          for (int j = ny - 2; j >= 0; --j) {
-            if (!rows[j + 1]) continue;
-            for (int i = 0; i < nx; ++i) relax(slice[j * sy + i], slice[(j + 1) * sy + i]);
-            rows[j] = 1;
-          }
+          for (int j = 1; j < ny; ++j)
+            if (rows[j - 1]) rows[j] |= relax_row(slice + j * sy, slice + (j - 1) * sy, nx);
+          for (int j = ny - 2; j >= 0; --j)
+            if (rows[j + 1]) rows[j] |= relax_row(slice + j * sy, slice + (j + 1) * sy, nx);
         }
       },
       2);
@@ -335,18 +384,12 @@ std::vector<uint8_t> within_steps(const std::vector<uint8_t>& in, const VoxelGri
       [&](size_t first, size_t last) {
         for (size_t j = first; j < last; ++j) {
           auto row_held = [&](int k) -> uint8_t& { return held[k * static_cast<size_t>(ny) + j]; };
-          for (int k = 1; k < nz; ++k) {
-            if (!row_held(k - 1)) continue;
-            for (int i = 0; i < nx; ++i)
-              relax(d[k * sz + j * sy + i], d[(k - 1) * sz + j * sy + i]);
-            row_held(k) = 1;
-          }
-          for (int k = nz - 2; k >= 0; --k) {
-            if (!row_held(k + 1)) continue;
-            for (int i = 0; i < nx; ++i)
-              relax(d[k * sz + j * sy + i], d[(k + 1) * sz + j * sy + i]);
-            row_held(k) = 1;
-          }
+          for (int k = 1; k < nz; ++k)
+            if (row_held(k - 1))
+              row_held(k) |= relax_row(&d[k * sz + j * sy], &d[(k - 1) * sz + j * sy], nx);
+          for (int k = nz - 2; k >= 0; --k)
+            if (row_held(k + 1))
+              row_held(k) |= relax_row(&d[k * sz + j * sy], &d[(k + 1) * sz + j * sy], nx);
         }
       },
       2);

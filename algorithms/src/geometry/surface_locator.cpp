@@ -131,17 +131,23 @@ struct SurfaceLocator::Tree {
 
   const Eigen::Vector3d& corner(int face, int k) const { return points[faces[face][k]]; }
 
-  // Builds the subtree over order[first, first + count) at the end of `nodes`; returns its node
-  // index. A large tree's two halves are built on two threads (their own ranges of `order`),
+  // A face and its centroid, side by side: the partitions read the centroids in order instead
+  // of through the face numbers (the same comparisons, so the same partitions).
+  struct Item {
+    Eigen::Vector3f centroid;
+    int face;
+  };
+
+  // Builds the subtree over items[first, first + count) at the end of `nodes`; returns its node
+  // index. A large tree's two halves are built on two threads (their own ranges of `items`),
   // the right one's nodes then appended after the left's as one thread would have made them.
-  int build(std::vector<Node>& nodes, int first, int count,
-            const std::vector<Eigen::Vector3f>& centroids, int depth) {
+  int build(std::vector<Node>& nodes, int first, int count, std::vector<Item>& items, int depth) {
     const int index = static_cast<int>(nodes.size());
     nodes.emplace_back();
     if (count <= kLeafFaces || depth >= kMaxDepth - 2) {
       Box box;
       for (int i = first; i < first + count; ++i)
-        for (int k = 0; k < 3; ++k) box.add(corner(order[i], k));
+        for (int k = 0; k < 3; ++k) box.add(corner(items[i].face, k));
       nodes[index].box = box;
       nodes[index].first = first;
       nodes[index].count = count;
@@ -150,22 +156,21 @@ struct SurfaceLocator::Tree {
     Eigen::Vector3f lo = Eigen::Vector3f::Constant(std::numeric_limits<float>::max());
     Eigen::Vector3f hi = -lo;
     for (int i = first; i < first + count; ++i) {
-      lo = lo.cwiseMin(centroids[order[i]]);
-      hi = hi.cwiseMax(centroids[order[i]]);
+      lo = lo.cwiseMin(items[i].centroid);
+      hi = hi.cwiseMax(items[i].centroid);
     }
     int axis = 0;
     (hi - lo).maxCoeff(&axis);
     const int half = count / 2;
-    std::nth_element(order.begin() + first, order.begin() + first + half,
-                     order.begin() + first + count,
-                     [&](int a, int b) { return centroids[a][axis] < centroids[b][axis]; });
+    std::nth_element(
+        items.begin() + first, items.begin() + first + half, items.begin() + first + count,
+        [axis](const Item& a, const Item& b) { return a.centroid[axis] < b.centroid[axis]; });
     int left = 0, right = 0;
     if (depth == 0 && count >= kParallelFaces && thread_count() > 1) {
       std::vector<Node> right_nodes;
       right_nodes.reserve(nodes.capacity() / 2);
-      std::thread other(
-          [&] { build(right_nodes, first + half, count - half, centroids, depth + 1); });
-      left = build(nodes, first, half, centroids, depth + 1);
+      std::thread other([&] { build(right_nodes, first + half, count - half, items, depth + 1); });
+      left = build(nodes, first, half, items, depth + 1);
       other.join();
       right = static_cast<int>(nodes.size());
       for (Node n : right_nodes) {
@@ -173,8 +178,8 @@ struct SurfaceLocator::Tree {
         nodes.push_back(n);
       }
     } else {
-      left = build(nodes, first, half, centroids, depth + 1);
-      right = build(nodes, first + half, count - half, centroids, depth + 1);
+      left = build(nodes, first, half, items, depth + 1);
+      right = build(nodes, first + half, count - half, items, depth + 1);
     }
     Box box = nodes[left].box;
     box.add(nodes[right].box);
@@ -225,7 +230,7 @@ SurfaceLocator::SurfaceLocator(const SkullMesh& mesh) {
     }
   const int n = static_cast<int>(handle.empty() ? mesh.n_faces() : handle.size());
   tree->faces.resize(static_cast<size_t>(n));
-  std::vector<Eigen::Vector3f> centroids(n);
+  std::vector<Tree::Item> items(static_cast<size_t>(n));
   parallel_for(static_cast<size_t>(n), [&](size_t first, size_t last) {
     for (size_t i = first; i < last; ++i) {
       std::array<int, 3>& f = tree->faces[i];
@@ -236,14 +241,15 @@ SurfaceLocator::SurfaceLocator(const SkullMesh& mesh) {
         f[k++] = vh.idx();
       }
       const int face = static_cast<int>(i);
-      centroids[i] = ((tree->corner(face, 0) + tree->corner(face, 1) + tree->corner(face, 2)) / 3.0)
-                         .cast<float>();
+      items[i] = {((tree->corner(face, 0) + tree->corner(face, 1) + tree->corner(face, 2)) / 3.0)
+                      .cast<float>(),
+                  face};
     }
   });
-  tree->order.resize(n);
-  std::iota(tree->order.begin(), tree->order.end(), 0);
   tree->nodes.reserve(static_cast<size_t>(2 * n / kLeafFaces + 2));
-  if (n > 0) tree->build(tree->nodes, 0, n, centroids, 0);
+  if (n > 0) tree->build(tree->nodes, 0, n, items, 0);
+  tree->order.resize(n);
+  for (int i = 0; i < n; ++i) tree->order[i] = items[i].face;
   tree->nodes.shrink_to_fit();
   tree_ = std::move(tree);
 }

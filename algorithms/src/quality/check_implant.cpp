@@ -54,7 +54,15 @@ void measure_thin_material(const std::vector<uint8_t>& solid, const std::vector<
     q.taper_reach_mm = q.corner_reach_mm = -1.0;
     return;
   }
-  const std::vector<float> to_core = distance_to_mask(centres, grid);
+  // Only the thin voxels' distances to the core are asked: within the widest taper and corner
+  // allowed (and a millimetre) first, in full when one lies further (a refused plan's figure).
+  const double window = r + h + std::max(params.max_taper_mm, params.max_corner_mm) + 1.0;
+  std::vector<float> to_core = distance_to_mask(centres, grid, window);
+  for (size_t c = 0; c < solid.size(); ++c)
+    if (solid[c] && std::isinf(to_core[c])) {
+      to_core = distance_to_mask(centres, grid);
+      break;
+    }
   // An edge held a clearance off the bone tapers that much further from it.
   const double on_bone = on_bone_mm(params, h);
   size_t thin = 0, off_bone = 0;

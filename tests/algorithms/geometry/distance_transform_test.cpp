@@ -62,16 +62,15 @@ VoxelGrid test_grid(double spacing) {
   return g;
 }
 
-// Every value is the float of spacing·√(integer squared distance), as brute force gives it.
-TEST(DistanceTransform, IsExactOnGridsWiderThanItsTiles) {
-  const VoxelGrid g = test_grid(0.25);
-  const std::vector<uint8_t> mask = random_blobs(g, 5);
-  const std::vector<float> d = distance_to_mask(mask, g);
+// Every voxel's distance to the nearest voxel of `mask` by trying them all: the float of
+// spacing·√(integer squared distance).
+std::vector<float> brute_force_distances(const std::vector<uint8_t>& mask, const VoxelGrid& g) {
   std::vector<std::array<int, 3>> marked;
   for (int k = 0; k < g.dims[2]; ++k)
     for (int j = 0; j < g.dims[1]; ++j)
       for (int i = 0; i < g.dims[0]; ++i)
         if (mask[g.index(i, j, k)]) marked.push_back({i, j, k});
+  std::vector<float> d(g.size());
   for (int k = 0; k < g.dims[2]; ++k)
     for (int j = 0; j < g.dims[1]; ++j)
       for (int i = 0; i < g.dims[0]; ++i) {
@@ -81,9 +80,49 @@ TEST(DistanceTransform, IsExactOnGridsWiderThanItsTiles) {
               (i - m[0]) * (i - m[0]) + (j - m[1]) * (j - m[1]) + (k - m[2]) * (k - m[2]);
           if (best < 0 || d2 < best) best = d2;
         }
-        ASSERT_EQ(d[g.index(i, j, k)],
-                  static_cast<float>(g.spacing * std::sqrt(static_cast<double>(best))));
+        d[g.index(i, j, k)] = static_cast<float>(g.spacing * std::sqrt(static_cast<double>(best)));
       }
+  return d;
+}
+
+// One step of 6-neighbour dilation.
+std::vector<uint8_t> dilate(const std::vector<uint8_t>& in, const VoxelGrid& g) {
+  std::vector<uint8_t> out(in);
+  for (int k = 0; k < g.dims[2]; ++k)
+    for (int j = 0; j < g.dims[1]; ++j)
+      for (int i = 0; i < g.dims[0]; ++i) {
+        const int nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k},
+                              {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
+        for (const auto& n : nb)
+          if (n[0] >= 0 && n[1] >= 0 && n[2] >= 0 && n[0] < g.dims[0] && n[1] < g.dims[1] &&
+              n[2] < g.dims[2] && in[g.index(n[0], n[1], n[2])])
+            out[g.index(i, j, k)] = 1;
+      }
+  return out;
+}
+
+// The bounded transform gives the whole one's float within the bound and more beyond it;
+// returns how many voxels it left infinite.
+size_t expect_bounded_agrees(const std::vector<uint8_t>& mask, const VoxelGrid& g,
+                             const std::vector<float>& full, double bound) {
+  const std::vector<float> bounded = distance_to_mask(mask, g, bound);
+  size_t cut = 0;
+  for (size_t c = 0; c < g.size(); ++c) {
+    if (full[c] <= bound) {
+      EXPECT_EQ(bounded[c], full[c]) << c << " within " << bound;
+    } else {
+      EXPECT_GT(bounded[c], bound) << c << " within " << bound;
+      cut += std::isinf(bounded[c]);
+    }
+  }
+  return cut;
+}
+
+// Every value is the float of spacing·√(integer squared distance), as brute force gives it.
+TEST(DistanceTransform, IsExactOnGridsWiderThanItsTiles) {
+  const VoxelGrid g = test_grid(0.25);
+  const std::vector<uint8_t> mask = random_blobs(g, 5);
+  EXPECT_EQ(distance_to_mask(mask, g), brute_force_distances(mask, g));
 }
 
 // The sweeps give what `steps` 6-neighbour dilations give, of blobs and of three single voxels
@@ -93,24 +132,10 @@ TEST(DistanceTransform, WithinStepsIsRepeatedDilation) {
   std::vector<uint8_t> specks(g.size(), 0);
   specks[g.index(0, 0, 0)] = specks[g.index(30, 20, 3)] = specks[g.index(9, 15, 17)] = 1;
   for (const std::vector<uint8_t>& mask : {random_blobs(g, 7), specks}) {
-    auto dilate = [&](const std::vector<uint8_t>& in) {
-      std::vector<uint8_t> out(in);
-      for (int k = 0; k < g.dims[2]; ++k)
-        for (int j = 0; j < g.dims[1]; ++j)
-          for (int i = 0; i < g.dims[0]; ++i) {
-            const int nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k},
-                                  {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
-            for (const auto& n : nb)
-              if (n[0] >= 0 && n[1] >= 0 && n[2] >= 0 && n[0] < g.dims[0] && n[1] < g.dims[1] &&
-                  n[2] < g.dims[2] && in[g.index(n[0], n[1], n[2])])
-                out[g.index(i, j, k)] = 1;
-          }
-      return out;
-    };
     std::vector<uint8_t> grown = mask;
     for (int steps = 0; steps <= 20; ++steps) {
       EXPECT_EQ(within_steps(mask, g, steps), grown) << steps << " steps";
-      grown = dilate(grown);
+      grown = dilate(grown, g);
     }
   }
   EXPECT_EQ(within_steps(std::vector<uint8_t>(g.size(), 0), g, 3),
@@ -128,18 +153,9 @@ TEST(DistanceTransform, BoundedAgreesWithTheWholeTransformUpToItsBound) {
     const std::vector<float> full = distance_to_mask(mask, g);
     size_t cut = 0;
     for (const double bound : {0.0, 0.3, 0.75, 1.0, 1.6, 100.0}) {
-      const std::vector<float> bounded = distance_to_mask(mask, g, bound);
+      cut += expect_bounded_agrees(mask, g, full, bound);
       size_t near = 0, far = 0;
-      for (size_t c = 0; c < g.size(); ++c) {
-        if (full[c] <= bound) {
-          ASSERT_EQ(bounded[c], full[c]) << c << " within " << bound;
-          ++near;
-        } else {
-          ASSERT_GT(bounded[c], bound) << c << " within " << bound;
-          ++far;
-          cut += std::isinf(bounded[c]);
-        }
-      }
+      for (size_t c = 0; c < g.size(); ++c) (full[c] <= bound ? near : far) += 1;
       EXPECT_GT(near, 0u);
       if (bound < 10.0) {
         EXPECT_GT(far, 0u);
@@ -159,6 +175,38 @@ TEST(DistanceTransform, BoundedAgreesWithTheWholeTransformUpToItsBound) {
         removed += mask[c] && !opened[c];
       }
       EXPECT_GT(removed, 0u);
+    }
+  }
+}
+
+// Blobs, and two slabs of whole rows along x (k = 8, 9, and j = 4 for every k): a mask with
+// rows all inside it, rows far from it and rows through its surface, and its complement (the
+// outside a depth is measured to).
+std::vector<uint8_t> slabs_and_blobs(const VoxelGrid& g) {
+  std::vector<uint8_t> mask = random_blobs(g, 23);
+  for (int k = 0; k < g.dims[2]; ++k)
+    for (int j = 0; j < g.dims[1]; ++j)
+      for (int i = 0; i < g.dims[0]; ++i)
+        if (k == 8 || k == 9 || j == 4) mask[g.index(i, j, k)] = 1;
+  return mask;
+}
+
+// The passes skip the rows that lie all inside the mask or far from it: every value is still
+// brute force's float, the bounded transform the whole one's, the steps the dilations'.
+TEST(DistanceTransform, RowsAllInsideOrFarFromTheMaskAreExact) {
+  const VoxelGrid g = test_grid(0.25);
+  std::vector<uint8_t> slabs = slabs_and_blobs(g), outside(slabs.size());
+  for (size_t c = 0; c < slabs.size(); ++c) outside[c] = !slabs[c];
+  for (const std::vector<uint8_t>& mask : {slabs, outside}) {
+    const std::vector<float> full = distance_to_mask(mask, g);
+    EXPECT_EQ(full, brute_force_distances(mask, g));
+    size_t cut = 0;
+    for (const double bound : {0.3, 0.75, 1.6}) cut += expect_bounded_agrees(mask, g, full, bound);
+    EXPECT_GT(cut, 0u) << "the windows were used";
+    std::vector<uint8_t> grown = mask;
+    for (int steps = 0; steps <= 8; ++steps) {
+      EXPECT_EQ(within_steps(mask, g, steps), grown) << steps << " steps";
+      grown = dilate(grown, g);
     }
   }
 }

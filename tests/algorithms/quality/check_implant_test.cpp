@@ -108,6 +108,10 @@ TEST(CheckImplant, ATaperedEdgeOnTheBoneIsPrintableUpToItsWidth) {
   const QualityReport sharp = check_implant(wedge(15, 0), &bone);
   expect_reach(sharp.taper_reach_mm, 15);
   EXPECT_TRUE(has_reason(sharp, "its edge stays thinner than 1.00 mm"));
+  // A 10° wedge's taper (5.2 mm) reaches past the distances the check first takes (as far as
+  // the widest taper and corner allowed, and a millimetre): it is measured in full.
+  const QualityReport sharper = check_implant(wedge(10, 0), &bone);
+  EXPECT_NEAR(sharper.taper_reach_mm, r / std::sin(5.0 * M_PI / 180) - r, 0.4);
 
   // A 30° wedge: on the bone its taper (1.4 mm) is printable; 5 mm above the bone its thin tip
   // is a sharp corner, not an edge resting on the bone (at most 0.8 mm: 45° and more).
