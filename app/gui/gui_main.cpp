@@ -1,13 +1,15 @@
 // cranioplan [MESH|VOLUME|SESSION] [--sample] [--units U] [--step N] [--screenshot OUT.png]
-// [--thickness-map] [--mould] [--report OUT.html] [--pauses] [--quit]
+// [--thickness-map] [--mould] [--report OUT.html] [--pauses] [--turn N] [--quit]
 #include <QApplication>
 #include <QCheckBox>
 #include <QCommandLineParser>
 #include <QFileInfo>
 #include <QStatusBar>
 #include <QTimer>
+#include <algorithm>
 #include <cstdio>
 #include <memory>
+#include <vector>
 
 #include "cranioplan/algorithms/geometry/huge_pages.h"
 #include "main_window.h"
@@ -47,8 +49,13 @@ int main(int argc, char** argv) {
       "pauses",
       "when quitting, print the window's longest pauses (the GUI thread held) and when the "
       "first picture of the skull was drawn");
+  const QCommandLineOption turn(
+      "turn",
+      "turn the view once around in N frames with the camera moving (the coarse copies a drag "
+      "draws) and in 3 at rest, and print each way's frame times",
+      "N");
   parser.addOptions({sample, units, step, screenshot, quit, view, layout, window_preset, thickness,
-                     mould, report, pauses});
+                     mould, report, pauses, turn});
   parser.process(app);
 
   cranioplan::gui::MainWindow window;
@@ -130,7 +137,27 @@ int main(int argc, char** argv) {
     const QString w = parser.value(window_preset).toLower();
     window.slices().apply_preset(w == "brain" ? P::Brain : w == "soft" ? P::SoftTissue : P::Bone);
   }
-  if (parser.isSet(report)) {
+  if (parser.isSet(turn)) {
+    const int frames = std::max(1, parser.value(turn).toInt());
+    QTimer::singleShot(300, &window, [&window, frames, automated, ok, &failed] {
+      auto median = [](std::vector<double> v) {
+        std::sort(v.begin(), v.end());
+        return v.empty() ? 0.0 : v[v.size() / 2];
+      };
+      auto longest = [](const std::vector<double>& v) {
+        return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end());
+      };
+      std::vector<double> moving = window.view().time_turn(frames, true);
+      const double copies = moving.empty() ? 0.0 : moving.front();
+      if (!moving.empty()) moving.erase(moving.begin());
+      const std::vector<double> still = window.view().time_turn(3, false);
+      std::printf(
+          "turning the view: moving %d frames, median %.0f ms, longest %.0f ms (coarse copies "
+          "made in %.0f ms); at rest 3 frames, median %.0f ms, longest %.0f ms\n",
+          frames, median(moving), longest(moving), copies, median(still), longest(still));
+      if (automated) QApplication::exit(ok && !failed ? 0 : 3);
+    });
+  } else if (parser.isSet(report)) {
     const QString out = parser.value(report);
     QTimer::singleShot(300, &window, [&window, out, automated, &ok] {
       const bool written = window.write_design_report(out);

@@ -80,6 +80,17 @@ class SkullView : public QOpenGLWidget {
   /// How many stretches of the rim no ray saw are drawn (the last proposal's).
   int unseen_rim_shown() const;
 
+  /// While the camera moves, meshes of more than 150,000 triangles are drawn from coarse copies
+  /// (vertex clustering, 1.5 mm): a drag or a wheel turn sets it, and it ends 250 ms after
+  /// the camera stops.
+  void set_moving(bool moving);
+  /// Draws `frames` frames turning the camera once around, moving (the coarse copies) or at
+  /// rest, and gives each one's time in ms; moving, the first entry is the time taken to make
+  /// the coarse copies (none when they were made already). `cranioplan --turn N`.
+  std::vector<double> time_turn(int frames, bool moving);
+  /// How many meshes are drawn from their coarse copies now.
+  int coarse_layers_drawn() const;
+
   /// Where a world point shows in the widget (logical pixels), if in front of the camera.
   std::optional<QPoint> project(const Eigen::Vector3d& world);
   /// The surface point under a widget position, on the given surface.

@@ -623,6 +623,67 @@ TEST(WizardFirstPicture, TheViewSaysOnceWhenItFirstDrawsTheSkull) {
   EXPECT_GT(seconds_since_start(), age);
 }
 
+// While the camera is dragged round, the skull and its mirror (more than 150,000 triangles
+// each) are drawn from coarse copies, the mirror's the skull's own copy reflected: the same
+// silhouette and the same light, in a fraction of a software renderer's time. 250 ms after
+// the drag ends they are drawn whole again.
+TEST(WizardMoving, ADraggedViewDrawsLargeMeshesCoarseUntilItStops) {
+  test::TempDir tmp;
+  const std::string path = tmp.path("head.stl");
+  const SkullMesh head = test::make_symmetric_head(7);
+  ASSERT_GT(head.n_faces(), 150000u);
+  write_mesh(head, path);
+  MainWindow w;
+  ASSERT_TRUE(shown(w, QSize(1280, 800)));
+  w.open_input(QString::fromStdString(path));
+  w.controller().wait();
+  ASSERT_TRUE(w.controller().push(commands::fit_plane()));
+  w.controller().wait();
+  ASSERT_TRUE(w.controller().push(commands::mirror()));
+  w.controller().wait();
+  ASSERT_TRUE(w.controller().state().mirrored);
+  SkullView& view = w.view();
+  view.set_standard_view(SkullView::StandardView::Left);
+  view.update();
+  QTest::qWait(100);
+  EXPECT_EQ(view.coarse_layers_drawn(), 0);
+  const QImage still = view.grabFramebuffer().convertToFormat(QImage::Format_RGB32);
+
+  // A press and a few moves that turn the camera by nothing measurable, the button still down.
+  const QPoint at(view.width() / 2, view.height() / 2);
+  mouse(&view, QEvent::MouseButtonPress, at, Qt::LeftButton);
+  for (int k = 1; k <= 3; ++k) mouse(&view, QEvent::MouseMove, at, Qt::LeftButton);
+  EXPECT_EQ(view.coarse_layers_drawn(), 2) << "the skull and its mirror";
+  const QImage moving = view.grabFramebuffer().convertToFormat(QImage::Format_RGB32);
+  // The same head in both: where it covers the background, and how bright it is.
+  const QRgb background = still.pixel(2, 2);
+  auto on_head = [background](QRgb p) {
+    return std::abs(qRed(p) - qRed(background)) + std::abs(qGreen(p) - qGreen(background)) +
+               std::abs(qBlue(p) - qBlue(background)) >
+           60;
+  };
+  long long head_px = 0, disagree = 0;
+  double bright_still = 0.0, bright_moving = 0.0;
+  for (int y = 0; y < still.height(); ++y)
+    for (int x = 0; x < still.width(); ++x) {
+      const QRgb a = still.pixel(x, y), b = moving.pixel(x, y);
+      disagree += on_head(a) != on_head(b);
+      if (on_head(a) && on_head(b)) {
+        ++head_px;
+        bright_still += qGray(a);
+        bright_moving += qGray(b);
+      }
+    }
+  ASSERT_GT(head_px, 50000);
+  EXPECT_LT(static_cast<double>(disagree) / head_px, 0.03) << "the coarse copies' silhouette";
+  EXPECT_NEAR(bright_moving / bright_still, 1.0, 0.15) << "lit from the same side";
+
+  mouse(&view, QEvent::MouseButtonRelease, at, Qt::NoButton);
+  EXPECT_EQ(view.coarse_layers_drawn(), 2) << "until the camera has stopped a while";
+  QTest::qWait(500);
+  EXPECT_EQ(view.coarse_layers_drawn(), 0);
+}
+
 TEST(WizardOrientation, TheCubeShowsTheFaceTheCameraLooksAt) {
   test::TempDir tmp;
   const std::string path = tmp.path("head.stl");
