@@ -684,6 +684,33 @@ TEST(WizardMoving, ADraggedViewDrawsLargeMeshesCoarseUntilItStops) {
   EXPECT_EQ(view.coarse_layers_drawn(), 0);
 }
 
+// `cranioplan --turn N` turns the view once around, moving and at rest, and prints both ways'
+// frame times (docs/BENCHMARKS.md); the view ends where it began, drawn whole.
+TEST(WizardMoving, TheCommandLineTimesATurnOfTheView) {
+  test::TempDir tmp;
+  const std::string path = tmp.path("head.stl");
+  write_mesh(test::make_symmetric_head(7), path);
+  std::string out;
+  ASSERT_EQ(test::run_command(std::string(CRANIOPLAN_GUI) + " " + path + " --turn 4 --quit", &out),
+            0)
+      << out;
+  const size_t at = out.find("turning the view: moving 4 frames, median ");
+  ASSERT_NE(at, std::string::npos) << out;
+  double moving = 0, longest = 0, copies = 0, still = 0, still_longest = 0;
+  ASSERT_EQ(std::sscanf(out.c_str() + at,
+                        "turning the view: moving 4 frames, median %lf ms, longest %lf ms "
+                        "(coarse copies made in %lf ms); at rest 3 frames, median %lf ms, "
+                        "longest %lf ms",
+                        &moving, &longest, &copies, &still, &still_longest),
+            5)
+      << out;
+  EXPECT_GT(moving, 0.0);
+  EXPECT_GE(longest, moving);
+  EXPECT_GT(copies, 0.0) << "the head has more triangles than are drawn whole while moving";
+  EXPECT_GT(still, 0.0);
+  EXPECT_GE(still_longest, still);
+}
+
 TEST(WizardOrientation, TheCubeShowsTheFaceTheCameraLooksAt) {
   test::TempDir tmp;
   const std::string path = tmp.path("head.stl");
