@@ -145,7 +145,8 @@ struct MeshLayer {
       mapper->SetInputData(poly);
       shown = mesh;
       reversed = reflection_of != nullptr;
-      actor->SetMapper(mapper);  // a coarse copy is of the mesh shown before
+      actor->SetMapper(mapper);  // a coarse copy is of the mesh shown before, which may go:
+      coarse_of = nullptr;       // its address is no name for it once another is shown
     }
     // The owner may be new with the same mesh (the mirror moved): its locator answers now.
     locator = mesh_locator;
@@ -159,6 +160,7 @@ struct MeshLayer {
       shown = key;
       reversed = false;
       actor->SetMapper(mapper);
+      coarse_of = nullptr;
     }
     locator = nullptr;
     keep = std::move(owner);
@@ -374,7 +376,6 @@ struct SkullView::Impl {
   bool skull_drawn = false;  // a frame with the skull has been drawn
   // While the camera moves (a drag, a wheel turn) the large meshes are drawn coarse; 250 ms
   // after it stops they are drawn whole again.
-  bool moving = false;
   QTimer settle;
   Eigen::Vector3d center = Eigen::Vector3d::Zero();
   double radius = 100.0;
@@ -682,7 +683,6 @@ void SkullView::show_state(const PlanState& s) {
 
 void SkullView::set_moving(bool moving) {
   Impl& d = *d_;
-  d.moving = moving;
   // The implant, what the plan is about, is always drawn whole. Depth peeling (the translucent
   // mirror's true colours) is left for the frames at rest: under llvmpipe it doubles a coarse
   // frame (125 against 60 ms); blended without it the mirror shows paler while moving.
