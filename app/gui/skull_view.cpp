@@ -374,9 +374,10 @@ struct SkullView::Impl {
   QPoint press_pos;
   bool moved = false;
   bool skull_drawn = false;  // a frame with the skull has been drawn
-  // While the camera moves (a drag, a wheel turn) the large meshes are drawn coarse; 250 ms
-  // after it stops they are drawn whole again.
+  // While the camera moves (a drag, a wheel turn) or a marker or handle is dragged, the large
+  // meshes are drawn coarse; 250 ms after it stops they are drawn whole again.
   QTimer settle;
+  bool dragging = false;  // a marker or a handle is being dragged
   Eigen::Vector3d center = Eigen::Vector3d::Zero();
   double radius = 100.0;
 
@@ -1084,6 +1085,14 @@ void SkullView::mouseMoveEvent(QMouseEvent* e) {
   Impl& d = *d_;
   const QPoint pos = e->position().toPoint();
   if ((pos - d.press_pos).manhattanLength() > 3) d.moved = true;
+  // A marker or a handle dragged redraws the scene at every move, as a turn of the camera
+  // does: the large meshes are drawn coarse until the drop (the drag picks on the plan's own
+  // surfaces, not on what is drawn).
+  if ((d.drag_id || d.handle_id) && d.moved && !d.dragging) {
+    d.dragging = true;
+    d.settle.stop();
+    set_moving(true);
+  }
   if (d.drag_id) {
     if (!d.moved) return;
     const Marker* m = nullptr;
@@ -1125,6 +1134,10 @@ void SkullView::mouseMoveEvent(QMouseEvent* e) {
 void SkullView::mouseReleaseEvent(QMouseEvent* e) {
   Impl& d = *d_;
   const QPoint pos = e->position().toPoint();
+  if (d.dragging) {
+    d.dragging = false;
+    d.settle.start();
+  }
   if (d.drag_id) {
     const int id = d.drag_id;
     const std::optional<Eigen::Vector3d> to = d.drag_to;

@@ -81,8 +81,8 @@ class SkullView : public QOpenGLWidget {
   int unseen_rim_shown() const;
 
   /// While the camera moves, meshes of more than 150,000 triangles are drawn from coarse copies
-  /// (vertex clustering, 1.5 mm): a drag or a wheel turn sets it, and it ends 250 ms after
-  /// the camera stops.
+  /// (quadric clustering, 3 mm): a drag of the camera, a wheel turn or a drag of a marker or
+  /// handle sets it, and it ends 250 ms after the camera stops or the drop.
   void set_moving(bool moving);
   /// Draws `frames` frames turning the camera once around, moving (the coarse copies) or at
   /// rest, and gives each one's time in ms; moving, the first entry is the time taken to make

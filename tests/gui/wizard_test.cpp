@@ -1027,6 +1027,7 @@ TEST(WizardMarkers, DragsInAFittedPlanQueueOffTheGuiThread) {
     longest_move_ms = std::max(longest_move_ms, clock.elapsed());
   }
   EXPECT_EQ(plan.session().index(), index) << "no command while the marker is dragged";
+  EXPECT_EQ(w.view().coarse_layers_drawn(), 2) << "the skull and the mirror, while dragged";
   clock.start();
   mouse(&w.view(), QEvent::MouseButtonRelease, drags[0].to, Qt::NoButton);
   std::printf("drag on the GUI thread: longest mouse move %lld ms, release %lld ms\n",
@@ -1056,6 +1057,8 @@ TEST(WizardMarkers, DragsInAFittedPlanQueueOffTheGuiThread) {
   plan.wait();
 
   EXPECT_EQ(plan.session().index(), index + 2) << "two moves, one command each";
+  QTest::qWait(400);
+  EXPECT_EQ(w.view().coarse_layers_drawn(), 0) << "drawn whole once the drags are over";
   EXPECT_EQ(&plan.shown_state(), &plan.state());
   EXPECT_LT((position(plan.state(), a) - dropped_a).norm(), 1e-9);
   EXPECT_LT((position(plan.state(), b) - dropped_b).norm(), 1e-9);
