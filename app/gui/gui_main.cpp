@@ -147,6 +147,7 @@ int main(int argc, char** argv) {
       auto longest = [](const std::vector<double>& v) {
         return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end());
       };
+      window.view().wait_for_coarse_copies();  // as after a moment's pause, made on a worker
       std::vector<double> moving = window.view().time_turn(frames, true);
       const double copies = moving.empty() ? 0.0 : moving.front();
       if (!moving.empty()) moving.erase(moving.begin());

@@ -39,10 +39,12 @@
 
 #include <Eigen/Geometry>
 #include <QElapsedTimer>
+#include <QFutureWatcher>
 #include <QMouseEvent>
 #include <QSurfaceFormat>
 #include <QTimer>
 #include <QWheelEvent>
+#include <QtConcurrent/QtConcurrent>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -109,6 +111,29 @@ vtkSmartPointer<vtkPolyData> reversed_winding(vtkPolyData* source) {
   out->SetPoints(source->GetPoints());
   out->SetPolys(cells);
   out->GetPointData()->SetNormals(source->GetPointData()->GetNormals());
+  return out;
+}
+
+// A coarse copy of a large mesh for the frames drawn while the camera moves: VTK's quadric
+// clustering on a grid of `cell_mm`, with normals from its winding (turned, with the winding
+// back, for a mesh whose triangles are wound against their normals: reversed_winding).
+vtkSmartPointer<vtkPolyData> coarse_copy(vtkPolyData* full, double cell_mm, bool reversed) {
+  double b[6];
+  full->GetBounds(b);
+  vtkNew<vtkQuadricClustering> cluster;
+  cluster->SetInputData(full);
+  cluster->SetNumberOfDivisions(std::max(2, static_cast<int>(std::ceil((b[1] - b[0]) / cell_mm))),
+                                std::max(2, static_cast<int>(std::ceil((b[3] - b[2]) / cell_mm))),
+                                std::max(2, static_cast<int>(std::ceil((b[5] - b[4]) / cell_mm))));
+  cluster->AutoAdjustNumberOfDivisionsOff();
+  vtkNew<vtkPolyDataNormals> normals;
+  normals->SetInputConnection(cluster->GetOutputPort());
+  normals->SplittingOff();
+  normals->ConsistencyOff();
+  normals->AutoOrientNormalsOff();
+  normals->SetFlipNormals(reversed);
+  normals->Update();
+  vtkSmartPointer<vtkPolyData> out = normals->GetOutput();
   return out;
 }
 
@@ -189,10 +214,11 @@ struct MeshLayer {
   bool visible() const { return shown && actor->GetVisibility(); }
 
   // While the camera moves, a mesh of more than kCoarseAbove triangles is drawn from a coarse
-  // copy (VTK's quadric clustering on a grid of kCoarseCellMm, made at the first move after
-  // the mesh changed; a reflection of another layer's mesh reverses that layer's copy, as the
-  // mesh itself is shared): under Mesa's software renderer the sample's skull and translucent
-  // mirror take 0.3–0.5 s a frame, their coarse copies (about 60,000 triangles each) a tenth.
+  // copy (coarse_copy, given by set_coarse when made on a worker, else made at the first move
+  // after the mesh changed; a reflection of another layer's mesh reverses that layer's copy,
+  // as the mesh itself is shared): under Mesa's software renderer the sample's skull and
+  // translucent mirror take 0.3–0.5 s a frame, their coarse copies (about 60,000 triangles
+  // each) a quarter of that.
   static constexpr vtkIdType kCoarseAbove = 150000;
   static constexpr double kCoarseCellMm = 3.0;
   vtkNew<vtkPolyDataMapper> coarse_mapper;
@@ -210,32 +236,19 @@ struct MeshLayer {
           reversed && reflection_of && reflection_of->coarse_of == shown
               ? vtkPolyData::SafeDownCast(reflection_of->coarse_mapper->GetInput())
               : nullptr;
-      if (shared) {
-        coarse_mapper->SetInputData(reversed_winding(shared));
-      } else {
-        double b[6];
-        full->GetBounds(b);
-        vtkNew<vtkQuadricClustering> cluster;
-        cluster->SetInputData(full);
-        cluster->SetNumberOfDivisions(
-            std::max(2, static_cast<int>(std::ceil((b[1] - b[0]) / kCoarseCellMm))),
-            std::max(2, static_cast<int>(std::ceil((b[3] - b[2]) / kCoarseCellMm))),
-            std::max(2, static_cast<int>(std::ceil((b[5] - b[4]) / kCoarseCellMm))));
-        cluster->AutoAdjustNumberOfDivisionsOff();
-        vtkNew<vtkPolyDataNormals> normals;
-        normals->SetInputConnection(cluster->GetOutputPort());
-        normals->SplittingOff();
-        normals->ConsistencyOff();
-        normals->AutoOrientNormalsOff();
-        normals->SetFlipNormals(reversed);  // turns the winding back, and the normals out
-        normals->Update();
-        coarse_mapper->SetInputData(normals->GetOutput());
-      }
+      coarse_mapper->SetInputData(shared ? reversed_winding(shared)
+                                         : coarse_copy(full, kCoarseCellMm, reversed));
       coarse_mapper->ScalarVisibilityOff();
       coarse_of = shown;
     }
     coarse_mapper->SetClippingPlanes(mapper->GetClippingPlanes());
     actor->SetMapper(coarse_mapper);
+  }
+  /// The coarse copy of the mesh shown, made elsewhere (on a worker, before the first move).
+  void set_coarse(vtkPolyData* copy) {
+    coarse_mapper->SetInputData(copy);
+    coarse_mapper->ScalarVisibilityOff();
+    coarse_of = shown;
   }
 };
 
@@ -378,6 +391,11 @@ struct SkullView::Impl {
   // meshes are drawn coarse; 250 ms after it stops they are drawn whole again.
   QTimer settle;
   bool dragging = false;  // a marker or a handle is being dragged
+  // The skull's coarse copy is made on a worker as soon as a large skull is shown, so the
+  // first move does not wait for it; `skull_generation` counts the meshes the skull layer
+  // has shown, and a copy is taken only for the mesh it was made of.
+  int skull_generation = 0;
+  QFutureWatcher<std::pair<int, vtkSmartPointer<vtkPolyData>>> coarse_watcher;
   Eigen::Vector3d center = Eigen::Vector3d::Zero();
   double radius = 100.0;
 
@@ -418,6 +436,7 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
     set_moving(false);
     update();
   });
+  connect(&d.coarse_watcher, &QFutureWatcherBase::finished, this, [this] { take_coarse_copy(); });
   vtkNew<vtkCallbackCommand> on_move;
   on_move->SetClientData(this);
   on_move->SetCallback([](vtkObject*, unsigned long event, void* self, void*) {
@@ -587,9 +606,21 @@ void SkullView::paintGL() {
 void SkullView::show_state(const PlanState& s) {
   Impl& d = *d_;
   const bool had_skull = d.skull.shown != nullptr;
+  const void* skull_before = d.skull.shown;
   d.skull.show(s.skull ? &s.skull->surface->mesh : nullptr,
                s.skull ? std::shared_ptr<const void>(s.skull) : nullptr,
                s.skull ? &s.skull->surface->locator : nullptr);
+  if (d.skull.shown != skull_before) {
+    ++d.skull_generation;
+    if (s.skull && s.skull->surface->mesh.n_faces() > MeshLayer::kCoarseAbove) {
+      std::shared_ptr<const SkullInput> skull = s.skull;  // kept alive for the worker
+      d.coarse_watcher.setFuture(QtConcurrent::run([skull, generation = d.skull_generation] {
+        const vtkSmartPointer<vtkPolyData> full = to_polydata(skull->surface->mesh);
+        return std::make_pair(generation,
+                              coarse_copy(full, MeshLayer::kCoarseCellMm, /*reversed=*/false));
+      }));
+    }
+  }
   d.mirror.show(s.mirrored ? &s.mirrored->skull->mesh : nullptr, s.mirrored,
                 s.mirrored ? &s.mirrored->locator : nullptr, &d.skull);
   if (s.mirrored) d.mirror.set_motion(s.mirrored->placement);
@@ -680,6 +711,21 @@ void SkullView::show_state(const PlanState& s) {
   }
   if (!s.skull) d.camera_set = false;
   update();
+}
+
+void SkullView::take_coarse_copy() {
+  Impl& d = *d_;
+  if (d.coarse_watcher.future().isCanceled() || !d.coarse_watcher.isFinished() ||
+      d.coarse_watcher.future().resultCount() == 0)
+    return;
+  const auto [generation, copy] = d.coarse_watcher.result();
+  if (generation == d.skull_generation && d.skull.coarse_of != d.skull.shown)
+    d.skull.set_coarse(copy);
+}
+
+void SkullView::wait_for_coarse_copies() {
+  d_->coarse_watcher.waitForFinished();
+  take_coarse_copy();
 }
 
 void SkullView::set_moving(bool moving) {

@@ -90,6 +90,9 @@ class SkullView : public QOpenGLWidget {
   std::vector<double> time_turn(int frames, bool moving);
   /// How many meshes are drawn from their coarse copies now.
   int coarse_layers_drawn() const;
+  /// Waits for the skull's coarse copy, made on a worker when a large skull is shown (else
+  /// the first move makes it).
+  void wait_for_coarse_copies();
 
   /// Where a world point shows in the widget (logical pixels), if in front of the camera.
   std::optional<QPoint> project(const Eigen::Vector3d& world);
@@ -121,6 +124,8 @@ class SkullView : public QOpenGLWidget {
  private:
   /// A press or release of a mouse button, handed to VTK's interactor (camera control).
   void forward_button(QMouseEvent* event, bool press);
+  /// Takes the worker's coarse copy of the skull, if it is done and of the skull shown.
+  void take_coarse_copy();
 
   struct Impl;
   std::unique_ptr<Impl> d_;
