@@ -56,7 +56,8 @@ namespace cranioplan::gui {
 
 namespace {
 
-vtkSmartPointer<vtkPolyData> to_polydata(const SkullMesh& mesh) {
+// The mesh's points and triangles.
+vtkSmartPointer<vtkPolyData> bare_polydata(const SkullMesh& mesh) {
   vtkNew<vtkPoints> points;
   points->SetDataTypeToDouble();
   points->SetNumberOfPoints(static_cast<vtkIdType>(mesh.n_vertices()));
@@ -76,11 +77,16 @@ vtkSmartPointer<vtkPolyData> to_polydata(const SkullMesh& mesh) {
     }
     if (k == 3) triangles->InsertNextCell(3, ids);
   }
-  vtkNew<vtkPolyData> poly;
+  auto poly = vtkSmartPointer<vtkPolyData>::New();
   poly->SetPoints(points);
   poly->SetPolys(triangles);
+  return poly;
+}
+
+// The same with point normals, for drawing.
+vtkSmartPointer<vtkPolyData> to_polydata(const SkullMesh& mesh) {
   vtkNew<vtkPolyDataNormals> normals;
-  normals->SetInputData(poly);
+  normals->SetInputData(bare_polydata(mesh));
   normals->SplittingOff();
   normals->ConsistencyOff();
   normals->AutoOrientNormalsOff();
@@ -116,7 +122,8 @@ vtkSmartPointer<vtkPolyData> reversed_winding(vtkPolyData* source) {
 
 // A coarse copy of a large mesh for the frames drawn while the camera moves: VTK's quadric
 // clustering on a grid of `cell_mm`, with normals from its winding (turned, with the winding
-// back, for a mesh whose triangles are wound against their normals: reversed_winding).
+// back, for a mesh whose triangles are wound against their normals: reversed_winding). The
+// clustering reads the points and triangles only, not the point data.
 vtkSmartPointer<vtkPolyData> coarse_copy(vtkPolyData* full, double cell_mm, bool reversed) {
   double b[6];
   full->GetBounds(b);
@@ -236,10 +243,7 @@ struct MeshLayer {
           reversed && reflection_of && reflection_of->coarse_of == shown
               ? vtkPolyData::SafeDownCast(reflection_of->coarse_mapper->GetInput())
               : nullptr;
-      coarse_mapper->SetInputData(shared ? reversed_winding(shared)
-                                         : coarse_copy(full, kCoarseCellMm, reversed));
-      coarse_mapper->ScalarVisibilityOff();
-      coarse_of = shown;
+      set_coarse(shared ? reversed_winding(shared) : coarse_copy(full, kCoarseCellMm, reversed));
     }
     coarse_mapper->SetClippingPlanes(mapper->GetClippingPlanes());
     actor->SetMapper(coarse_mapper);
@@ -615,7 +619,8 @@ void SkullView::show_state(const PlanState& s) {
     if (s.skull && s.skull->surface->mesh.n_faces() > MeshLayer::kCoarseAbove) {
       std::shared_ptr<const SkullInput> skull = s.skull;  // kept alive for the worker
       d.coarse_watcher.setFuture(QtConcurrent::run([skull, generation = d.skull_generation] {
-        const vtkSmartPointer<vtkPolyData> full = to_polydata(skull->surface->mesh);
+        // The drawn copy's normals are of no use to the clustering.
+        const vtkSmartPointer<vtkPolyData> full = bare_polydata(skull->surface->mesh);
         return std::make_pair(generation,
                               coarse_copy(full, MeshLayer::kCoarseCellMm, /*reversed=*/false));
       }));
