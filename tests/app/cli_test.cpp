@@ -54,26 +54,47 @@ TEST(Cli, InfoPlaneMirrorRegisterOnASyntheticHead) {
   EXPECT_LT(reg["rms_mm"].get<double>(), 0.1);
 }
 
-// The programs start themselves again with malloc in transparent huge pages (huge_pages.h);
-// that changes the allocations, not the arithmetic: a CT's surface is the same bytes with it
-// (the default), without it (CRANIOPLAN_HUGE_PAGES=0) and with a user's own GLIBC_TUNABLES.
+// The programs run with malloc in transparent huge pages (huge_pages.h): started by their
+// launchers (what bin holds, the CLI kCli names) or starting themselves again when run directly.
+// That changes the allocations, not the arithmetic: a CT's surface is the same bytes through the
+// launcher (the default), from the program itself, without huge pages (CRANIOPLAN_HUGE_PAGES=0)
+// and with a user's own GLIBC_TUNABLES.
 TEST(Cli, HugePagesChangeNoByte) {
   test::TempDir dir;
   test::write_nrrd(test::oblique_ball_volume({-5, 12, 40}), dir.path("ct.nrrd"), true);
+  const std::string program = CRANIOPLAN_CLI_PROGRAM;
   const std::vector<std::pair<std::string, std::string>> runs = {
-      {"", "default.stl"},
-      {"env CRANIOPLAN_HUGE_PAGES=0 ", "off.stl"},
-      {"env GLIBC_TUNABLES=glibc.malloc.hugetlb=0 ", "own.stl"}};
+      {kCli, "default.stl"},
+      {program, "direct.stl"},
+      {"env CRANIOPLAN_HUGE_PAGES=0 " + kCli, "off.stl"},
+      {"env GLIBC_TUNABLES=glibc.malloc.hugetlb=0 " + kCli, "own.stl"}};
   std::string out;
-  for (const auto& [env, name] : runs)
+  for (const auto& [command, name] : runs)
     ASSERT_EQ(test::run_command(
-                  env + kCli + " import-ct " + dir.path("ct.nrrd") + " -o " + dir.path(name), &out),
+                  command + " import-ct " + dir.path("ct.nrrd") + " -o " + dir.path(name), &out),
               0)
-        << env << out;
+        << command << out;
   const std::string with = test::read_bytes(dir.path("default.stl"));
   EXPECT_GT(with.size(), 1000u);
+  EXPECT_EQ(with, test::read_bytes(dir.path("direct.stl")));
   EXPECT_EQ(with, test::read_bytes(dir.path("off.stl")));
   EXPECT_EQ(with, test::read_bytes(dir.path("own.stl")));
+}
+
+// The launcher passes its arguments and exit code through, and says so when the program it
+// starts is missing (a partial installation) instead of failing silently.
+TEST(Cli, TheLauncherStartsTheProgramOrSaysWhatIsMissing) {
+  std::string out;
+  EXPECT_EQ(test::run_command(kCli + " --version", &out), 0);
+  EXPECT_NE(out.find("cranioplan-cli"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(kCli + " frobnicate"), 2);
+  test::TempDir dir;
+  const std::filesystem::path lone = std::filesystem::path(dir.path("bin")) / "cranioplan-cli";
+  std::filesystem::create_directories(lone.parent_path());
+  std::filesystem::copy_file(kCli, lone);
+  EXPECT_EQ(test::run_command("(" + lone.string() + " --version 2>&1)", &out), 1);
+  EXPECT_NE(out.find("cannot start"), std::string::npos) << out;
+  EXPECT_NE(out.find("libexec/cranioplan/cranioplan-cli"), std::string::npos) << out;
 }
 
 // An implant mesh as a Slicer segmentation on a volume's grid, read back as the same volume.

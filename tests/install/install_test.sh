@@ -11,6 +11,7 @@ prefix=$tmp/usr
 cmake --install "$build" --prefix "$prefix" >/dev/null
 fail() { echo "install test: $*" >&2; exit 1; }
 for f in bin/cranioplan bin/cranioplan-cli \
+         libexec/cranioplan/cranioplan libexec/cranioplan/cranioplan-cli \
          share/man/man1/cranioplan.1 share/man/man1/cranioplan-cli.1 \
          share/applications/cranioplan.desktop \
          share/icons/hicolor/scalable/apps/cranioplan.svg \
@@ -33,7 +34,8 @@ grep -q '^\.TH CRANIOPLAN-CLI "1"' "$prefix/share/man/man1/cranioplan-cli.1" || 
 grep -q '^\.SS autoplan' "$prefix/share/man/man1/cranioplan-cli.1" || fail "subcommands in man page"
 grep -q '^\.TH CRANIOPLAN "1"' "$prefix/share/man/man1/cranioplan.1" || fail "wizard man page"
 
-# The installed programs run, say their version, and find the sample case.
+# The installed programs run (bin's launchers start libexec's programs), say their version,
+# and find the sample case.
 "$prefix/bin/cranioplan-cli" --version | grep -q "^cranioplan-cli [0-9]" || fail "cli --version"
 QT_QPA_PLATFORM=offscreen XDG_RUNTIME_DIR=$tmp "$prefix/bin/cranioplan" --version |
   grep -q "^Cranioplan [0-9]" || fail "wizard --version"
@@ -54,6 +56,8 @@ for lib in libvtk9.1 libqt6widgets6 libopenmesh1 libgdcm libc6; do
 done
 contents=$(dpkg-deb -c "$deb")
 grep -q './usr/bin/cranioplan-cli$' <<<"$contents" || fail "the package lacks the CLI"
+grep -q './usr/libexec/cranioplan/cranioplan-cli$' <<<"$contents" ||
+  fail "the package lacks the program its CLI launcher starts"
 grep -q './usr/share/man/man1/cranioplan.1' <<<"$contents" || fail "the package lacks man pages"
 [ "$(dpkg-deb -f "$deb" Recommends)" = "invesalius-examples" ] || fail "Recommends"
 echo "install test: installed, ran the sample, packaged $(basename "$deb")"

@@ -5,7 +5,9 @@
 // SkullFix import's time). glibc's malloc asks for transparent huge pages (2 MB) when its
 // tunable glibc.malloc.hugetlb=1 is set; tunables are read when a process starts, so the
 // programs start themselves once more with it. The allocations change, not the arithmetic: the
-// same implant bytes either way (tested).
+// same implant bytes either way (tested). The installed programs are small launchers
+// (app/launcher.cpp) that set the tunable before the program and its libraries are loaded; run
+// directly, a program starts itself again.
 #include <optional>
 #include <string>
 
@@ -17,6 +19,10 @@ namespace cranioplan {
 /// choice) or when CRANIOPLAN_HUGE_PAGES is "0".
 std::optional<std::string> huge_page_tunables(const char* glibc_tunables,
                                               const char* cranioplan_huge_pages);
+
+/// Sets GLIBC_TUNABLES to huge_page_tunables's value for the programs this process starts, when
+/// it gives one and the kernel offers transparent huge pages; whether it did.
+bool ask_for_huge_pages();
 
 /// Starts this program again (same arguments and environment) with huge_page_tunables's value
 /// of GLIBC_TUNABLES, when it gives one and the kernel offers transparent huge pages; returns
