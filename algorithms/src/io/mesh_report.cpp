@@ -13,7 +13,6 @@
 #include <utility>
 
 #include "cranioplan/algorithms/geometry/mesh_components.h"
-#include "cranioplan/model/parallel.h"
 
 namespace cranioplan {
 namespace {
@@ -236,18 +235,42 @@ Welded weld_positions(const std::vector<Eigen::Vector3d>& points) {
   return w;
 }
 
+// Keys below 2^bits in ascending order by their digits, least significant first (12 bits a
+// pass): the order std::sort gives, as the keys are plain values, in about half its time.
+void radix_sort(std::vector<unsigned long long>& keys, int bits) {
+  constexpr int kDigit = 12;
+  constexpr unsigned long long kMask = (1ull << kDigit) - 1;
+  std::vector<unsigned long long> other(keys.size());
+  std::vector<size_t> start(size_t{1} << kDigit);
+  for (int shift = 0; shift < bits; shift += kDigit) {
+    std::fill(start.begin(), start.end(), 0);
+    for (const unsigned long long k : keys) ++start[(k >> shift) & kMask];
+    size_t sum = 0;
+    for (size_t& s : start) sum += std::exchange(s, sum);
+    for (const unsigned long long k : keys) other[start[(k >> shift) & kMask]++] = k;
+    keys.swap(other);
+  }
+}
+
 // Every triangle's three undirected edges as (smaller id << 32 | larger id), sorted: an edge's
 // triangles are a run.
-std::vector<unsigned long long> sorted_edges(const std::vector<Eigen::Vector3i>& triangles) {
+std::vector<unsigned long long> sorted_edges(const std::vector<Eigen::Vector3i>& triangles,
+                                             size_t vertices) {
+  // Sorted packed as (smaller << b | larger), b the bits of the largest id, so that the digits
+  // cover only bits the ids use; the same order.
+  int b = 1;
+  while (b < 32 && (size_t{1} << b) < vertices) ++b;
   std::vector<unsigned long long> edges;
   edges.reserve(triangles.size() * 3);
   for (const auto& t : triangles)
     for (int k = 0; k < 3; ++k) {
       const unsigned long long a = static_cast<unsigned>(t[k]),
-                               b = static_cast<unsigned>(t[(k + 1) % 3]);
-      edges.push_back(std::min(a, b) << 32 | std::max(a, b));
+                               c = static_cast<unsigned>(t[(k + 1) % 3]);
+      edges.push_back(std::min(a, c) << b | std::max(a, c));
     }
-  parallel_sort(edges.begin(), edges.end(), std::less<>());
+  radix_sort(edges, 2 * b);
+  const unsigned long long low = (1ull << b) - 1;
+  for (unsigned long long& e : edges) e = (e >> b) << 32 | (e & low);
   return edges;
 }
 
@@ -275,7 +298,7 @@ MeshReport report_mesh(const SkullMesh& mesh) {
   for (auto& t : soup.triangles)
     for (int k = 0; k < 3; ++k) t[k] = w.id[t[k]];
   soup.vertices = std::move(w.positions);
-  const std::vector<unsigned long long> edges = sorted_edges(soup.triangles);
+  const std::vector<unsigned long long> edges = sorted_edges(soup.triangles, soup.vertices.size());
   std::vector<std::pair<int, int>> boundary;
   for (size_t e = 0; e < edges.size();) {
     size_t count = 1;
@@ -303,7 +326,7 @@ bool is_watertight(const SkullMesh& mesh) {
   for (auto& t : soup.triangles)
     for (int k = 0; k < 3; ++k) t[k] = w.id[t[k]];
   // Every undirected edge of the welded triangles twice: no boundary, nothing non-manifold.
-  const std::vector<unsigned long long> edges = sorted_edges(soup.triangles);
+  const std::vector<unsigned long long> edges = sorted_edges(soup.triangles, soup.vertices.size());
   for (size_t e = 0; e < edges.size();) {
     size_t run = 1;
     while (e + run < edges.size() && edges[e + run] == edges[e]) ++run;
