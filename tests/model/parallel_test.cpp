@@ -21,15 +21,20 @@ struct ThreadCount {
   ~ThreadCount() { set_thread_count(0); }
 };
 
-// The tunable the programs start again with: added to the user's own tunables, never twice,
-// and not at all when the user sets it or turns it off.
-TEST(HugePages, TheTunableIsAddedOnceAndTheUsersChoiceKept) {
-  EXPECT_EQ(huge_page_tunables(nullptr, nullptr), "glibc.malloc.hugetlb=1");
-  EXPECT_EQ(huge_page_tunables("", nullptr), "glibc.malloc.hugetlb=1");
-  EXPECT_EQ(huge_page_tunables("glibc.malloc.check=3", "1"),
-            "glibc.malloc.check=3:glibc.malloc.hugetlb=1");
-  EXPECT_FALSE(huge_page_tunables("glibc.malloc.hugetlb=1", nullptr));
-  EXPECT_FALSE(huge_page_tunables("glibc.malloc.check=3:glibc.malloc.hugetlb=0", nullptr));
+// The tunables the programs start again with: added to the user's own tunables, never twice,
+// each not at all when the user sets it, and none when the user turns them off.
+TEST(HugePages, TheTunablesAreAddedOnceAndTheUsersChoiceKept) {
+  const std::string ours = "glibc.malloc.hugetlb=1:glibc.malloc.arena_max=1";
+  EXPECT_EQ(huge_page_tunables(nullptr, nullptr), ours);
+  EXPECT_EQ(huge_page_tunables("", nullptr), ours);
+  EXPECT_EQ(huge_page_tunables("glibc.malloc.check=3", "1"), "glibc.malloc.check=3:" + ours);
+  EXPECT_EQ(huge_page_tunables("glibc.malloc.hugetlb=1", nullptr),
+            "glibc.malloc.hugetlb=1:glibc.malloc.arena_max=1");
+  EXPECT_EQ(huge_page_tunables("glibc.malloc.check=3:glibc.malloc.hugetlb=0", nullptr),
+            "glibc.malloc.check=3:glibc.malloc.hugetlb=0:glibc.malloc.arena_max=1");
+  EXPECT_EQ(huge_page_tunables("glibc.malloc.arena_max=4", nullptr),
+            "glibc.malloc.arena_max=4:glibc.malloc.hugetlb=1");
+  EXPECT_FALSE(huge_page_tunables(ours.c_str(), nullptr));  // the second start
   EXPECT_FALSE(huge_page_tunables(nullptr, "0"));
 }
 

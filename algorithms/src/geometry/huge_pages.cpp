@@ -3,31 +3,35 @@
 #include <unistd.h>
 
 #include <cstdlib>
-#include <fstream>
+#include <utility>
 
 namespace cranioplan {
 
 namespace {
-constexpr const char* kTunable = "glibc.malloc.hugetlb";
-}
+// Each with the value the programs ask for; a name the user's GLIBC_TUNABLES holds keeps the
+// user's value.
+constexpr std::pair<const char*, const char*> kTunables[] = {{"glibc.malloc.hugetlb", "1"},
+                                                             {"glibc.malloc.arena_max", "1"}};
+}  // namespace
 
 std::optional<std::string> huge_page_tunables(const char* glibc_tunables,
                                               const char* cranioplan_huge_pages) {
   if (cranioplan_huge_pages && std::string(cranioplan_huge_pages) == "0") return std::nullopt;
-  const std::string present = glibc_tunables ? glibc_tunables : "";
-  if (present.find(kTunable) != std::string::npos) return std::nullopt;
-  return (present.empty() ? "" : present + ":") + kTunable + "=1";
+  std::string tunables = glibc_tunables ? glibc_tunables : "";
+  bool added = false;
+  for (const auto& [name, value] : kTunables) {
+    if (tunables.find(name) != std::string::npos) continue;
+    tunables += (tunables.empty() ? "" : ":") + std::string(name) + "=" + value;
+    added = true;
+  }
+  if (!added) return std::nullopt;
+  return tunables;
 }
 
 bool ask_for_huge_pages() {
   const std::optional<std::string> tunables =
       huge_page_tunables(std::getenv("GLIBC_TUNABLES"), std::getenv("CRANIOPLAN_HUGE_PAGES"));
-  if (!tunables) return false;
-  // "always [madvise] never": malloc's advice is taken unless the kernel says never.
-  std::ifstream thp("/sys/kernel/mm/transparent_hugepage/enabled");
-  std::string modes;
-  if (!std::getline(thp, modes) || modes.find("[never]") != std::string::npos) return false;
-  return setenv("GLIBC_TUNABLES", tunables->c_str(), 1) == 0;
+  return tunables && setenv("GLIBC_TUNABLES", tunables->c_str(), 1) == 0;
 }
 
 void start_with_huge_pages(char** argv) {
