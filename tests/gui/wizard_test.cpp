@@ -682,10 +682,15 @@ TEST(WizardMoving, ADraggedViewDrawsLargeMeshesCoarseUntilItStops) {
   EXPECT_EQ(view.coarse_layers_drawn(), 2) << "until the camera has stopped a while";
   QTest::qWait(500);
   EXPECT_EQ(view.coarse_layers_drawn(), 0);
+
+  // A timed turn (`cranioplan --turn N`) draws its moving frames coarse and leaves the view
+  // drawn whole.
+  EXPECT_EQ(view.time_turn(2, true).size(), 3u) << "the copies' time and two frames";
+  EXPECT_EQ(view.coarse_layers_drawn(), 0);
 }
 
-// `cranioplan --turn N` turns the view once around, moving and at rest, and prints both ways'
-// frame times (docs/BENCHMARKS.md); the view ends where it began, drawn whole.
+// `cranioplan --turn N` turns the view once around, moving and at rest, prints both ways'
+// frame times (docs/BENCHMARKS.md) and quits with success.
 TEST(WizardMoving, TheCommandLineTimesATurnOfTheView) {
   test::TempDir tmp;
   const std::string path = tmp.path("head.stl");
@@ -704,11 +709,8 @@ TEST(WizardMoving, TheCommandLineTimesATurnOfTheView) {
                         &moving, &longest, &copies, &still, &still_longest),
             5)
       << out;
-  EXPECT_GT(moving, 0.0);
-  EXPECT_GE(longest, moving);
-  EXPECT_GE(copies, 0.0) << "the skull's copy is made on a worker beforehand";
+  EXPECT_GT(moving, 0.0) << "frames were drawn and timed";
   EXPECT_GT(still, 0.0);
-  EXPECT_GE(still_longest, still);
 }
 
 TEST(WizardOrientation, TheCubeShowsTheFaceTheCameraLooksAt) {

@@ -230,7 +230,7 @@ std::vector<float> distance_within(const std::vector<uint8_t>& mask, const Voxel
             const int lo = std::max(-reach, -z), hi = std::min(reach, nz - 1 - z);
             auto kind_at = [&](int t) { return kind[static_cast<size_t>(z + t) * ny + j]; };
             if (kind_at(0) == kFull) {
-              std::fill(out, out + nx, static_cast<float>(grid.spacing * std::sqrt(0.0)));
+              std::fill(out, out + nx, 0.0f);
               continue;
             }
             bool empty = true;
@@ -347,11 +347,13 @@ std::vector<uint8_t> within_steps(const std::vector<uint8_t>& in, const VoxelGri
   // Relaxes row `to` from its neighbour `from`; whether `to` now holds a value below the cap.
   // A row is held only then: a row relaxed from a held row whose values all stayed at the cap
   // holds nothing either, so the sweeps keep to the rows near the mask.
-  auto relax_row = [cap](uint8_t* to, const uint8_t* from, int n) -> uint8_t {
+  auto one_more = [cap](uint8_t from) {
+    return static_cast<uint8_t>(std::min<int>(from + 1, cap));
+  };
+  auto relax_row = [cap, one_more](uint8_t* to, const uint8_t* from, int n) -> uint8_t {
     uint8_t low = cap;
     for (int i = 0; i < n; ++i) {
-      const uint8_t v = static_cast<uint8_t>(std::min<int>(from[i] + 1, cap));
-      to[i] = std::min(to[i], v);
+      to[i] = std::min(to[i], one_more(from[i]));
       low = std::min(low, to[i]);
     }
     return low < cap;
@@ -366,10 +368,8 @@ std::vector<uint8_t> within_steps(const std::vector<uint8_t>& in, const VoxelGri
           for (int j = 0; j < ny; ++j) {
             if (!rows[j]) continue;
             uint8_t* row = slice + j * sy;
-            for (int i = 1; i < nx; ++i)
-              row[i] = std::min(row[i], static_cast<uint8_t>(std::min<int>(row[i - 1] + 1, cap)));
-            for (int i = nx - 2; i >= 0; --i)
-              row[i] = std::min(row[i], static_cast<uint8_t>(std::min<int>(row[i + 1] + 1, cap)));
+            for (int i = 1; i < nx; ++i) row[i] = std::min(row[i], one_more(row[i - 1]));
+            for (int i = nx - 2; i >= 0; --i) row[i] = std::min(row[i], one_more(row[i + 1]));
           }
           for (int j = 1; j < ny; ++j)
             if (rows[j - 1]) rows[j] |= relax_row(slice + j * sy, slice + (j - 1) * sy, nx);
