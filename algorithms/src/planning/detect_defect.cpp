@@ -2,6 +2,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <Eigen/LU>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -13,6 +14,7 @@
 #include "cranioplan/algorithms/geometry/point_index.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/surface_samples.h"
+#include "cranioplan/model/parallel.h"
 #include "cranioplan/model/plane.h"
 
 namespace cranioplan {
@@ -103,6 +105,70 @@ Eigen::Matrix3d skull_frame(const SkullMesh& skull, const Eigen::Vector3d& cente
   Eigen::Matrix3d frame;
   frame << a, b, a.cross(b);
   return frame;
+}
+
+namespace {
+
+std::optional<Eigen::Vector3d> trimmed_sphere(const std::vector<Eigen::Vector3d>& points,
+                                              double& radius) {
+  std::vector<char> keep(points.size(), 1);
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  std::vector<double> off(points.size());
+  for (int round = 0; round < 6; ++round) {
+    Eigen::Matrix4d a = Eigen::Matrix4d::Zero();
+    Eigen::Vector4d b = Eigen::Vector4d::Zero();
+    for (size_t i = 0; i < points.size(); ++i) {
+      if (!keep[i]) continue;
+      const Eigen::Vector4d row(2.0 * points[i].x(), 2.0 * points[i].y(), 2.0 * points[i].z(), 1);
+      a += row * row.transpose();
+      b += row * points[i].squaredNorm();
+    }
+    const Eigen::FullPivLU<Eigen::Matrix4d> lu(a);
+    if (lu.rank() < 4) return std::nullopt;
+    const Eigen::Vector4d x = lu.solve(b);
+    c = x.head<3>();
+    const double r2 = x(3) + c.squaredNorm();
+    if (!c.allFinite() || !(r2 > 0.0)) return std::nullopt;
+    radius = std::sqrt(r2);
+    for (size_t i = 0; i < points.size(); ++i) off[i] = std::abs((points[i] - c).norm() - radius);
+    std::vector<double> sorted = off;
+    std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
+    const double limit = 2.5 * sorted[sorted.size() / 2] + 0.5;
+    for (size_t i = 0; i < points.size(); ++i) keep[i] = off[i] < limit;
+  }
+  return c;
+}
+
+}  // namespace
+
+std::optional<Eigen::Vector3d> vault_center(const SurfaceLocator& locator, const Plane& plane,
+                                            const Eigen::Vector3d& start, double* radius_mm) {
+  const std::vector<Eigen::Vector3d> dirs = fibonacci_sphere(4000);
+  Eigen::Vector3d c = plane.project(start);
+  double radius = 0.0;
+  for (int round = 0; round < 10; ++round) {
+    std::vector<std::optional<Eigen::Vector3d>> hit(dirs.size());
+    parallel_for(dirs.size(), [&](size_t first, size_t last) {
+      for (size_t i = first; i < last; ++i) {
+        const RayThroughBone h = cast_through_bone(locator, c, dirs[i], 400.0, 1.5, 15.0);
+        if (h.paired && h.outer_normal.dot(dirs[i]) > M_SQRT1_2 &&
+            -h.inner_normal.dot(dirs[i]) > M_SQRT1_2)
+          hit[i] = h.inner;
+      }
+    });
+    std::vector<Eigen::Vector3d> vault;
+    for (const auto& h : hit)
+      if (h) vault.push_back(*h);
+    if (vault.size() < 100) return std::nullopt;
+    const std::optional<Eigen::Vector3d> fitted = trimmed_sphere(vault, radius);
+    if (!fitted) return std::nullopt;
+    const Eigen::Vector3d next = plane.project(*fitted);
+    const double step = (next - c).norm();
+    c = next;
+    if (step < 0.05) break;
+  }
+  if (radius_mm) *radius_mm = radius;
+  return c;
 }
 
 namespace {
@@ -258,13 +324,20 @@ Openings find_openings(const RayFan& fan, const Eigen::Vector3d& center,
 // would otherwise be taken for the base if it reached 105°. Without such an opening, or without
 // a vault direction, the skull is closed below.
 size_t skull_base(const Openings& o, const Eigen::Vector3d& up, const Eigen::Matrix3d& frame,
-                  bool framed) {
+                  bool framed, const std::vector<ScanBorder>& borders) {
   constexpr double kBaseAwayFromVault = -0.2588;  // cos 105°
   constexpr double kBaseNearMidline = 0.5;        // sin 30°
+  constexpr double kTowardsCut = 0.5;             // cos 60°
+  std::vector<Eigen::Vector3d> cuts_below;
+  for (const ScanBorder& b : borders)
+    if (b.normal.dot(up) < -kTowardsCut) cuts_below.push_back(b.normal);
   for (size_t r = 0; r < o.order.size() && up.norm() > 0; ++r) {
     const Eigen::Vector3d& mean = o.mean_dir[o.order[r]];
     const bool near_midline = !framed || std::abs(mean.dot(frame.col(2))) < kBaseNearMidline;
-    if (mean.dot(up) < kBaseAwayFromVault && near_midline) return r;
+    bool towards_cut = cuts_below.empty();
+    for (const Eigen::Vector3d& n : cuts_below)
+      towards_cut = towards_cut || mean.dot(n) > kTowardsCut;
+    if (mean.dot(up) < kBaseAwayFromVault && near_midline && towards_cut) return r;
   }
   return o.order.size();
 }
@@ -405,7 +478,8 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
                               params.frame.has_value());
   region.up = fan.up;
   const Openings openings = find_openings(fan, center, params.scan_borders);
-  const size_t base = skull_base(openings, region.up, region.frame, params.frame.has_value());
+  const size_t base =
+      skull_base(openings, region.up, region.frame, params.frame.has_value(), params.scan_borders);
   // The defect is the largest of the others whose area, at the radius of its rim, is large
   // enough (or the one towards a point given); the rest are named by a ray through each.
   const std::vector<Candidate> candidates = defect_candidates(fan, openings, base, center, params);

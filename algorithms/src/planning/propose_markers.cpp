@@ -67,16 +67,45 @@ std::vector<size_t> along(const std::vector<Eigen::Vector3d>& loop, double spaci
   return out;
 }
 
+// Where the rays start. The vault's centre (vault_center, found from the skull's vertex centroid
+// on the plane) is a property of the bone: no meshing moves it by more than 0.3 mm and a crop
+// of the face by a few millimetres, where the vertex centroid moved 4-12 mm and 40 mm
+// (docs/AUTOPLAN.md). A small opening seen from it is seen narrow and its rim at a grazing
+// angle, so the start moves from there towards the opening until the opening is seen 50° wide
+// (at most half the vault's radius). An opening seen that wide from the vault's centre already
+// (SkullFix's large defects) keeps the vertex centroid, where those plans were measured best.
+// The vertex centroid too when there is no vault to fit or no opening seen from it.
+Eigen::Vector3d rays_start(const SkullMesh& skull, const SurfaceLocator& bone, const Plane& plane,
+                           const DetectDefectParams& params) {
+  constexpr double kSeenWide = 25.0 * M_PI / 180.0;
+  constexpr double kFarthest = 0.5;
+  const Eigen::Vector3d centroid = plane.project(vertex_centroid(skull));
+  double radius = 0.0;
+  const std::optional<Eigen::Vector3d> vault = vault_center(bone, plane, centroid, &radius);
+  if (!vault) return centroid;
+  DetectDefectParams from_vault = params;
+  from_vault.frame = skull_frame(skull, *vault, plane.normal);
+  const DefectRegion seen = detect_defect(skull, bone, *vault, from_vault);
+  if (seen.status != DefectRegion::Status::Found || seen.outer_rim.empty()) return centroid;
+  double rim = 0.0;
+  for (const Eigen::Vector3d& p : seen.outer_rim) rim += (p - *vault).norm();
+  rim /= static_cast<double>(seen.outer_rim.size());
+  const double half_width = std::sqrt(seen.area_mm2 / M_PI);
+  const double shift = rim - half_width / std::tan(kSeenWide);
+  if (shift <= 0.0) return centroid;  // seen wide enough from the vault's centre already
+  return plane.project(*vault + std::min(shift, kFarthest * radius) * seen.axis);
+}
+
 }  // namespace
 
 DefectRegion detect_defect_near_plane(const SkullMesh& skull, const SurfaceLocator& bone,
                                       const Plane& plane, const DetectDefectParams& params) {
-  const Eigen::Vector3d center =
-      params.center ? *params.center : plane.project(vertex_centroid(skull));
   DetectDefectParams framed = params;
-  if (!framed.frame) framed.frame = skull_frame(skull, center, plane.normal);
   if (framed.scan_borders.empty() && has_boundary(skull))
     framed.scan_borders = scan_borders(report_mesh(skull));
+  const Eigen::Vector3d center =
+      params.center ? *params.center : rays_start(skull, bone, plane, framed);
+  if (!params.frame) framed.frame = skull_frame(skull, center, plane.normal);
   return detect_defect(skull, bone, center, framed);
 }
 

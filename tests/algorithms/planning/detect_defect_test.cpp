@@ -27,6 +27,50 @@ ScanBorder lower_border() {
   return b;
 }
 
+// A two-table spherical shell around `center`: outer radius 70 mm, inner 64 mm (facing the
+// cavity), on make_symmetric_head's triangles (`subdivisions` 4: 5,120 per table, edges about
+// 6 mm; 5: 20,480, about 3 mm).
+SkullMesh spherical_shell(const Eigen::Vector3d& center, int subdivisions) {
+  const TriangleSoup unit = to_soup(test::make_symmetric_head(subdivisions));
+  TriangleSoup soup = unit;
+  for (auto& p : soup.vertices) p = center + 70.0 * p.normalized();
+  const int n = static_cast<int>(soup.vertices.size());
+  for (const auto& p : unit.vertices) soup.vertices.push_back(center + 64.0 * p.normalized());
+  for (const auto& t : unit.triangles) soup.triangles.emplace_back(t[0] + n, t[2] + n, t[1] + n);
+  return build_mesh(soup);
+}
+
+// The vault's centre is the inner table's sphere's, from a start anywhere in the cavity, on a
+// coarse and a fine mesh of it, with a defect in it, and with everything below a cut gone (the
+// rays there leave through the scan's end): it is sampled by direction, not by vertices.
+TEST(VaultCenter, IsTheInnerTablesCentreHoweverTheShellIsMeshedOrCut) {
+  const Eigen::Vector3d c(3.0, -5.0, 10.0);
+  const Plane plane = Plane::through(c, Eigen::Vector3d::UnitX());
+  const Eigen::Vector3d start = c + Eigen::Vector3d(0.0, 20.0, -15.0);
+  const SkullMesh fine = spherical_shell(c, 5);
+  const SkullMesh coarse = spherical_shell(c, 4);
+  const SkullMesh holed =
+      test::cut_hole(fine, c + 67.0 * Eigen::Vector3d(0.6, -0.5, 0.6).normalized(), 25.0);
+  const SkullMesh cropped =
+      test::cut_open(fine, c - Eigen::Vector3d(0, 0, 20), Eigen::Vector3d::UnitZ());
+  ASSERT_LT(holed.n_faces(), fine.n_faces());
+  ASSERT_LT(cropped.n_faces(), fine.n_faces());
+  for (const SkullMesh* mesh : {&fine, &coarse, &holed, &cropped}) {
+    double radius = 0.0;
+    const auto center = vault_center(SurfaceLocator(*mesh), plane, start, &radius);
+    ASSERT_TRUE(center.has_value());
+    EXPECT_LT((*center - c).norm(), 0.3) << center->transpose();
+    EXPECT_NEAR(radius, 64.0, 0.5);
+    EXPECT_NEAR(plane.signed_distance(*center), 0.0, 1e-9);
+  }
+  // A flat plate has no vault's centre: its hits lie in a plane.
+  const SkullMesh plate = build_mesh(test::box_soup({-50, -50, 0}, {50, 50, 5}));
+  const Eigen::Vector3d below(0, 0, -20);
+  EXPECT_FALSE(
+      vault_center(SurfaceLocator(plate), Plane::through(below, Eigen::Vector3d::UnitX()), below)
+          .has_value());
+}
+
 TEST(ScanBorder, IsReachedByRaysThatMeetItsPlaneWithinTheBox) {
   const ScanBorder b = lower_border();
   const Eigen::Vector3d o = Eigen::Vector3d::Zero();

@@ -75,8 +75,8 @@ PlaneFit plane(const SkullMesh& skull, const Landmarks& landmarks, const Autopla
 /// on a skull of two million triangles a mesh and its locator are a few hundred megabytes each).
 RegisterResult registration(const SkullMesh& skull, const Plane& plane,
                             const AutoplanParams& params, const VertexCloud* cloud = nullptr);
-/// The opening to plan, seen from the skull's centroid on the plane (`params.propose.detect`:
-/// `near` chooses among several, `center` starts the rays elsewhere).
+/// The opening to plan, seen from inside the cavity (detect_defect_near_plane;
+/// `params.propose.detect`: `near` chooses among several, `center` starts the rays elsewhere).
 DefectRegion detect(const SkullMesh& skull, const SurfaceLocator& bone, const Plane& plane,
                     const AutoplanParams& params);
 

@@ -11,6 +11,7 @@
 
 #include "cranioplan/algorithms/io/mesh_report.h"
 #include "cranioplan/model/mesh.h"
+#include "cranioplan/model/plane.h"
 
 namespace cranioplan {
 
@@ -47,8 +48,9 @@ struct DetectDefectParams {
   /// click near the defect, mm) rather than the largest.
   std::optional<Eigen::Vector3d> near;
   /// Where the rays start, a point inside the cranial cavity (detect_defect_near_plane; mm).
-  /// Unset: the skull's vertex centroid moved onto the midsagittal plane. Set, the plan's
-  /// dependence on its own rays can be measured (docs/AUTOPLAN.md).
+  /// Unset: from the vault's centre (vault_center) towards a small opening, or the skull's
+  /// vertex centroid on the midsagittal plane for a large one (detect_defect_near_plane). Set,
+  /// the plan's dependence on its own rays can be measured (docs/AUTOPLAN.md).
   std::optional<Eigen::Vector3d> center;
   /// The rays' lattice is turned by this rotation (columns: its axes in the skull's
   /// coordinates). With the skull's own frame (skull_frame) the rays meet the same anatomy
@@ -149,6 +151,17 @@ struct RayThroughBone {
 RayThroughBone cast_through_bone(const SurfaceLocator& locator, const Eigen::Vector3d& center,
                                  const Eigen::Vector3d& dir, double reach, double min_thickness_mm,
                                  double max_thickness_mm);
+
+/// The centre of the vault as the rays see it: from `start` (inside the cranial cavity, on
+/// `plane`), rays in 4,000 directions; the inner-table hits of those that cross a regular
+/// two-table shell (both tables facing the ray within 45°) are fitted with a sphere (least
+/// squares, then again without the hits more than 2.5 median deviations + 0.5 mm off it); its
+/// centre moved onto the plane is the next start, until it moves less than 0.05 mm (at most 10
+/// times). `radius_mm` gets the sphere's radius. Nothing when fewer than 100 rays cross the
+/// vault or the hits lie in a plane.
+std::optional<Eigen::Vector3d> vault_center(const SurfaceLocator& locator, const Plane& plane,
+                                            const Eigen::Vector3d& start,
+                                            double* radius_mm = nullptr);
 
 /// `center`: a point inside the cranial cavity (e.g. the skull's centroid moved onto the
 /// midsagittal plane).
