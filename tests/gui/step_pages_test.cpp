@@ -126,6 +126,28 @@ TEST(StepPages, TheClipPlaneIsACommandAndFollowsTheState) {
   EXPECT_EQ(host.pushed.size(), 2u);
 }
 
+// Stretches of the rim no ray saw: the view draws one orange line for each, and the edge page
+// says what they mean; a proposal without them shows neither.
+TEST(StepPages, TheEdgePageAndTheViewShowTheRimsUnseenStretches) {
+  RecordingHost host;
+  EdgeMarkersPage edges(host);
+  host.state.proposal_message = "161 markers proposed";
+  host.state.unseen_rim = {{Eigen::Vector3d(0, 0, 0), Eigen::Vector3d(13, 0, 0)},
+                           {Eigen::Vector3d(0, 5, 0), Eigen::Vector3d(0, 17, 0)}};
+  edges.show_state(host.state);
+  host.view().show_state(host.state);
+  const QLabel* note = child<QLabel>(edges, "proposalNote");
+  ASSERT_TRUE(note);
+  EXPECT_TRUE(note->text().contains("orange lines")) << note->text().toStdString();
+  EXPECT_EQ(host.view().unseen_rim_shown(), 2);
+  host.state.unseen_rim.clear();
+  edges.show_state(host.state);
+  host.view().show_state(host.state);
+  EXPECT_FALSE(note->text().contains("orange lines")) << note->text().toStdString();
+  EXPECT_TRUE(note->text().contains("161 markers proposed"));
+  EXPECT_EQ(host.view().unseen_rim_shown(), 0);
+}
+
 TEST(StepPages, MarkersGoOnTheSurfaceTheirTypeBelongsTo) {
   RecordingHost host;
   EdgeMarkersPage edges(host);

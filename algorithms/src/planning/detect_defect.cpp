@@ -311,15 +311,18 @@ Openings find_openings(const RayFan& fan, const Eigen::Vector3d& center,
 
 // The skull base (or the scan's cut): the rank (in `o.order`) of the largest opening whose mean
 // direction points away from the vault, more than 105° from its direction; o.order.size() for
-// none. The sample's foramen magnum lies at 124° from the CT, but at 118°, 115° and 113° on
-// copies decimated to 250,000, 120,000 and 60,000 triangles (the thin bone around it and the
-// orbits opens up, which moves both the opening's mean and the vault's direction), and its
-// frontal defect at 96°, 89°, 84°, 82°; SkullFix's bases 125–154°, their defects 26–53°. The
-// orbits lie further still (120–150°) but are smaller than the foramen (a limit of 114° took an
-// orbit of the 60,000-triangle copy for the base, and planned the foramen magnum as the
-// defect). With the skull's frame (its third axis the midsagittal plane's normal), the base must
-// also lie within 30° of the plane, as the foramen magnum and a scan's cut do (on the sample 0°,
-// and 17–27° for its orbits): a large one-sided defect low on the side of the head (a
+// none. Seen from the rays' start (detect_defect_near_plane) the sample's foramen magnum lies
+// at 130° and its frontal defect at 100°, within 0.4° on copies decimated to 250,000-60,000
+// triangles (seen from the vertex centroid: the foramen 113-124°, the defect 82-96°, as the
+// thin bone around them opens up on the decimated copies); SkullFix's bases 125–154°, their
+// defects 26–53°. The orbits lie further still (120–150°) but are smaller than the foramen (a
+// limit of 114° took an orbit of a 60,000-triangle copy for the base, and planned the foramen
+// magnum as the defect). Where the surface is open along a cut that faces away from the vault
+// (`borders`), the base must face it too (its mean direction within 60° of the cut's outward
+// normal): the cut blocks the base's own rays, and a defect seen far from the vault is then
+// not taken for the base. With the skull's frame (its third axis the midsagittal plane's normal),
+// the base must also lie within 30° of the plane, as the foramen magnum and a scan's cut do (on the
+// sample 0°, and 17–27° for its orbits): a large one-sided defect low on the side of the head (a
 // decompressive hemicraniectomy, 8,000 mm² and more) is larger than the foramen magnum and
 // would otherwise be taken for the base if it reached 105°. Without such an opening, or without
 // a vault direction, the skull is closed below.
