@@ -232,7 +232,10 @@ int current_version(CommandType type) {
   // build_implant 7: fixation tabs ("tabs"); version 6 is read without them.
   // build_implant 8 and export_implant 2: tabs, holes and a mould meshed with field values kept
   // 1e-3 off the iso-level (no sliver triangles); earlier versions are meshed as they were.
-  if (type == CommandType::BuildImplant) return 8;
+  // build_implant 9: holes drilled along the plate's mid-normal and under their whole
+  // footprint ("perforations" unchanged; PerforationParams::mid_normal); version 8 is drilled
+  // along the outer normal.
+  if (type == CommandType::BuildImplant) return 9;
   if (type == CommandType::ExportImplant) return 2;
   // propose_markers 4: support markers only where the fitted surface describes the ring's bone
   // ("max_support_off_fit_mm"; versions 1 to 3 are read with 0, every ring point of the band).

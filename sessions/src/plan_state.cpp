@@ -766,6 +766,9 @@ void apply_build(PlanState& s, const ParamReader& r, int version) {
   params_from_json(ParamReader(recorded, r.where() + " params"), params);
   // Before version 8, tabs and holes were meshed without the iso-level gap.
   params.tabs.iso_gap = params.perforations.iso_gap = version >= 8;
+  // Before version 9, holes were drilled along the outer normal, to below the inner surface
+  // under their centre.
+  params.perforations.mid_normal = version >= 9;
   s.implant_params = params;
   unacknowledge(s, 8, "the implant was built again");
   rebuild_implant(s);

@@ -1,5 +1,6 @@
 #include "cranioplan/algorithms/implant/perforate.h"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cassert>
@@ -132,6 +133,63 @@ bool hole_goes_through(const SurfaceLocator& locator, const Hole& hole) {
 
 namespace {
 
+// The plate under a hole, along lines parallel to `axis` through its centre and on two rings
+// (half `reach` and `reach` off the axis, 8 directions each), each followed from above the
+// outer surface to its first and second crossing (the plate's two surfaces), at most 16 mm
+// down: not on into another part of a curved implant. Lines that miss the plate (past its
+// edge) are left out. `above` and `depth`: how far the outer surface rises above the centre
+// and the inner one lies below it along the axis, the most of any line; `inner`: where the
+// lines leave the plate.
+struct PlateUnder {
+  double above = 0.0, depth = 0.0;
+  bool under_centre = false;  // the centre's line leaves the plate within 16 mm
+  std::vector<Eigen::Vector3d> inner;
+};
+PlateUnder plate_under(const SurfaceLocator& self, const Eigen::Vector3d& center,
+                       const Eigen::Vector3d& axis, double reach) {
+  constexpr double kFrom = 3.0, kDown = 16.0;
+  const Eigen::Vector3d u = axis.unitOrthogonal(), v = axis.cross(u);
+  PlateUnder plate;
+  for (int ring = 0; ring < 3; ++ring)
+    for (int k = 0; k < (ring == 0 ? 1 : 8); ++k) {
+      const double phi = 2.0 * M_PI * k / 8.0, rho = 0.5 * ring * reach;
+      const Eigen::Vector3d o = center + rho * (std::cos(phi) * u + std::sin(phi) * v);
+      const auto top = self.first_hit(o + kFrom * axis, o - kDown * axis);
+      if (!top) continue;
+      const double t_top = kFrom - top->distance;
+      plate.above = std::max(plate.above, t_top);
+      const auto under = self.first_hit(top->point - 1e-3 * axis, o - kDown * axis);
+      if (!under) {
+        plate.depth = std::max(plate.depth, kDown);
+        continue;
+      }
+      plate.depth = std::max(plate.depth, under->distance + 1e-3 - t_top);
+      plate.inner.push_back(under->point);
+      plate.under_centre = plate.under_centre || ring == 0;
+    }
+  if (!plate.under_centre) plate.depth = std::max(plate.depth, 15.0);
+  return plate;
+}
+
+// The plate's mid-normal at a hole: halfway between the outer normal `axis` and the inner
+// surface's normal under the hole (the plane fitted to where the plate_under lines leave it,
+// turned outward; a marching-cubes facet's own normal is a staircase's). `axis` when fewer
+// than five lines leave the plate.
+Eigen::Vector3d mid_normal(const SurfaceLocator& self, const Hole& hole, double reach) {
+  const PlateUnder plate = plate_under(self, hole.center, hole.axis, reach);
+  if (plate.inner.size() < 5) return hole.axis;
+  Eigen::Vector3d c = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& q : plate.inner) c += q;
+  c /= static_cast<double>(plate.inner.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& q : plate.inner) cov += (q - c) * (q - c).transpose();
+  const Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d> eig(cov);
+  Eigen::Vector3d n = eig.eigenvectors().col(0);
+  if (n.dot(hole.axis) < 0.0) n = -n;
+  const Eigen::Vector3d mid = hole.axis + n;
+  return mid.norm() > 1e-6 ? mid.normalized() : hole.axis;
+}
+
 // perforate, the drilled implant meshed in `into` (the result's own mesh, or the caller's).
 void perforate_into(const SkullMesh& implant, const Eigen::Vector3d& inside,
                     const PerforationParams& p, PerforateResult& r, SkullMesh& into) {
@@ -184,6 +242,9 @@ void perforate_into(const SkullMesh& implant, const Eigen::Vector3d& inside,
     return done(r);
   }
 
+  // Along the plate's mid-normal, so that the hole leaves both surfaces alike.
+  if (p.mid_normal)
+    for (Hole& hole : r.holes) hole.axis = mid_normal(self, hole, radius + kRimRoundMm);
   // The implant as a field on a fine grid: its signed distance near its surface, less each
   // hole's cylinder (their smooth minimum, so the rims come out rounded).
   const auto [lo, hi] = mesh_bounds(implant);
@@ -196,12 +257,20 @@ void perforate_into(const SkullMesh& implant, const Eigen::Vector3d& inside,
   std::vector<float> field = signed_distance_near_surface(self, solid, g);
   const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
   for (const Hole& hole : r.holes) {
-    // The drill goes from above the outer surface to below the inner one at the centre, not
-    // on into another part of a curved implant.
-    const auto under =
-        self.first_hit(hole.center - 1e-3 * hole.axis, hole.center - 16.0 * hole.axis);
-    const double depth = (under ? under->distance : 15.0) + 1.0 + 2.0 * h, above = 1.0 + 2.0 * h;
-    const Eigen::Vector3d reach = Eigen::Vector3d::Constant(radius + 2.0 * h + 16.0);
+    // The drill goes from above the outer surface to below the inner one under all of it
+    // (plate_under; as plans saved before mid_normal: at the centre), not on into another part
+    // of a curved implant.
+    PlateUnder span;
+    if (p.mid_normal) {
+      span = plate_under(self, hole.center, hole.axis, radius + kRimRoundMm);
+    } else {
+      const auto under =
+          self.first_hit(hole.center - 1e-3 * hole.axis, hole.center - 16.0 * hole.axis);
+      span.depth = under ? under->distance : 15.0;
+    }
+    const double depth = span.depth + 1.0 + 2.0 * h, above = span.above + 1.0 + 2.0 * h;
+    const Eigen::Vector3d reach =
+        Eigen::Vector3d::Constant(radius + kRimRoundMm + 2.0 * h + std::max(depth, above));
     const Eigen::Vector3d a = ((hole.center - reach) - g.origin) / h,
                           b = ((hole.center + reach) - g.origin) / h;
     for (int k = std::max(0, static_cast<int>(a.z()));

@@ -59,6 +59,57 @@ TEST(Perforate, APatternOnAPlateGoesThroughEveryHole) {
   EXPECT_EQ(count_self_intersections(r.mesh), 0);
 }
 
+// A plate whose inner surface slopes 45° under a flat outer one (as where a curved implant
+// turns down): 4 mm thick (z 7 to 11) at x = 0, sloping down to x = 12 (16 mm thick), flat
+// on to x = 20; meshed from a mask as an implant is.
+SkullMesh sloping_plate() {
+  const double slope = std::tan(45.0 * M_PI / 180.0);
+  const VoxelGrid g = VoxelGrid::covering({-2, -2, -7.5}, {22, 32, 13}, 0.25);
+  std::vector<uint8_t> inside(g.size(), 0);
+  for (int k = 0; k < g.dims[2]; ++k)
+    for (int j = 0; j < g.dims[1]; ++j)
+      for (int i = 0; i < g.dims[0]; ++i) {
+        const Eigen::Vector3d c = g.center(i, j, k);
+        inside[g.index(i, j, k)] = c.x() >= 0 && c.x() <= 20 && c.y() >= 0 && c.y() <= 30 &&
+                                   c.z() <= 11 && c.z() >= 7 - slope * std::min(c.x(), 12.0);
+      }
+  ExtractBoneSurfaceParams mask;
+  mask.threshold = 0.5;
+  return extract_bone_surface(mask_volume(inside, g), mask).mesh;
+}
+
+// A hole through the slope: drilled along the plate's mid-normal (22.5° from the outer
+// normal, halfway to the inner surface's), it leaves both surfaces at the same angle and its
+// rims stay as thick as the material asks (PEEK's 2 mm, a corner of up to 0.8 mm); drilled
+// along the outer normal (plans saved before), it leaves the inner surface 45° askew and its
+// rim there is a thin wedge the quality report refuses.
+TEST(Perforate, AHoleThroughASlopingPlateRunsAlongItsMidNormal) {
+  const SkullMesh wedge = sloping_plate();
+  const Eigen::Vector3d inside(10, 15, -80);
+  PerforationParams params;
+  params.added = {Eigen::Vector3d(6, 15, 11)};
+  QualityParams q;
+  q.min_thickness_mm = 2.0;
+  for (const bool mid : {true, false}) {
+    SCOPED_TRACE(mid ? "mid-normal" : "outer normal");
+    params.mid_normal = mid;
+    const PerforateResult r = perforate(wedge, inside, params);
+    ASSERT_TRUE(r.usable()) << r.message;
+    ASSERT_EQ(r.holes.size(), 1u);
+    const double tilt = std::acos(r.holes[0].axis.z()) * 180.0 / M_PI;
+    EXPECT_NEAR(tilt, mid ? 22.5 : 0.0, 1.5);
+    q.holes = r.holes;
+    const QualityReport report = check_implant(r.mesh, nullptr, q);
+    EXPECT_EQ(report.holes_blocked, 0);
+    EXPECT_EQ(report_mesh(r.mesh).pieces, 1);
+    EXPECT_EQ(test::genus(r.mesh), 1);
+    RecordProperty(mid ? "corner_mid_normal_mm" : "corner_outer_normal_mm",
+                   std::to_string(report.corner_reach_mm));
+    EXPECT_EQ(report.printable, mid)
+        << report.corner_reach_mm << " mm: " << (report.reasons.empty() ? "" : report.reasons[0]);
+  }
+}
+
 // A single hole added where the user clicks (moved onto the surface), the pattern's holes near
 // it giving way; a pattern hole taken away; two added holes that would merge are refused.
 // Meshed into a mesh the caller gives, the drilled plate is what the result would hold (the

@@ -33,6 +33,16 @@ struct PerforationParams {
   /// triangles); false: only a value exactly at it, as plans saved before this were meshed (set
   /// from the session command's version, not recorded).
   bool iso_gap = true;
+  /// Each hole drilled along the plate's mid-normal (halfway between the outer surface's
+  /// normal and the inner surface's under the hole) and below the inner surface under its
+  /// whole footprint. Along the outer normal alone, a hole leaves a sloping inner surface
+  /// obliquely, and its rim there is an acute wedge thinner than the material allows (the
+  /// sample's PEEK plan: the inner surface 44° from the outer under one hole, a thin corner
+  /// reaching 0.95 mm); a drill ending below the centre's inner surface leaves a floor at its
+  /// deeper side. False: along the outer normal and 1 mm below the centre's inner surface, as
+  /// plans saved before this were drilled (set from the session command's version, not
+  /// recorded).
+  bool mid_normal = true;
   bool any() const { return pattern || !added.empty(); }
 };
 /// Why the parameters cannot be used (a value out of its range), or empty.
