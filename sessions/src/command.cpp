@@ -233,8 +233,9 @@ int current_version(CommandType type) {
   // build_implant 8 and export_implant 2: tabs, holes and a mould meshed with field values kept
   // 1e-3 off the iso-level (no sliver triangles); earlier versions are meshed as they were.
   // build_implant 9: holes drilled along the plate's mid-normal and under their whole
-  // footprint ("perforations" unchanged; PerforationParams::mid_normal); version 8 is drilled
-  // along the outer normal.
+  // footprint (PerforationParams::mid_normal), tabs whose underside follows the implant
+  // however far below the outer table (TabParams::follow_implant); the parameters recorded are
+  // unchanged, and version 8 is made as it was.
   if (type == CommandType::BuildImplant) return 9;
   if (type == CommandType::ExportImplant) return 2;
   // propose_markers 4: support markers only where the fitted surface describes the ring's bone

@@ -767,8 +767,9 @@ void apply_build(PlanState& s, const ParamReader& r, int version) {
   // Before version 8, tabs and holes were meshed without the iso-level gap.
   params.tabs.iso_gap = params.perforations.iso_gap = version >= 8;
   // Before version 9, holes were drilled along the outer normal, to below the inner surface
-  // under their centre.
-  params.perforations.mid_normal = version >= 9;
+  // under their centre, and a tab's underside went nowhere deeper than 1.5 mm below the outer
+  // table at the implant's edge.
+  params.perforations.mid_normal = params.tabs.follow_implant = version >= 9;
   s.implant_params = params;
   unacknowledge(s, 8, "the implant was built again");
   rebuild_implant(s);

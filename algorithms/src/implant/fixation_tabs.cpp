@@ -375,11 +375,14 @@ TabMaps tab_maps(const Candidate& c, const SurfaceLocator& self, const SurfaceLo
       const double a = m.a0 + static_cast<double>(q % m.na) * m.step,
                    b = m.b0 + static_cast<double>(q / m.na) * m.step;
       const Eigen::Vector3d x = t.rim + a * u + b * v;
-      double z = floor;
+      // Over the implant: on it (or on bone above it); beyond it, on the bone and no deeper
+      // than the plug into the gap at the implant's edge.
+      const double deepest = floor - (p.follow_implant ? p.thickness_mm + 1.0 : 1.0);
+      const auto on_implant = self.first_hit(x + reach * n, x + deepest * n);
+      double z = on_implant && p.follow_implant ? -1e300 : floor;
       if (const auto hit = bone.first_hit(x + reach * n, x + (floor - 1.0) * n))
         z = std::max(z, (hit->point - t.rim).dot(n) + kUndersideMm);
-      if (const auto hit = self.first_hit(x + reach * n, x + (floor - 1.0) * n))
-        z = std::max(z, (hit->point - t.rim).dot(n));
+      if (on_implant) z = std::max(z, (on_implant->point - t.rim).dot(n));
       seen[q] = z;
     }
   });
@@ -668,6 +671,30 @@ void tabs_into(const SkullMesh& implant, const SurfaceLocator& bone, const Eigen
   const ExtractBoneSurfaceResult mesh =
       surface_of_signed_distance(std::move(field), g, into, p.iso_gap);
   if (!mesh.usable()) return fail("joining the tabs to the implant: " + mesh.message);
+  // The meshing keeps the largest piece: a tab that does not touch the implant would be gone
+  // from the mesh while the result still counted it. A point inside each tab, beside its
+  // screws, must lie inside the joined solid (an odd number of crossings along its normal).
+  // Also on replaying a plan saved before follow_implant: such a plan exported the implant
+  // without the tab.
+  const SurfaceLocator joined(into);
+  for (size_t k = 0; k < placed.size(); ++k) {
+    const Tab& t = placed[k].tab;
+    const double a = 0.5 * p.length_mm, b = 0.3 * p.width_mm;
+    const auto [under, top] = maps[k].at(a, b);
+    const Eigen::Vector3d v = t.normal.cross(t.outward);
+    const Eigen::Vector3d mid = t.rim + a * t.outward + b * v + 0.5 * (under + top) * t.normal;
+    const Eigen::Vector3d far = mid + (maps[k].high - 0.5 * (under + top) + 20.0) * t.normal;
+    int crossings = 0;
+    Eigen::Vector3d at = mid;
+    while (const auto hit = joined.first_hit(at, far)) {
+      ++crossings;
+      at = hit->point + 1e-4 * t.normal;
+    }
+    if (crossings % 2 == 0)
+      return fail("tab " + std::to_string(k + 1) +
+                  " does not join the implant (it would stand apart from it): move it along the "
+                  "rim");
+  }
   for (Candidate& c : placed) r.tabs.push_back(std::move(c.tab));
   r.status = TabResult::Status::Added;
   char buf[160];

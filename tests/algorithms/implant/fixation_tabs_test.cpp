@@ -41,12 +41,12 @@ SkullMesh bone(double top = 6.0) {
       },
       {0, 0, 0}, {100, 100, top});
 }
-SkullMesh plug() {
+SkullMesh plug(double top = 6.0) {
   return solid_of(
-      [](const Eigen::Vector3d& p) {
-        return p.z() > 0 && p.z() < 6 && p.x() > 31 && p.x() < 69 && p.y() > 31 && p.y() < 69;
+      [top](const Eigen::Vector3d& p) {
+        return p.z() > 0 && p.z() < top && p.x() > 31 && p.x() < 69 && p.y() > 31 && p.y() < 69;
       },
-      {31, 31, 0}, {69, 69, 6});
+      {31, 31, 0}, {69, 69, top});
 }
 const Eigen::Vector3d kInside(50, 50, -60);
 constexpr double kTop = 5.875, kBoneMm = 5.75;  // the meshed bone's top and thickness
@@ -102,6 +102,52 @@ TEST(FixationTabs, EvenlyPlacedTabsLieOnTheBoneWithTheirScrewsThrough) {
   EXPECT_EQ(report.tabs, 4);
   EXPECT_EQ(report.screws_blocked, 0);
   EXPECT_LE(report.tab_gap_mm, 0.2);
+}
+
+// An implant whose outer surface lies 2.5 mm below the bone's outer table (within the 3 mm
+// tab's reach): over the implant the tab's underside lies on it, so tab and implant are one
+// solid, without a gap under the tab's inner end, and the quality report passes it. With the
+// underside kept 1.5 mm below the outer table, as plans saved before build_implant 9 are made
+// on replay, the tab stands 1 mm over the implant and touches it nowhere: it is refused by
+// name, not left out of the mesh (its largest piece) while the result counts it.
+TEST(FixationTabs, OverALowerImplantTheTabLiesOnIt) {
+  const SkullMesh skull = bone(), implant = plug(3.5);
+  const SurfaceLocator on_bone(skull);
+  TabParams p = resolved(TabParams{}, std::nan(""));
+  p.thickness_mm = 3.0;
+  p.positions = {Eigen::Vector3d(50, 75, 6)};
+  const TabResult r = add_fixation_tabs(implant, on_bone, kInside, p);
+  ASSERT_TRUE(r.usable()) << r.message;
+  ASSERT_EQ(r.tabs.size(), 1u);
+  // Down a line 1.5 mm inside the implant's edge, under the tab's inner end: the tab's top and
+  // the implant's bottom, nothing between.
+  const SurfaceLocator self(r.mesh);
+  const Eigen::Vector3d from(50, 67.5, 20), to(50, 67.5, -5);
+  std::vector<double> crossings;
+  Eigen::Vector3d at = from;
+  while (const auto hit = self.first_hit(at, to)) {
+    crossings.push_back(hit->point.z());
+    at = hit->point - Eigen::Vector3d(0, 0, 1e-3);
+  }
+  ASSERT_EQ(crossings.size(), 2u);
+  // The tab's top at least its thickness over the implant's (3.375 mm, meshed), at most over
+  // the bone's.
+  EXPECT_GE(crossings[0], 3.375 + 3.0 - 0.1) << "the tab's top";
+  EXPECT_LE(crossings[0], kTop + 0.05 + 3.0 + 0.1) << "the tab's top";
+  EXPECT_NEAR(crossings[1], 0.125, 0.01) << "the implant's bottom";
+  QualityParams q;
+  q.edge_clearance_mm = 1.0;
+  q.tabs = r.tabs;
+  const QualityReport report = check_implant(r.mesh, &skull, q);
+  EXPECT_TRUE(report.printable) << (report.reasons.empty() ? "" : report.reasons.front());
+  EXPECT_LE(report.tab_gap_mm, 0.2);
+
+  p.follow_implant = false;
+  const TabResult before = add_fixation_tabs(implant, on_bone, kInside, p);
+  EXPECT_FALSE(before.usable());
+  EXPECT_TRUE(before.tabs.empty());
+  EXPECT_NE(before.message.find("tab 1 does not join the implant"), std::string::npos)
+      << before.message;
 }
 
 // The midline: with the plane x = 50 and 10 mm asked, no tab comes nearer it; the tabs that

@@ -49,6 +49,13 @@ struct TabParams {
   /// triangles); false: only a value exactly at it, as plans saved before this were meshed (set
   /// from the session command's version, not recorded).
   bool iso_gap = true;
+  /// Over the implant a tab's underside lies on the implant's outer surface, however far below
+  /// the bone's outer table that is (at most the tab's thickness where it leaves the edge: the
+  /// placement refuses a larger step). False: nowhere deeper than 1.5 mm below the outer table
+  /// at the edge, which left a gap and a thin overhang over an implant lower than that, as
+  /// plans saved before build_implant 9 were made (set from the session command's version, not
+  /// recorded).
+  bool follow_implant = true;
   bool any() const { return automatic || !positions.empty(); }
 };
 /// Why the parameters cannot be used (a value out of its range), or empty.
