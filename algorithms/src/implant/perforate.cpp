@@ -269,8 +269,9 @@ void perforate_into(const SkullMesh& implant, const Eigen::Vector3d& inside,
       span.depth = under ? under->distance : 15.0;
     }
     const double depth = span.depth + 1.0 + 2.0 * h, above = span.above + 1.0 + 2.0 * h;
-    const Eigen::Vector3d reach =
-        Eigen::Vector3d::Constant(radius + kRimRoundMm + 2.0 * h + std::max(depth, above));
+    const Eigen::Vector3d reach = Eigen::Vector3d::Constant(
+        p.mid_normal ? radius + kRimRoundMm + 2.0 * h + std::max(depth, above)
+                     : radius + 2.0 * h + 16.0);
     const Eigen::Vector3d a = ((hole.center - reach) - g.origin) / h,
                           b = ((hole.center + reach) - g.origin) / h;
     for (int k = std::max(0, static_cast<int>(a.z()));
