@@ -672,25 +672,34 @@ void tabs_into(const SkullMesh& implant, const SurfaceLocator& bone, const Eigen
       surface_of_signed_distance(std::move(field), g, into, p.iso_gap);
   if (!mesh.usable()) return fail("joining the tabs to the implant: " + mesh.message);
   // The meshing keeps the largest piece: a tab that does not touch the implant would be gone
-  // from the mesh while the result still counted it. A point inside each tab, beside its
-  // screws, must lie inside the joined solid (an odd number of crossings along its normal).
-  // Also on replaying a plan saved before follow_implant: such a plan exported the implant
-  // without the tab.
+  // from the mesh while the result still counted it. Of six points inside each tab (a third,
+  // half and two thirds along it, a third of its width to either side: off its screws and
+  // their countersinks, which lie along its middle), one must lie inside the joined solid (an
+  // odd number of crossings along the tab's normal). Also on replaying a plan saved before
+  // follow_implant: such a plan exported the implant without the tab.
   const SurfaceLocator joined(into);
+  auto inside_joined = [&](const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
+    int crossings = 0;
+    Eigen::Vector3d at = from;
+    while (const auto hit = joined.first_hit(at, to)) {
+      ++crossings;
+      at = hit->point + 1e-4 * (to - from).normalized();
+    }
+    return crossings % 2 == 1;
+  };
   for (size_t k = 0; k < placed.size(); ++k) {
     const Tab& t = placed[k].tab;
-    const double a = 0.5 * p.length_mm, b = 0.3 * p.width_mm;
-    const auto [under, top] = maps[k].at(a, b);
     const Eigen::Vector3d v = t.normal.cross(t.outward);
-    const Eigen::Vector3d mid = t.rim + a * t.outward + b * v + 0.5 * (under + top) * t.normal;
-    const Eigen::Vector3d far = mid + (maps[k].high - 0.5 * (under + top) + 20.0) * t.normal;
-    int crossings = 0;
-    Eigen::Vector3d at = mid;
-    while (const auto hit = joined.first_hit(at, far)) {
-      ++crossings;
-      at = hit->point + 1e-4 * t.normal;
-    }
-    if (crossings % 2 == 0)
+    bool joins = false;
+    for (const double along : {1.0 / 3.0, 0.5, 2.0 / 3.0})
+      for (const double across : {-1.0 / 3.0, 1.0 / 3.0}) {
+        const double a = along * p.length_mm, b = across * p.width_mm;
+        const auto [under, top] = maps[k].at(a, b);
+        const Eigen::Vector3d mid = t.rim + a * t.outward + b * v + 0.5 * (under + top) * t.normal;
+        joins = joins ||
+                inside_joined(mid, mid + (maps[k].high - 0.5 * (under + top) + 20.0) * t.normal);
+      }
+    if (!joins)
       return fail("tab " + std::to_string(k + 1) +
                   " does not join the implant (it would stand apart from it): move it along the "
                   "rim");
