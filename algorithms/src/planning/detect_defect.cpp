@@ -2,7 +2,6 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
-#include <Eigen/LU>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -11,6 +10,7 @@
 #include <optional>
 #include <string>
 
+#include "cranioplan/algorithms/geometry/fit_sphere.h"
 #include "cranioplan/algorithms/geometry/point_index.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/surface_samples.h"
@@ -109,32 +109,26 @@ Eigen::Matrix3d skull_frame(const SkullMesh& skull, const Eigen::Vector3d& cente
 
 namespace {
 
+// The least-squares sphere through `points` (fit_sphere), fitted again six times without the
+// points more than 2.5 median deviations + 0.5 mm off the last.
 std::optional<Eigen::Vector3d> trimmed_sphere(const std::vector<Eigen::Vector3d>& points,
                                               double& radius) {
-  std::vector<char> keep(points.size(), 1);
+  std::vector<size_t> kept(points.size());
+  std::iota(kept.begin(), kept.end(), size_t{0});
   Eigen::Vector3d c = Eigen::Vector3d::Zero();
   std::vector<double> off(points.size());
   for (int round = 0; round < 6; ++round) {
-    Eigen::Matrix4d a = Eigen::Matrix4d::Zero();
-    Eigen::Vector4d b = Eigen::Vector4d::Zero();
-    for (size_t i = 0; i < points.size(); ++i) {
-      if (!keep[i]) continue;
-      const Eigen::Vector4d row(2.0 * points[i].x(), 2.0 * points[i].y(), 2.0 * points[i].z(), 1);
-      a += row * row.transpose();
-      b += row * points[i].squaredNorm();
-    }
-    const Eigen::FullPivLU<Eigen::Matrix4d> lu(a);
-    if (lu.rank() < 4) return std::nullopt;
-    const Eigen::Vector4d x = lu.solve(b);
-    c = x.head<3>();
-    const double r2 = x(3) + c.squaredNorm();
-    if (!c.allFinite() || !(r2 > 0.0)) return std::nullopt;
-    radius = std::sqrt(r2);
+    const std::optional<FittedSphere> fitted = fit_sphere(points, kept);
+    if (!fitted || !(fitted->radius > 0.0)) return std::nullopt;
+    c = fitted->center;
+    radius = fitted->radius;
     for (size_t i = 0; i < points.size(); ++i) off[i] = std::abs((points[i] - c).norm() - radius);
     std::vector<double> sorted = off;
     std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
     const double limit = 2.5 * sorted[sorted.size() / 2] + 0.5;
-    for (size_t i = 0; i < points.size(); ++i) keep[i] = off[i] < limit;
+    kept.clear();
+    for (size_t i = 0; i < points.size(); ++i)
+      if (off[i] < limit) kept.push_back(i);
   }
   return c;
 }

@@ -11,6 +11,7 @@
 #include <string>
 #include <tuple>
 
+#include "cranioplan/algorithms/geometry/fit_sphere.h"
 #include "cranioplan/algorithms/geometry/point_index.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/surface_samples.h"
@@ -26,26 +27,14 @@ double median(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// Least-squares sphere through points[idx] (algebraic fit: |p|² = 2 c·p + k); none when it
-// does not enclose `inside` (the rays' centre) or the points are degenerate.
+// The least-squares sphere through points[idx] (geometry/fit_sphere.h); none when it does not
+// enclose `inside` (the rays' centre) or the points are degenerate.
 std::optional<VaultSphere> fit_sphere(const std::vector<Eigen::Vector3d>& points,
                                       const std::vector<size_t>& idx,
                                       const Eigen::Vector3d& inside) {
-  if (idx.size() < 4) return std::nullopt;
-  Eigen::MatrixXd A(idx.size(), 4);
-  Eigen::VectorXd b(idx.size());
-  for (size_t k = 0; k < idx.size(); ++k) {
-    const Eigen::Vector3d& p = points[idx[k]];
-    A.row(static_cast<Eigen::Index>(k)) << 2.0 * p.x(), 2.0 * p.y(), 2.0 * p.z(), 1.0;
-    b[static_cast<Eigen::Index>(k)] = p.squaredNorm();
-  }
-  const Eigen::ColPivHouseholderQR<Eigen::MatrixXd> qr(A);
-  if (qr.rank() < 4) return std::nullopt;
-  const Eigen::Vector4d x = qr.solve(b);
-  const VaultSphere sphere{x.head<3>(), std::sqrt(std::max(0.0, x[3] + x.head<3>().squaredNorm()))};
-  if (!std::isfinite(sphere.radius) || (sphere.center - inside).norm() >= sphere.radius)
-    return std::nullopt;
-  return sphere;
+  const std::optional<FittedSphere> fitted = cranioplan::fit_sphere(points, idx);
+  if (!fitted || (fitted->center - inside).norm() >= fitted->radius) return std::nullopt;
+  return VaultSphere{fitted->center, fitted->radius};
 }
 
 // The ring's band next to the opening (beyond the clearance) that tells the vault's models apart.
