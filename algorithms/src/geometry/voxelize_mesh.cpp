@@ -3,6 +3,10 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <map>
+#include <mutex>
+
+#include "cranioplan/model/parallel.h"
 
 namespace cranioplan {
 
@@ -38,15 +42,15 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> mesh_bounds(const SkullMesh& mesh) {
 
 namespace {
 
-// The heights (in voxel units along axis w) at which a line along w through each voxel column
-// (u, v) crosses the mesh, w = `axis` and (u, v) the other two in cyclic order.
-std::vector<std::vector<float>> crossings(const SkullMesh& mesh, const VoxelGrid& grid, int axis) {
+// The faces [first, last) add their crossings to `columns` (crossings(), below).
+void add_crossings(const SkullMesh& mesh, const VoxelGrid& grid, int axis, size_t first,
+                   size_t last, std::vector<std::vector<float>>& columns) {
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
   const int nu = grid.dims[u], nv = grid.dims[v];
-  std::vector<std::vector<float>> columns(static_cast<size_t>(nu) * nv);
   // A tiny irrational shift keeps column lines off vertices and edges of regular meshes.
   const double jitter_u = 1.3e-6 * M_PI, jitter_v = 1.7e-6 * M_E;
-  for (auto fh : mesh.faces()) {
+  for (size_t f = first; f < last; ++f) {
+    const auto fh = mesh.face_handle(static_cast<int>(f));
     Eigen::Vector3d p[3];
     int k = 0;
     for (auto vh : mesh.fv_range(fh)) {
@@ -77,7 +81,31 @@ std::vector<std::vector<float>> crossings(const SkullMesh& mesh, const VoxelGrid
         columns[static_cast<size_t>(j) * nu + i].push_back(static_cast<float>(z));
       }
   }
-  return columns;
+}
+
+// The heights (in voxel units along axis w) at which a line along w through each voxel column
+// (u, v) crosses the mesh, w = `axis` and (u, v) the other two in cyclic order; in no
+// particular order (the callers sort them). The faces are read on all threads, each into
+// columns of its own, appended in thread order.
+std::vector<std::vector<float>> crossings(const SkullMesh& mesh, const VoxelGrid& grid, int axis) {
+  const size_t columns = static_cast<size_t>(grid.dims[(axis + 1) % 3]) * grid.dims[(axis + 2) % 3];
+  std::mutex m;
+  std::map<size_t, std::vector<std::vector<float>>> parts;  // by the range's first face
+  parallel_for(
+      mesh.n_faces(),
+      [&](size_t first, size_t last) {
+        std::vector<std::vector<float>> part(columns);
+        add_crossings(mesh, grid, axis, first, last, part);
+        const std::lock_guard<std::mutex> lock(m);
+        parts.emplace(first, std::move(part));
+      },
+      50000);
+  if (parts.empty()) return std::vector<std::vector<float>>(columns);
+  std::vector<std::vector<float>> all = std::move(parts.begin()->second);
+  for (auto p = std::next(parts.begin()); p != parts.end(); ++p)
+    for (size_t c = 0; c < columns; ++c)
+      all[c].insert(all[c].end(), p->second[c].begin(), p->second[c].end());
+  return all;
 }
 
 }  // namespace

@@ -829,7 +829,7 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
   const SkullMesh* current = staged ? &shell : &r.mesh;  // the implant as the stages left it
   if (r.usable() && fitted) {
     SkullMesh& out = tabbed || drilled ? fitted_mesh : r.mesh;
-    const TrimToBoneResult t = trim_to_bone(*current, *skull, params.trim, out);
+    const TrimToBoneResult t = trim_to_bone(*current, *skull, params.trim, out, skull_locator);
     if (t.usable()) {
       current = &out;
       r.watertight = is_watertight(out);

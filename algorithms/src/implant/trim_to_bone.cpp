@@ -305,12 +305,16 @@ std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const Vo
       for (int i = 0; i < g.dims[0]; ++i) {
         const size_t c = g.index(i, j, k);
         if (field[c] <= 0.0f || !near_bone[c]) continue;
-        // Without zones only a surface nearer than the clearance and a voxel makes the cap
-        // other than 1 outside the bone and 0 inside it.
-        const auto near = locator->closest_within(
-            g.center(i, j, k),
-            zones.empty() ? clearance + h : std::numeric_limits<double>::infinity());
+        // Without zones only a surface nearer than half a voxel beyond the clearance (outside
+        // the bone) or half a voxel short of it (inside) makes the cap other than 1 outside the
+        // bone and 0 inside it: farther, the cap below is clamped to that. A millionth of a
+        // voxel more keeps the rounding of the clamped values out of it.
         double cap = bone[c] ? 0.0 : 1.0;
+        const double radius =
+            !zones.empty() ? std::numeric_limits<double>::infinity()
+                           : (bone[c] ? 0.5 * h - clearance : 0.5 * h + clearance) + 1e-6 * h;
+        const auto near =
+            radius > 0.0 ? locator->closest_within(g.center(i, j, k), radius) : std::nullopt;
         if (near) {
           const double d = near->distance * (bone[c] ? -1.0 : 1.0);
           const double want =
@@ -330,7 +334,8 @@ std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const Vo
 namespace {
 
 // trim_to_bone, meshed in `into` (the result's own mesh, or the caller's).
-void trim_into(const SkullMesh& implant, const SkullMesh& skull, const TrimToBoneParams& params,
+void trim_into(const SkullMesh& implant, const SkullMesh& skull,
+               const SurfaceLocator* skull_locator, const TrimToBoneParams& params,
                TrimToBoneResult& result, SkullMesh& into) {
   assert(&into != &implant && "the fit is meshed into another mesh than the implant");
   const auto t0 = std::chrono::steady_clock::now();
@@ -351,14 +356,20 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull, const TrimToBon
   // widest clearance.
   double widest = params.clearance_mm.value_or(0.0);
   for (const ClearanceZone& z : params.zones) widest = std::max(widest, z.clearance_mm);
-  std::unique_ptr<SurfaceLocator> locator;
+  // The caller's locator of the whole skull gives the same distances: the nearest triangle
+  // is the same one, and where no triangle lies near the grid, every distance asked is beyond
+  // the band (the caps are then 1 outside the bone and 0 inside, as without a locator).
+  const SurfaceLocator* locator = nullptr;
+  std::unique_ptr<SurfaceLocator> own;
   SkullMesh local;
-  if (params.clearance_mm) {
+  if (params.clearance_mm && skull_locator) {
+    locator = skull_locator;
+  } else if (params.clearance_mm) {
     const double reach = 3.0 * h + widest;
     local = faces_in_box(skull, grid.origin - Eigen::Vector3d::Constant(reach),
                          grid.center(grid.dims[0] - 1, grid.dims[1] - 1, grid.dims[2] - 1) +
                              Eigen::Vector3d::Constant(reach));
-    if (local.n_faces() > 0) locator = std::make_unique<SurfaceLocator>(local);
+    if (local.n_faces() > 0) locator = (own = std::make_unique<SurfaceLocator>(local)).get();
   }
   // A clearance wider than a voxel is cut first (to the voxels' resolution; the surface is held
   // at it exactly below), so that the opening also takes what it leaves thin: a tongue of the
@@ -429,7 +440,7 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull, const TrimToBon
   }
   std::vector<float> smooth;
   if (params.clearance_mm) {
-    smooth = fit_against_bone(mask, bone, grid, locator.get(), params.smoothing_mm / h,
+    smooth = fit_against_bone(mask, bone, grid, locator, params.smoothing_mm / h,
                               std::max(0.0, *params.clearance_mm), params.zones, to_bone);
     Mask().swap(mask);
     std::vector<float>().swap(to_bone);
@@ -463,14 +474,15 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull, const TrimToBon
 TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
                               const TrimToBoneParams& params) {
   TrimToBoneResult result;
-  trim_into(implant, skull, params, result, result.mesh);
+  trim_into(implant, skull, nullptr, params, result, result.mesh);
   return result;
 }
 
 TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
-                              const TrimToBoneParams& params, SkullMesh& into) {
+                              const TrimToBoneParams& params, SkullMesh& into,
+                              const SurfaceLocator* skull_locator) {
   TrimToBoneResult result;
-  trim_into(implant, skull, params, result, into);
+  trim_into(implant, skull, skull_locator, params, result, into);
   return result;
 }
 

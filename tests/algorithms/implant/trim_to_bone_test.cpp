@@ -243,6 +243,41 @@ TEST(TrimToBone, HoldsAWideClearanceAndAZoneOffObliqueCutFaces) {
   EXPECT_TRUE(report_mesh(t.mesh).watertight);
 }
 
+// The caller's locator of the whole skull (a plate far from the implant included) gives the
+// fit, to the byte, that a locator of the skull's triangles near the implant gives: with the
+// default clearance, a wide one, a zone, and for an implant with no bone near it.
+TEST(TrimToBone, TheSkullsOwnLocatorGivesTheSameFit) {
+  const Eigen::Matrix3d r =
+      (Eigen::AngleAxisd(0.5, Eigen::Vector3d(1, 2, 3).normalized())).toRotationMatrix();
+  TriangleSoup plates = box({0, 0, 0}, {20, 20, 5});
+  const TriangleSoup right = box({40, 0, 0}, {60, 20, 5}), far = box({0, 80, 0}, {60, 100, 5});
+  for (const TriangleSoup* b : {&right, &far}) {
+    const int n = static_cast<int>(plates.vertices.size());
+    plates.vertices.insert(plates.vertices.end(), b->vertices.begin(), b->vertices.end());
+    for (auto t : b->triangles) plates.triangles.push_back({t[0] + n, t[1] + n, t[2] + n});
+  }
+  const SkullMesh bone = turned(build_mesh(plates), r);
+  const SurfaceLocator whole(bone);
+  const SkullMesh over_gap = turned(build_mesh(box({17, 2, 0}, {43, 18, 5.3})), r);
+  const SkullMesh alone = turned(build_mesh(box({20, 40, 0}, {40, 60, 4})), r);
+  TrimToBoneParams base;
+  base.max_voxels = 2e5;
+  TrimToBoneParams wide = base, zoned = base;
+  wide.clearance_mm = 2.0;
+  zoned.zones = {{r * Eigen::Vector3d(20, 10, 2.5), 6.5, 0.8}};
+  for (const SkullMesh* implant : {&over_gap, &alone})
+    for (const TrimToBoneParams* p : {&base, &wide, &zoned}) {
+      SkullMesh with, without;
+      const TrimToBoneResult a = trim_to_bone(*implant, bone, *p, with, &whole);
+      const TrimToBoneResult b = trim_to_bone(*implant, bone, *p, without);
+      ASSERT_TRUE(a.usable() && b.usable()) << a.message << b.message;
+      EXPECT_EQ(a.volume_mm3, b.volume_mm3);
+      const TriangleSoup sa = to_soup(with), sb = to_soup(without);
+      EXPECT_EQ(sa.vertices, sb.vertices);
+      EXPECT_EQ(sa.triangles, sb.triangles);
+    }
+}
+
 // A large box on a fine grid is coarsened to the voxel budget; a small one keeps the spacing.
 TEST(VoxelGrid, CoveringAtMostKeepsToTheVoxelBudget) {
   const Eigen::Vector3d lo(0, 0, 0), big(110, 90, 60), small(10, 10, 10);

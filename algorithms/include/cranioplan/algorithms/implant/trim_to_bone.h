@@ -64,9 +64,13 @@ struct TrimToBoneResult {
 /// keeps `clearance_mm` off the skull's surface (unset: a fraction of a voxel off its voxels).
 TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
                               const TrimToBoneParams& params = {});
+class SurfaceLocator;
 /// The same with the result meshed in `into` (whatever it held is replaced; the result's own
 /// mesh stays empty): a mesh cannot be moved, only copied. `into` must not be `implant`.
+/// `skull_locator`: the skull's locator, when the caller has one (the same result, without
+/// a locator of the skull's triangles near the implant built for the fit).
 TrimToBoneResult trim_to_bone(const SkullMesh& implant, const SkullMesh& skull,
-                              const TrimToBoneParams& params, SkullMesh& into);
+                              const TrimToBoneParams& params, SkullMesh& into,
+                              const SurfaceLocator* skull_locator = nullptr);
 
 }  // namespace cranioplan
