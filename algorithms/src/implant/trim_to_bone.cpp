@@ -62,39 +62,40 @@ Mask dilate(const Mask& in, const VoxelGrid& g) {
   return out;
 }
 
-// Keeps the largest 6-connected piece.
+// Keeps the largest 6-connected piece (the first found, by its lowest voxel index, among
+// pieces as large). Each piece is gathered as a list of its voxels; only the largest list is
+// kept, so the work follows the mask's voxels rather than the grid's.
 Mask largest_piece(const Mask& in, const VoxelGrid& g) {
-  std::vector<int> label(in.size(), 0);
-  std::vector<size_t> sizes{0};
-  std::vector<size_t> stack;
+  Mask seen(in.size(), 0);
+  std::vector<size_t> best, piece;
   const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
+  const size_t sy = static_cast<size_t>(nx), sz = sy * ny;
   for (size_t seed = 0; seed < in.size(); ++seed) {
-    if (!in[seed] || label[seed]) continue;
-    const int id = static_cast<int>(sizes.size());
-    sizes.push_back(0);
-    stack.push_back(seed);
-    label[seed] = id;
-    while (!stack.empty()) {
-      const size_t c = stack.back();
-      stack.pop_back();
-      ++sizes[id];
-      const int i = static_cast<int>(c % nx), j = static_cast<int>((c / nx) % ny),
-                k = static_cast<int>(c / (static_cast<size_t>(nx) * ny));
-      const int nb[6][3] = {{i - 1, j, k}, {i + 1, j, k}, {i, j - 1, k},
-                            {i, j + 1, k}, {i, j, k - 1}, {i, j, k + 1}};
-      for (const auto& n : nb) {
-        if (n[0] < 0 || n[1] < 0 || n[2] < 0 || n[0] >= nx || n[1] >= ny || n[2] >= nz) continue;
-        const size_t d = g.index(n[0], n[1], n[2]);
-        if (in[d] && !label[d]) {
-          label[d] = id;
-          stack.push_back(d);
+    if (!in[seed] || seen[seed]) continue;
+    piece.clear();
+    piece.push_back(seed);
+    seen[seed] = 1;
+    for (size_t next = 0; next < piece.size(); ++next) {
+      const size_t c = piece[next];
+      const int i = static_cast<int>(c % sy), j = static_cast<int>((c / sy) % ny),
+                k = static_cast<int>(c / sz);
+      auto visit = [&](size_t d) {
+        if (in[d] && !seen[d]) {
+          seen[d] = 1;
+          piece.push_back(d);
         }
-      }
+      };
+      if (i > 0) visit(c - 1);
+      if (i + 1 < nx) visit(c + 1);
+      if (j > 0) visit(c - sy);
+      if (j + 1 < ny) visit(c + sy);
+      if (k > 0) visit(c - sz);
+      if (k + 1 < nz) visit(c + sz);
     }
+    if (piece.size() > best.size()) best.swap(piece);
   }
-  const int best = static_cast<int>(std::max_element(sizes.begin(), sizes.end()) - sizes.begin());
   Mask out(in.size(), 0);
-  for (size_t c = 0; c < in.size(); ++c) out[c] = best > 0 && label[c] == best;
+  for (size_t c : best) out[c] = 1;
   return out;
 }
 
@@ -148,10 +149,11 @@ Mask bridge_cracks(const Mask& implant, const Mask& bone, const VoxelGrid& g, in
   return out;
 }
 
-// Separable Gaussian blur of a 0/1 mask along the three axes. Rows (along x) that are zero in
-// a pass's input and in every row its taps reach are zero in its output and are not summed: a
-// zero adds nothing to a sum of non-negative terms, so the floats are those of the whole sum,
-// and the implant fills only a shell of its grid.
+// Separable Gaussian blur of a 0/1 mask along the three axes. Each row (along x) of a pass's
+// input is zero outside a span [lo, hi] of it; the output is summed within the spans its taps
+// reach and is zero elsewhere. A zero adds nothing to a sum of non-negative terms (x + 0 = x
+// in floats), so every float is that of the whole sum, and the implant fills only a shell of
+// its grid.
 std::vector<float> blur(const Mask& in, const VoxelGrid& g, double sigma_voxels) {
   std::vector<float> a(in.begin(), in.end());
   if (sigma_voxels <= 0.05) return a;
@@ -165,32 +167,50 @@ std::vector<float> blur(const Mask& in, const VoxelGrid& g, double sigma_voxels)
   const int dims[3] = {g.dims[0], g.dims[1], g.dims[2]};
   const size_t stride[3] = {1, static_cast<size_t>(dims[0]),
                             static_cast<size_t>(dims[0]) * dims[1]};
-  // Which rows (j, k) of the current input hold anything.
+  // The span of each row (j, k) of the current input that may be other than zero; lo > hi:
+  // none.
+  struct Span {
+    int lo, hi;
+  };
   const size_t rows = static_cast<size_t>(dims[1]) * dims[2];
-  std::vector<uint8_t> held(rows), next(rows);
+  std::vector<Span> held(rows), next(rows);
   parallel_for(rows, [&](size_t first, size_t last) {
     for (size_t row = first; row < last; ++row) {
       const uint8_t* at = &in[row * stride[1]];
-      held[row] = std::any_of(at, at + dims[0], [](uint8_t v) { return v != 0; });
+      Span span{dims[0], -1};
+      for (int i = 0; i < dims[0]; ++i)
+        if (at[i]) {
+          span.lo = std::min(span.lo, i);
+          span.hi = i;
+        }
+      held[row] = span;
     }
   });
   for (int axis = 0; axis < 3; ++axis) {
-    // The output's rows: along x the input's; along y and z those a tap reaches from a held row.
-    if (axis == 0) next = held;
-    for (int k = 0; k < dims[2] && axis > 0; ++k)
+    // The output's spans: along x the input's widened by the taps; along y and z the union of
+    // the rows' a tap reaches.
+    for (int k = 0; k < dims[2]; ++k)
       for (int j = 0; j < dims[1]; ++j) {
-        const int pos = axis == 1 ? j : k;
-        bool any = false;
-        for (int t = -r; t <= r && !any; ++t) {
-          if (pos + t < 0 || pos + t >= dims[axis]) continue;
-          any = held[static_cast<size_t>(axis == 1 ? j + t : j) +
-                     static_cast<size_t>(axis == 2 ? k + t : k) * dims[1]];
+        const size_t row = static_cast<size_t>(j) + static_cast<size_t>(k) * dims[1];
+        Span span{dims[0], -1};
+        if (axis == 0) {
+          if (held[row].lo <= held[row].hi)
+            span = {std::max(0, held[row].lo - r), std::min(dims[0] - 1, held[row].hi + r)};
+        } else {
+          const int pos = axis == 1 ? j : k;
+          for (int t = -r; t <= r; ++t) {
+            if (pos + t < 0 || pos + t >= dims[axis]) continue;
+            const Span& s = held[static_cast<size_t>(axis == 1 ? j + t : j) +
+                                 static_cast<size_t>(axis == 2 ? k + t : k) * dims[1]];
+            span.lo = std::min(span.lo, s.lo);
+            span.hi = std::max(span.hi, s.hi);
+          }
         }
-        next[static_cast<size_t>(j) + static_cast<size_t>(k) * dims[1]] = any;
+        next[row] = span;
       }
     // Slices on all threads; each voxel's sum is taken over the taps in order (the same
     // float operations however the loops run) and written once. Along y and z a whole row in
-    // x has the same taps: it is summed tap by tap.
+    // x has the same taps: it is summed tap by tap, each over its row's span.
     parallel_for(
         static_cast<size_t>(dims[2]),
         [&](size_t first, size_t last) {
@@ -198,12 +218,11 @@ std::vector<float> blur(const Mask& in, const VoxelGrid& g, double sigma_voxels)
             for (int j = 0; j < dims[1]; ++j) {
               const size_t row = g.index(0, j, k);
               float* out = &b[row];
-              if (!next[static_cast<size_t>(j) + static_cast<size_t>(k) * dims[1]]) {
-                std::fill(out, out + dims[0], 0.0f);
-                continue;
-              }
+              std::fill(out, out + dims[0], 0.0f);
+              const Span span = next[static_cast<size_t>(j) + static_cast<size_t>(k) * dims[1]];
+              if (span.lo > span.hi) continue;
               if (axis == 0) {
-                for (int i = 0; i < dims[0]; ++i) {
+                for (int i = span.lo; i <= span.hi; ++i) {
                   const float* at = &a[row + i];
                   float v = 0;
                   if (i >= r && i + r < dims[0]) {
@@ -217,16 +236,15 @@ std::vector<float> blur(const Mask& in, const VoxelGrid& g, double sigma_voxels)
                 continue;
               }
               const int pos = axis == 1 ? j : k;
-              std::fill(out, out + dims[0], 0.0f);
               for (int t = -r; t <= r; ++t) {
                 if (pos + t < 0 || pos + t >= dims[axis]) continue;
-                if (!held[static_cast<size_t>(axis == 1 ? j + t : j) +
-                          static_cast<size_t>(axis == 2 ? k + t : k) * dims[1]])
-                  continue;
+                const Span& s = held[static_cast<size_t>(axis == 1 ? j + t : j) +
+                                     static_cast<size_t>(axis == 2 ? k + t : k) * dims[1]];
+                if (s.lo > s.hi) continue;
                 const float wt = w[t + r];
                 const float* in = &a[row + static_cast<std::ptrdiff_t>(t) *
                                                static_cast<std::ptrdiff_t>(stride[axis])];
-                for (int i = 0; i < dims[0]; ++i) out[i] += wt * in[i];
+                for (int i = s.lo; i <= s.hi; ++i) out[i] += wt * in[i];
               }
             }
         },
