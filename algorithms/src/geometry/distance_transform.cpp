@@ -158,30 +158,67 @@ std::vector<float> distance_within(const std::vector<uint8_t>& mask, const Voxel
   const int nx = grid.dims[0], ny = grid.dims[1], nz = grid.dims[2];
   const size_t sy = static_cast<size_t>(nx), sz = sy * ny;
   const float capped = static_cast<float>(reach + 1) * static_cast<float>(reach + 1);
-  // What each row (along x) holds after a pass: kFull rows are all 0 (every voxel in the mask)
-  // and stay so, kEmpty rows are all capped; a window of kEmpty rows gives a capped row. Only
-  // the other rows, near the mask's surface, are summed: the same values as summing them all.
-  enum : uint8_t { kEmpty = 0, kFull = 1, kMixed = 2 };
-  auto kind_of = [capped](const float* row, int n) -> uint8_t {
-    bool zero = true, empty = true;
-    for (int i = 0; i < n; ++i) {
-      zero &= row[i] == 0.0f;
-      empty &= row[i] == capped;
+  // What each row (along x) holds after a pass, as two spans: where its values are other than
+  // 0 (outside it every voxel is in the mask) and where they are below the cap (outside it
+  // they are capped). A window's minimum is 0 outside its middle row's first span (that row's
+  // term is 0 and none is below it) and capped outside the union of its rows' second spans;
+  // only what lies in both is summed: the same values as summing whole rows. A mask fills a
+  // shell of its grid: most rows are all in it or all far from it, and the others cross its
+  // surface in short spans.
+  struct Span {
+    int lo = 1, hi = 0;  // empty
+    bool empty() const { return lo > hi; }
+    void add(int i) {
+      if (empty()) lo = i;
+      hi = i;
     }
-    return zero ? kFull : empty ? kEmpty : kMixed;
+  };
+  struct Spans {
+    Span nonzero, below_cap;
+  };
+  auto spans_of = [capped](const float* row, int n) {
+    Spans s;
+    for (int i = 0; i < n; ++i) {
+      if (row[i] != 0.0f) s.nonzero.add(i);
+      if (row[i] < capped) s.below_cap.add(i);
+    }
+    return s;
+  };
+  // The union of the second spans of rows at(t), t in [lo, hi].
+  auto union_below_cap = [](int lo, int hi, const auto& at) {
+    Span u;
+    for (int t = lo; t <= hi; ++t) {
+      const Span& s = at(t).below_cap;
+      if (s.empty()) continue;
+      if (u.empty()) {
+        u = s;
+      } else {
+        u.lo = std::min(u.lo, s.lo);
+        u.hi = std::max(u.hi, s.hi);
+      }
+    }
+    return u;
   };
   std::vector<float> sq(mask.size());
-  std::vector<uint8_t> kind(static_cast<size_t>(ny) * nz);
+  std::vector<Spans> spans(static_cast<size_t>(ny) * nz);
   // Along x, and along y within each slice (slices on all threads).
   parallel_for(
       static_cast<size_t>(nz),
       [&](size_t first, size_t last) {
         std::vector<float> slice(sz);
-        std::vector<uint8_t> row_kind(static_cast<size_t>(ny));
+        std::vector<Spans> row_spans(static_cast<size_t>(ny));
         for (size_t k = first; k < last; ++k) {
           for (int j = 0; j < ny; ++j) {
             const uint8_t* in = &mask[k * sz + j * sy];
             float* out = &slice[j * sy];
+            // A row all in the mask is all 0, one without any of it all capped.
+            const bool none = std::none_of(in, in + nx, [](uint8_t v) { return v != 0; });
+            if (none || std::all_of(in, in + nx, [](uint8_t v) { return v != 0; })) {
+              std::fill(out, out + nx, none ? capped : 0.0f);
+              row_spans[j] = Spans{};
+              (none ? row_spans[j].nonzero : row_spans[j].below_cap) = Span{0, nx - 1};
+              continue;
+            }
             int gap = reach + 1;
             for (int i = 0; i < nx; ++i) {
               gap = in[i] ? 0 : std::min(gap + 1, reach + 1);
@@ -193,25 +230,25 @@ std::vector<float> distance_within(const std::vector<uint8_t>& mask, const Voxel
               const float g = std::min(out[i], static_cast<float>(gap));
               out[i] = g * g;
             }
-            row_kind[j] = kind_of(out, nx);
+            row_spans[j] = spans_of(out, nx);
           }
           for (int j = 0; j < ny; ++j) {
             float* out = &sq[k * sz + j * sy];
             const int lo = std::max(-reach, -j), hi = std::min(reach, ny - 1 - j);
-            if (row_kind[j] == kFull) {
-              std::fill(out, out + nx, 0.0f);
-            } else if (std::all_of(&row_kind[j + lo], &row_kind[j + hi] + 1,
-                                   [](uint8_t r) { return r == kEmpty; })) {
-              std::fill(out, out + nx, capped);
-            } else {
-              std::fill(out, out + nx, capped);
+            const Span& middle = row_spans[j].nonzero;
+            const Span u =
+                union_below_cap(lo, hi, [&](int t) -> const Spans& { return row_spans[j + t]; });
+            std::fill(out, out + nx, 0.0f);
+            if (!middle.empty()) std::fill(out + middle.lo, out + middle.hi + 1, capped);
+            const int from = std::max(middle.lo, u.lo), to = std::min(middle.hi, u.hi);
+            if (!middle.empty() && !u.empty() && from <= to) {
               for (int t = lo; t <= hi; ++t) {
                 const float step = static_cast<float>(t * t);
                 const float* in = &slice[(j + t) * sy];
-                for (int i = 0; i < nx; ++i) out[i] = std::min(out[i], in[i] + step);
+                for (int i = from; i <= to; ++i) out[i] = std::min(out[i], in[i] + step);
               }
             }
-            kind[k * static_cast<size_t>(ny) + j] = kind_of(out, nx);
+            spans[k * static_cast<size_t>(ny) + j] = spans_of(out, nx);
           }
         }
       },
@@ -228,24 +265,25 @@ std::vector<float> distance_within(const std::vector<uint8_t>& mask, const Voxel
             float* out = &d[k * sz + j * sy];
             const int z = static_cast<int>(k);
             const int lo = std::max(-reach, -z), hi = std::min(reach, nz - 1 - z);
-            auto kind_at = [&](int t) { return kind[static_cast<size_t>(z + t) * ny + j]; };
-            if (kind_at(0) == kFull) {
-              std::fill(out, out + nx, 0.0f);
-              continue;
-            }
-            bool empty = true;
-            for (int t = lo; t <= hi && empty; ++t) empty = kind_at(t) == kEmpty;
-            if (empty) {
-              std::fill(out, out + nx, std::numeric_limits<float>::infinity());
-              continue;
-            }
-            std::fill(row.begin(), row.end(), capped);
+            auto at = [&](int t) -> const Spans& {
+              return spans[static_cast<size_t>(z + t) * ny + j];
+            };
+            const Span& middle = at(0).nonzero;
+            const Span u = union_below_cap(lo, hi, at);
+            // Outside the middle row's span the minimum is 0 (0 mm); within it, outside the
+            // union, capped (beyond the reach).
+            std::fill(out, out + nx, 0.0f);
+            if (middle.empty()) continue;
+            std::fill(out + middle.lo, out + middle.hi + 1, std::numeric_limits<float>::infinity());
+            const int from = std::max(middle.lo, u.lo), to = std::min(middle.hi, u.hi);
+            if (u.empty() || from > to) continue;
+            std::fill(row.begin() + from, row.begin() + to + 1, capped);
             for (int t = lo; t <= hi; ++t) {
               const float step = static_cast<float>(t * t);
               const float* in = &sq[static_cast<size_t>(z + t) * sz + j * sy];
-              for (int i = 0; i < nx; ++i) row[i] = std::min(row[i], in[i] + step);
+              for (int i = from; i <= to; ++i) row[i] = std::min(row[i], in[i] + step);
             }
-            for (int i = 0; i < nx; ++i)
+            for (int i = from; i <= to; ++i)
               out[i] =
                   row[i] <= limit
                       ? static_cast<float>(grid.spacing * std::sqrt(static_cast<double>(row[i])))
