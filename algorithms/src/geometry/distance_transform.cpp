@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cassert>
 #include <cmath>
+#include <iterator>
 #include <limits>
 
 #include "cranioplan/model/parallel.h"
@@ -381,33 +382,52 @@ std::vector<uint8_t> within_steps(const std::vector<uint8_t>& in, const VoxelGri
   const uint8_t cap = static_cast<uint8_t>(steps + 1);
   const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
   const size_t sy = static_cast<size_t>(nx), sz = sy * ny;
-  // Rows (along x) that may hold a distance below the cap: a row relaxed from a row without one
-  // cannot change (cap + 1 is clipped to the cap), so those sweeps are skipped and the sums are
-  // those of the whole sweep. A mask fills a shell of its grid; most rows stay at the cap.
-  std::vector<uint8_t> d(in.size()), held(static_cast<size_t>(ny) * nz);
+  // Each row (along x) keeps the span outside which all its values are the cap (lo > hi: the
+  // whole row). A row relaxed from a neighbour changes only within the neighbour's span, and a
+  // sweep along x only within steps of its own: the sweeps keep to the spans, and the values
+  // are those of sweeping whole rows. A mask fills a shell of its grid; most rows stay capped.
+  struct Span {
+    int lo = 1, hi = 0;
+    bool empty() const { return lo > hi; }
+  };
+  std::vector<uint8_t> d(in.size());
+  std::vector<Span> held(static_cast<size_t>(ny) * nz);
   parallel_for(held.size(), [&](size_t first, size_t last) {
     for (size_t row = first; row < last; ++row) {
-      bool any = false;
-      for (size_t c = row * sy; c < (row + 1) * sy; ++c) {
-        d[c] = in[c] ? 0 : cap;
-        any |= in[c] != 0;
+      Span span;
+      const uint8_t* from = &in[row * sy];
+      uint8_t* to = &d[row * sy];
+      for (int i = 0; i < nx; ++i) to[i] = from[i] ? 0 : cap;
+      auto in_mask = [](uint8_t v) { return v != 0; };
+      const uint8_t* lo = std::find_if(from, from + nx, in_mask);
+      if (lo != from + nx) {
+        span.lo = static_cast<int>(lo - from);
+        span.hi = nx - 1 -
+                  static_cast<int>(std::find_if(std::make_reverse_iterator(from + nx),
+                                                std::make_reverse_iterator(lo), in_mask) -
+                                   std::make_reverse_iterator(from + nx));
       }
-      held[row] = any;
+      held[row] = span;
     }
   });
-  // Relaxes row `to` from its neighbour `from`; whether `to` now holds a value below the cap.
-  // A row is held only then: a row relaxed from a held row whose values all stayed at the cap
-  // holds nothing either, so the sweeps keep to the rows near the mask.
   auto one_more = [cap](uint8_t from) {
     return static_cast<uint8_t>(std::min<int>(from + 1, cap));
   };
-  auto relax_row = [cap, one_more](uint8_t* to, const uint8_t* from, int n) -> uint8_t {
-    uint8_t low = cap;
-    for (int i = 0; i < n; ++i) {
+  // Relaxes row `to` from its neighbour `from` within the neighbour's span; `to`'s span grows
+  // by where it now holds a value below the cap.
+  auto relax_row = [cap, one_more](uint8_t* to, Span& to_span, const uint8_t* from,
+                                   const Span& from_span) {
+    for (int i = from_span.lo; i <= from_span.hi; ++i) {
       to[i] = std::min(to[i], one_more(from[i]));
-      low = std::min(low, to[i]);
+      if (to[i] < cap) {
+        if (to_span.empty()) {
+          to_span.lo = to_span.hi = i;
+        } else {
+          to_span.lo = std::min(to_span.lo, i);
+          to_span.hi = std::max(to_span.hi, i);
+        }
+      }
     }
-    return low < cap;
   };
   // Along x: each row by itself; along y: row by row within a slice (slices on all threads).
   parallel_for(
@@ -415,17 +435,24 @@ std::vector<uint8_t> within_steps(const std::vector<uint8_t>& in, const VoxelGri
       [&](size_t first, size_t last) {
         for (size_t k = first; k < last; ++k) {
           uint8_t* slice = &d[k * sz];
-          uint8_t* rows = &held[k * static_cast<size_t>(ny)];
+          Span* rows = &held[k * static_cast<size_t>(ny)];
           for (int j = 0; j < ny; ++j) {
-            if (!rows[j]) continue;
+            Span& span = rows[j];
+            if (span.empty()) continue;
             uint8_t* row = slice + j * sy;
-            for (int i = 1; i < nx; ++i) row[i] = std::min(row[i], one_more(row[i - 1]));
-            for (int i = nx - 2; i >= 0; --i) row[i] = std::min(row[i], one_more(row[i + 1]));
+            const int hi = std::min(nx - 1, span.hi + steps), lo = std::max(0, span.lo - steps);
+            for (int i = std::max(1, span.lo); i <= hi; ++i)
+              row[i] = std::min(row[i], one_more(row[i - 1]));
+            for (int i = std::min(nx - 2, span.hi); i >= lo; --i)
+              row[i] = std::min(row[i], one_more(row[i + 1]));
+            span = {lo, hi};
           }
           for (int j = 1; j < ny; ++j)
-            if (rows[j - 1]) rows[j] |= relax_row(slice + j * sy, slice + (j - 1) * sy, nx);
+            if (!rows[j - 1].empty())
+              relax_row(slice + j * sy, rows[j], slice + (j - 1) * sy, rows[j - 1]);
           for (int j = ny - 2; j >= 0; --j)
-            if (rows[j + 1]) rows[j] |= relax_row(slice + j * sy, slice + (j + 1) * sy, nx);
+            if (!rows[j + 1].empty())
+              relax_row(slice + j * sy, rows[j], slice + (j + 1) * sy, rows[j + 1]);
         }
       },
       2);
@@ -434,20 +461,24 @@ std::vector<uint8_t> within_steps(const std::vector<uint8_t>& in, const VoxelGri
       static_cast<size_t>(ny),
       [&](size_t first, size_t last) {
         for (size_t j = first; j < last; ++j) {
-          auto row_held = [&](int k) -> uint8_t& { return held[k * static_cast<size_t>(ny) + j]; };
+          auto row_held = [&](int k) -> Span& { return held[k * static_cast<size_t>(ny) + j]; };
           for (int k = 1; k < nz; ++k)
-            if (row_held(k - 1))
-              row_held(k) |= relax_row(&d[k * sz + j * sy], &d[(k - 1) * sz + j * sy], nx);
+            if (!row_held(k - 1).empty())
+              relax_row(&d[k * sz + j * sy], row_held(k), &d[(k - 1) * sz + j * sy],
+                        row_held(k - 1));
           for (int k = nz - 2; k >= 0; --k)
-            if (row_held(k + 1))
-              row_held(k) |= relax_row(&d[k * sz + j * sy], &d[(k + 1) * sz + j * sy], nx);
+            if (!row_held(k + 1).empty())
+              relax_row(&d[k * sz + j * sy], row_held(k), &d[(k + 1) * sz + j * sy],
+                        row_held(k + 1));
         }
       },
       2);
   std::vector<uint8_t> out(in.size());
   parallel_for(held.size(), [&](size_t first, size_t last) {
-    for (size_t row = first; row < last; ++row)
-      for (size_t c = row * sy; c < (row + 1) * sy; ++c) out[c] = held[row] && d[c] <= steps;
+    for (size_t row = first; row < last; ++row) {
+      const Span& span = held[row];
+      for (int i = span.lo; i <= span.hi; ++i) out[row * sy + i] = d[row * sy + i] <= steps;
+    }
   });
   return out;
 }
