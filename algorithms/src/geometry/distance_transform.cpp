@@ -347,24 +347,11 @@ std::vector<uint8_t> ball_centres(const std::vector<uint8_t>& mask, const VoxelG
 
 std::vector<uint8_t> open_by_ball(const std::vector<uint8_t>& mask, const VoxelGrid& grid,
                                   double radius) {
-  // A voxel of the mask is kept when a centre lies within radius + ½ voxel of it: the centres
-  // around each voxel are tried in order of distance, on distance_to_mask's floats (the same
-  // test as that transform's value at the voxel, without the transform over the whole grid;
-  // most voxels of a thick mask are centres themselves).
   const double reach = radius + 0.5 * grid.spacing;
-  const std::vector<uint8_t> centres = ball_centres(mask, grid, radius);
-  const VoxelOffsets ball(grid, reach);
+  const std::vector<float> to_centre =
+      distance_to_mask(ball_centres(mask, grid, radius), grid, reach);
   std::vector<uint8_t> out(mask.size());
-  parallel_for(
-      mask.size(),
-      [&](size_t first, size_t last) {
-        for (size_t c = first; c < last; ++c)
-          out[c] = mask[c] &&
-                   (centres[c] || ball.first(
-                                      c, [&](size_t v, int, int, int) { return centres[v] != 0; },
-                                      [&](float d) { return d <= reach; }));
-      },
-      1 << 16);
+  for (size_t c = 0; c < mask.size(); ++c) out[c] = mask[c] && to_centre[c] <= reach;
   return out;
 }
 
