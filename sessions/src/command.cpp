@@ -236,7 +236,9 @@ int current_version(CommandType type) {
   // footprint (PerforationParams::mid_normal), tabs whose underside follows the implant
   // however far below the outer table (TabParams::follow_implant); the parameters recorded are
   // unchanged, and version 8 is made as it was.
-  if (type == CommandType::BuildImplant) return 9;
+  // build_implant 10: over the implant a tab's underside comes down onto its rounded edge
+  // instead of bridging over it (TabParams::on_implant_edge); version 9 is made as it was.
+  if (type == CommandType::BuildImplant) return 10;
   if (type == CommandType::ExportImplant) return 2;
   // propose_markers 4: support markers only where the fitted surface describes the ring's bone
   // ("max_support_off_fit_mm"; versions 1 to 3 are read with 0, every ring point of the band).

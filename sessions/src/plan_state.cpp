@@ -770,6 +770,8 @@ void apply_build(PlanState& s, const ParamReader& r, int version) {
   // under their centre, and a tab's underside went nowhere deeper than 1.5 mm below the outer
   // table at the implant's edge.
   params.perforations.mid_normal = params.tabs.follow_implant = version >= 9;
+  // Before version 10, the bridging of narrow gaps held a tab over the implant's rounded edge.
+  params.tabs.on_implant_edge = version >= 10;
   s.implant_params = params;
   unacknowledge(s, 8, "the implant was built again");
   rebuild_implant(s);

@@ -83,7 +83,7 @@ TEST(Commands, EveryTypeRoundTripsThroughJson) {
 // read as recorded, built without the fit.
 TEST(Commands, BuildImplantVersionOneIsReadByItsOwnRules) {
   Json v1 = to_json(commands::build_implant());
-  EXPECT_EQ(v1["version"], 9);
+  EXPECT_EQ(v1["version"], 10);
   v1["version"] = 1;
   v1["params"]["params"].erase("trim");
   v1["params"]["params"].erase("fit_to_bone_mm");
@@ -130,7 +130,7 @@ TEST(Commands, OlderPlansReadTheSkullAndFitTheBoneAsTheyWereMade) {
   p.trim.min_feature_mm = 1.7;
   p.trim.bridge_mm = 0.8;
   const Json build = to_json(commands::build_implant(p));
-  EXPECT_EQ(build["version"], 9);
+  EXPECT_EQ(build["version"], 10);
   ImplantParams back;
   params_from_json(ParamReader(build["params"]["params"], "test"), back);
   EXPECT_EQ(back.trim.min_feature_mm, 1.7);
@@ -176,7 +176,7 @@ TEST(Commands, TheBuildRecordsItsMaterialAndClearanceZones) {
   p.perforations.added = {Eigen::Vector3d(4, 5, 6)};
   p.perforations.removed = {Eigen::Vector3d(7, 8, 9)};
   const Json build = to_json(commands::build_implant(p));
-  EXPECT_EQ(build["version"], 9);
+  EXPECT_EQ(build["version"], 10);
   const Json& recorded = build["params"]["params"];
   EXPECT_EQ(recorded["material"]["name"], "PMMA");
   EXPECT_TRUE(recorded["material"]["thickness_mm"].is_null()) << "follows the bone";

@@ -34,6 +34,9 @@ constexpr double kOverlapMm = 3.0;
 constexpr double kPlugMm = 1.5;
 // Narrower gaps under a tab than twice this radius are bridged at most this deep, mm.
 constexpr double kCrackRadiusMm = 0.6, kCrackDepthMm = 0.3;
+// Over the implant a tab's underside comes down onto the implant where it lies up to the first
+// below the bridged underside, not where the second or more, mm.
+constexpr double kFillFullMm = 1.0, kFillNoneMm = 2.0;
 // The tab's top edges are rounded over this radius, mm.
 constexpr double kEdgeRoundMm = 1.5;
 // The even placement spaces tabs by one per this much rim, mm.
@@ -370,6 +373,7 @@ TabMaps tab_maps(const Candidate& c, const SurfaceLocator& self, const SurfaceLo
   const double reach = std::max(c.implant_high, c.bone_high) + 1.0;
   const double floor = c.edge_height - kPlugMm;
   std::vector<double> seen(cells);
+  std::vector<uint8_t> over_implant(cells, 0);  // the underside lies on the implant there
   parallel_for(cells, [&](size_t begin, size_t end) {
     for (size_t q = begin; q < end; ++q) {
       const double a = m.a0 + static_cast<double>(q % m.na) * m.step,
@@ -384,13 +388,17 @@ TabMaps tab_maps(const Candidate& c, const SurfaceLocator& self, const SurfaceLo
         z = std::max(z, (hit->point - t.rim).dot(n) + kUndersideMm);
       if (on_implant) z = std::max(z, (on_implant->point - t.rim).dot(n));
       seen[q] = z;
+      over_implant[q] = on_implant && z == (on_implant->point - t.rim).dot(n);
     }
   });
   // No deeper than kCrackDepthMm below the highest within kCrackRadiusMm: the gap at the
   // implant's edge (and a crack in the bone) narrower than twice that is bridged, not filled
-  // with a fin.
+  // with a fin. Where the implant is the outermost surface, the underside comes down onto its
+  // rounded edge (over which the bridging would hold the tab with air under it); the top is
+  // made on the bridged underside, so the tab's top does not dip where it does.
   const int r1 = static_cast<int>(std::round(kCrackRadiusMm / m.step));
   m.under.assign(cells, 0.0);
+  std::vector<double> bridged(cells);  // the underside with every narrow gap bridged
   for (int y = 0; y < m.nb; ++y)
     for (int x = 0; x < m.na; ++x) {
       double highest = -1e300;
@@ -401,9 +409,18 @@ TabMaps tab_maps(const Candidate& c, const SurfaceLocator& self, const SurfaceLo
           highest = std::max(highest, seen[static_cast<size_t>(yy) * m.na + xx]);
         }
       const size_t q = static_cast<size_t>(y) * m.na + x;
-      m.under[q] = std::max(seen[q], highest - kCrackDepthMm);
+      bridged[q] = std::max(seen[q], highest - kCrackDepthMm);
+      // Down to the implant where it lies up to kFillFullMm below the bridged underside, not
+      // at all where kFillNoneMm or more, part of the way in between: the underside stays
+      // continuous where the implant's edge drops away under the tab's side.
+      const double below = bridged[q] - seen[q];
+      const double fill =
+          p.on_implant_edge && over_implant[q]
+              ? std::clamp((kFillNoneMm - below) / (kFillNoneMm - kFillFullMm), 0.0, 1.0)
+              : 0.0;
+      m.under[q] = bridged[q] - fill * below;
     }
-  // The top: the upper envelope of the balls of the thickness on the underside.
+  // The top: the upper envelope of the balls of the thickness on the bridged underside.
   const int rt = static_cast<int>(std::ceil(p.thickness_mm / m.step));
   m.top.assign(cells, 0.0);
   parallel_for(
@@ -419,7 +436,7 @@ TabMaps tab_maps(const Candidate& c, const SurfaceLocator& self, const SurfaceLo
                 const double r2 = p.thickness_mm * p.thickness_mm -
                                   m.step * m.step * static_cast<double>(dx * dx + dy * dy);
                 if (r2 < 0) continue;
-                top = std::max(top, m.under[static_cast<size_t>(yy) * m.na + xx] + std::sqrt(r2));
+                top = std::max(top, bridged[static_cast<size_t>(yy) * m.na + xx] + std::sqrt(r2));
               }
             m.top[y * m.na + x] = top;
           }

@@ -150,6 +150,72 @@ TEST(FixationTabs, OverALowerImplantTheTabLiesOnIt) {
       << before.message;
 }
 
+// The crossings of the surface along a line, from `from` to `to` (heights along z).
+std::vector<double> crossings_along(const SurfaceLocator& s, const Eigen::Vector3d& from,
+                                    const Eigen::Vector3d& to) {
+  std::vector<double> z;
+  Eigen::Vector3d at = from;
+  while (const auto hit = s.first_hit(at, to)) {
+    z.push_back(hit->point.z());
+    at = hit->point + 1e-3 * (to - from).normalized();
+  }
+  return z;
+}
+
+// An implant whose outer edge is rounded over 4 mm (a quarter circle from z 6 down to 2 at its
+// wall, as a fitted implant's edge is): under the tab the implant drops away faster than the
+// bridging of narrow gaps allows (0.3 mm within 0.6 mm). The tab's underside comes down onto
+// the rounded edge — tab and implant one solid, nothing between them down lines through the
+// rounding up to 0.6 mm from its wall (nearer, within the union's 0.2 mm grid) — and the gap at
+// the edge keeps its clearance below the plug. As plans saved before
+// build_implant 10 are made, the tab stands over the rounding with air under it.
+TEST(FixationTabs, OverARoundedImplantEdgeTheTabComesDownOntoIt) {
+  const SkullMesh skull = bone();
+  const SkullMesh implant = solid_of(
+      [](const Eigen::Vector3d& p) {
+        if (!(p.z() > 0 && p.x() > 31 && p.x() < 69 && p.y() > 31 && p.y() < 69)) return false;
+        const double over = std::max(0.0, p.y() - 65.0);  // into the rounding at y = 69
+        return p.z() < 2.0 + std::sqrt(std::max(0.0, 16.0 - over * over));
+      },
+      {31, 31, 0}, {69, 69, 6});
+  const SurfaceLocator on_bone(skull);
+  TabParams p = resolved(TabParams{}, std::nan(""));
+  p.thickness_mm = 3.0;
+  p.positions = {Eigen::Vector3d(50, 75, 6)};
+  for (const bool on_edge : {true, false}) {
+    SCOPED_TRACE(on_edge ? "onto the edge" : "as before build_implant 10");
+    p.on_implant_edge = on_edge;
+    const TabResult r = add_fixation_tabs(implant, on_bone, kInside, p);
+    ASSERT_TRUE(r.usable()) << r.message;
+    const SurfaceLocator self(r.mesh);
+    int with_air = 0;
+    for (const double y : {67.6, 68.0, 68.4})
+      for (const double x : {48.0, 50.0, 52.0}) {
+        const std::vector<double> z =
+            crossings_along(self, Eigen::Vector3d(x, y, 20), Eigen::Vector3d(x, y, -5));
+        ASSERT_GE(z.size(), 2u);
+        with_air += z.size() > 2;
+      }
+    if (on_edge) {
+      EXPECT_EQ(with_air, 0) << "the tab and the implant are one solid under the tab";
+      // In the gap at the edge (y 69 to 70), below the plug (1.5 mm under the outer table),
+      // nothing was added.
+      for (const double x : {48.0, 50.0, 52.0})
+        EXPECT_TRUE(
+            crossings_along(self, Eigen::Vector3d(x, 69.5, 3.8), Eigen::Vector3d(x, 69.5, 0.5))
+                .empty());
+      QualityParams q;
+      q.edge_clearance_mm = 1.0;
+      q.tabs = r.tabs;
+      const QualityReport report = check_implant(r.mesh, &skull, q);
+      EXPECT_TRUE(report.printable) << (report.reasons.empty() ? "" : report.reasons.front());
+      EXPECT_EQ(report.penetration_mm3, 0.0);
+    } else {
+      EXPECT_GT(with_air, 0) << "the tab stood over the rounding";
+    }
+  }
+}
+
 // The midline: with the plane x = 50 and 10 mm asked, no tab comes nearer it; the tabs that
 // would lie across it move along the rim.
 TEST(FixationTabs, TheEvenPlacementKeepsOffTheMidline) {

@@ -56,6 +56,14 @@ struct TabParams {
   /// plans saved before build_implant 9 were made (set from the session command's version, not
   /// recorded).
   bool follow_implant = true;
+  /// Where the implant is the outermost surface under a tab, the underside comes down onto it
+  /// from the bridging of narrow gaps (at most 0.3 mm deep within 0.6 mm of the highest point)
+  /// where it lies up to 1 mm below, not where 2 mm or more (its wall, dropping into the gap at
+  /// the edge), part of the way between. False: the bridging applies over the implant too,
+  /// which held a tab up to 1 mm over a rounded edge with air under it (thin material away
+  /// from the bone), as plans saved before build_implant 10 were made (set from the session
+  /// command's version, not recorded).
+  bool on_implant_edge = true;
   bool any() const { return automatic || !positions.empty(); }
 };
 /// Why the parameters cannot be used (a value out of its range), or empty.
