@@ -370,8 +370,8 @@ std::vector<uint8_t> within_steps(const std::vector<uint8_t>& in, const VoxelGri
   const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
   const size_t sy = static_cast<size_t>(nx), sz = sy * ny;
   // Each row (along x) keeps the span outside which all its values are the cap (lo > hi: the
-  // whole row). A row relaxed from a neighbour changes only within the neighbour's span, and a
-  // sweep along x only within steps of its own: the sweeps keep to the spans, and the values
+  // whole row is capped). A row relaxed from a neighbour changes only within the neighbour's span,
+  // and a sweep along x only within steps of its own: the sweeps keep to the spans, and the values
   // are those of sweeping whole rows. A mask fills a shell of its grid; most rows stay capped.
   struct Span {
     int lo = 1, hi = 0;
