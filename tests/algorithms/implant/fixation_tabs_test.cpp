@@ -104,6 +104,18 @@ TEST(FixationTabs, EvenlyPlacedTabsLieOnTheBoneWithTheirScrewsThrough) {
   EXPECT_LE(report.tab_gap_mm, 0.2);
 }
 
+// The crossings of the surface along a line, from `from` to `to` (heights along z).
+std::vector<double> crossings_along(const SurfaceLocator& s, const Eigen::Vector3d& from,
+                                    const Eigen::Vector3d& to) {
+  std::vector<double> z;
+  Eigen::Vector3d at = from;
+  while (const auto hit = s.first_hit(at, to)) {
+    z.push_back(hit->point.z());
+    at = hit->point + 1e-3 * (to - from).normalized();
+  }
+  return z;
+}
+
 // An implant whose outer surface lies 2.5 mm below the bone's outer table (within the 3 mm
 // tab's reach): over the implant the tab's underside lies on it, so tab and implant are one
 // solid, without a gap under the tab's inner end, and the quality report passes it. With the
@@ -122,13 +134,8 @@ TEST(FixationTabs, OverALowerImplantTheTabLiesOnIt) {
   // Down a line 1.5 mm inside the implant's edge, under the tab's inner end: the tab's top and
   // the implant's bottom, nothing between.
   const SurfaceLocator self(r.mesh);
-  const Eigen::Vector3d from(50, 67.5, 20), to(50, 67.5, -5);
-  std::vector<double> crossings;
-  Eigen::Vector3d at = from;
-  while (const auto hit = self.first_hit(at, to)) {
-    crossings.push_back(hit->point.z());
-    at = hit->point - Eigen::Vector3d(0, 0, 1e-3);
-  }
+  const std::vector<double> crossings =
+      crossings_along(self, Eigen::Vector3d(50, 67.5, 20), Eigen::Vector3d(50, 67.5, -5));
   ASSERT_EQ(crossings.size(), 2u);
   // The tab's top at least its thickness over the implant's (3.375 mm, meshed), at most over
   // the bone's.
@@ -148,18 +155,6 @@ TEST(FixationTabs, OverALowerImplantTheTabLiesOnIt) {
   EXPECT_TRUE(before.tabs.empty());
   EXPECT_NE(before.message.find("tab 1 does not join the implant"), std::string::npos)
       << before.message;
-}
-
-// The crossings of the surface along a line, from `from` to `to` (heights along z).
-std::vector<double> crossings_along(const SurfaceLocator& s, const Eigen::Vector3d& from,
-                                    const Eigen::Vector3d& to) {
-  std::vector<double> z;
-  Eigen::Vector3d at = from;
-  while (const auto hit = s.first_hit(at, to)) {
-    z.push_back(hit->point.z());
-    at = hit->point + 1e-3 * (to - from).normalized();
-  }
-  return z;
 }
 
 // An implant whose outer edge is rounded over 4 mm (a quarter circle from z 6 down to 2 at its
