@@ -6,7 +6,9 @@
 #include <chrono>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <optional>
+#include <vector>
 
 #include "cranioplan/algorithms/geometry/mesh_distance_field.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
@@ -507,28 +509,63 @@ TabParams resolved(const TabParams& p, double material_min_thickness_mm) {
 
 double tab_gap(const SurfaceLocator& self, const SurfaceLocator& bone, const Tab& tab) {
   const Eigen::Vector3d u = tab.outward, n = tab.normal, v = n.cross(u);
-  double worst = -1e9;
-  bool any = false;
-  const double half = 0.5 * tab.width_mm - 0.75;
-  for (double a = 0.5; a <= tab.length_mm - 0.75; a += 0.5)
-    for (double b = -half; b <= half + 1e-9; b += 0.5) {
-      // Inside the outline, shrunk by 0.75 mm (the round end), off the screw holes.
-      const double end = tab.length_mm - 0.5 * tab.width_mm;
-      if (a > end && std::hypot(a - end, b) > 0.5 * tab.width_mm - 0.75) continue;
+  // Points every kStep mm inside the outline, shrunk by 0.75 mm (the round end), from 0.5 mm
+  // beyond the implant's edge; `back` more rows nearer the edge only tell where the bone is.
+  constexpr double kStep = 0.25;
+  const int r = static_cast<int>(std::floor(kCrackRadiusMm / kStep + 1e-9)), back = r;
+  const double half = 0.5 * tab.width_mm - 0.75, end = tab.length_mm - 0.5 * tab.width_mm;
+  const double a0 = 0.5 - back * kStep;
+  const int na = static_cast<int>(std::floor((tab.length_mm - 0.75 - a0) / kStep + 1e-9)) + 1,
+            nb = static_cast<int>(std::floor(2.0 * half / kStep + 1e-9)) + 1;
+  if (na <= back || nb < 1) return std::numeric_limits<double>::quiet_NaN();
+  const size_t cells = static_cast<size_t>(na) * nb;
+  // The gap where the bone's outer table faces the tab (not its cut face or the rounding into
+  // it), off the screw holes; NaN elsewhere. `table`: the outer table lies under the point.
+  std::vector<double> gap(cells, std::numeric_limits<double>::quiet_NaN());
+  std::vector<uint8_t> table(cells, 0);
+  parallel_for(cells, [&](size_t first, size_t last) {
+    for (size_t q = first; q < last; ++q) {
+      const int x = static_cast<int>(q % static_cast<size_t>(na));
+      const double a = a0 + kStep * x, b = -half + kStep * static_cast<double>(q / na);
       const Eigen::Vector3d m = tab.rim + a * u + b * v;
+      const auto top = bone.first_hit(m + 8.0 * n, m - 8.0 * n);
+      if (!top || std::abs(bone.face_normal(top->face).dot(n)) < 0.9) continue;
+      table[q] = 1;
+      if (x < back || (a > end && std::hypot(a - end, b) > 0.5 * tab.width_mm - 0.75)) continue;
       bool by_screw = false;
       for (const Hole& s : tab.screws) {
         const Eigen::Vector3d d = s.center - m;
         by_screw = by_screw || (d - d.dot(n) * n).norm() < 0.5 * tab.width_mm - 0.5;
       }
       if (by_screw) continue;
-      // The bone's outer table there (not its cut face or the rounding into it).
-      const auto top = bone.first_hit(m + 8.0 * n, m - 8.0 * n);
-      if (!top) continue;
-      Eigen::Vector3d f = bone.face_normal(top->face);
-      if (std::abs(f.dot(n)) < 0.9) continue;
       const auto under = self.first_hit(top->point - 0.5 * n, top->point + 8.0 * n);
-      worst = std::max(worst, under ? under->distance - 0.5 : 7.5);
+      gap[q] = under ? under->distance - 0.5 : 7.5;
+    }
+  });
+  // The underside bridges narrow gaps as it is made (kCrackRadiusMm, kCrackDepthMm): within
+  // that reach beyond the bone's edge (the gap at the implant's edge and the bone's rounding
+  // into it), where the tab spans the gap, a point does not count; elsewhere each point takes
+  // the smallest gap within that reach (the tab rests on the bone on either side of a crack).
+  double worst = -1e9;
+  bool any = false;
+  for (int y = 0; y < nb; ++y)
+    for (int x = back; x < na; ++x) {
+      const size_t q = static_cast<size_t>(y) * na + x;
+      if (std::isnan(gap[q])) continue;
+      bool beyond_edge = true;
+      for (int s = 1; s <= back; ++s) beyond_edge = beyond_edge && table[q - s];
+      if (!beyond_edge) continue;
+      double nearest = gap[q];
+      for (int dy = -r; dy <= r; ++dy)
+        for (int dx = -r; dx <= r; ++dx) {
+          const int xx = x + dx, yy = y + dy;
+          if (xx < back || yy < 0 || xx >= na || yy >= nb ||
+              kStep * kStep * (dx * dx + dy * dy) > kCrackRadiusMm * kCrackRadiusMm + 1e-9)
+            continue;
+          const double g = gap[static_cast<size_t>(yy) * na + xx];
+          if (!std::isnan(g)) nearest = std::min(nearest, g);
+        }
+      worst = std::max(worst, nearest);
       any = true;
     }
   return any ? worst : std::numeric_limits<double>::quiet_NaN();

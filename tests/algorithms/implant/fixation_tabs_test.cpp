@@ -318,6 +318,70 @@ TEST(FixationTabs, TheQualityReportRefusesATabOffTheBone) {
   EXPECT_EQ(found, 2);
 }
 
+// The bone of bone() with a crack `width` mm wide and 1 mm deep across y = 69 + 4.5 (from
+// x 40 to 60, under a tab at x = 50), and, with `rounded`, its outer table's edge at the
+// opening rounded over 1.5 mm (a quarter circle, as a cut's edge often is).
+SkullMesh cracked_bone(double width, bool rounded) {
+  return solid_of(
+      [=](const Eigen::Vector3d& p) {
+        const bool hole = p.x() > 30 && p.x() < 70 && p.y() > 30 && p.y() < 70;
+        double top = 6.0;
+        const double from_edge = p.y() - 70.0;  // beyond the opening's edge at y = 70
+        if (rounded && from_edge >= 0 && from_edge < 1.5 && p.x() > 30 && p.x() < 70)
+          top -= 1.5 - std::sqrt(1.5 * 1.5 - (1.5 - from_edge) * (1.5 - from_edge));
+        const bool crack =
+            p.x() > 40 && p.x() < 60 && std::abs(p.y() - 73.5) < 0.5 * width && p.z() > 5.0;
+        return p.z() > 0 && p.z() < top && !hole && !crack;
+      },
+      {0, 0, 0}, {100, 100, 6});
+}
+
+// The report's tab gap counts where the tab rests on the bone as it was made to: it bridges a
+// crack narrower than 1.2 mm (the underside over it up to 0.3 mm below the bone beside it),
+// beside a square edge of the bone and a rounded one; a stretch wider than that with the tab
+// off the bone is still refused. (The rule for the first 0.5 mm beyond the bone's edge is met
+// on the sample's PMMA plan, where the rounding's facets face the tab here and there.)
+TEST(FixationTabs, TheTabGapCountsWhereTheTabRestsOnTheBone) {
+  const SkullMesh implant = plug();
+  for (const bool rounded : {false, true}) {
+    SCOPED_TRACE(rounded ? "the bone's edge rounded" : "the bone's edge square");
+    const SkullMesh skull = cracked_bone(0.75, rounded);
+    const SurfaceLocator on_bone(skull);
+    TabParams p = resolved(TabParams{}, std::nan(""));
+    p.positions = {Eigen::Vector3d(50, 95, 6)};
+    const TabResult r = add_fixation_tabs(implant, on_bone, kInside, p);
+    ASSERT_TRUE(r.usable()) << r.message;
+    // The underside spans the crack: over its middle it stands more than the limit above the
+    // crack's floor, and on the bone beside it.
+    const SurfaceLocator self(r.mesh);
+    const auto underside = [&](double y) {
+      const std::vector<double> z =
+          crossings_along(self, Eigen::Vector3d(50, y, 4.0), Eigen::Vector3d(50, y, 20));
+      return z.empty() ? 0.0 : z[0];
+    };
+    const auto bone_top = [&](double y) {
+      const auto hit = on_bone.first_hit(Eigen::Vector3d(50, y, 20), Eigen::Vector3d(50, y, 0));
+      return hit ? hit->point.z() : 0.0;
+    };
+    EXPECT_NEAR(bone_top(73.5), 5.0, 0.15) << "the crack's floor";
+    EXPECT_GT(underside(73.5) - bone_top(73.5), 0.4) << "the crack is bridged";
+    EXPECT_NEAR(underside(76.0) - bone_top(76.0), 0.05, 0.1) << "on the bone beside it";
+    QualityParams q;
+    q.edge_clearance_mm = 1.0;
+    q.tabs = r.tabs;
+    const QualityReport report = check_implant(r.mesh, &skull, q);
+    EXPECT_TRUE(report.printable) << (report.reasons.empty() ? "" : report.reasons.front());
+    EXPECT_LE(report.tab_gap_mm, 0.2);
+    EXPECT_GE(report.tab_gap_mm, -0.05);
+    // The same tab over a crack 3 mm wide (the bone there as before, the tab as made on the
+    // narrow one): it stands off the crack's floor over more than twice the bridging's reach.
+    const SkullMesh wide = cracked_bone(3.0, rounded);
+    const QualityReport off = check_implant(r.mesh, &wide, q);
+    EXPECT_FALSE(off.printable);
+    EXPECT_GT(off.tab_gap_mm, 0.5);
+  }
+}
+
 TEST(FixationTabs, ParametersOutOfRangeAreNamed) {
   TabParams p;
   p.automatic = true;

@@ -108,9 +108,12 @@ TabResult add_fixation_tabs(const SkullMesh& implant, const SurfaceLocator& bone
                             const Eigen::Vector3d& inside, const TabParams& params,
                             SkullMesh& into);
 
-/// The largest gap between a tab's underside and the bone over the part of it that lies on the
-/// bone (beyond its edge's groove, away from the screw holes), mm; negative where the tab enters
-/// the bone. `implant` (with the tab) is located by `self`.
+/// How far a tab stands off the bone, mm: over the part of it that lies on the bone's outer
+/// table (beyond its edge's groove, away from the screw holes, sampled every 0.25 mm), the
+/// largest of the gaps between its underside and the bone, each point taking the smallest gap
+/// within 0.6 mm of it (the underside bridges cracks narrower than twice that and rests on the
+/// bone beside them); negative where the tab enters the bone. `implant` (with the tab) is
+/// located by `self`.
 double tab_gap(const SurfaceLocator& self, const SurfaceLocator& bone, const Tab& tab);
 
 }  // namespace cranioplan
