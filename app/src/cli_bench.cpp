@@ -172,10 +172,23 @@ Json run_bench(const BenchOptions& options) {
       const SmoothResult s = smooth_markers(plan.markers, SmoothParams{10.0, 2.0, 1}, &mirror);
       build_implant(s.markers, &skull.mesh, &bone, live);
     });
+    // The fitted rebuild's stages (ImplantResult::stage_seconds), each the median of the runs:
+    // where a committed drag's time goes.
+    std::vector<std::vector<std::pair<std::string, double>>> stages;
     out["smooth_and_rebuild_fitted_s"] = median_seconds(runs, [&] {
       const SmoothResult s = smooth_markers(plan.markers, SmoothParams{10.0, 2.0, 1}, &mirror);
-      build_implant(s.markers, &skull.mesh, &bone, AutoplanParams{}.implant);
+      stages.push_back(
+          build_implant(s.markers, &skull.mesh, &bone, AutoplanParams{}.implant).stage_seconds);
     });
+    Json profile = Json::object();
+    for (size_t k = 0; !stages.empty() && k < stages.front().size(); ++k) {
+      std::vector<double> t;
+      for (const auto& run : stages)
+        if (k < run.size() && run[k].first == stages.front()[k].first) t.push_back(run[k].second);
+      std::sort(t.begin(), t.end());
+      if (!t.empty()) profile[stages.front()[k].first] = t[t.size() / 2];
+    }
+    out["fitted_rebuild_stages_s"] = profile;
   }
   // The same plan as session commands: one marker drag (the implant follows), then undo and
   // redo of it, which the session serves from its cache of states.

@@ -827,9 +827,18 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
                         ? build_shell(used, skull, skull_locator, params, staged ? &shell : nullptr)
                         : build_delaunay(used, params);
   const SkullMesh* current = staged ? &shell : &r.mesh;  // the implant as the stages left it
+  auto stage_done = [&, last = t0](const char* stage) mutable {
+    const auto now = std::chrono::steady_clock::now();
+    r.stage_seconds.emplace_back(stage, std::chrono::duration<double>(now - last).count());
+    last = now;
+  };
+  stage_done("shell");
   if (r.usable() && fitted) {
     SkullMesh& out = tabbed || drilled ? fitted_mesh : r.mesh;
     const TrimToBoneResult t = trim_to_bone(*current, *skull, params.trim, out, skull_locator);
+    stage_done("fit");
+    for (const auto& [stage, seconds] : t.stage_seconds)
+      r.stage_seconds.emplace_back("fit: " + stage, seconds);
     if (t.usable()) {
       current = &out;
       r.watertight = is_watertight(out);
@@ -850,6 +859,7 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
     SkullMesh& out = drilled ? with_tabs : r.mesh;
     TabResult t =
         add_fixation_tabs(*current, skull_locator ? *skull_locator : *own, inside, tabs, out);
+    stage_done("tabs");
     if (t.usable()) {
       current = &out;
       r.tabs = std::move(t.tabs);
@@ -864,6 +874,7 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
     PerforationParams holes = params.perforations;
     if (params.material) holes.min_thickness_mm = params.material->min_thickness_mm;
     PerforateResult p = perforate(*current, inside, holes, r.mesh);
+    stage_done("holes");
     if (p.usable()) {
       current = &r.mesh;
       r.holes = std::move(p.holes);

@@ -7,6 +7,8 @@
 #include <limits>
 #include <memory>
 #include <numeric>
+#include <string>
+#include <utility>
 #include <vector>
 
 #include "cranioplan/algorithms/geometry/distance_transform.h"
@@ -20,6 +22,22 @@ namespace cranioplan {
 namespace {
 
 using Mask = std::vector<uint8_t>;
+
+// Appends each stage's seconds since the one before (TrimToBoneResult::stage_seconds).
+class StageClock {
+ public:
+  explicit StageClock(std::vector<std::pair<std::string, double>>& out)
+      : out_(out), last_(std::chrono::steady_clock::now()) {}
+  void mark(const char* stage) {
+    const auto now = std::chrono::steady_clock::now();
+    out_.emplace_back(stage, std::chrono::duration<double>(now - last_).count());
+    last_ = now;
+  }
+
+ private:
+  std::vector<std::pair<std::string, double>>& out_;
+  std::chrono::steady_clock::time_point last_;
+};
 
 // Calls f(k) for every slice k < nz on all threads, the slices dealt in a spread order (k = q ·
 // step mod nz) so that each thread gets some of the implant's slices and some of the empty
@@ -293,7 +311,7 @@ SkullMesh faces_in_box(const SkullMesh& mesh, const Eigen::Vector3d& lo,
 std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const VoxelGrid& g,
                                     const SurfaceLocator* locator, double sigma_voxels,
                                     double clearance, const std::vector<ClearanceZone>& zones,
-                                    const std::vector<float>& to_bone) {
+                                    const std::vector<float>& to_bone, StageClock& clock) {
   const double h = g.spacing;
   double widest = clearance;
   for (const ClearanceZone& z : zones) widest = std::max(widest, z.clearance_mm);
@@ -301,8 +319,10 @@ std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const Vo
   const Mask near_implant = within_steps(mask, g, 2);
   Mask joined = mask;
   for (size_t c = 0; c < joined.size(); ++c) joined[c] = mask[c] || (bone[c] && near_implant[c]);
+  clock.mark("bone joined");
   std::vector<float> field = blur(joined, g, sigma_voxels);
   Mask().swap(joined);
+  clock.mark("blur");
   if (!locator) {  // no surface near the grid: its bone voxels stay empty
     for (size_t c = 0; c < field.size(); ++c)
       if (bone[c]) field[c] = 0.0f;
@@ -318,6 +338,7 @@ std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const Vo
     const float band = static_cast<float>(widest + 2.0 * h);
     for (size_t c = 0; c < to_bone.size(); ++c) near_bone[c] = to_bone[c] <= band;
   }
+  clock.mark("band");
   for_slices_spread(g.dims[2], [&](int k) {
     for (int j = 0; j < g.dims[1]; ++j)
       for (int i = 0; i < g.dims[0]; ++i) {
@@ -342,6 +363,7 @@ std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const Vo
         field[c] = std::min(field[c], static_cast<float>(cap));
       }
   });
+  clock.mark("cap");
   // Every bone voxel is in the band, and half a voxel or more inside the surface its cap is 0
   // (a distance to fewer triangles is never shorter), so the blur leaves nothing in the bone.
   return field;
@@ -357,6 +379,7 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull,
                TrimToBoneResult& result, SkullMesh& into) {
   assert(&into != &implant && "the fit is meshed into another mesh than the implant");
   const auto t0 = std::chrono::steady_clock::now();
+  StageClock clock(result.stage_seconds);
   const auto [lo, hi] = mesh_bounds(implant);
   const VoxelGrid grid = VoxelGrid::covering_at_most(lo, hi, std::clamp(params.voxel_mm, 0.1, 1.0),
                                                      std::max(1e5, params.max_voxels), 4);
@@ -370,6 +393,7 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull,
     before += mask[c];
     mask[c] = mask[c] && !bone[c];
   }
+  clock.mark("voxels");
   // The skull's triangles near the grid suffice for distances up to a few voxels beyond the
   // widest clearance.
   double widest = params.clearance_mm.value_or(0.0);
@@ -407,6 +431,7 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull,
                                                  *params.clearance_mm, params.zones);
           if (to_bone[c] < want) mask[c] = 0;
         }
+    clock.mark("clearance cut");
   }
   // Opening by a ball: slivers thinner than the feature size (left on top of intact bone, and
   // the thin lip where the shell's outer surface grazes the bone's) disappear, so the implant
@@ -414,6 +439,7 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull,
   if (params.min_feature_mm > 0) mask = open_by_ball(mask, grid, 0.5 * params.min_feature_mm);
   // The opening must not give back bone.
   for (size_t c = 0; c < mask.size(); ++c) mask[c] = mask[c] && !bone[c];
+  clock.mark("opening");
   // Bridging: where the implant stops short of the bone by less than twice the bridge width
   // (ragged thin bone, e.g. by an orbit), the crack between them is filled, so the implant
   // rests on the bone. A voxel is in a crack when, along one of 13 directions, the implant lies
@@ -422,6 +448,7 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull,
   const int bridge = static_cast<int>(std::lround(params.bridge_mm / h));
   if (bridge > 0) {
     Mask bridged = bridge_cracks(mask, bone, grid, bridge);
+    clock.mark("cracks");
     // What the fills leave thinner than the feature size away from the bone goes (a rod
     // between the implant's edge and a fragment; a wall between the implant and a cut face is
     // thick along the cut): what lies within a millimetre of the bone is the fill's contact.
@@ -439,10 +466,12 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull,
           if (far[c] && !opening.contains(c)) thin.push_back(c);
         for (size_t c : thin) bridged[c] = 0;
       }
+      clock.mark("thin fills");
     }
     mask = std::move(bridged);
   }
   mask = largest_piece(mask, grid);
+  clock.mark("largest piece");
   size_t after = 0;
   for (uint8_t m : mask) after += m;
   result.removed_mm3 = static_cast<double>(before - std::min(before, after)) * grid.voxel_volume();
@@ -459,7 +488,7 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull,
   std::vector<float> smooth;
   if (params.clearance_mm) {
     smooth = fit_against_bone(mask, bone, grid, locator, params.smoothing_mm / h,
-                              std::max(0.0, *params.clearance_mm), params.zones, to_bone);
+                              std::max(0.0, *params.clearance_mm), params.zones, to_bone, clock);
     Mask().swap(mask);
     std::vector<float>().swap(to_bone);
   } else {
@@ -472,11 +501,13 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull,
     const Mask keep_out = dilate(bone, grid);
     for (size_t c = 0; c < smooth.size(); ++c)
       if (keep_out[c]) smooth[c] = 0.0f;
+    clock.mark("blur");
   }
   Mask().swap(bone);
   // The implant as the meshing gives it: plans saved before meshes were made canonical replay
   // to their bytes.
   ExtractBoneSurfaceResult s = surface_of_field(std::move(smooth), grid, into);
+  clock.mark("meshing");
   if (!s.usable()) {
     result.message = s.message;
     into = implant;

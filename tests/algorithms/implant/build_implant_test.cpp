@@ -168,6 +168,25 @@ TEST(BuildImplant, AMaterialsClearanceHoldsTheEdgeOffTheBoneOnEveryArc) {
   }
 }
 
+// The build says where its time went: the shell, the whole fit, then the fit's own stages;
+// the build's stages together no more than the whole.
+TEST(BuildImplant, ItsStagesCarryTheFitsStages) {
+  const ImplantResult r = finished(std::nullopt);
+  ASSERT_TRUE(r.usable()) << r.message;
+  ASSERT_GE(r.stage_seconds.size(), 4u);
+  EXPECT_EQ(r.stage_seconds[0].first, "shell");
+  EXPECT_EQ(r.stage_seconds[1].first, "fit");
+  EXPECT_EQ(r.stage_seconds[2].first, "fit: voxels");
+  EXPECT_EQ(r.stage_seconds.back().first, "fit: meshing");
+  double whole = 0.0, parts = 0.0;
+  for (const auto& [stage, seconds] : r.stage_seconds) {
+    EXPECT_GE(seconds, 0.0) << stage;
+    (stage.rfind("fit: ", 0) == 0 ? parts : whole) += seconds;
+  }
+  EXPECT_LE(whole, r.seconds + 1e-9);
+  EXPECT_LE(parts, r.stage_seconds[1].second + 1e-9);
+}
+
 // The radii along rays from the head's centre through the middle of the opening: outer and
 // inner surface of `implant`.
 std::vector<std::pair<double, double>> radii(const SkullMesh& implant) {

@@ -278,6 +278,37 @@ TEST(TrimToBone, TheSkullsOwnLocatorGivesTheSameFit) {
     }
 }
 
+// The fit says where its time went (bench's profile): each stage it ran once, in order, none
+// negative, together no more than the whole; a clearance wider than a voxel adds its cut.
+TEST(TrimToBone, ItsStagesAreTimedInTheOrderTheyRan) {
+  const SkullMesh bone = merge(box({0, 0, 0}, {20, 20, 5}), box({40, 0, 0}, {60, 20, 5}));
+  const SkullMesh implant = build_mesh(box({17, 2, 0}, {43, 18, 5.3}));
+  TrimToBoneParams p;
+  p.max_voxels = 1e5;
+  const auto names = [](const TrimToBoneResult& t) {
+    std::vector<std::string> n;
+    double sum = 0.0;
+    for (const auto& [stage, seconds] : t.stage_seconds) {
+      n.push_back(stage);
+      EXPECT_GE(seconds, 0.0) << stage;
+      sum += seconds;
+    }
+    EXPECT_LE(sum, t.seconds + 1e-9);
+    return n;
+  };
+  const TrimToBoneResult t = trim_to_bone(implant, bone, p);
+  ASSERT_TRUE(t.usable()) << t.message;
+  EXPECT_EQ(names(t),
+            (std::vector<std::string>{"voxels", "opening", "cracks", "thin fills", "largest piece",
+                                      "bone joined", "blur", "band", "cap", "meshing"}));
+  p.clearance_mm = 2.0;
+  const TrimToBoneResult wide = trim_to_bone(implant, bone, p);
+  ASSERT_TRUE(wide.usable()) << wide.message;
+  const std::vector<std::string> n = names(wide);
+  ASSERT_GE(n.size(), 2u);
+  EXPECT_EQ(n[1], "clearance cut");
+}
+
 // A large box on a fine grid is coarsened to the voxel budget; a small one keeps the spacing.
 TEST(VoxelGrid, CoveringAtMostKeepsToTheVoxelBudget) {
   const Eigen::Vector3d lo(0, 0, 0), big(110, 90, 60), small(10, 10, 10);

@@ -76,6 +76,10 @@ struct ImplantResult {
   std::vector<Hole> holes;           ///< the perforations drilled
   std::vector<Tab> tabs;             ///< the fixation tabs added
   double seconds = 0.0;
+  /// Where the time went, in the order it ran, s: "shell", "fit" (the whole fit to the bone)
+  /// followed by its parts ("fit: opening", ...: TrimToBoneResult::stage_seconds), "tabs",
+  /// "holes" (the stages the build ran).
+  std::vector<std::pair<std::string, double>> stage_seconds;
   bool usable() const { return status == Status::Built; }
 };
 

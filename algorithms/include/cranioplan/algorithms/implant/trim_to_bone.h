@@ -5,6 +5,8 @@
 // of the defect everywhere (no gap) and never enters the bone (no overlap).
 #include <optional>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "cranioplan/model/material.h"
 #include "cranioplan/model/mesh.h"
@@ -57,6 +59,8 @@ struct TrimToBoneResult {
   double removed_mm3 = 0.0;  ///< volume taken away (bone overlap and slivers)
   double volume_mm3 = 0.0;   ///< volume kept
   double seconds = 0.0;
+  /// Where the time went, stage by stage in the order they ran (bench's profile of the fit), s.
+  std::vector<std::pair<std::string, double>> stage_seconds;
   bool usable() const { return status == Status::Trimmed; }
 };
 
