@@ -338,6 +338,20 @@ std::optional<SurfaceLocator::Hit> SurfaceLocator::first_hit(
   return h;
 }
 
+std::vector<SurfaceLocator::Hit> SurfaceLocator::hits_along(const Eigen::Vector3d& from,
+                                                            const Eigen::Vector3d& to) const {
+  std::vector<Hit> hits;
+  if (!((to - from).norm() > 0.0)) return hits;
+  const Eigen::Vector3d step = 1e-4 * (to - from).normalized();
+  Eigen::Vector3d at = from;
+  while (auto hit = first_hit(at, to)) {
+    at = hit->point + step;
+    hit->distance = (hit->point - from).norm();
+    hits.push_back(*hit);
+  }
+  return hits;
+}
+
 Eigen::Vector3d SurfaceLocator::face_normal(int face) const {
   const Tree& t = *tree_;
   const Eigen::Vector3d n =

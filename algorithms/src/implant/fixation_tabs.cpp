@@ -733,13 +733,7 @@ void tabs_into(const SkullMesh& implant, const SurfaceLocator& bone, const Eigen
   // follow_implant: such a plan exported the implant without the tab.
   const SurfaceLocator joined(into);
   auto inside_joined = [&](const Eigen::Vector3d& from, const Eigen::Vector3d& to) {
-    int crossings = 0;
-    Eigen::Vector3d at = from;
-    while (const auto hit = joined.first_hit(at, to)) {
-      ++crossings;
-      at = hit->point + 1e-4 * (to - from).normalized();
-    }
-    return crossings % 2 == 1;
+    return joined.hits_along(from, to).size() % 2 == 1;
   };
   for (size_t k = 0; k < placed.size(); ++k) {
     const Tab& t = placed[k].tab;

@@ -198,6 +198,28 @@ TEST(SurfaceLocator, SegmentsThroughVerticesAndEdgesHit) {
   }
 }
 
+// Every crossing of a segment, in order: through two boxes four, from inside one the odd
+// count that says so, along a segment through a vertex or an edge each crossing once.
+TEST(SurfaceLocator, HitsAlongASegmentAreEveryCrossingInOrder) {
+  TriangleSoup soup = test::box_soup({0, 0, 0}, {10, 10, 10});
+  const TriangleSoup second = test::box_soup({20, 0, 0}, {30, 10, 10});
+  const int n = static_cast<int>(soup.vertices.size());
+  soup.vertices.insert(soup.vertices.end(), second.vertices.begin(), second.vertices.end());
+  for (const auto& t : second.triangles) soup.triangles.push_back({t[0] + n, t[1] + n, t[2] + n});
+  const SurfaceLocator locator(build_mesh(soup));
+  const auto through = locator.hits_along({-5, 3, 4}, {35, 3, 4});
+  ASSERT_EQ(through.size(), 4u);
+  const double at[] = {0, 10, 20, 30};
+  for (size_t k = 0; k < 4; ++k) {
+    EXPECT_NEAR(through[k].point.x(), at[k], 1e-9);
+    EXPECT_NEAR(through[k].distance, at[k] + 5.0, 1e-9);
+  }
+  EXPECT_EQ(locator.hits_along({5, 3, 4}, {35, 3, 4}).size() % 2, 1u) << "inside the first";
+  EXPECT_EQ(locator.hits_along({15, 3, 4}, {15, 3, 40}).size(), 0u) << "between them";
+  EXPECT_EQ(locator.hits_along({-5, -5, -5}, {15, 15, 15}).size(), 2u) << "corner to corner";
+  EXPECT_EQ(locator.hits_along({-5, 5, 5}, {-5, 5, 5}).size(), 0u) << "no segment";
+}
+
 // The locator of a skull, moved by a reflection and a rigid motion, answers exactly as the
 // locator of the mirrored, moved mesh does (a shared tree: nothing copied), with outward normals.
 TEST(SurfaceLocator, MovedByAReflectionAnswersForTheMirror) {

@@ -108,11 +108,7 @@ TEST(FixationTabs, EvenlyPlacedTabsLieOnTheBoneWithTheirScrewsThrough) {
 std::vector<double> crossings_along(const SurfaceLocator& s, const Eigen::Vector3d& from,
                                     const Eigen::Vector3d& to) {
   std::vector<double> z;
-  Eigen::Vector3d at = from;
-  while (const auto hit = s.first_hit(at, to)) {
-    z.push_back(hit->point.z());
-    at = hit->point + 1e-3 * (to - from).normalized();
-  }
+  for (const SurfaceLocator::Hit& hit : s.hits_along(from, to)) z.push_back(hit.point.z());
   return z;
 }
 

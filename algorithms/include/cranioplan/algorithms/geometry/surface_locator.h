@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <memory>
 #include <optional>
+#include <vector>
 
 #include "cranioplan/model/mesh.h"
 #include "cranioplan/model/rigid_transform.h"
@@ -45,6 +46,10 @@ class SurfaceLocator {
   };
   /// First intersection of the segment from `from` to `to` with the surface, if any.
   std::optional<Hit> first_hit(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const;
+  /// Every intersection of the segment with the surface, in order along it (each found from
+  /// 1e-4 mm past the one before; distances from `from`): for a closed surface, a point lies
+  /// inside when a segment from it to a point outside crosses an odd number of times.
+  std::vector<Hit> hits_along(const Eigen::Vector3d& from, const Eigen::Vector3d& to) const;
 
   /// Unit normal of face `face` (counter-clockwise orientation; zero for a degenerate face).
   Eigen::Vector3d face_normal(int face) const;
