@@ -55,13 +55,29 @@ TEST(MeshReport, IsWatertightAgreesWithTheReport) {
     two.vertices.push_back(two.vertices[i] + Eigen::Vector3d(300, 0, 0));
   for (size_t t = 0; t < m; ++t)
     two.triangles.push_back(two.triangles[t] + Eigen::Vector3i::Constant(static_cast<int>(n)));
+  // Two closed boxes, each on its own vertices, meeting along an edge (welded, four
+  // triangles on it) and at a corner only (welded, every edge still has two).
+  const auto boxes = [](const Eigen::Vector3d& shift) {
+    TriangleSoup s = test::box_soup({0, 0, 0}, {10, 10, 10});
+    const TriangleSoup b = test::box_soup(shift, shift + Eigen::Vector3d(10, 10, 10));
+    const int k = static_cast<int>(s.vertices.size());
+    s.vertices.insert(s.vertices.end(), b.vertices.begin(), b.vertices.end());
+    for (const auto& t : b.triangles) s.triangles.push_back(t + Eigen::Vector3i::Constant(k));
+    return build_mesh(s);
+  };
   const SkullMesh meshes[] = {test::make_symmetric_head(3),
                               test::cut_hole(test::make_symmetric_head(3), {70, 0, 0}, 20),
-                              build_mesh(fin), build_mesh(two), SkullMesh()};
+                              build_mesh(fin),
+                              build_mesh(two),
+                              SkullMesh(),
+                              boxes({10, 10, 0}),
+                              boxes({10, 10, 10})};
   for (const SkullMesh& mesh : meshes)
     EXPECT_EQ(is_watertight(mesh), report_mesh(mesh).watertight) << mesh.n_faces();
   EXPECT_TRUE(is_watertight(meshes[0]));
   EXPECT_TRUE(is_watertight(meshes[3]));
+  EXPECT_FALSE(is_watertight(meshes[5])) << "four triangles on the shared edge";
+  EXPECT_TRUE(is_watertight(meshes[6])) << "a shared corner";
 }
 
 }  // namespace
