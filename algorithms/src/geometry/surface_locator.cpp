@@ -308,6 +308,74 @@ std::optional<SurfaceLocator::Closest> SurfaceLocator::closest_within(
   return best;
 }
 
+void SurfaceLocator::faces_near(const Eigen::Vector3d& world_lo, const Eigen::Vector3d& world_hi,
+                                double reach, std::vector<int>& faces) const {
+  faces.clear();
+  const Tree& t = *tree_;
+  // The box in the tree's frame: the box around the moved corners.
+  Eigen::Vector3d lo = world_lo, hi = world_hi;
+  if (moved_) {
+    const RigidTransform to_tree = motion_.inverse();
+    lo = hi = to_tree.apply(world_lo);
+    for (int k = 1; k < 8; ++k) {
+      const Eigen::Vector3d corner((k & 1) ? world_hi.x() : world_lo.x(),
+                                   (k & 2) ? world_hi.y() : world_lo.y(),
+                                   (k & 4) ? world_hi.z() : world_lo.z());
+      const Eigen::Vector3d p = to_tree.apply(corner);
+      lo = lo.cwiseMin(p);
+      hi = hi.cwiseMax(p);
+    }
+  }
+  const double reach2 = reach * reach;
+  t.walk(
+      [&](const Node& node) {
+        double d2 = 0.0;
+        for (int k = 0; k < 3; ++k) {
+          const double d = std::max({static_cast<double>(node.box.lo[k]) - hi[k], 0.0,
+                                     lo[k] - static_cast<double>(node.box.hi[k])});
+          d2 += d * d;
+        }
+        return d2 > reach2;
+      },
+      [](int index, const Node& node, const auto& push) {
+        push(node.first);
+        push(index + 1);
+      },
+      [&](int f) { faces.push_back(f); });
+}
+
+std::optional<SurfaceLocator::Closest> SurfaceLocator::closest_within(
+    const Eigen::Vector3d& world_query, double radius, const std::vector<int>& faces) const {
+  const Tree& t = *tree_;
+  const Eigen::Vector3d query = moved_ ? motion_.inverse().apply(world_query) : world_query;
+  Closest best;
+  double best_d2 = radius * radius;
+  for (const int f : faces) {
+    const Eigen::Vector3d &a = t.corner(f, 0), &b = t.corner(f, 1), &c = t.corner(f, 2);
+    // The triangle's box first: no nearer than it.
+    double box2 = 0.0;
+    for (int k = 0; k < 3; ++k) {
+      const double d = std::max(
+          {std::min({a[k], b[k], c[k]}) - query[k], 0.0, query[k] - std::max({a[k], b[k], c[k]})});
+      box2 += d * d;
+    }
+    // (With a margin far above the rounding of the closest point, so that a face skipped is
+    // one the search below would not have taken.)
+    if (box2 > best_d2 + 1e-12) continue;
+    const Eigen::Vector3d p = closest_on_triangle(query, a, b, c);
+    const double d2 = (p - query).squaredNorm();
+    if (d2 < best_d2) {
+      best_d2 = d2;
+      best.point = p;
+      best.face = f;
+    }
+  }
+  if (best.face < 0) return std::nullopt;
+  best.distance = std::sqrt(best_d2);
+  if (moved_) best.point = motion_.apply(best.point);
+  return best;
+}
+
 std::optional<SurfaceLocator::Hit> SurfaceLocator::first_hit(
     const Eigen::Vector3d& world_from, const Eigen::Vector3d& world_to) const {
   const Tree& t = *tree_;

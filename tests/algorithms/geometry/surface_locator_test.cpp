@@ -99,6 +99,51 @@ TEST(SurfaceLocator, ClosestWithinARadiusAgreesWithTheUnboundedSearch) {
             plain.closest(Eigen::Vector3d(0, 0, 0)).distance);
 }
 
+// The faces near a box, found once, answer each query from a point in the box with the very
+// distance the tree's search gives (the fit to the bone asks a row of voxels this way), on the
+// locator and on the locator moved; a box too far from the surface finds no face.
+TEST(SurfaceLocator, FacesNearABoxGiveTheSameDistances) {
+  const SkullMesh head = test::cut_hole(test::make_symmetric_head(3), {40, 20, 50}, 30);
+  const SurfaceLocator plain(head);
+  const SurfaceLocator moved = plain.moved(RigidTransform{
+      Eigen::AngleAxisd(0.3, Eigen::Vector3d(1, 2, 3).normalized()).toRotationMatrix(),
+      Eigen::Vector3d(5, -2, 7)});
+  std::mt19937 rng(12);
+  std::uniform_int_distribution<int> vertex(0, static_cast<int>(head.n_vertices()) - 1);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  int within = 0, beyond = 0;
+  std::vector<int> faces;
+  for (const SurfaceLocator* locator : {&plain, &moved}) {
+    for (int row = 0; row < 60; ++row) {
+      // A row of 20 points 0.25 mm apart along x near the surface, asked within 0.35 mm.
+      const Eigen::Vector3d on = to_eigen(head.point(SkullMesh::VertexHandle(vertex(rng))));
+      const Eigen::Vector3d start = (locator == &plain ? on : moved.closest(on).point) +
+                                    Eigen::Vector3d(u(rng), u(rng), u(rng));
+      const Eigen::Vector3d end = start + Eigen::Vector3d(19 * 0.25, 0, 0);
+      const double radius = 0.35;
+      locator->faces_near(start, end, radius, faces);
+      EXPECT_LT(faces.size(), head.n_faces() / 10) << "a few faces, not the surface";
+      for (int i = 0; i < 20; ++i) {
+        const Eigen::Vector3d q = start + Eigen::Vector3d(i * 0.25, 0, 0);
+        const auto tree = locator->closest_within(q, radius);
+        const auto listed = locator->closest_within(q, radius, faces);
+        ASSERT_EQ(listed.has_value(), tree.has_value()) << row << " " << i;
+        if (!tree) {
+          ++beyond;
+          continue;
+        }
+        ++within;
+        EXPECT_EQ(listed->distance, tree->distance) << row << " " << i;
+        EXPECT_NEAR((listed->point - tree->point).norm(), 0.0, 1e-9);
+      }
+    }
+  }
+  EXPECT_GT(within, 200);
+  EXPECT_GT(beyond, 200);
+  plain.faces_near(Eigen::Vector3d(500, 500, 500), Eigen::Vector3d(501, 500, 500), 1.0, faces);
+  EXPECT_TRUE(faces.empty());
+}
+
 // A tree large enough to be built on two threads is the tree one thread builds: the same
 // faces found for the same queries (ties included), the same bytes.
 TEST(SurfaceLocator, TheTreeDoesNotDependOnTheThreads) {

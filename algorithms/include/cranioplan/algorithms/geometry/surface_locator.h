@@ -38,6 +38,16 @@ class SurfaceLocator {
   /// (and, but among points exactly as near, the same point), found faster when the surface is
   /// mostly farther.
   std::optional<Closest> closest_within(const Eigen::Vector3d& query, double radius) const;
+  /// The faces that come within `reach` mm of the box [lo, hi] (every face nearer than that to
+  /// some point in it, and some farther), into `faces` (cleared first): for many queries from
+  /// points in the box, found once.
+  void faces_near(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double reach,
+                  std::vector<int>& faces) const;
+  /// closest_within() among `faces` only: the same distance when they hold every face within
+  /// `radius` of `query` (faces_near() of a box holding it, with a reach of at least `radius`),
+  /// and among points exactly as near perhaps another point.
+  std::optional<Closest> closest_within(const Eigen::Vector3d& query, double radius,
+                                        const std::vector<int>& faces) const;
 
   struct Hit {
     Eigen::Vector3d point;
