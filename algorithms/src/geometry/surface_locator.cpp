@@ -314,6 +314,11 @@ void SurfaceLocator::faces_near(const Eigen::Vector3d& world_lo, const Eigen::Ve
   const Tree& t = *tree_;
   // The box in the tree's frame: the box around the moved corners.
   Eigen::Vector3d lo = world_lo, hi = world_hi;
+  if (moved_ && !(lo.allFinite() && hi.allFinite())) {  // unbounded: every face
+    for (const auto& n : t.nodes)
+      for (int i = n.first; i < n.first + n.count; ++i) faces.push_back(t.order[i]);
+    return;
+  }
   if (moved_) {
     const RigidTransform to_tree = motion_.inverse();
     lo = hi = to_tree.apply(world_lo);

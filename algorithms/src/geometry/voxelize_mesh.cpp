@@ -6,6 +6,7 @@
 #include <map>
 #include <mutex>
 
+#include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/model/parallel.h"
 
 namespace cranioplan {
@@ -42,15 +43,16 @@ std::pair<Eigen::Vector3d, Eigen::Vector3d> mesh_bounds(const SkullMesh& mesh) {
 
 namespace {
 
-// The faces [first, last) add their crossings to `columns` (crossings(), below).
-void add_crossings(const SkullMesh& mesh, const VoxelGrid& grid, int axis, size_t first,
-                   size_t last, std::vector<std::vector<float>>& columns) {
+// The faces faces[first, last) (all the mesh's faces when `faces` is null) add their
+// crossings to `columns` (crossings(), below).
+void add_crossings(const SkullMesh& mesh, const std::vector<int>* faces, const VoxelGrid& grid,
+                   int axis, size_t first, size_t last, std::vector<std::vector<float>>& columns) {
   const int u = (axis + 1) % 3, v = (axis + 2) % 3;
   const int nu = grid.dims[u], nv = grid.dims[v];
   // A tiny irrational shift keeps column lines off vertices and edges of regular meshes.
   const double jitter_u = 1.3e-6 * M_PI, jitter_v = 1.7e-6 * M_E;
-  for (size_t f = first; f < last; ++f) {
-    const auto fh = mesh.face_handle(static_cast<int>(f));
+  for (size_t n = first; n < last; ++n) {
+    const auto fh = mesh.face_handle(faces ? (*faces)[n] : static_cast<int>(n));
     Eigen::Vector3d p[3];
     int k = 0;
     for (auto vh : mesh.fv_range(fh)) {
@@ -86,16 +88,29 @@ void add_crossings(const SkullMesh& mesh, const VoxelGrid& grid, int axis, size_
 // The heights (in voxel units along axis w) at which a line along w through each voxel column
 // (u, v) crosses the mesh, w = `axis` and (u, v) the other two in cyclic order; in no
 // particular order (the callers sort them). The faces are read on all threads, each into
-// columns of its own, appended in thread order.
-std::vector<std::vector<float>> crossings(const SkullMesh& mesh, const VoxelGrid& grid, int axis) {
+// columns of its own, appended in thread order. `locator` (the mesh's): only the faces it
+// finds over the lines are read (a face elsewhere crosses none of them).
+std::vector<std::vector<float>> crossings(const SkullMesh& mesh, const VoxelGrid& grid, int axis,
+                                          const SurfaceLocator* locator) {
   const size_t columns = static_cast<size_t>(grid.dims[(axis + 1) % 3]) * grid.dims[(axis + 2) % 3];
+  std::vector<int> near;
+  if (locator) {
+    // The lines' slab, a voxel wider across them, unbounded along them.
+    Eigen::Vector3d lo = grid.origin - Eigen::Vector3d::Constant(grid.spacing),
+                    hi = grid.center(grid.dims[0] - 1, grid.dims[1] - 1, grid.dims[2] - 1) +
+                         Eigen::Vector3d::Constant(grid.spacing);
+    lo[axis] = -std::numeric_limits<double>::infinity();
+    hi[axis] = std::numeric_limits<double>::infinity();
+    locator->faces_near(lo, hi, 0.0, near);
+  }
+  const std::vector<int>* faces = locator ? &near : nullptr;
   std::mutex m;
   std::map<size_t, std::vector<std::vector<float>>> parts;  // by the range's first face
   parallel_for(
-      mesh.n_faces(),
+      faces ? faces->size() : mesh.n_faces(),
       [&](size_t first, size_t last) {
         std::vector<std::vector<float>> part(columns);
-        add_crossings(mesh, grid, axis, first, last, part);
+        add_crossings(mesh, faces, grid, axis, first, last, part);
         const std::lock_guard<std::mutex> lock(m);
         parts.emplace(first, std::move(part));
       },
@@ -108,13 +123,11 @@ std::vector<std::vector<float>> crossings(const SkullMesh& mesh, const VoxelGrid
   return all;
 }
 
-}  // namespace
-
-std::vector<uint8_t> voxelize_mesh(const SkullMesh& mesh, const VoxelGrid& grid,
-                                   const VoxelizeParams& params) {
+std::vector<uint8_t> voxelize(const SkullMesh& mesh, const VoxelGrid& grid,
+                              const VoxelizeParams& params, const SurfaceLocator* locator) {
   std::vector<uint8_t> mask(grid.size(), 0);
   const int nx = grid.dims[0], ny = grid.dims[1], nz = grid.dims[2];
-  std::vector<std::vector<float>> columns = crossings(mesh, grid, 2);
+  std::vector<std::vector<float>> columns = crossings(mesh, grid, 2, locator);
   // Lines along x and y, made only when a line along z passes through a hole.
   std::vector<std::vector<float>> along_x, along_y;
   for (int j = 0; j < ny; ++j)
@@ -123,8 +136,8 @@ std::vector<uint8_t> voxelize_mesh(const SkullMesh& mesh, const VoxelGrid& grid,
       std::sort(c.begin(), c.end());
       if (c.size() % 2 != 0 && params.vote_through_holes) {
         if (along_x.empty()) {
-          along_x = crossings(mesh, grid, 0);
-          along_y = crossings(mesh, grid, 1);
+          along_x = crossings(mesh, grid, 0, locator);
+          along_y = crossings(mesh, grid, 1, locator);
           for (auto* lines : {&along_x, &along_y})
             for (auto& line : *lines) std::sort(line.begin(), line.end());
         }
@@ -159,6 +172,18 @@ std::vector<uint8_t> voxelize_mesh(const SkullMesh& mesh, const VoxelGrid& grid,
       }
     }
   return mask;
+}
+
+}  // namespace
+
+std::vector<uint8_t> voxelize_mesh(const SkullMesh& mesh, const VoxelGrid& grid,
+                                   const VoxelizeParams& params) {
+  return voxelize(mesh, grid, params, nullptr);
+}
+
+std::vector<uint8_t> voxelize_mesh(const SkullMesh& mesh, const VoxelGrid& grid,
+                                   const VoxelizeParams& params, const SurfaceLocator& locator) {
+  return voxelize(mesh, grid, params, &locator);
 }
 
 Volume mask_volume(const std::vector<uint8_t>& mask, const VoxelGrid& grid) {

@@ -401,7 +401,9 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull,
   VoxelizeParams solid;
   solid.vote_through_holes = params.vote_through_holes;
   Mask mask = voxelize_mesh(implant, grid, solid);
-  Mask bone = voxelize_mesh(skull, grid, solid);
+  // The skull's faces over the grid's lines only, found by its locator when the caller has one.
+  Mask bone = skull_locator ? voxelize_mesh(skull, grid, solid, *skull_locator)
+                            : voxelize_mesh(skull, grid, solid);
   size_t before = 0;
   for (size_t c = 0; c < mask.size(); ++c) {
     before += mask[c];

@@ -7,6 +7,7 @@
 
 #include <Eigen/Geometry>
 
+#include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/model/parallel.h"
 #include "support/synthetic.h"
 
@@ -130,6 +131,34 @@ TEST(VoxelizeMesh, TheMaskIsTheSameOnOneThreadAndOnTwo) {
     for (uint8_t v : masks[0]) inside += v;
     EXPECT_GT(inside, 10000);
     EXPECT_EQ(masks[0], masks[1]);
+  }
+}
+
+// Read through the mesh's locator (only the faces over the grid's lines), the mask is the one
+// all the faces give: closed and cut open (the lines through the cut vote along x and y), on
+// a grid over a small part of the surface, over its cut, and over the whole.
+TEST(VoxelizeMesh, ThroughTheMeshsLocatorTheMaskIsTheSame) {
+  const SkullMesh closed = hollow_head(6);
+  const auto [lo, hi] = mesh_bounds(closed);
+  const Eigen::Vector3d mid = (lo + hi) / 2, size = hi - lo;
+  const SkullMesh open = test::cut_open(closed, mid - 0.2 * size.z() * Eigen::Vector3d::UnitZ(),
+                                        Eigen::Vector3d::UnitZ());
+  const VoxelGrid grids[] = {
+      VoxelGrid::covering(mid + Eigen::Vector3d(0.3 * size.x(), -10, -10),
+                          mid + Eigen::Vector3d(0.5 * size.x() + 5, 10, 10), 0.25),
+      VoxelGrid::covering(mid + Eigen::Vector3d(0.3 * size.x(), -15, -0.2 * size.z() - 10),
+                          mid + Eigen::Vector3d(0.5 * size.x() + 5, 15, -0.2 * size.z() + 10), 0.3),
+      VoxelGrid::covering(lo, hi, 0.8)};
+  for (const SkullMesh* mesh : {&closed, &open}) {
+    const SurfaceLocator locator(*mesh);
+    for (const VoxelGrid& g : grids) {
+      const std::vector<uint8_t> all = voxelize_mesh(*mesh, g),
+                                 near = voxelize_mesh(*mesh, g, VoxelizeParams{}, locator);
+      long long inside = 0;
+      for (uint8_t v : all) inside += v;
+      EXPECT_GT(inside, 1000);
+      EXPECT_EQ(near, all);
+    }
   }
 }
 

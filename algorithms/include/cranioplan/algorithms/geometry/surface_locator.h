@@ -40,7 +40,7 @@ class SurfaceLocator {
   std::optional<Closest> closest_within(const Eigen::Vector3d& query, double radius) const;
   /// The faces that come within `reach` mm of the box [lo, hi] (every face nearer than that to
   /// some point in it, and some farther), into `faces` (cleared first): for many queries from
-  /// points in the box, found once.
+  /// points in the box, found once. The box may be unbounded along an axis (±infinity).
   void faces_near(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi, double reach,
                   std::vector<int>& faces) const;
   /// closest_within() among `faces` only: the same distance when they hold every face within

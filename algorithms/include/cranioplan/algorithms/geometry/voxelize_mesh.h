@@ -54,6 +54,12 @@ struct VoxelizeParams {
 /// through a hole (VoxelizeParams).
 std::vector<uint8_t> voxelize_mesh(const SkullMesh& mesh, const VoxelGrid& grid,
                                    const VoxelizeParams& params = {});
+class SurfaceLocator;
+/// The same, reading only the faces that `locator` (the mesh's own, not moved) finds over the
+/// grid's lines: the same mask, from a fraction of the faces when the grid covers a small part
+/// of a large mesh (the fit to the bone voxelizes the skull on the implant's grid).
+std::vector<uint8_t> voxelize_mesh(const SkullMesh& mesh, const VoxelGrid& grid,
+                                   const VoxelizeParams& params, const SurfaceLocator& locator);
 
 /// The mask as a Volume (values 0/1), for surface extraction.
 Volume mask_volume(const std::vector<uint8_t>& mask, const VoxelGrid& grid);
