@@ -24,6 +24,7 @@
 #include "cranioplan/algorithms/implant/trim_to_bone.h"
 #include "cranioplan/algorithms/io/mesh_report.h"
 #include "cranioplan/model/error.h"
+#include "cranioplan/model/parallel.h"
 #include "cranioplan/model/plane.h"
 
 namespace cranioplan {
@@ -563,23 +564,37 @@ class ShellBuilder {
       return Eigen::Vector3d(f_.lift(q, offset_base(q) + correction) - offset(q) * outer_normal(q));
     };
     const size_t n_rim = angles_.size();
-    std::vector<Eigen::Vector3i> tris;
-    const int center_vertex = static_cast<int>(soup_.vertices.size());
-    soup_.vertices.push_back(surface_point(center_, 0.0));
-    Ring previous;
+    // Where the cap's points lie in the parametrisation, the centre first and then ring by
+    // ring; their heights (thin-plate splines over every marker, the bulk of the shell's time
+    // on a large opening) are evaluated on all threads, each point once, in this order.
+    std::vector<std::pair<Eigen::Vector2d, double>> at{{center_, 0.0}};  // point, correction
+    std::vector<std::vector<double>> ring_angles(static_cast<size_t>(std::max(0, n_rings_ - 1)));
     for (int k = 1; k < n_rings_; ++k) {
       const double s = static_cast<double>(k) / n_rings_;
       const int count = std::max(6, static_cast<int>(std::lround(static_cast<double>(n_rim) * s)));
-      std::vector<double> ring_angles;
-      const int first = static_cast<int>(soup_.vertices.size());
       for (int j = 0; j < count; ++j) {
         const double a = start_ + kTwoPi * (j + 0.5) / count;
         const auto [boundary, correction] = poly.at(a);
-        soup_.vertices.push_back(
-            surface_point(center_ + s * (boundary - center_), std::pow(s, 4) * correction));
-        ring_angles.push_back(a);
+        at.emplace_back(center_ + s * (boundary - center_), std::pow(s, 4) * correction);
+        ring_angles[static_cast<size_t>(k - 1)].push_back(a);
       }
-      Ring ring = make_ring(ring_angles, first, start_, false);
+    }
+    const int center_vertex = static_cast<int>(soup_.vertices.size());
+    soup_.vertices.resize(soup_.vertices.size() + at.size());
+    parallel_for(
+        at.size(),
+        [&](size_t first, size_t last) {
+          for (size_t i = first; i < last; ++i)
+            soup_.vertices[center_vertex + i] = surface_point(at[i].first, at[i].second);
+        },
+        64);
+    std::vector<Eigen::Vector3i> tris;
+    Ring previous;
+    int first = center_vertex + 1;
+    for (int k = 1; k < n_rings_; ++k) {
+      const std::vector<double>& angles = ring_angles[static_cast<size_t>(k - 1)];
+      Ring ring = make_ring(angles, first, start_, false);
+      first += static_cast<int>(angles.size());
       if (k == 1) {
         for (size_t j = 0; j < ring.size(); ++j)
           tris.emplace_back(center_vertex, ring[j].vertex, ring[(j + 1) % ring.size()].vertex);
