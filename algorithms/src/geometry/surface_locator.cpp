@@ -414,13 +414,15 @@ std::optional<SurfaceLocator::Hit> SurfaceLocator::first_hit(
 std::vector<SurfaceLocator::Hit> SurfaceLocator::hits_along(const Eigen::Vector3d& from,
                                                             const Eigen::Vector3d& to) const {
   std::vector<Hit> hits;
-  if (!((to - from).norm() > 0.0)) return hits;
-  const Eigen::Vector3d step = 1e-4 * (to - from).normalized();
+  const double length = (to - from).norm();
+  if (!(length > 0.0)) return hits;
+  const Eigen::Vector3d along = (to - from) / length, step = 1e-4 * (to - from).normalized();
   Eigen::Vector3d at = from;
   while (auto hit = first_hit(at, to)) {
     at = hit->point + step;
     hit->distance = (hit->point - from).norm();
     hits.push_back(*hit);
+    if ((at - from).dot(along) >= length) break;  // past the end: a segment back would loop
   }
   return hits;
 }

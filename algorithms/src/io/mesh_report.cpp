@@ -324,7 +324,7 @@ bool is_watertight(const SkullMesh& mesh) {
   // has two. When no two vertices share a position, welding changes nothing, and that is the
   // answer below without a copy, a weld and an edge sort (the fitted implant's commit waits
   // for this). Otherwise, the welded triangles decide.
-  bool closed = mesh.n_faces() > 0;
+  bool closed = mesh.faces().begin() != mesh.faces().end();  // a face not deleted
   for (auto he : mesh.halfedges())
     if (mesh.is_boundary(he)) {
       closed = false;
