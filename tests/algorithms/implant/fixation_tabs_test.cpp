@@ -51,6 +51,15 @@ SkullMesh plug(double top = 6.0) {
 const Eigen::Vector3d kInside(50, 50, -60);
 constexpr double kTop = 5.875, kBoneMm = 5.75;  // the meshed bone's top and thickness
 
+// The quality report of an implant with tabs on `skull`, the plug's 1 mm gap all round asked as
+// its edge clearance.
+QualityReport report_with_tabs(const TabResult& r, const SkullMesh& skull) {
+  QualityParams q;
+  q.edge_clearance_mm = 1.0;
+  q.tabs = r.tabs;
+  return check_implant(r.mesh, &skull, q);
+}
+
 // Evenly placed tabs on a flat rim: one per 40 mm of the 152 mm edge, each lying on the bone
 // (its underside within 0.2 mm of it), reaching its length beyond the edge, 2 mm thick, with a
 // screw hole through; tabs and plate one closed, manifold solid with a tunnel per screw, which
@@ -94,10 +103,7 @@ TEST(FixationTabs, EvenlyPlacedTabsLieOnTheBoneWithTheirScrewsThrough) {
   EXPECT_EQ(rep.nonmanifold_edges, 0);
   EXPECT_EQ(rep.pieces, 1);
   EXPECT_EQ(test::genus(r.mesh), 4) << "a tunnel per screw";
-  QualityParams q;
-  q.edge_clearance_mm = 1.0;  // the plug's gap all round
-  q.tabs = r.tabs;
-  const QualityReport report = check_implant(r.mesh, &skull, q);
+  const QualityReport report = report_with_tabs(r, skull);
   EXPECT_TRUE(report.printable) << (report.reasons.empty() ? "" : report.reasons.front());
   EXPECT_EQ(report.tabs, 4);
   EXPECT_EQ(report.screws_blocked, 0);
@@ -138,10 +144,7 @@ TEST(FixationTabs, OverALowerImplantTheTabLiesOnIt) {
   EXPECT_GE(crossings[0], 3.375 + 3.0 - 0.1) << "the tab's top";
   EXPECT_LE(crossings[0], kTop + 0.05 + 3.0 + 0.1) << "the tab's top";
   EXPECT_NEAR(crossings[1], 0.125, 0.01) << "the implant's bottom";
-  QualityParams q;
-  q.edge_clearance_mm = 1.0;
-  q.tabs = r.tabs;
-  const QualityReport report = check_implant(r.mesh, &skull, q);
+  const QualityReport report = report_with_tabs(r, skull);
   EXPECT_TRUE(report.printable) << (report.reasons.empty() ? "" : report.reasons.front());
   EXPECT_LE(report.tab_gap_mm, 0.2);
 
@@ -195,10 +198,7 @@ TEST(FixationTabs, OverARoundedImplantEdgeTheTabComesDownOntoIt) {
         EXPECT_TRUE(
             crossings_along(self, Eigen::Vector3d(x, 69.5, 3.8), Eigen::Vector3d(x, 69.5, 0.5))
                 .empty());
-      QualityParams q;
-      q.edge_clearance_mm = 1.0;
-      q.tabs = r.tabs;
-      const QualityReport report = check_implant(r.mesh, &skull, q);
+      const QualityReport report = report_with_tabs(r, skull);
       EXPECT_TRUE(report.printable) << (report.reasons.empty() ? "" : report.reasons.front());
       EXPECT_EQ(report.penetration_mm3, 0.0);
     } else {
@@ -362,17 +362,14 @@ TEST(FixationTabs, TheTabGapCountsWhereTheTabRestsOnTheBone) {
     EXPECT_NEAR(bone_top(73.5), 5.0, 0.15) << "the crack's floor";
     EXPECT_GT(underside(73.5) - bone_top(73.5), 0.4) << "the crack is bridged";
     EXPECT_NEAR(underside(76.0) - bone_top(76.0), 0.05, 0.1) << "on the bone beside it";
-    QualityParams q;
-    q.edge_clearance_mm = 1.0;
-    q.tabs = r.tabs;
-    const QualityReport report = check_implant(r.mesh, &skull, q);
+    const QualityReport report = report_with_tabs(r, skull);
     EXPECT_TRUE(report.printable) << (report.reasons.empty() ? "" : report.reasons.front());
     EXPECT_LE(report.tab_gap_mm, 0.2);
     EXPECT_GE(report.tab_gap_mm, -0.05);
     // The same tab over a crack 3 mm wide (the bone there as before, the tab as made on the
     // narrow one): it stands off the crack's floor over more than twice the bridging's reach.
     const SkullMesh wide = cracked_bone(3.0, rounded);
-    const QualityReport off = check_implant(r.mesh, &wide, q);
+    const QualityReport off = report_with_tabs(r, wide);
     EXPECT_FALSE(off.printable);
     EXPECT_GT(off.tab_gap_mm, 0.5);
   }
