@@ -238,7 +238,10 @@ int current_version(CommandType type) {
   // unchanged, and version 8 is made as it was.
   // build_implant 10: over the implant a tab's underside comes down onto its rounded edge
   // instead of bridging over it (TabParams::on_implant_edge); version 9 is made as it was.
-  if (type == CommandType::BuildImplant) return 10;
+  // build_implant 11: fitted to the bone, a rim point that has not crossed the bone's surface
+  // where the bone is first found goes on until it has (ImplantParams::fit_reaches_the_bone);
+  // version 10 is made as it was.
+  if (type == CommandType::BuildImplant) return 11;
   if (type == CommandType::ExportImplant) return 2;
   // propose_markers 4: support markers only where the fitted surface describes the ring's bone
   // ("max_support_off_fit_mm"; versions 1 to 3 are read with 0, every ring point of the band).

@@ -83,7 +83,7 @@ TEST(Commands, EveryTypeRoundTripsThroughJson) {
 // read as recorded, built without the fit.
 TEST(Commands, BuildImplantVersionOneIsReadByItsOwnRules) {
   Json v1 = to_json(commands::build_implant());
-  EXPECT_EQ(v1["version"], 10);
+  EXPECT_EQ(v1["version"], 11);
   v1["version"] = 1;
   v1["params"]["params"].erase("trim");
   v1["params"]["params"].erase("fit_to_bone_mm");
@@ -130,7 +130,7 @@ TEST(Commands, OlderPlansReadTheSkullAndFitTheBoneAsTheyWereMade) {
   p.trim.min_feature_mm = 1.7;
   p.trim.bridge_mm = 0.8;
   const Json build = to_json(commands::build_implant(p));
-  EXPECT_EQ(build["version"], 10);
+  EXPECT_EQ(build["version"], 11);
   ImplantParams back;
   params_from_json(ParamReader(build["params"]["params"], "test"), back);
   EXPECT_EQ(back.trim.min_feature_mm, 1.7);
@@ -176,7 +176,7 @@ TEST(Commands, TheBuildRecordsItsMaterialAndClearanceZones) {
   p.perforations.added = {Eigen::Vector3d(4, 5, 6)};
   p.perforations.removed = {Eigen::Vector3d(7, 8, 9)};
   const Json build = to_json(commands::build_implant(p));
-  EXPECT_EQ(build["version"], 10);
+  EXPECT_EQ(build["version"], 11);
   const Json& recorded = build["params"]["params"];
   EXPECT_EQ(recorded["material"]["name"], "PMMA");
   EXPECT_TRUE(recorded["material"]["thickness_mm"].is_null()) << "follows the bone";
@@ -379,6 +379,21 @@ TEST(Commands, OlderBuildsMeshTheirTabsAndHolesAsTheyWereMade) {
     ASSERT_TRUE(out.state.implant_params.has_value()) << out.message;
     EXPECT_EQ(out.state.implant_params->tabs.iso_gap, gap);
     EXPECT_EQ(out.state.implant_params->perforations.iso_gap, gap);
+  }
+}
+
+// Plans saved before build_implant 11 take their rims out to where the bone is first found, as
+// they were fitted; today's go on until the rim has crossed the bone's surface.
+TEST(Commands, OlderBuildsTakeTheirRimsOutAsTheyWereMade) {
+  const Session planned = Session::open(test::planned_defect_case().session_path);
+  const Json today = to_json(commands::build_implant(ImplantParams{}));
+  EXPECT_EQ(today["version"], 11);
+  Json older = today;
+  older["version"] = 10;
+  for (const auto& [json, reaches] : {std::pair{today, true}, std::pair{older, false}}) {
+    const ApplyOutcome out = apply_command(planned.state(), command_from_json(json, "test"));
+    ASSERT_TRUE(out.state.implant_params.has_value()) << out.message;
+    EXPECT_EQ(out.state.implant_params->fit_reaches_the_bone, reaches);
   }
 }
 

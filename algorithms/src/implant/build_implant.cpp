@@ -476,6 +476,41 @@ class ShellBuilder {
     return poly;
   }
 
+  // A rim point taken `d` beyond the opening at `q` (along `out`, `near` mm from the bone) that
+  // has not yet crossed the bone's surface, while the bone comes nearer further out: at a
+  // corner or a burr hole of the opening the ray runs along a cut face, and the shell would
+  // stop short of the bone there. It goes on in half millimetres until it has crossed the
+  // surface (and half a millimetre into the bone), up to twice the reach, as long as the bone
+  // comes nearer by a fifth of each step (a ray at 12° or more to the surface it approaches);
+  // where it comes no nearer (the surface riding over the outer table), is already within the
+  // bridging of cracks (half a millimetre) or is never crossed, the point stays at `d`.
+  template <class Lift>
+  void reach_the_bone(const Eigen::Vector2d& q, const Eigen::Vector2d& out, double d, double near,
+                      const Lift& lift, Eigen::Vector3d& point) const {
+    constexpr double kStep = 0.5, kMinApproach = 0.2 * kStep, kBridged = 0.5;
+    if (near < kBridged) return;
+    Eigen::Vector3d previous = lift(q);
+    for (double e = 1.0; e < d + 0.5; e += 1.0) {
+      const Eigen::Vector3d p = e < d ? lift(q + e * out) : point;
+      if (!bone_->hits_along(previous, p).empty()) return;
+      previous = p;
+    }
+    const double reach = 2.0 * kFitReach * std::max(0.0, params_.fit_to_bone_mm);
+    for (double e = d + kStep; e <= reach + 1e-9; e += kStep) {
+      const Eigen::Vector3d p = lift(q + e * out);
+      if (!bone_->hits_along(previous, p).empty()) {
+        point = p;
+        const Eigen::Vector3d deeper = lift(q + (e + kStep) * out);
+        if (e + kStep <= reach + 1e-9 && bone_->hits_along(p, deeper).empty()) point = deeper;
+        return;
+      }
+      const double now = bone_->closest(p).distance;
+      if (now > near - kMinApproach) return;
+      near = now;
+      previous = p;
+    }
+  }
+
   // One rim in 3D along `poly` at the rim's angles: on the surface `tps` (or the outer one set
   // in by the thickness), beyond the opening into the bone when fitting to it, snapped onto the
   // bone between markers.
@@ -504,9 +539,11 @@ class ShellBuilder {
         const Eigen::Vector2d out = (q - center_).normalized();
         for (double d = fit_margin; d <= kFitReach * fit_margin + 1e-9; d += 1.0) {
           const Eigen::Vector3d beyond = lift_rim(q + d * out);
-          if (bone_->closest(beyond).distance < 0.5 * fit_margin) {
+          const double near = bone_->closest(beyond).distance;
+          if (near < 0.5 * fit_margin) {
             pts[k] = beyond;
             extended = true;
+            if (params_.fit_reaches_the_bone) reach_the_bone(q, out, d, near, lift_rim, pts[k]);
             break;
           }
         }

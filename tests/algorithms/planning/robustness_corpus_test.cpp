@@ -352,9 +352,9 @@ TEST(RobustnessCorpus, ASkullFixCaseOpenAndDecimatedIsPlannedOnTheBone) {
   const AutoplanResult r = autoplan(skull, Landmarks{});
   ASSERT_TRUE(r.planned()) << r.message;
   EXPECT_TRUE(r.quality.printable) << (r.quality.reasons.empty() ? "" : r.quality.reasons[0]);
-  // Measured 0.62 mm: within the quality report's limit, not yet within the 0.5 mm asked of
-  // the corpus (docs/AUTOPLAN.md).
-  EXPECT_LE(r.quality.rim_gap_mm, QualityParams{}.max_rim_gap_mm);
+  // Measured 0.15 mm (0.62 mm when the rim stopped short of a corner of the cube's cut with
+  // its burr hole: docs/IMPLANT.md, "Fitting to the bone").
+  EXPECT_LE(r.quality.rim_gap_mm, kMaxRimGapMm);
   EXPECT_LE(r.quality.penetration_mm3, kMaxOverlapMm3);
   const SkullMesh truth = load_surface(dir + "/001_implant.nrrd").mesh;
   const CompareResult own_truth = compare_implants(reference.implant.mesh, truth);

@@ -40,6 +40,12 @@ struct ImplantParams {
   /// is none even then (an orbit), the rim stays at the edge markers. 0: off (the rims pass
   /// through the edge markers).
   double fit_to_bone_mm = 0.0;
+  /// Fit to the bone: a rim point taken out to where the bone is first found, more than 0.5 mm
+  /// off it and not yet across its surface, goes on while the bone comes nearer (the ray runs
+  /// along a cut face past a corner or a burr hole of the opening) until it has crossed the
+  /// surface, up to six times fit_to_bone_mm; false: it stays where the bone was first found
+  /// (build_implant commands before version 11).
+  bool fit_reaches_the_bone = true;
   TrimToBoneParams trim;  ///< how the shell is fitted to the bone (when fit_to_bone_mm > 0)
   /// What the implant is made of (none: the plan's surfaces as they are). A thickness of the
   /// material's replaces the inner surface (inner markers are not used); its under-contour sets
