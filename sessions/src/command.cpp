@@ -239,7 +239,8 @@ int current_version(CommandType type) {
   // build_implant 10: over the implant a tab's underside comes down onto its rounded edge
   // instead of bridging over it (TabParams::on_implant_edge); version 9 is made as it was.
   // build_implant 11: fitted to the bone, a rim point that has not crossed the bone's surface
-  // where the bone is first found goes on until it has (ImplantParams::fit_reaches_the_bone);
+  // where the bone is first found goes on until it has (ImplantParams::fit_reaches_the_bone),
+  // and the fit's field is meshed kept 1e-3 off the iso-level (TrimToBoneParams::iso_gap);
   // version 10 is made as it was.
   if (type == CommandType::BuildImplant) return 11;
   if (type == CommandType::ExportImplant) return 2;

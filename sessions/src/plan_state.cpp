@@ -772,8 +772,9 @@ void apply_build(PlanState& s, const ParamReader& r, int version) {
   params.perforations.mid_normal = params.tabs.follow_implant = version >= 9;
   // Before version 10, the bridging of narrow gaps held a tab over the implant's rounded edge.
   params.tabs.on_implant_edge = version >= 10;
-  // Before version 11, a rim point fitted to the bone stayed where the bone was first found.
-  params.fit_reaches_the_bone = version >= 11;
+  // Before version 11, a rim point fitted to the bone stayed where the bone was first found,
+  // and the fit was meshed without the iso-level gap.
+  params.fit_reaches_the_bone = params.trim.iso_gap = version >= 11;
   s.implant_params = params;
   unacknowledge(s, 8, "the implant was built again");
   rebuild_implant(s);

@@ -382,8 +382,9 @@ TEST(Commands, OlderBuildsMeshTheirTabsAndHolesAsTheyWereMade) {
   }
 }
 
-// Plans saved before build_implant 11 take their rims out to where the bone is first found, as
-// they were fitted; today's go on until the rim has crossed the bone's surface.
+// Plans saved before build_implant 11 take their rims out to where the bone is first found and
+// mesh the fit as its field comes, as they were fitted; today's go on until the rim has crossed
+// the bone's surface and keep the field off the iso-level.
 TEST(Commands, OlderBuildsTakeTheirRimsOutAsTheyWereMade) {
   const Session planned = Session::open(test::planned_defect_case().session_path);
   const Json today = to_json(commands::build_implant(ImplantParams{}));
@@ -394,6 +395,7 @@ TEST(Commands, OlderBuildsTakeTheirRimsOutAsTheyWereMade) {
     const ApplyOutcome out = apply_command(planned.state(), command_from_json(json, "test"));
     ASSERT_TRUE(out.state.implant_params.has_value()) << out.message;
     EXPECT_EQ(out.state.implant_params->fit_reaches_the_bone, reaches);
+    EXPECT_EQ(out.state.implant_params->trim.iso_gap, reaches);
   }
 }
 

@@ -520,6 +520,7 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull,
     clock.mark("blur");
   }
   Mask().swap(bone);
+  if (params.iso_gap) keep_off_iso_level(smooth);
   // The implant as the meshing gives it: plans saved before meshes were made canonical replay
   // to their bytes.
   ExtractBoneSurfaceResult s = surface_of_field(std::move(smooth), grid, into);

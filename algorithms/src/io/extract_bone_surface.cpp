@@ -209,26 +209,26 @@ ExtractBoneSurfaceParams field_surface() {
   return surface;
 }
 
-// From 0 (outside) to 1 (inside), ½ on the surface. A value at or next to the iso-level puts a
-// vertex on or next to a grid point, where the vertices of the edges meeting there fall
-// together: triangles without area, whose neighbours then seem to cross. Values within kIsoGap
-// of ½ are moved kIsoGap off it, on their side (the surface moves by at most a thousandth of a
-// voxel). Without `iso_gap`, only a value exactly at ½ is moved, 1e-4 up (plans saved before).
+// From 0 (outside) to 1 (inside), ½ on the surface, kept off the iso-level
+// (keep_off_iso_level). Without `iso_gap`, only a value exactly at ½ is moved, 1e-4 up (plans
+// saved before).
 std::vector<float> unit_field(std::vector<float> distance, const VoxelGrid& grid, bool iso_gap) {
-  constexpr float kIsoGap = 1e-3f;
   const double h = grid.spacing;
   for (float& v : distance) {
     v = static_cast<float>(std::clamp(0.5 + v / h, 0.0, 1.0));
-    if (!iso_gap) {
-      if (v == 0.5f) v = 0.5f + 1e-4f;
-    } else if (std::abs(v - 0.5f) < kIsoGap) {
-      v = v < 0.5f ? 0.5f - kIsoGap : 0.5f + kIsoGap;
-    }
+    if (!iso_gap && v == 0.5f) v = 0.5f + 1e-4f;
   }
+  if (iso_gap) keep_off_iso_level(distance);
   return distance;
 }
 
 }  // namespace
+
+void keep_off_iso_level(std::vector<float>& field) {
+  constexpr float kIsoGap = 1e-3f;
+  for (float& v : field)
+    if (std::abs(v - 0.5f) < kIsoGap) v = v < 0.5f ? 0.5f - kIsoGap : 0.5f + kIsoGap;
+}
 
 ExtractBoneSurfaceResult surface_of_field(std::vector<float> field, const VoxelGrid& grid) {
   return extract_bone_surface(field_volume(std::move(field), grid), field_surface());

@@ -49,6 +49,10 @@ struct TrimToBoneParams {
   /// along z, as plans saved before version 0.2 fitted their implants (a skull open at the
   /// scan's lower border then counted the air above its cut as bone, and the bone as air).
   bool vote_through_holes = true;
+  /// The smooth field kept 1e-3 off its iso-level before meshing (keep_off_iso_level): no
+  /// triangles without area, whose neighbours seem to cross. false: meshed as it comes
+  /// (build_implant commands before version 11).
+  bool iso_gap = true;
 };
 
 struct TrimToBoneResult {

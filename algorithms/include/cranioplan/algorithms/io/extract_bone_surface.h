@@ -78,6 +78,11 @@ ExtractBoneSurfaceResult surface_of_field(std::vector<float> field, const VoxelG
 /// The same, the surface built in `mesh` (the result's own mesh left empty).
 ExtractBoneSurfaceResult surface_of_field(std::vector<float> field, const VoxelGrid& grid,
                                           SkullMesh& mesh);
+/// Moves the values of a 0..1 field within 1e-3 of ½ that far off it, on their side: a value at
+/// or next to the iso-level puts a vertex on or next to a grid point, where the vertices of the
+/// edges meeting there fall together into triangles without area, whose neighbours then seem
+/// to cross. The surface moves by at most a thousandth of a voxel.
+void keep_off_iso_level(std::vector<float>& field);
 /// A solid given by its signed distance (mm, positive inside) meshed at 0: the field is mapped
 /// to surface_of_field's 0..1 over one voxel on either side of the surface. Values within 1e-3
 /// of ½ are moved that far off it, so that no vertices fall together into sliver triangles;
