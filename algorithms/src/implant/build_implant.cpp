@@ -26,6 +26,7 @@
 #include "cranioplan/model/error.h"
 #include "cranioplan/model/parallel.h"
 #include "cranioplan/model/plane.h"
+#include "stage_clock.h"
 
 namespace cranioplan {
 
@@ -492,16 +493,16 @@ class ShellBuilder {
     Eigen::Vector3d previous = lift(q);
     for (double e = 1.0; e < d + 0.5; e += 1.0) {
       const Eigen::Vector3d p = e < d ? lift(q + e * out) : point;
-      if (!bone_->hits_along(previous, p).empty()) return;
+      if (bone_->first_hit(previous, p)) return;
       previous = p;
     }
     const double reach = 2.0 * kFitReach * std::max(0.0, params_.fit_to_bone_mm);
     for (double e = d + kStep; e <= reach + 1e-9; e += kStep) {
       const Eigen::Vector3d p = lift(q + e * out);
-      if (!bone_->hits_along(previous, p).empty()) {
+      if (bone_->first_hit(previous, p)) {
         point = p;
         const Eigen::Vector3d deeper = lift(q + (e + kStep) * out);
-        if (e + kStep <= reach + 1e-9 && bone_->hits_along(p, deeper).empty()) point = deeper;
+        if (e + kStep <= reach + 1e-9 && !bone_->first_hit(p, deeper)) point = deeper;
         return;
       }
       const double now = bone_->closest(p).distance;
@@ -879,16 +880,12 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
                         ? build_shell(used, skull, skull_locator, params, staged ? &shell : nullptr)
                         : build_delaunay(used, params);
   const SkullMesh* current = staged ? &shell : &r.mesh;  // the implant as the stages left it
-  auto stage_done = [&, last = t0](const char* stage) mutable {
-    const auto now = std::chrono::steady_clock::now();
-    r.stage_seconds.emplace_back(stage, std::chrono::duration<double>(now - last).count());
-    last = now;
-  };
-  stage_done("shell");
+  StageClock clock(r.stage_seconds, t0);
+  clock.mark("shell");
   if (r.usable() && fitted) {
     SkullMesh& out = tabbed || drilled ? fitted_mesh : r.mesh;
     const TrimToBoneResult t = trim_to_bone(*current, *skull, params.trim, out, skull_locator);
-    stage_done("fit");
+    clock.mark("fit");
     for (const auto& [stage, seconds] : t.stage_seconds)
       r.stage_seconds.emplace_back("fit: " + stage, seconds);
     if (t.usable()) {
@@ -911,7 +908,7 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
     SkullMesh& out = drilled ? with_tabs : r.mesh;
     TabResult t =
         add_fixation_tabs(*current, skull_locator ? *skull_locator : *own, inside, tabs, out);
-    stage_done("tabs");
+    clock.mark("tabs");
     if (t.usable()) {
       current = &out;
       r.tabs = std::move(t.tabs);
@@ -926,7 +923,7 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
     PerforationParams holes = params.perforations;
     if (params.material) holes.min_thickness_mm = params.material->min_thickness_mm;
     PerforateResult p = perforate(*current, inside, holes, r.mesh);
-    stage_done("holes");
+    clock.mark("holes");
     if (p.usable()) {
       current = &r.mesh;
       r.holes = std::move(p.holes);

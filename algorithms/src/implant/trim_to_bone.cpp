@@ -16,28 +16,13 @@
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
 #include "cranioplan/model/parallel.h"
+#include "stage_clock.h"
 
 namespace cranioplan {
 
 namespace {
 
 using Mask = std::vector<uint8_t>;
-
-// Appends each stage's seconds since the one before (TrimToBoneResult::stage_seconds).
-class StageClock {
- public:
-  explicit StageClock(std::vector<std::pair<std::string, double>>& out)
-      : out_(out), last_(std::chrono::steady_clock::now()) {}
-  void mark(const char* stage) {
-    const auto now = std::chrono::steady_clock::now();
-    out_.emplace_back(stage, std::chrono::duration<double>(now - last_).count());
-    last_ = now;
-  }
-
- private:
-  std::vector<std::pair<std::string, double>>& out_;
-  std::chrono::steady_clock::time_point last_;
-};
 
 // Calls f(k) for every slice k < nz on all threads, the slices dealt in a spread order (k = q ·
 // step mod nz) so that each thread gets some of the implant's slices and some of the empty
