@@ -246,7 +246,9 @@ int current_version(CommandType type) {
   if (type == CommandType::ExportImplant) return 2;
   // propose_markers 4: support markers only where the fitted surface describes the ring's bone
   // ("max_support_off_fit_mm"; versions 1 to 3 are read with 0, every ring point of the band).
-  if (type == CommandType::ProposeMarkers) return 4;
+  // propose_markers 5: the mirror read over a footprint around each ray
+  // ("surfaces.mirror_footprint_mm"; versions 1 to 4 are read with 0, along the one ray).
+  if (type == CommandType::ProposeMarkers) return 5;
   // load_skull 4: volumes in the patient's frame ("import.patient_frame"), a DICOM folder's
   // series ("import.dicom_series"), a mesh's far pieces dropped ("import.drop_far_pieces");
   // absent, as version 3 read them.
@@ -350,6 +352,7 @@ Json params_to_json(const ProposeParams& p) {
   if (p.detect.center) j["detect"]["center"] = to_json(*p.detect.center);
   j["smooth"] = params_to_json(p.smooth);
   j["surfaces"] = write_fields([](auto& v, auto& q) { surface_fit_fields(v, q); }, p.surfaces);
+  j["surfaces"]["mirror_footprint_mm"] = p.surfaces.mirror_footprint_mm;
   j["max_support_off_fit_mm"] = p.max_support_off_fit_mm;
   return j;
 }
@@ -584,10 +587,14 @@ void params_from_json(const ParamReader& r, ProposeParams& p) {
   if (detect.has("center")) p.detect.center = detect.vector3("center");
   params_from_json(ParamReader(r.value("smooth"), r.where() + " smooth"), p.smooth);
   // Version 1 (before the surfaces were fitted to the ring) has no "surfaces": the defaults.
+  // Versions 1 to 4 read the mirror along one ray: no footprint.
+  p.surfaces.mirror_footprint_mm = 0.0;
   if (r.has("surfaces")) {
     const ParamReader surfaces(r.value("surfaces"), r.where() + " surfaces");
     Reader sv{surfaces};
     surface_fit_fields(sv, p.surfaces);
+    if (surfaces.has("mirror_footprint_mm"))
+      p.surfaces.mirror_footprint_mm = surfaces.number("mirror_footprint_mm");
   }
   // Versions 1 to 3 have none: support markers on every ring point of the band (0: off).
   p.max_support_off_fit_mm =

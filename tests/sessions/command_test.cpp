@@ -468,20 +468,23 @@ TEST(Commands, BuildImplant3FitsTheBoneAsItWasMadeTo) {
 
 // propose_markers 2 records how the surfaces are fitted and which opening was asked for; a
 // version-1 command (neither) is read with their defaults. Version 4 records how far support
-// markers may lie from the fitted surfaces; older ones are read without that rule.
+// markers may lie from the fitted surfaces; older ones are read without that rule. Version 5
+// records the footprint the mirror is read over; older ones read it along one ray.
 TEST(Commands, ProposeMarkersVersionTwoRoundTripsAndVersionOneGetsDefaults) {
   ProposeParams p;
   p.surfaces.ring_width_mm = 31.0;
   p.surfaces.smoothing = 0.07;
   p.detect.near = Eigen::Vector3d(1.5, -2.0, 70.25);
   p.max_support_off_fit_mm = 2.25;
+  p.surfaces.mirror_footprint_mm = 2.5;
   const Json j = to_json(commands::propose_markers(p));
-  EXPECT_EQ(j["version"], 4);
+  EXPECT_EQ(j["version"], 5);
   ProposeParams back;
   params_from_json(ParamReader(j["params"]["params"], "test"), back);
   EXPECT_EQ(back.surfaces.ring_width_mm, 31.0);
   EXPECT_EQ(back.surfaces.smoothing, 0.07);
   EXPECT_EQ(back.max_support_off_fit_mm, 2.25);
+  EXPECT_EQ(back.surfaces.mirror_footprint_mm, 2.5);
   ASSERT_TRUE(back.detect.near.has_value());
   EXPECT_EQ(*back.detect.near, *p.detect.near);
   EXPECT_FALSE(j["params"]["params"]["detect"].contains("center")) << "unset: not written";
@@ -508,6 +511,15 @@ TEST(Commands, ProposeMarkersVersionTwoRoundTripsAndVersionOneGetsDefaults) {
   EXPECT_EQ(old.surfaces.ring_width_mm, DefectSurfaceParams{}.ring_width_mm);
   // Before version 4 support markers stood on every ring point of the band.
   EXPECT_EQ(old.max_support_off_fit_mm, 0.0);
+  EXPECT_EQ(old.surfaces.mirror_footprint_mm, 0.0);
+  // Version 4 has the surfaces but no footprint: the mirror along one ray.
+  Json v4 = j;
+  v4["version"] = 4;
+  v4["params"]["params"]["surfaces"].erase("mirror_footprint_mm");
+  ProposeParams four;
+  params_from_json(ParamReader(command_from_json(v4, "old plan").params["params"], "test"), four);
+  EXPECT_EQ(four.surfaces.ring_width_mm, 31.0);
+  EXPECT_EQ(four.surfaces.mirror_footprint_mm, 0.0);
 }
 
 TEST(Commands, UnknownTypeVersionAndMissingParameterAreNamed) {

@@ -149,6 +149,37 @@ Eigen::Vector2d DefectSurfaces::uv(const Eigen::Vector3d& dir) const {
   return scale_ * Eigen::Vector2d(dir.dot(e1_), dir.dot(e2_)) / z;
 }
 
+// The footprint: the ray and this many around it, of which at least kFootprintPaired pass
+// through both of the mirror's tables.
+constexpr int kFootprintAround = 6;
+constexpr int kFootprintPaired = 4;
+
+std::optional<std::pair<double, double>> DefectSurfaces::mirror_along(
+    const Eigen::Vector3d& dir) const {
+  // Around the ray in the fit's own frame, so that neighbouring rays' footprints are turned
+  // alike.
+  const Eigen::Vector3d a = unit_across(e1_, dir), b = dir.cross(a);
+  const double spread = std::max(0.0, mirror_footprint_mm_) / scale_;
+  const int around = spread > 0.0 ? kFootprintAround : 0;
+  double r_out = 0.0, t = 0.0;
+  int paired = 0;
+  for (int k = -1; k < around; ++k) {
+    const double angle = 2.0 * M_PI * k / around;
+    const Eigen::Vector3d d =
+        k < 0 ? dir
+              : Eigen::Vector3d(
+                    (dir + spread * (std::cos(angle) * a + std::sin(angle) * b)).normalized());
+    const RayThroughBone m =
+        cast_through_bone(*mirror_, center_, d, kReach, 0.5, max_thickness_mm_);
+    if (!m.paired) continue;
+    r_out += (*m.outer - center_).norm();
+    t += (*m.outer - *m.inner).norm();
+    ++paired;
+  }
+  if (paired == 0 || (around > 0 && paired < kFootprintPaired)) return std::nullopt;
+  return std::make_pair(r_out / paired, t / paired);
+}
+
 double VaultSphere::radius_along(const Eigen::Vector3d& from, const Eigen::Vector3d& dir) const {
   // |from + t·dir − center|² = radius²: the far root (`from` lies inside the sphere).
   const Eigen::Vector3d w = from - center;
@@ -164,11 +195,10 @@ std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> DefectSurfaces::at(
   const Eigen::Vector2d q = uv(dir);
   double r_out = outer_(q) + (vault_ ? vault_->radius_along(center_, dir) : 0.0), t = thickness_(q);
   if (mirror_) {
-    const RayThroughBone m =
-        cast_through_bone(*mirror_, center_, dir, kReach, 0.5, max_thickness_mm_);
-    if (!m.paired) return std::nullopt;
-    r_out += (*m.outer - center_).norm();
-    t += (*m.outer - *m.inner).norm();
+    const auto m = mirror_along(dir);
+    if (!m) return std::nullopt;
+    r_out += m->first;
+    t += m->second;
   }
   // The bone is at least half a millimetre thick and no thicker than one layer can be.
   const double r_in = r_out - std::clamp(t, 0.5, max_thickness_mm_);
@@ -189,6 +219,7 @@ struct DefectSurfaceFit {
     s.e2_ = s.axis_.cross(s.e1_);
     s.mirror_ = mirror;
     s.mirror_guided = mirror != nullptr;
+    s.mirror_footprint_mm_ = params.mirror_footprint_mm;
     s.max_thickness_mm_ = detect.max_thickness_mm;
     double rim_radius = 0.0;
     for (const auto& p : defect.outer_rim) rim_radius += (p - s.center_).norm();
@@ -239,11 +270,10 @@ struct DefectSurfaceFit {
         continue;  // left through a cut face rather than the outer table
       Sample smp{d, r_out, r_out - r_in, parallel};
       if (mirror) {
-        const RayThroughBone m =
-            cast_through_bone(*mirror, s.center_, d, kReach, 0.5, detect.max_thickness_mm);
-        if (!m.paired) continue;
-        smp.r_out -= (*m.outer - s.center_).norm();
-        smp.t -= (*m.outer - *m.inner).norm();
+        const auto m = s.mirror_along(d);
+        if (!m) continue;
+        smp.r_out -= m->first;
+        smp.t -= m->second;
       }
       ring.push_back(smp);
       s.ring_outer.push_back(*o.outer);

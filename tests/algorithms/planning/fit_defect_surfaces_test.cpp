@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <memory>
 
 #include "cranioplan/algorithms/geometry/surface_locator.h"
@@ -174,6 +175,57 @@ TEST(FitDefectSurfaces, MirrorGuidedCorrectsTheMirrorsMismatch) {
   EXPECT_TRUE(s.mirror_guided);
   const Errors e = errors_against_truth(s);
   expect_near_truth(e);
+}
+
+// A mirror whose bone steps out by 2 mm along a line across the opening (one side of the head
+// moved outward): read along one ray, the fitted outer surface steps as sharply as the mirror
+// (0.59 mm over 0.1 mm), and which side of the line a marker lands on decides 2 mm of the
+// implant; read over the footprint it ramps across about 3 mm, by at most 0.12 mm over 0.1 mm.
+// Away from the line the footprint changes nothing.
+TEST(FitDefectSurfaces, MirrorReadOverAFootprintRampsWhereItsBoneSteps) {
+  const Case& c = the_case();
+  ASSERT_TRUE(c.defect.found());
+  const Eigen::Vector3d center = c.defect.center, axis = c.defect.axis;
+  const Eigen::Vector3d across = unit_across(c.defect.frame.col(0), axis);
+  SkullMesh stepped = c.intact;
+  for (auto vh : stepped.vertices()) {
+    const Eigen::Vector3d p = to_eigen(stepped.point(vh));
+    if ((p - center).dot(across) > 0.0)
+      stepped.set_point(vh, to_point(p + 2.0 * (p - center).normalized()));
+  }
+  const SurfaceLocator mirror(stepped), bone(c.defective);
+  DefectSurfaceParams one_ray;
+  one_ray.mirror_footprint_mm = 0.0;
+  const DefectSurfaces along_ray = fit_defect_surfaces(c.defect, bone, &mirror, one_ray);
+  const DefectSurfaces over_footprint = fit_defect_surfaces(c.defect, bone, &mirror);
+  ASSERT_TRUE(along_ray.fitted()) << along_ray.message;
+  ASSERT_TRUE(over_footprint.fitted()) << over_footprint.message;
+  // Directions across the line, 0.1 mm apart at the outer surface, 12 mm to either side.
+  auto outer_radii = [&](const DefectSurfaces& s) {
+    std::vector<double> r;
+    const double radius = (s.at(axis)->first - center).norm();
+    for (double x = -12.0; x <= 12.0; x += 0.1) {
+      const auto p = s.at((axis + x / radius * across).normalized());
+      r.push_back(p ? (p->first - center).norm() : std::nan(""));
+    }
+    return r;
+  };
+  auto largest_step = [](const std::vector<double>& r) {
+    double step = 0.0;
+    for (size_t i = 1; i < r.size(); ++i) step = std::max(step, std::abs(r[i] - r[i - 1]));
+    return step;
+  };
+  const std::vector<double> a = outer_radii(along_ray), b = outer_radii(over_footprint);
+  for (size_t i = 0; i < a.size(); ++i) {
+    ASSERT_FALSE(std::isnan(a[i]) || std::isnan(b[i])) << "the fit reaches every direction";
+  }
+  std::printf("largest change over 0.1 mm: %.3f mm along one ray, %.3f over the footprint\n",
+              largest_step(a), largest_step(b));
+  EXPECT_GT(largest_step(a), 0.4);
+  EXPECT_LT(largest_step(b), 0.25);
+  // 6 mm and more from the line, the two agree.
+  for (size_t i : {size_t{0}, size_t{60}, a.size() - 61, a.size() - 1})
+    EXPECT_NEAR(a[i], b[i], 0.2) << "at " << (static_cast<double>(i) * 0.1 - 12.0) << " mm";
 }
 
 // Mirror-guided, the whole ring is fitted (the mirror meets the same roof past an orbit on the

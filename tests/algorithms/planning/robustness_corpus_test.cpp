@@ -146,7 +146,7 @@ constexpr double kMaxRimGapMm = 0.5, kMaxOverlapMm3 = 5.0, kTargetDice = 0.90;
 // The same defect planned (a plan of another opening has Dice 0 against it).
 constexpr double kSameDefectDice = 0.8;
 // The own import's bone where the implant sits (bone_agreement): measured 0.980-1.000 on the
-// exports of its surface (re-meshed on 0.8 mm cells the lowest), 0.904-0.971 on other
+// exports of its surface (re-meshed on 0.8 mm cells the lowest), 0.906-0.971 on other
 // thresholds and smoothings.
 constexpr double kSameBone = 0.975;
 
@@ -182,7 +182,7 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
     bool on_bone, meets_dice;
     // The own import's bone where the implant sits (bone_agreement ≥ kSameBone): planned with
     // the own plan's rays it meets the Dice target — all but where the rays start depends on
-    // the bone, not on its triangles (measured 0.951-0.996).
+    // the bone, not on its triangles (measured 0.956-0.996).
     bool same_bone;
   };
   const std::vector<Case> cases = {
@@ -323,9 +323,9 @@ TEST(RobustnessCorpus, HowFarThePlanMovesWithItsOwnRays) {
     std::printf("| %s | %.3f | %.2f | %s |\n", m.name.c_str(), dice, r.quality.rim_gap_mm,
                 r.quality.printable ? "yes" : "no");
     EXPECT_TRUE(r.quality.printable) << (r.quality.reasons.empty() ? "" : r.quality.reasons[0]);
-    // Measured 0.885-0.950: a floor below it, so that a change that makes the plan follow its
-    // rays more fails here.
-    EXPECT_GE(dice, 0.87);
+    // Measured 0.912-0.956 (0.885-0.950 with the mirror read along one ray): a floor below
+    // it, so that a change that makes the plan follow its rays more fails here.
+    EXPECT_GE(dice, 0.90);
   }
   std::printf("mean Dice %.3f\n", sum / static_cast<double>(moves.size()));
 }

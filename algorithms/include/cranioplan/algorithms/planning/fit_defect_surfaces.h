@@ -52,6 +52,14 @@ struct DefectSurfaceParams {
   /// Sites whose residual after a first fit exceeds this many robust standard deviations
   /// (and 1 mm) are dropped before the final fit: foramina, sutures, cut-face fragments.
   double outlier_sigmas = 3.0;
+  /// Mirror-guided, the mirror is read over a footprint of this radius at the rim's radius, mm
+  /// (0: along the one ray): the ray and six around it, their outer radii and thicknesses
+  /// averaged, none where fewer than four pass through both of its tables. Read along one
+  /// ray, the mirror's surfaces jump wherever its bone does (a brow ridge, a sinus wall, a
+  /// ray through bone just thicker than `max_thickness_mm`), and which markers land on such a
+  /// ray changes with where the rays start. 2 mm, the ring's ray spacing: neighbouring rays'
+  /// footprints meet.
+  double mirror_footprint_mm = 2.0;
 };
 
 /// A sphere fitted to the vault around an opening.
@@ -101,12 +109,16 @@ class DefectSurfaces {
  private:
   friend struct DefectSurfaceFit;  // the fit's stages (fit_defect_surfaces.cpp)
   Eigen::Vector2d uv(const Eigen::Vector3d& dir) const;
+  /// The mirror's outer radius and thickness along `dir` over the footprint; none where it has
+  /// too little bone there.
+  std::optional<std::pair<double, double>> mirror_along(const Eigen::Vector3d& dir) const;
   Eigen::Vector3d center_ = Eigen::Vector3d::Zero(), axis_ = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d e1_ = Eigen::Vector3d::UnitX(), e2_ = Eigen::Vector3d::UnitY();
   double scale_ = 1.0;                      // mm per unit of the gnomonic projection
   double max_cos_ = 0.0;                    // cosine of the cap's half-angle
   const SurfaceLocator* mirror_ = nullptr;  // prior (not owned); null: rim-only
   double max_thickness_mm_ = 15.0;
+  double mirror_footprint_mm_ = 0.0;
   ThinPlateSpline outer_, thickness_;
   std::optional<VaultSphere> vault_;  // set: outer_ fits the radius beyond this sphere
 };
