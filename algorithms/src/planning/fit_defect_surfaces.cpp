@@ -159,7 +159,10 @@ std::optional<std::pair<double, double>> DefectSurfaces::mirror_along(
   // Around the ray in the fit's own frame, so that neighbouring rays' footprints are turned
   // alike.
   const Eigen::Vector3d a = unit_across(e1_, dir), b = dir.cross(a);
-  const double spread = std::max(0.0, mirror_footprint_mm_) / scale_;
+  // A session's value read as it was written: off when not a number, at most 10 mm.
+  const double footprint =
+      std::isfinite(mirror_footprint_mm_) ? std::clamp(mirror_footprint_mm_, 0.0, 10.0) : 0.0;
+  const double spread = footprint / scale_;
   const int around = spread > 0.0 ? kFootprintAround : 0;
   double r_out = 0.0, t = 0.0;
   int paired = 0;

@@ -223,6 +223,10 @@ TEST(FitDefectSurfaces, MirrorReadOverAFootprintRampsWhereItsBoneSteps) {
               largest_step(a), largest_step(b));
   EXPECT_GT(largest_step(a), 0.4);
   EXPECT_LT(largest_step(b), 0.25);
+  // A footprint that is not a number (a session edited by hand) reads along the one ray.
+  DefectSurfaceParams not_a_number;
+  not_a_number.mirror_footprint_mm = std::nan("");
+  EXPECT_EQ(outer_radii(fit_defect_surfaces(c.defect, bone, &mirror, not_a_number)), a);
   // 6 mm and more from the line, the two agree.
   for (size_t i : {size_t{0}, size_t{60}, a.size() - 61, a.size() - 1})
     EXPECT_NEAR(a[i], b[i], 0.2) << "at " << (static_cast<double>(i) * 0.1 - 12.0) << " mm";

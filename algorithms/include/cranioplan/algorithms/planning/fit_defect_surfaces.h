@@ -53,7 +53,7 @@ struct DefectSurfaceParams {
   /// (and 1 mm) are dropped before the final fit: foramina, sutures, cut-face fragments.
   double outlier_sigmas = 3.0;
   /// Mirror-guided, the mirror is read over a footprint of this radius at the rim's radius, mm
-  /// (0: along the one ray): the ray and six around it, their outer radii and thicknesses
+  /// (0..10; 0: along the one ray): the ray and six around it, their outer radii and thicknesses
   /// averaged, none where fewer than four pass through both of its tables. Read along one
   /// ray, the mirror's surfaces jump wherever its bone does (a brow ridge, a sinus wall, a
   /// ray through bone just thicker than `max_thickness_mm`), and which markers land on such a
