@@ -180,7 +180,7 @@ TEST(FitDefectSurfaces, MirrorGuidedCorrectsTheMirrorsMismatch) {
 // A mirror whose bone steps out by 2 mm along a line across the opening (one side of the head
 // moved outward): read along one ray, the fitted outer surface steps as sharply as the mirror
 // (0.59 mm over 0.1 mm), and which side of the line a marker lands on decides 2 mm of the
-// implant; read over the footprint it ramps across about 3 mm, by at most 0.12 mm over 0.1 mm.
+// implant; read over the footprint it ramps across about 6 mm, by at most 0.08 mm over 0.1 mm.
 // Away from the line the footprint changes nothing.
 TEST(FitDefectSurfaces, MirrorReadOverAFootprintRampsWhereItsBoneSteps) {
   const Case& c = the_case();
@@ -222,7 +222,7 @@ TEST(FitDefectSurfaces, MirrorReadOverAFootprintRampsWhereItsBoneSteps) {
   std::printf("largest change over 0.1 mm: %.3f mm along one ray, %.3f over the footprint\n",
               largest_step(a), largest_step(b));
   EXPECT_GT(largest_step(a), 0.4);
-  EXPECT_LT(largest_step(b), 0.25);
+  EXPECT_LT(largest_step(b), 0.2);
   // A footprint that is not a number (a session edited by hand) reads along the one ray.
   DefectSurfaceParams not_a_number;
   not_a_number.mirror_footprint_mm = std::nan("");

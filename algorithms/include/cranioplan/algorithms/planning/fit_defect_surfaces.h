@@ -57,9 +57,10 @@ struct DefectSurfaceParams {
   /// averaged, none where fewer than four pass through both of its tables. Read along one
   /// ray, the mirror's surfaces jump wherever its bone does (a brow ridge, a sinus wall, a
   /// ray through bone just thicker than `max_thickness_mm`), and which markers land on such a
-  /// ray changes with where the rays start. 2 mm, the ring's ray spacing: neighbouring rays'
-  /// footprints meet.
-  double mirror_footprint_mm = 2.0;
+  /// ray changes with where the rays start. 3 mm, half the 6 mm between surface markers: each
+  /// marker reads the mirror over the stretch it stands for, and features of the mirror
+  /// narrower than the markers' spacing do not alias into the implant.
+  double mirror_footprint_mm = 3.0;
 };
 
 /// A sphere fitted to the vault around an opening.
