@@ -166,12 +166,12 @@ std::optional<std::pair<double, double>> DefectSurfaces::mirror_along(
   const int around = spread > 0.0 ? kFootprintAround : 0;
   double r_out = 0.0, t = 0.0;
   int paired = 0;
-  for (int k = -1; k < around; ++k) {
-    const double angle = 2.0 * M_PI * k / around;
-    const Eigen::Vector3d d =
-        k < 0 ? dir
-              : Eigen::Vector3d(
-                    (dir + spread * (std::cos(angle) * a + std::sin(angle) * b)).normalized());
+  for (int k = -1; k < around; ++k) {  // k = -1: the ray itself
+    Eigen::Vector3d d = dir;
+    if (k >= 0) {
+      const double angle = 2.0 * M_PI * k / around;
+      d = (dir + spread * (std::cos(angle) * a + std::sin(angle) * b)).normalized();
+    }
     const RayThroughBone m =
         cast_through_bone(*mirror_, center_, d, kReach, 0.5, max_thickness_mm_);
     if (!m.paired) continue;
