@@ -232,6 +232,74 @@ TEST(FitDefectSurfaces, MirrorReadOverAFootprintRampsWhereItsBoneSteps) {
     EXPECT_NEAR(a[i], b[i], 0.2) << "at " << (static_cast<double>(i) * 0.1 - 12.0) << " mm";
 }
 
+// A mirror with a hole over the opening (a foramen, a gap where the scan or the export lost
+// bone). Over the footprint the ray and six around it, 3 mm off, are read, and a value needs at
+// least four of the seven through both tables: a hole of 1.5 mm under the ray is read across
+// from the six around it (along one ray: no value), and in a hole of 8 mm there is none at its
+// middle (no ray through bone) nor 1 mm inside its edge (three of seven at most), but there is
+// 2 mm outside it (four or more).
+TEST(FitDefectSurfaces, MirrorFootprintReadsAcrossSmallHolesNotLargeOnes) {
+  const Case& c = the_case();
+  ASSERT_TRUE(c.defect.found());
+  const Eigen::Vector3d center = c.defect.center, d0 = c.defect.axis;
+  const Eigen::Vector3d across = unit_across(c.defect.frame.col(0), d0);
+  // Millimetres across at the rim's radius, as the footprint measures them.
+  double rim_radius = 0.0;
+  for (const auto& p : c.defect.outer_rim) rim_radius += (p - center).norm();
+  rim_radius /= static_cast<double>(c.defect.outer_rim.size());
+  auto off_axis = [&](double mm) { return (d0 + mm / rim_radius * across).normalized(); };
+  // Every face with a corner within `radius_mm` of the axis goes, through both tables.
+  auto holed = [&](double radius_mm) {
+    SkullMesh m = c.intact;
+    std::vector<SkullMesh::FaceHandle> gone;
+    for (auto fh : m.faces())
+      for (auto vh : m.fv_range(fh)) {
+        const Eigen::Vector3d v = (to_eigen(m.point(vh)) - center).normalized();
+        if (v.dot(d0) > 0.0 && (v - v.dot(d0) * d0).norm() / v.dot(d0) * rim_radius < radius_mm) {
+          gone.push_back(fh);
+          break;
+        }
+      }
+    for (auto fh : gone) m.delete_face(fh, true);
+    m.garbage_collection();
+    return m;
+  };
+  const SurfaceLocator bone(c.defective), whole(c.intact);
+  const SkullMesh small_hole = holed(1.5), large_hole = holed(8.0);
+  const SurfaceLocator small_mirror(small_hole), large_mirror(large_hole);
+  // The holes are there: no ray along the axis meets both tables.
+  EXPECT_FALSE(cast_through_bone(small_mirror, center, d0, 400.0, 0.5, 15.0).paired);
+  EXPECT_FALSE(cast_through_bone(large_mirror, center, off_axis(7.0), 400.0, 0.5, 15.0).paired);
+
+  const DefectSurfaces intact = fit_defect_surfaces(c.defect, bone, &whole);
+  const DefectSurfaces small = fit_defect_surfaces(c.defect, bone, &small_mirror);
+  ASSERT_TRUE(intact.fitted()) << intact.message;
+  ASSERT_TRUE(small.fitted()) << small.message;
+  const auto expected = intact.at(d0), read_across = small.at(d0);
+  ASSERT_TRUE(expected.has_value());
+  ASSERT_TRUE(read_across.has_value()) << "six of seven rays meet bone around a 1.5 mm hole";
+  EXPECT_NEAR((read_across->first - center).norm(), (expected->first - center).norm(), 0.1);
+  EXPECT_NEAR((read_across->second - center).norm(), (expected->second - center).norm(), 0.1);
+  DefectSurfaceParams one_ray;
+  one_ray.mirror_footprint_mm = 0.0;
+  const DefectSurfaces small_one_ray = fit_defect_surfaces(c.defect, bone, &small_mirror, one_ray);
+  ASSERT_TRUE(small_one_ray.fitted()) << small_one_ray.message;
+  EXPECT_FALSE(small_one_ray.at(d0).has_value()) << "along one ray the hole has no bone";
+
+  const DefectSurfaces large = fit_defect_surfaces(c.defect, bone, &large_mirror);
+  ASSERT_TRUE(large.fitted()) << large.message;
+  EXPECT_FALSE(large.at(d0).has_value()) << "no ray of the footprint meets bone";
+  EXPECT_FALSE(large.at(off_axis(7.0)).has_value()) << "at most three of seven meet bone";
+  EXPECT_FALSE(large.at(off_axis(-7.0)).has_value()) << "at most three of seven meet bone";
+  for (double mm : {10.0, -10.0}) {
+    const auto beyond = large.at(off_axis(mm)), there = intact.at(off_axis(mm));
+    ASSERT_TRUE(beyond.has_value()) << "four or more of seven meet bone " << mm << " mm off";
+    ASSERT_TRUE(there.has_value());
+    // The rays that meet bone are averaged: a fraction of a millimetre from the whole read.
+    EXPECT_NEAR((beyond->first - center).norm(), (there->first - center).norm(), 0.3) << mm;
+  }
+}
+
 // Mirror-guided, the whole ring is fitted (the mirror meets the same roof past an orbit on the
 // other side), but where it does not, a ray's mismatch is 30-50 mm. Such rays are left out of
 // the fit and counted apart from its residual: on the sample a few of them made the residual
