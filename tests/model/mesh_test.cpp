@@ -83,6 +83,43 @@ TEST(Mesh, SignedVolumeOfHeadIsPositiveAndFlipNegates) {
   EXPECT_NEAR(signed_volume(head), -v, 1e-6 * v);
 }
 
+// Known answer: the surface of a box (two triangles a side) has its centroid at the box's
+// centre, and keeps it when one side is split into many more triangles, while the vertices'
+// mean moves towards that side. An open surface too: a lone triangle's is its centroid.
+TEST(Mesh, SurfaceCentroidIsTheSameHoweverTheSurfaceIsTriangulated) {
+  TriangleSoup box;
+  box.vertices = {{0, 0, 0}, {4, 0, 0}, {4, 2, 0}, {0, 2, 0},
+                  {0, 0, 6}, {4, 0, 6}, {4, 2, 6}, {0, 2, 6}};
+  box.triangles = {{0, 2, 1}, {0, 3, 2}, {4, 5, 6}, {4, 6, 7}, {0, 1, 5}, {0, 5, 4},
+                   {1, 2, 6}, {1, 6, 5}, {2, 3, 7}, {2, 7, 6}, {3, 0, 4}, {3, 4, 7}};
+  SkullMesh mesh = build_mesh(box);
+  const Eigen::Vector3d centre(2, 1, 3);
+  EXPECT_LT((surface_centroid(mesh) - centre).norm(), 1e-12);
+  EXPECT_LT((vertex_centroid(mesh) - centre).norm(), 1e-12);
+  // The side z = 6 split at its faces' centroids, four times over (2 faces to 162).
+  for (int round = 0; round < 4; ++round) {
+    std::vector<SkullMesh::FaceHandle> top;
+    for (auto fh : mesh.faces()) {
+      bool on_top = true;
+      for (auto vh : mesh.fv_range(fh)) on_top = on_top && mesh.point(vh)[2] == 6.0;
+      if (on_top) top.push_back(fh);
+    }
+    for (auto fh : top) {
+      Eigen::Vector3d c = Eigen::Vector3d::Zero();
+      for (auto vh : mesh.fv_range(fh)) c += to_eigen(mesh.point(vh)) / 3.0;
+      mesh.split(fh, to_point(c));
+    }
+  }
+  ASSERT_EQ(mesh.n_faces(), 10u + 162u);
+  EXPECT_LT((surface_centroid(mesh) - centre).norm(), 1e-9);
+  EXPECT_GT(vertex_centroid(mesh).z() - centre.z(), 2.0);
+  TriangleSoup one;
+  one.vertices = {{0, 0, 0}, {3, 0, 0}, {0, 3, 3}};
+  one.triangles = {{0, 1, 2}};
+  EXPECT_LT((surface_centroid(build_mesh(one)) - Eigen::Vector3d(1, 1, 1)).norm(), 1e-12);
+  EXPECT_EQ(surface_centroid(SkullMesh()), Eigen::Vector3d::Zero());
+}
+
 // Coordinates are rounded as a conversion to float rounds (to nearest, ties to even), also at
 // exact ties, where a carry reaches the next power of two, for negative numbers and zeros.
 TEST(Mesh, CanonicalCoordinatesAreRoundedAsAFloatConversionRounds) {

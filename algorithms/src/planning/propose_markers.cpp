@@ -67,21 +67,24 @@ std::vector<size_t> along(const std::vector<Eigen::Vector3d>& loop, double spaci
   return out;
 }
 
-// Where the rays start. The vault's centre (vault_center, found from the skull's vertex centroid
-// on the plane) is a property of the bone: no meshing moves it by more than 0.3 mm and a crop
-// of the face by a few millimetres, where the vertex centroid moved 4-12 mm and 40 mm
-// (docs/AUTOPLAN.md). A small opening seen from it is seen narrow and its rim at a grazing
-// angle, so the start moves from there towards the opening until the opening is seen 50° wide
-// (at most half the vault's radius). An opening seen that wide from the vault's centre already
-// (SkullFix's large defects) keeps the vertex centroid, where those plans were measured best.
-// The vertex centroid too when there is no vault to fit or no opening seen from it.
+// Where the rays start. The vault's centre (vault_center, found from the skull's vertex
+// centroid on the plane: any start in the cavity converges to it within 0.05 mm) is a property
+// of the bone: no meshing moves it by more than 0.3 mm and a crop of the face by a few
+// millimetres (docs/AUTOPLAN.md). A small opening seen from it is seen narrow and its rim at a
+// grazing angle, so the start moves from there towards the opening until the opening is seen
+// 50° wide (at most half the vault's radius). An opening seen that wide from the vault's
+// centre already (SkullFix's large defects) keeps the surface centroid, where those plans were
+// measured best. The surface centroid too when there is no vault to fit or no opening seen
+// from it. Not the vertex centroid: decimation moved it 7-12 mm, on a SkullFix skull into the
+// bone of its base, where no ray from it crosses one table.
 Eigen::Vector3d rays_start(const SkullMesh& skull, const SurfaceLocator& bone, const Plane& plane,
                            const DetectDefectParams& params) {
   constexpr double kSeenWide = 25.0 * M_PI / 180.0;
   constexpr double kFarthest = 0.5;
-  const Eigen::Vector3d centroid = plane.project(vertex_centroid(skull));
+  const Eigen::Vector3d centroid = plane.project(surface_centroid(skull));
   double radius = 0.0;
-  const std::optional<Eigen::Vector3d> vault = vault_center(bone, plane, centroid, &radius);
+  const std::optional<Eigen::Vector3d> vault =
+      vault_center(bone, plane, plane.project(vertex_centroid(skull)), &radius);
   if (!vault) return centroid;
   DetectDefectParams from_vault = params;
   from_vault.frame = skull_frame(skull, *vault, plane.normal);

@@ -61,8 +61,13 @@ Eigen::Matrix3Xd vertex_matrix(const SkullMesh& mesh);
 /// Taken about `about` (the same for any point when the surface is closed; for a surface with
 /// holes, a point inside it keeps the open parts' share small).
 double signed_volume(const SkullMesh& mesh);
-/// The mean of the mesh's vertices, mm (zero for a mesh without vertices).
+/// The mean of the mesh's vertices, mm (zero for a mesh without vertices). It moves towards
+/// wherever the triangles are dense: decimation moved skulls' by up to 12 mm, one's into the
+/// bone of its base.
 Eigen::Vector3d vertex_centroid(const SkullMesh& mesh);
+/// The centroid of the surface, each triangle weighted by its area, mm: the same for the same
+/// surface however it is triangulated (the vertex centroid when no face has an area).
+Eigen::Vector3d surface_centroid(const SkullMesh& mesh);
 double signed_volume(const TriangleSoup& soup,
                      const Eigen::Vector3d& about = Eigen::Vector3d::Zero());
 

@@ -49,7 +49,7 @@ struct DetectDefectParams {
   std::optional<Eigen::Vector3d> near;
   /// Where the rays start, a point inside the cranial cavity (detect_defect_near_plane; mm).
   /// Unset: from the vault's centre (vault_center) towards a small opening, or the skull's
-  /// vertex centroid on the midsagittal plane for a large one (detect_defect_near_plane). Set,
+  /// surface centroid on the midsagittal plane for a large one (detect_defect_near_plane). Set,
   /// the plan's dependence on its own rays can be measured (docs/AUTOPLAN.md).
   std::optional<Eigen::Vector3d> center;
   /// The rays' lattice is turned by this rotation (columns: its axes in the skull's

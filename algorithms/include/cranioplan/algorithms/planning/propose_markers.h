@@ -63,8 +63,9 @@ std::string describe_method(PlanMethod method, double mirror_coverage);
 
 /// The defect seen from inside the cavity, on the midsagittal plane: from the vault's centre
 /// (vault_center) moved towards the opening seen from there until it is seen 50° wide (at most
-/// half the vault's radius), or from the skull's vertex centroid when the opening is seen that
-/// wide from the vault's centre already; from DetectDefectParams::center when set.
+/// half the vault's radius), or from the skull's surface centroid (surface_centroid) when the
+/// opening is seen that wide from the vault's centre already; from DetectDefectParams::center when
+/// set.
 DefectRegion detect_defect_near_plane(const SkullMesh& skull, const SurfaceLocator& bone,
                                       const Plane& plane, const DetectDefectParams& params);
 
