@@ -83,8 +83,11 @@ Eigen::Vector3d rays_start(const SkullMesh& skull, const SurfaceLocator& bone, c
   constexpr double kFarthest = 0.5;
   const Eigen::Vector3d centroid = plane.project(surface_centroid(skull));
   double radius = 0.0;
-  const std::optional<Eigen::Vector3d> vault =
+  std::optional<Eigen::Vector3d> vault =
       vault_center(bone, plane, plane.project(vertex_centroid(skull)), &radius);
+  // Dense pieces away from the skull (a headrest, a collar) can pull the vertices' mean out of
+  // the cavity, where no vault is seen: the surface's centroid then.
+  if (!vault) vault = vault_center(bone, plane, centroid, &radius);
   if (!vault) return centroid;
   DetectDefectParams from_vault = params;
   from_vault.frame = skull_frame(skull, *vault, plane.normal);
