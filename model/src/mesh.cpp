@@ -470,13 +470,21 @@ Eigen::Vector3d vertex_centroid(const SkullMesh& mesh) {
   return c / static_cast<double>(std::max<size_t>(1, mesh.n_vertices()));
 }
 
+namespace {
+// A face's three corners.
+std::array<Eigen::Vector3d, 3> corners(const SkullMesh& mesh, SkullMesh::FaceHandle fh) {
+  std::array<Eigen::Vector3d, 3> p;
+  int k = 0;
+  for (auto vh : mesh.fv_range(fh)) p[k++] = to_eigen(mesh.point(vh));
+  return p;
+}
+}  // namespace
+
 Eigen::Vector3d surface_centroid(const SkullMesh& mesh) {
   Eigen::Vector3d sum = Eigen::Vector3d::Zero();
   double area = 0.0;
   for (auto fh : mesh.faces()) {
-    std::array<Eigen::Vector3d, 3> p;
-    int k = 0;
-    for (auto vh : mesh.fv_range(fh)) p[k++] = to_eigen(mesh.point(vh));
+    const std::array<Eigen::Vector3d, 3> p = corners(mesh, fh);
     const double a = 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm();
     sum += a * (p[0] + p[1] + p[2]) / 3.0;
     area += a;
@@ -487,9 +495,7 @@ Eigen::Vector3d surface_centroid(const SkullMesh& mesh) {
 double signed_volume(const SkullMesh& mesh) {
   double six_v = 0.0;
   for (auto fh : mesh.faces()) {
-    std::array<Eigen::Vector3d, 3> p;
-    int k = 0;
-    for (auto vh : mesh.fv_range(fh)) p[k++] = to_eigen(mesh.point(vh));
+    const std::array<Eigen::Vector3d, 3> p = corners(mesh, fh);
     six_v += p[0].dot(p[1].cross(p[2]));
   }
   return six_v / 6.0;
