@@ -16,6 +16,7 @@
 #include <vtkWindowedSincPolyDataFilter.h>
 
 #include <Eigen/Geometry>
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
@@ -138,6 +139,7 @@ struct Row {
   double rim_gap_mm = -1, overlap_mm3 = -1, dice = 0;
   double bone = 0, same_rays_dice = 0;  // bone_agreement; Dice planned with the own rays
   double centre_moved_mm = -1;          // the rays' centre from the own import's
+  double frame_turned_deg = -1;         // the rays' lattice (skull_frame) from the own import's
   std::string message, why;
 };
 
@@ -240,6 +242,9 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
       row.overlap_mm3 = r.quality.penetration_mm3;
       row.dice = compare_implants(r.implant.mesh, reference.implant.mesh).dice;
       row.centre_moved_mm = (r.defect.center - reference.defect.center).norm();
+      const Eigen::Matrix3d turn = reference.defect.frame.transpose() * r.defect.frame;
+      row.frame_turned_deg =
+          std::acos(std::clamp(0.5 * (turn.trace() - 1.0), -1.0, 1.0)) * 180.0 / M_PI;
       if (!r.quality.reasons.empty()) row.why = r.quality.reasons[0];
     }
     row.bone = bone_agreement(own.mesh, skull, reference.implant.mesh);
@@ -267,20 +272,21 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
   std::printf(
       "\n| export of Cranium.inv3 | planned | printable | rim gap (mm) | overlap (mm³) | "
       "Dice vs own import | all met | bone near the implant vs own import (Dice) | Dice with "
-      "the own plan's rays | rays' centre moved (mm) "
-      "|\n|---|---|---|---|---|---|---|---|---|---|\n");
+      "the own plan's rays | rays' centre moved (mm) | rays' lattice turned (°) "
+      "|\n|---|---|---|---|---|---|---|---|---|---|---|\n");
   for (const Row& row : rows) {
     const bool all = row.planned && row.printable && row.rim_gap_mm <= kMaxRimGapMm &&
                      row.overlap_mm3 <= kMaxOverlapMm3 && row.dice >= kTargetDice;
     if (row.planned)
-      std::printf("| %s | yes | %s | %.2f | %.1f | %.3f | %s | %.3f | %.3f | %.1f |\n",
+      std::printf("| %s | yes | %s | %.2f | %.1f | %.3f | %s | %.3f | %.3f | %.1f | %.1f |\n",
                   row.name.c_str(), row.printable ? "yes" : "no", row.rim_gap_mm, row.overlap_mm3,
-                  row.dice, all ? "yes" : "no", row.bone, row.same_rays_dice, row.centre_moved_mm);
+                  row.dice, all ? "yes" : "no", row.bone, row.same_rays_dice, row.centre_moved_mm,
+                  row.frame_turned_deg);
     else
-      std::printf("| %s | no: %.120s | | | | | no | %.3f | %.3f | |\n", row.name.c_str(),
+      std::printf("| %s | no: %.120s | | | | | no | %.3f | %.3f | | |\n", row.name.c_str(),
                   row.message.c_str(), row.bone, row.same_rays_dice);
     if (row.planned && !row.printable)
-      std::printf("|  | not printable: %.160s | | | | | | | | |\n", row.why.c_str());
+      std::printf("|  | not printable: %.160s | | | | | | | | | |\n", row.why.c_str());
   }
 }
 
