@@ -164,9 +164,14 @@ std::vector<FittedPoints> fitted_along_ring(const DefectRegion& defect,
 // Outer edge markers along the rim. Where intact bone continues beyond the rim (the ring has
 // bone just outside it), on the fitted outer surface: at a cut face that is not along the
 // rays, the last bone the rays meet lies below where the outer table goes on. Where it does
-// not (the rim runs along an orbit or the skull base), the fit only extrapolates there: at
-// the last bone. No inner edge markers: the inner rim is the outer one set in by the
-// thickness field of the inner markers (docs/IMPLANT.md).
+// not (the rim runs along an orbit or the skull base), rim-only the fit only extrapolates
+// there: at the last bone. Mirror-guided, the fitted surface there is the mirror's own outer
+// table (where the mirror has bone), and the marker stands on it too: the rim's rays meet the
+// rounded edge of the bone above an orbit at a grazing angle, and where they met it moved by
+// 2-3 mm when the rays' start moved by a fraction of a millimetre (the sample's brow: its
+// lower wall held most of what differed between such plans; docs/AUTOPLAN.md). No inner edge
+// markers: the inner rim is the outer one set in by the thickness field of the inner markers
+// (docs/IMPLANT.md).
 // The ring is probed by direction from the centre, not by position (at an oblique cut face
 // the rim's last bone is the cut's inner corner, a table's thickness below the ring's outer
 // table), 5 and 7 mm out, with the ring's bone up to 15 mm out (the rays that leave through
@@ -218,7 +223,7 @@ void add_edge_markers(const DefectRegion& defect, const DefectSurfaces& surfaces
   for (size_t i : along(defect.outer_rim, params.edge_spacing_mm)) {
     const Eigen::Vector3d& rim = defect.outer_rim[i];
     const auto fitted = surfaces.at(rim - c);
-    if (fitted && bone_beyond(rim)) {
+    if (fitted && (surfaces.mirror_guided || bone_beyond(rim))) {
       out.push_back({id++, MarkerType::OuterEdge, fitted->first, MarkerSurface::Original});
       continue;
     }

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "cranioplan/algorithms/geometry/surface_locator.h"
+#include "cranioplan/algorithms/planning/fit_defect_surfaces.h"
 #include "support/synthetic.h"
 
 namespace cranioplan {
@@ -74,6 +75,64 @@ TEST(ProposeMarkers, TheRimKeepsEdgeMarkersWhereTheMirrorHasNoBone) {
   EXPECT_GE(rim_in_hole, 2) << "the mirror's hole lies over a stretch of the rim";
   // Those edge markers lie on the skull's bone.
   for (const Eigen::Vector3d& e : edges) EXPECT_LT(bone.closest(e).distance, 1.0);
+}
+
+// An orbit beside the defect: a hole 24 mm across in both skulls, its edge 2.5 mm beyond a
+// stretch of the rim, so no intact bone goes on beyond the rim there. Rim-only, the fit only
+// extrapolates over such a stretch and its edge markers stand on the rim's last bone.
+// Mirror-guided, the mirror has its own table there, and every edge marker stands on the
+// fitted outer surface, as where bone goes on: where a ray grazes the rounded edge of the bone
+// above a real orbit, the last bone it meets moves by millimetres with the rays' start.
+TEST(ProposeMarkers, MirrorGuidedEdgeMarkersBesideAnOrbitStandOnTheMirrorsTable) {
+  const test::ThickHeadDefect& c = test::thick_head_defect();
+  ASSERT_TRUE(c.defect.found()) << c.defect.message;
+  const Eigen::Vector3d rim = c.defect.outer_rim.front();
+  const Eigen::Vector3d out = (rim - rim.dot(c.defect.axis) * c.defect.axis).normalized();
+  constexpr double kOrbitRadius = 12.0, kBridge = 2.5;  // mm
+  const Eigen::Vector3d orbit =
+      test::head_surface_point((rim + (kOrbitRadius + kBridge) * out).normalized());
+  const SkullMesh skull = test::cut_hole(c.defective, orbit, kOrbitRadius);
+  const SkullMesh mirror_mesh = test::cut_hole(c.intact, orbit, kOrbitRadius);
+  const SurfaceLocator bone(skull), mirror(mirror_mesh);
+  const DefectRegion defect = detect_defect(skull, bone, Eigen::Vector3d::Zero());
+  ASSERT_TRUE(defect.found()) << defect.message;
+  ASSERT_LT(defect.area_mm2, 1.2 * c.defect.area_mm2) << "the defect, not the two together";
+  auto at_rim = [&](const Eigen::Vector3d& p) {
+    for (const Eigen::Vector3d& r : defect.outer_rim)
+      if ((r - p).norm() < 1e-9) return true;
+    return false;
+  };
+
+  ProposeParams rim_only;
+  rim_only.method = PlanMethod::RimOnly;
+  const MarkerProposal a = propose_markers_for_defect(defect, bone, mirror, rim_only);
+  ASSERT_TRUE(a.proposed()) << a.message;
+  int last_bone = 0;
+  for (const Marker& m : a.markers)
+    if (m.type == MarkerType::OuterEdge && at_rim(m.position)) {
+      ++last_bone;
+      EXPECT_LT((m.position - orbit).norm(), kOrbitRadius + 10.0) << "only beside the orbit";
+    }
+  EXPECT_GE(last_bone, 2) << "the stretch beside the orbit";
+
+  ProposeParams guided;
+  guided.method = PlanMethod::Mirror;
+  const MarkerProposal b = propose_markers_for_defect(defect, bone, mirror, guided);
+  ASSERT_TRUE(b.proposed()) << b.message;
+  const DefectSurfaces fitted =
+      fit_defect_surfaces(defect, bone, &mirror, guided.surfaces, guided.detect);
+  ASSERT_TRUE(fitted.fitted()) << fitted.message;
+  int beside_orbit = 0;
+  for (const Marker& m : b.markers) {
+    if (m.type != MarkerType::OuterEdge) continue;
+    const auto on = fitted.at(m.position - defect.center);
+    ASSERT_TRUE(on.has_value()) << "the mirror has bone along every rim point";
+    EXPECT_LT((m.position - on->first).norm(), 1e-6) << "edge marker " << m.id;
+    // There the fitted surface is the intact head's outer table (a perfect mirror).
+    EXPECT_LT(mirror.closest(m.position).distance, 0.5) << "edge marker " << m.id;
+    beside_orbit += (m.position - orbit).norm() < kOrbitRadius + 5.0;
+  }
+  EXPECT_GE(beside_orbit, 2);
 }
 
 TEST(ProposeMarkers, RimOnlyFittingIsUsedWhenAsked) {

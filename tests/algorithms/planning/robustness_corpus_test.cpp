@@ -184,14 +184,14 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
     bool on_bone, meets_dice;
     // The own import's bone where the implant sits (bone_agreement ≥ kSameBone): planned with
     // the own plan's rays it meets the Dice target — all but where the rays start depends on
-    // the bone, not on its triangles (measured 0.939-0.986).
+    // the bone, not on its triangles (measured 0.957-0.988).
     bool same_bone;
   };
   const std::vector<Case> cases = {
       {"open, 200 HU", [&] { return open(200.0); }, true, false, false},
-      {"open, 226 HU (InVesalius bone)", [&] { return open(226.0); }, true, false, false},
+      {"open, 226 HU (InVesalius bone)", [&] { return open(226.0); }, true, true, false},
       {"open, 300 HU", [&] { return open300; }, true, true, true},
-      {"open, 400 HU", [&] { return open(400.0); }, true, false, false},
+      {"open, 400 HU", [&] { return open(400.0); }, true, true, false},
       {"open, 450 HU", [&] { return open(450.0); }, true, false, false},
       {"open, sinc pass band 0.1", [&] { return sinc_smoothed(open300, 0.1); }, true, false, false},
       {"open, sinc pass band 0.01", [&] { return sinc_smoothed(open300, 0.01); }, true, true,
@@ -220,7 +220,7 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
              m, Eigen::Vector3d(0, 0.5 * (box.bbox_min.y() + box.bbox_max.y()), 60.0),
              Eigen::Vector3d(0, -std::sin(tilt), std::cos(tilt))));
        },
-       true, false, true},
+       true, true, true},
   };
   std::vector<Row> rows;
   for (size_t i = 0; i < cases.size(); ++i) {
@@ -329,9 +329,10 @@ TEST(RobustnessCorpus, HowFarThePlanMovesWithItsOwnRays) {
     std::printf("| %s | %.3f | %.2f | %s |\n", m.name.c_str(), dice, r.quality.rim_gap_mm,
                 r.quality.printable ? "yes" : "no");
     EXPECT_TRUE(r.quality.printable) << (r.quality.reasons.empty() ? "" : r.quality.reasons[0]);
-    // Measured 0.900-0.954 (0.885-0.950 with the mirror read along one ray): a floor below
-    // it, so that a change that makes the plan follow its rays more fails here.
-    EXPECT_GE(dice, 0.89);
+    // Measured 0.915-0.941 (0.900-0.954 with the edge markers beside the orbit at the rim's
+    // last bone, 0.885-0.950 with the mirror read along one ray as well): a floor below it, so
+    // that a change that makes the plan follow its rays more fails here.
+    EXPECT_GE(dice, 0.905);
   }
   std::printf("mean Dice %.3f\n", sum / static_cast<double>(moves.size()));
 }
