@@ -227,12 +227,12 @@ void add_edge_markers(const DefectRegion& defect, const DefectSurfaces& surfaces
       out.push_back({id++, MarkerType::OuterEdge, fitted->first, MarkerSurface::Original});
       continue;
     }
-    // At the rim's last bone: where no intact bone continues beyond the rim, and where it does
-    // but no fitted surface says where (mirror-guided, the mirror has no bone there either: a
+    // At the rim's last bone: rim-only where no intact bone continues beyond the rim, and where
+    // it does but no fitted surface says where (mirror-guided, the mirror has no bone there: a
     // rim point left out there left the outline to cut straight across that stretch, and an
     // export of the sample smoothed as Slicer does lost one next to the frontal sinus). Not
-    // where that bone lies below the fitted bone altogether, or, without a fitted surface
-    // there, more than one layer of bone below its neighbours on the rim: its ray met other
+    // where that bone lies below the fitted bone altogether (rim-only), or, without a fitted
+    // surface there, more than one layer of bone below its neighbours on the rim: its ray met other
     // bone past the vault's edge (an orbital roof, a sinus wall), and a marker there pulls the
     // implant's outer surface down into a funnel (the sample: a rim point 18 mm below the
     // surface; decimated, two 20-30 mm below their neighbours, rim gap 7 mm).
