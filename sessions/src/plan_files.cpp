@@ -54,6 +54,7 @@ Json to_json(const MeshReport& r) {
               {"boundary_loops", r.loops.size()},
               {"longest_boundary_loops", loops},
               {"openings", describe_openings(r)},
+              {"caps", describe_caps(r)},
               {"triangles", r.triangles},
               {"bbox_min", to_json(r.bbox_min)},
               {"bbox_max", to_json(r.bbox_max)},

@@ -124,6 +124,22 @@ SkullMesh cut_hole(const SkullMesh& mesh, const Eigen::Vector3d& center, double 
   return build_mesh(s);
 }
 
+SkullMesh scanned_padded(const SkullMesh& mesh, const Eigen::Vector3d& point,
+                         const Eigen::Vector3d& up, double voxel_mm) {
+  const auto [lo, hi] = mesh_bounds(mesh);
+  const Eigen::Vector3d margin = Eigen::Vector3d::Constant(2.0 * voxel_mm);
+  const VoxelGrid grid = VoxelGrid::covering(lo - margin, hi + margin, voxel_mm);
+  std::vector<uint8_t> inside = voxelize_mesh(mesh, grid);
+  for (int k = 0; k < grid.dims[2]; ++k)
+    for (int j = 0; j < grid.dims[1]; ++j)
+      for (int i = 0; i < grid.dims[0]; ++i)
+        if ((grid.center(i, j, k) - point).dot(up) < 0.0) inside[grid.index(i, j, k)] = 0;
+  ExtractBoneSurfaceParams all;
+  all.largest_piece_only = false;
+  all.min_piece_triangles = 1;
+  return extract_bone_surface(mask_volume(inside, grid), all).mesh;
+}
+
 SkullMesh cut_open(const SkullMesh& mesh, const Eigen::Vector3d& point, const Eigen::Vector3d& up) {
   TriangleSoup s = to_soup(mesh);
   std::vector<Eigen::Vector3i> kept;

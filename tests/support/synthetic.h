@@ -40,6 +40,13 @@ SkullMesh cut_hole(const SkullMesh& mesh, const Eigen::Vector3d& center, double 
 /// exporters leave it).
 SkullMesh cut_open(const SkullMesh& mesh, const Eigen::Vector3d& point, const Eigen::Vector3d& up);
 
+/// The closed `mesh` as an importer that pads the volume meshes a scan that ended at the plane
+/// through `point` with normal `up`: voxelized on `voxel_mm` voxels, those below the plane
+/// cleared, the iso-surface closed by the padding (a flat cap across the bone where an axis
+/// plane cuts it). Every piece is kept.
+SkullMesh scanned_padded(const SkullMesh& mesh, const Eigen::Vector3d& point,
+                         const Eigen::Vector3d& up, double voxel_mm = 1.0);
+
 SkullMesh transformed(const SkullMesh& mesh, const RigidTransform& t);
 /// The mesh with every coordinate multiplied by `factor` (a head written in another unit:
 /// 1/1000 for metres).

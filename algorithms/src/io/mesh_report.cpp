@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <limits>
 #include <map>
 #include <numeric>
 #include <unordered_map>
@@ -24,6 +25,19 @@ constexpr double kCutSpanMm = 30.0;
 // plane within this angle of it (degrees).
 constexpr double kBorderReachMm = 2.0;
 constexpr double kAxisSnapDeg = 1.0;
+
+// The side a cut or cap faces, named by the patient's direction nearest its outward normal;
+// within 1° of it, the normal is made that axis (a slice's plane, up to rounding).
+std::string name_border(Eigen::Vector3d& outward) {
+  int axis = 0;
+  outward.cwiseAbs().maxCoeff(&axis);
+  const double sign = outward[axis] < 0 ? -1.0 : 1.0;
+  if (std::abs(outward[axis]) >= std::cos(kAxisSnapDeg * M_PI / 180.0))
+    outward = sign * Eigen::Vector3d::Unit(axis);
+  static const char* const kLow[3] = {"right", "front", "lower"};
+  static const char* const kHigh[3] = {"left", "back", "upper"};
+  return sign < 0 ? kLow[axis] : kHigh[axis];
+}
 
 // The chains of boundary edges (welded vertex ids), measured and placed.
 std::vector<BoundaryLoop> boundary_loops(const TriangleSoup& welded,
@@ -95,17 +109,8 @@ std::vector<BoundaryLoop> boundary_loops(const TriangleSoup& welded,
       l.outward = l.normal;
     else
       continue;
-    // Named by the patient's direction nearest its outward normal; within 1° of it, the
-    // normal is that axis (a slice's plane, up to rounding).
-    int axis = 0;
-    l.outward.cwiseAbs().maxCoeff(&axis);
-    const double sign = l.outward[axis] < 0 ? -1.0 : 1.0;
-    if (std::abs(l.outward[axis]) >= std::cos(kAxisSnapDeg * M_PI / 180.0))
-      l.outward = sign * Eigen::Vector3d::Unit(axis);
-    static const char* const kLow[3] = {"right", "front", "lower"};
-    static const char* const kHigh[3] = {"left", "back", "upper"};
     l.at_border = true;
-    l.border = sign < 0 ? kLow[axis] : kHigh[axis];
+    l.border = name_border(l.outward);
   }
   // The cut also leaves small loops in its plane (around islands of bone the plane crosses, in
   // the orbits or the nose): each lying within reach of a border's plane is part of that cut.
@@ -134,17 +139,183 @@ std::vector<BoundaryLoop> boundary_loops(const TriangleSoup& welded,
   return loops;
 }
 
+// A cap: this much area at least, within a cut's reach of the mesh's end (kBorderReachMm: an
+// importer's cap lies between the scan's last slice and the padding), its triangles facing out
+// within this angle (degrees), and as wide as a cut through the head along both of its plane's
+// principal axes (mm): a scan's end crosses the head's shell in a ring, 60 mm across at the
+// least; a skull's own curve keeps a disc of only 38 mm within 2 mm of its end (at a 90 mm
+// radius), and a defect's flat cut face is a band as narrow as the bone is thick. Measured
+// (docs/AUTOPLAN.md): scans' lower ends cover 18-32 % of their outline, 6,000-8,000 mm² of it
+// open; the sample's sides, shaved by the field of view, 95 % (90-100 mm² open).
+constexpr double kCapMinAreaMm2 = 200.0;
+constexpr double kCapFacingDeg = 30.0;
+constexpr double kCapMajorMm = 60.0, kCapMinorMm = 30.0;
+// A ring: at least this much of its outline open (mm²), and its triangles covering at most this
+// fraction of it.
+constexpr double kCapOpenMm2 = 1000.0, kCapCoverage = 0.5;
+
+// The convex hull of `points` seen along `normal` (projected on its plane), counter-clockwise
+// about it: Andrew's monotone chain on the plane's coordinates.
+std::vector<Eigen::Vector3d> hull_in_plane(std::vector<Eigen::Vector3d> points,
+                                           const Eigen::Vector3d& normal) {
+  const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
+  auto uv = [&](const Eigen::Vector3d& p) { return Eigen::Vector2d(p.dot(u), p.dot(v)); };
+  std::sort(points.begin(), points.end(), [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    const Eigen::Vector2d x = uv(a), y = uv(b);
+    return x.x() < y.x() || (x.x() == y.x() && x.y() < y.y());
+  });
+  if (points.size() < 3) return points;
+  auto turn = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    const Eigen::Vector2d p = uv(a) - uv(o), q = uv(b) - uv(o);
+    return p.x() * q.y() - p.y() * q.x();
+  };
+  std::vector<Eigen::Vector3d> hull(2 * points.size());
+  size_t k = 0;
+  for (size_t i = 0; i < points.size(); ++i) {  // lower chain
+    while (k >= 2 && turn(hull[k - 2], hull[k - 1], points[i]) <= 0.0) --k;
+    hull[k++] = points[i];
+  }
+  for (size_t i = points.size() - 1, lower = k + 1; i-- > 0;) {  // upper chain
+    while (k >= lower && turn(hull[k - 2], hull[k - 1], points[i]) <= 0.0) --k;
+    hull[k++] = points[i];
+  }
+  hull.resize(k - 1);  // the last point is the first
+  return hull;
+}
+
+// The flat caps where a closed surface ends (welded soup), tried along the axes (a volume's
+// slices) and along the directions that many triangles' normals share (in cells of 0.005: an
+// oblique volume's slices), either way: the triangles within 2 mm of the mesh's end along one and
+// facing out through it form a cap if they cover enough and are as wide as a cut.
+std::vector<BorderCap> border_caps(const TriangleSoup& welded) {
+  const size_t nt = welded.triangles.size();
+  std::vector<Eigen::Vector3d> normal(nt, Eigen::Vector3d::Zero());
+  std::vector<double> area(nt, 0.0);
+  std::map<std::array<long, 3>, std::pair<Eigen::Vector3d, double>> by_direction;
+  for (size_t t = 0; t < nt; ++t) {
+    const Eigen::Vector3i& f = welded.triangles[t];
+    const Eigen::Vector3d c = (welded.vertices[f[1]] - welded.vertices[f[0]])
+                                  .cross(welded.vertices[f[2]] - welded.vertices[f[0]]);
+    const double twice = c.norm();
+    if (!(twice > 0.0)) continue;
+    normal[t] = c / twice;
+    area[t] = 0.5 * twice;
+    int axis = 0;
+    normal[t].cwiseAbs().maxCoeff(&axis);
+    const Eigen::Vector3d unsigned_n = normal[t][axis] < 0 ? -normal[t] : normal[t];
+    const std::array<long, 3> key{std::lround(unsigned_n.x() * 200.0),
+                                  std::lround(unsigned_n.y() * 200.0),
+                                  std::lround(unsigned_n.z() * 200.0)};
+    auto& [sum, total] = by_direction[key];
+    sum += area[t] * unsigned_n;
+    total += area[t];
+  }
+  std::vector<Eigen::Vector3d> directions{Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
+                                          Eigen::Vector3d::UnitZ()};
+  const double same = std::cos(kAxisSnapDeg * M_PI / 180.0);
+  for (const auto& [key, bin] : by_direction) {
+    const Eigen::Vector3d d = bin.first.normalized();
+    if (bin.second >= 0.25 * kCapMinAreaMm2 &&
+        std::none_of(directions.begin(), directions.end(),
+                     [&](const Eigen::Vector3d& e) { return std::abs(e.dot(d)) >= same; }))
+      directions.push_back(d);
+  }
+  std::vector<BorderCap> caps;
+  const double facing = std::cos(kCapFacingDeg * M_PI / 180.0);
+  for (const Eigen::Vector3d& d : directions) {
+    double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
+    for (const Eigen::Vector3d& p : welded.vertices) {
+      lowest = std::min(lowest, p.dot(d));
+      highest = std::max(highest, p.dot(d));
+    }
+    for (const double sign : {-1.0, 1.0}) {
+      const Eigen::Vector3d out = sign * d;
+      const double end = sign < 0 ? -lowest : highest;  // out · p at the mesh's end
+      BorderCap cap;
+      cap.outward = out;
+      cap.box_min = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+      cap.box_max = -cap.box_min;
+      std::vector<Eigen::Vector3d> corners;
+      for (size_t t = 0; t < nt; ++t) {
+        if (area[t] == 0.0 || normal[t].dot(out) < facing) continue;
+        const Eigen::Vector3i& f = welded.triangles[t];
+        bool at_end = true;
+        for (int k = 0; k < 3 && at_end; ++k)
+          at_end = end - welded.vertices[f[k]].dot(out) <= kBorderReachMm;
+        if (!at_end) continue;
+        cap.area_mm2 += area[t];
+        for (int k = 0; k < 3; ++k) {
+          const Eigen::Vector3d& p = welded.vertices[f[k]];
+          cap.centroid += area[t] / 3.0 * p;
+          cap.box_min = cap.box_min.cwiseMin(p);
+          cap.box_max = cap.box_max.cwiseMax(p);
+          corners.push_back(p);
+        }
+      }
+      if (cap.area_mm2 < kCapMinAreaMm2) continue;
+      cap.centroid /= cap.area_mm2;
+      // Its width along the principal axes of its corners in its plane.
+      Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+      for (const Eigen::Vector3d& p : corners) {
+        const Eigen::Vector3d q = (p - cap.centroid) - (p - cap.centroid).dot(out) * out;
+        cov += q * q.transpose();
+      }
+      const Eigen::Matrix3d axes =
+          Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors();
+      double width[2] = {0.0, 0.0};
+      for (int a = 0; a < 2; ++a) {
+        const Eigen::Vector3d e = axes.col(a + 1);  // the two largest: in the plane
+        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+        for (const Eigen::Vector3d& p : corners) {
+          lo = std::min(lo, p.dot(e));
+          hi = std::max(hi, p.dot(e));
+        }
+        width[a] = hi - lo;
+      }
+      if (std::max(width[0], width[1]) < kCapMajorMm || std::min(width[0], width[1]) < kCapMinorMm)
+        continue;
+      // A ring around the head's inside: the outline encloses open space that the triangles
+      // do not cover. A cap across solid bone (a field of view that shaves the side of the
+      // head) covers most of its outline and closes no opening.
+      cap.outline = hull_in_plane(std::move(corners), cap.outward);
+      double enclosed = 0.0;
+      for (size_t i = 1; i + 1 < cap.outline.size(); ++i)
+        enclosed += 0.5 * (cap.outline[i] - cap.outline[0])
+                              .cross(cap.outline[i + 1] - cap.outline[0])
+                              .dot(cap.outward);
+      if (enclosed - cap.area_mm2 < kCapOpenMm2 || cap.area_mm2 > kCapCoverage * enclosed) continue;
+      cap.border = name_border(cap.outward);
+      caps.push_back(cap);
+    }
+  }
+  std::stable_sort(caps.begin(), caps.end(),
+                   [](const BorderCap& a, const BorderCap& b) { return a.area_mm2 > b.area_mm2; });
+  return caps;
+}
+
 std::string fmt(const char* f, double a, double b = 0.0, double c = 0.0) {
   char buf[160];
   std::snprintf(buf, sizeof(buf), f, a, b, c);
   return buf;
 }
 
+// Where a cut's or a cap's plane lies, for a person: "z = 0.0 mm", or "a plane tilted 20° from
+// z = const, through z = 61.0 mm at its centre".
+std::string plane_place(const Eigen::Vector3d& outward, const Eigen::Vector3d& through) {
+  static const char* const kAxis = "xyz";
+  int axis = 0;
+  outward.cwiseAbs().maxCoeff(&axis);
+  const double at = std::round(through[axis] * 10.0) / 10.0 + 0.0;  // no "-0.0"
+  const double tilt = std::acos(std::min(1.0, std::abs(outward[axis]))) * 180.0 / M_PI;
+  if (tilt == 0.0) return std::string(1, kAxis[axis]) + fmt(" = %.1f mm", at);
+  return fmt("a plane tilted %.0f° from ", tilt) + kAxis[axis] + " = const, through " +
+         kAxis[axis] + fmt(" = %.1f mm at its centre", at);
+}
+
 }  // namespace
 
 std::vector<std::string> describe_openings(const MeshReport& report) {
   std::vector<std::string> out;
-  static const char* const kAxis = "xyz";
   for (const char* side : {"lower", "upper", "front", "back", "right", "left"}) {
     long long count = 0;
     double length = 0.0;
@@ -156,14 +327,7 @@ std::vector<std::string> describe_openings(const MeshReport& report) {
       if (!first) first = &l;
     }
     if (count == 0) continue;
-    int axis = 0;
-    first->outward.cwiseAbs().maxCoeff(&axis);
-    const double at = std::round(first->centroid[axis] * 10.0) / 10.0 + 0.0;  // no "-0.0"
-    const double tilt = std::acos(std::min(1.0, std::abs(first->outward[axis]))) * 180.0 / M_PI;
-    const std::string where = tilt == 0.0 ? std::string(1, kAxis[axis]) + fmt(" = %.1f mm", at)
-                                          : fmt("a plane tilted %.0f° from ", tilt) + kAxis[axis] +
-                                                " = const, through " + kAxis[axis] +
-                                                fmt(" = %.1f mm at its centre", at);
+    const std::string where = plane_place(first->outward, first->centroid);
     out.push_back(std::string("open along a flat cut at its ") + side + " border (" + where +
                   "): " + std::to_string(count) + (count == 1 ? " loop, " : " loops, ") +
                   fmt("%.0f mm", length) +
@@ -185,6 +349,21 @@ std::vector<std::string> describe_openings(const MeshReport& report) {
                   fmt(", at (%.0f, %.0f, %.0f) mm", largest->centroid.x(), largest->centroid.y(),
                       largest->centroid.z()) +
                   "; left open, the bone's inside taken by votes through them");
+  return out;
+}
+
+std::vector<std::string> describe_caps(const MeshReport& report) {
+  std::vector<std::string> out;
+  for (const BorderCap& cap : report.caps) {
+    const bool open_there =
+        std::any_of(report.loops.begin(), report.loops.end(),
+                    [&](const BoundaryLoop& l) { return l.at_border && l.border == cap.border; });
+    if (open_there) continue;
+    out.push_back("closed by a flat cap at its " + cap.border + " border (" +
+                  plane_place(cap.outward, cap.centroid) +
+                  fmt("): %.0f mm², where the scan ended; an opening through it is not a defect",
+                      cap.area_mm2));
+  }
   return out;
 }
 
@@ -314,6 +493,7 @@ MeshReport report_mesh(const SkullMesh& mesh) {
   // In the order of the welded ids: the same loops on any run.
   std::sort(boundary.begin(), boundary.end());
   r.loops = boundary_loops(soup, boundary);
+  r.caps = border_caps(soup);
   r.pieces = static_cast<long long>(soup_components(soup).sizes.size());
   r.watertight = r.boundary_edges == 0 && r.nonmanifold_edges == 0;
   return r;

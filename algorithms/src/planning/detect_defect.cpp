@@ -61,23 +61,41 @@ bool ScanBorder::reached_by(const Eigen::Vector3d& from, const Eigen::Vector3d& 
     const double slack = std::abs(normal[k]) < 0.5 ? 0.0 : kBorderSlackMm;
     if (hit[k] < box_min[k] - slack || hit[k] > box_max[k] + slack) return false;
   }
+  // Within a convex outline counter-clockwise about the normal: left of every edge.
+  for (size_t i = 0; i < outline.size(); ++i) {
+    const Eigen::Vector3d& a = outline[i];
+    const Eigen::Vector3d& b = outline[(i + 1) % outline.size()];
+    if ((b - a).cross(hit - a).dot(normal) < 0.0) return false;
+  }
   return true;
 }
 
 std::vector<ScanBorder> scan_borders(const MeshReport& report) {
   std::vector<ScanBorder> out;
   std::vector<std::string> sides;
-  for (const BoundaryLoop& loop : report.loops) {
-    if (!loop.at_border || std::find(sides.begin(), sides.end(), loop.border) != sides.end())
-      continue;
-    sides.push_back(loop.border);
-    ScanBorder b;
-    b.normal = loop.outward;
-    b.offset = b.normal.dot(loop.centroid);
+  auto add = [&](const std::string& side, const Eigen::Vector3d& outward,
+                 const Eigen::Vector3d& in_plane) -> ScanBorder* {
+    if (std::find(sides.begin(), sides.end(), side) != sides.end()) return nullptr;
+    sides.push_back(side);
+    ScanBorder& b = out.emplace_back();
+    b.normal = outward;
+    b.offset = outward.dot(in_plane);
     b.box_min = report.bbox_min;
     b.box_max = report.bbox_max;
-    out.push_back(b);
-  }
+    return &b;
+  };
+  for (const BoundaryLoop& loop : report.loops)
+    if (loop.at_border) add(loop.border, loop.outward, loop.centroid);
+  // A closed surface capped where the scan ended: the head's inside is open through the cap's
+  // plane as through an open cut, within the cap's own outline (a scan's field of view that
+  // clips the side of the head leaves a cap there, which rays through an opening elsewhere meet
+  // beside the head; a defect that breaks the cap's ring leaves its outline whole).
+  for (const BorderCap& cap : report.caps)
+    if (ScanBorder* b = add(cap.border, cap.outward, cap.centroid)) {
+      b->box_min = cap.box_min;
+      b->box_max = cap.box_max;
+      b->outline = cap.outline;
+    }
   return out;
 }
 

@@ -118,6 +118,33 @@ TEST(MeshReport, ACutAtTheBorderAndAHoleAreToldApart) {
   EXPECT_TRUE(describe_openings(whole).empty());
 }
 
+// The thick head as an importer that pads the volume meshes a scan that ended 30 mm above its
+// lowest point: closed, with a flat cap across the bone at the lower border, found and
+// described; the whole head has none (its lowest part is curved, not flat).
+TEST(MeshReport, AScanEndClosedByPaddingIsACap) {
+  const SkullMesh head = test::make_thick_head(0.93, 1.0);
+  const MeshReport whole = report_mesh(head);
+  EXPECT_TRUE(whole.caps.empty());
+  EXPECT_TRUE(describe_caps(whole).empty());
+  const double cut_z = whole.bbox_min.z() + 30.0;
+  const SkullMesh padded =
+      test::scanned_padded(head, Eigen::Vector3d(0, 0, cut_z), Eigen::Vector3d::UnitZ());
+  const MeshReport r = report_mesh(padded);
+  EXPECT_TRUE(r.watertight);
+  ASSERT_EQ(r.caps.size(), 1u);
+  const BorderCap& cap = r.caps[0];
+  EXPECT_EQ(cap.border, "lower");
+  EXPECT_EQ(cap.outward, -Eigen::Vector3d::UnitZ());
+  EXPECT_NEAR(cap.centroid.z(), cut_z, 1.0);
+  // The ring of bone the cut crosses: about its length (400-500 mm) times the bone's 5-6 mm.
+  EXPECT_GT(cap.area_mm2, 1500.0);
+  EXPECT_LT(cap.area_mm2, 4000.0);
+  EXPECT_TRUE(describe_openings(r).empty()) << "closed: no opening to repair";
+  const std::vector<std::string> said = describe_caps(r);
+  ASSERT_EQ(said.size(), 1u);
+  EXPECT_EQ(said[0].rfind("closed by a flat cap at its lower border (z = ", 0), 0u) << said[0];
+}
+
 // The same head cut along a plane tilted 30° from the axial (a tilted gantry, or a skull that
 // came in turned): the cut is still the lower border, its outward normal the plane's.
 TEST(MeshReport, AnObliqueCutAtTheBorderIsFoundInItsOwnPlane) {

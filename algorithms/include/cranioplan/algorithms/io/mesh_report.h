@@ -27,6 +27,23 @@ struct BoundaryLoop {
   std::string border;
 };
 
+/// A flat cap where a closed surface ends: triangles in one plane (within 0.5 mm) at the mesh's
+/// end along the plane's normal, at least 50 mm² of them spanning 30 mm or more. An importer that
+/// pads the volume (this program's, 3D Slicer's closed surfaces) leaves one where the scan ended:
+/// the bone's cross-section is closed there, and the head's inside is open through it.
+struct BorderCap {
+  /// Unit normal out of the surface through the cap (an axis when within 1° of one).
+  Eigen::Vector3d outward = Eigen::Vector3d::Zero();
+  Eigen::Vector3d centroid = Eigen::Vector3d::Zero();  ///< of its triangles' area, mm
+  double area_mm2 = 0.0;
+  Eigen::Vector3d box_min = Eigen::Vector3d::Zero();  ///< of its triangles, mm
+  Eigen::Vector3d box_max = Eigen::Vector3d::Zero();
+  /// The convex hull of its triangles in its plane, counter-clockwise about `outward`: the
+  /// outline of the bone's cross-section, around the head's inside that the cap leaves open.
+  std::vector<Eigen::Vector3d> outline;
+  std::string border;  ///< which border, named as BoundaryLoop::border
+};
+
 struct MeshReport {
   long long vertices = 0;
   long long triangles = 0;
@@ -39,12 +56,18 @@ struct MeshReport {
   long long pieces = 0;             ///< connected pieces
   bool watertight = false;          ///< no boundary and no non-manifold edge
   std::vector<BoundaryLoop> loops;  ///< the boundary's chains, longest first
+  std::vector<BorderCap> caps;      ///< flat caps at its border, largest first
 };
 
 /// What a person should know of a skull mesh's openness, one sentence each (empty when it is
 /// closed): the flat cuts at its border ("open along a flat cut at its lower border (z = −1.0 mm):
 /// 3 loops, 412 mm"), and the other holes with the largest's size and place.
 std::vector<std::string> describe_openings(const MeshReport& report);
+
+/// The flat caps at its border, one sentence each, none on a side where it is also open
+/// ("closed by a flat cap at its lower border (z = -0.4 mm): 1913 mm², where the scan ended;
+/// ..."): what the mesh has, not a repair, so not among a load's warnings (`info` lists them).
+std::vector<std::string> describe_caps(const MeshReport& report);
 
 /// Counts and measures a mesh. Vertices at identical positions are treated as one, so edges a
 /// reader split to keep OpenMesh manifold are still reported as non-manifold.

@@ -19,18 +19,22 @@ class SurfaceLocator;
 
 /// A side of the surface where the scan ended: the plane of a flat cut at the surface's border
 /// (`normal` points out of the surface; the plane is normal·x = offset) and the surface's
-/// bounding box.
+/// bounding box; for a cap (a closed surface), the cap's own box and outline.
 struct ScanBorder {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
   double offset = 0.0;
   Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();
-  /// The ray from `from` along `dir` reaches the plane within the box's extent.
+  /// A cap's outline (BorderCap::outline, convex, counter-clockwise about `normal`); empty for
+  /// an open cut.
+  std::vector<Eigen::Vector3d> outline;
+  /// The ray from `from` along `dir` reaches the plane within the box's extent, and within the
+  /// outline when there is one.
   bool reached_by(const Eigen::Vector3d& from, const Eigen::Vector3d& dir) const;
 };
 
-/// The sides where a surface is open along a flat cut at its border (MeshReport's loops
-/// `at_border`: where a scan ended or an exporter cropped), one per side; none for a closed
-/// surface.
+/// The sides where a surface ends along a flat cut at its border, where a scan ended or an
+/// exporter cropped: open there (MeshReport's loops `at_border`) or closed by a flat cap
+/// (MeshReport's caps: a padded import), one per side; none for a closed surface without caps.
 std::vector<ScanBorder> scan_borders(const MeshReport& report);
 
 struct DetectDefectParams {
