@@ -149,6 +149,8 @@ Json autoplan_with_session(const std::string& skull, const ExtractBoneSurfacePar
   j.update(plan_state_json(s));
   if (s.skull && !s.skull->surface->loaded.warnings.empty())
     j["warnings"] = s.skull->surface->loaded.warnings;
+  if (s.skull && !s.skull->surface->loaded.notes.empty())
+    j["notes"] = s.skull->surface->loaded.notes;
   Json times = Json::object();
   for (const auto& c : a.session.effective_commands())
     times[type_tag(c.type)] = c.meta.duration_ms / 1000.0;
@@ -615,9 +617,11 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
                                    o->session, o->all_openings, json);
         const LoadedSkull loaded = load_skull(o->skull, o->import);
         const SkullMesh& skull = loaded.mesh;
-        // The reader's warnings (a skull turned outward, non-manifold edges) with the plan.
+        // The reader's warnings (a skull turned outward, non-manifold edges) and notes (a flat
+        // cap where the scan ended) with the plan.
         auto with_warnings = [&loaded](Json j) {
           if (!loaded.warnings.empty()) j["warnings"] = loaded.warnings;
+          if (!loaded.notes.empty()) j["notes"] = loaded.notes;
           return j;
         };
         if (!o->all_openings) {

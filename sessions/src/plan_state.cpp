@@ -423,6 +423,7 @@ void apply_load(PlanState& s, const ParamReader& r, const ApplyContext& ctx, Jso
                   " triangles";
   if (!loaded.frame.empty()) fresh.message += "; patient frame: " + loaded.frame;
   for (const std::string& w : loaded.warnings) fresh.message += "; " + w;
+  for (const std::string& n : loaded.notes) fresh.message += "; " + n;
   const Json report = input_report(loaded, fresh.skull->surface->mesh, path);
   const Json recorded_report = r.has("input_report") ? r.value("input_report") : Json();
   if (!recorded_report.is_object())

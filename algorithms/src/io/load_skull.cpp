@@ -60,9 +60,12 @@ LoadedSkull load(const std::string& path, const ExtractBoneSurfaceParams& import
       out.description += " in " + named;
     }
     // Where a skull's surface is open, and what planning does about it.
-    if (as_skull)
-      for (const std::string& s : describe_openings(report_mesh(out.mesh)))
+    if (as_skull) {
+      const MeshReport report = report_mesh(out.mesh);
+      for (const std::string& s : describe_openings(report))
         out.warnings.push_back(path + ": " + s);
+      for (const std::string& s : describe_caps(report)) out.notes.push_back(path + ": " + s);
+    }
     out.frame = "the file's own coordinates (a mesh file declares no frame), taken as LPS";
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

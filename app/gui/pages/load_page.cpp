@@ -65,6 +65,9 @@ void LoadPage::show_state(const PlanState& s) {
     for (const std::string& w : loaded.warnings)
       info += QStringLiteral("<br><span style='color:#a05a00'>⚠ %1</span>")
                   .arg(QString::fromStdString(w).toHtmlEscaped());
+    // What it has that needs no repair (a flat cap where the scan ended).
+    for (const std::string& n : loaded.notes)
+      info += QStringLiteral("<br>ℹ %1").arg(QString::fromStdString(n).toHtmlEscaped());
   }
   skull_info_->setText(info);
 }

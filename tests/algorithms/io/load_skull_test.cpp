@@ -76,6 +76,23 @@ TEST(LoadSkull, ASkullInAnotherUnitIsRefusedNamingTheUnitAndReadInIt) {
 // sample turned inside out: "too little intact bone around the opening (0 rays)"). load_skull
 // turns it outward, with a warning, into the very mesh the outward file gives; load_surface
 // (an implant for the quality check) keeps it as it is.
+// A skull closed by the padding where its scan ended: the cap is a note of what the mesh has,
+// not a warning (the warnings are the repair report a plan records).
+TEST(LoadSkull, AFlatCapWhereTheScanEndedIsANoteNotAWarning) {
+  TempDir dir;
+  const SkullMesh head = test::make_thick_head(0.93, 1.0);
+  const MeshReport whole = report_mesh(head);
+  write_mesh(test::scanned_padded(head, Eigen::Vector3d(0, 0, whole.bbox_min.z() + 30.0),
+                                  Eigen::Vector3d::UnitZ()),
+             dir.path("padded.stl"));
+  const std::string path = dir.path("padded.stl");
+  const LoadedSkull loaded = load_skull(path);
+  ASSERT_EQ(loaded.notes.size(), 1u);
+  EXPECT_EQ(loaded.notes[0].rfind(path + ": closed by a flat cap at its lower border", 0), 0u)
+      << loaded.notes[0];
+  for (const std::string& w : loaded.warnings) EXPECT_EQ(w.find("cap"), std::string::npos) << w;
+}
+
 TEST(LoadSkull, ASkullThatWindsInwardIsTurnedOutward) {
   TempDir dir;
   const SkullMesh head =

@@ -19,6 +19,9 @@ struct LoadedSkull {
   std::string source_kind;            ///< "mesh" or "volume"
   std::string description;            ///< format / volume description
   std::vector<std::string> warnings;  ///< reader warnings, each naming the file
+  /// What a skull mesh has that needs no repair (a flat cap where the scan ended), each naming
+  /// the file: not among the warnings, which a plan records as its input's repair report.
+  std::vector<std::string> notes;
   /// The frame the file declared and how it was brought to the patient's LPS (Volume::frame).
   std::string frame;
   long long pieces_dropped = 0;  ///< a mesh's pieces far from the skull (drop_far_pieces)
