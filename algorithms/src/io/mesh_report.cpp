@@ -191,7 +191,10 @@ std::vector<BorderCap> border_caps(const TriangleSoup& welded) {
   const size_t nt = welded.triangles.size();
   std::vector<Eigen::Vector3d> normal(nt, Eigen::Vector3d::Zero());
   std::vector<double> area(nt, 0.0);
-  std::map<std::array<long, 3>, std::pair<Eigen::Vector3d, double>> by_direction;
+  // Each triangle's direction cell (its normal either way, in cells of 0.005), sorted so that
+  // a cell's triangles are a run.
+  std::vector<std::pair<std::array<long, 3>, int>> cells;
+  cells.reserve(nt);
   for (size_t t = 0; t < nt; ++t) {
     const Eigen::Vector3i& f = welded.triangles[t];
     const Eigen::Vector3d c = (welded.vertices[f[1]] - welded.vertices[f[0]])
@@ -202,26 +205,50 @@ std::vector<BorderCap> border_caps(const TriangleSoup& welded) {
     area[t] = 0.5 * twice;
     int axis = 0;
     normal[t].cwiseAbs().maxCoeff(&axis);
-    const Eigen::Vector3d unsigned_n = normal[t][axis] < 0 ? -normal[t] : normal[t];
-    const std::array<long, 3> key{std::lround(unsigned_n.x() * 200.0),
-                                  std::lround(unsigned_n.y() * 200.0),
-                                  std::lround(unsigned_n.z() * 200.0)};
-    auto& [sum, total] = by_direction[key];
-    sum += area[t] * unsigned_n;
-    total += area[t];
+    const Eigen::Vector3d n = normal[t][axis] < 0 ? -normal[t] : normal[t];
+    cells.push_back(
+        {{std::lround(n.x() * 200.0), std::lround(n.y() * 200.0), std::lround(n.z() * 200.0)},
+         static_cast<int>(t)});
   }
+  std::sort(cells.begin(), cells.end());
   std::vector<Eigen::Vector3d> directions{Eigen::Vector3d::UnitX(), Eigen::Vector3d::UnitY(),
                                           Eigen::Vector3d::UnitZ()};
   const double same = std::cos(kAxisSnapDeg * M_PI / 180.0);
-  for (const auto& [key, bin] : by_direction) {
-    const Eigen::Vector3d d = bin.first.normalized();
-    if (bin.second >= 0.25 * kCapMinAreaMm2 &&
+  for (size_t i = 0; i < cells.size();) {
+    size_t j = i;
+    Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+    double total = 0.0;
+    for (; j < cells.size() && cells[j].first == cells[i].first; ++j) {
+      const int t = cells[j].second;
+      int axis = 0;
+      normal[t].cwiseAbs().maxCoeff(&axis);
+      sum += area[t] * (normal[t][axis] < 0 ? -normal[t] : normal[t]);
+      total += area[t];
+    }
+    i = j;
+    const Eigen::Vector3d d = sum.normalized();
+    if (total >= 0.25 * kCapMinAreaMm2 &&
         std::none_of(directions.begin(), directions.end(),
                      [&](const Eigen::Vector3d& e) { return std::abs(e.dot(d)) >= same; }))
       directions.push_back(d);
   }
   std::vector<BorderCap> caps;
   const double facing = std::cos(kCapFacingDeg * M_PI / 180.0);
+  // Each vertex's triangles (a compressed list), so that a direction looks only at the triangles
+  // of the vertices at its ends rather than at every triangle.
+  const size_t nv = welded.vertices.size();
+  std::vector<size_t> first(nv + 1, 0);
+  for (const Eigen::Vector3i& f : welded.triangles)
+    for (int k = 0; k < 3; ++k) ++first[static_cast<size_t>(f[k]) + 1];
+  for (size_t v = 0; v < nv; ++v) first[v + 1] += first[v];
+  std::vector<int> of_vertex(first[nv]);
+  {
+    std::vector<size_t> at(first.begin(), first.end() - 1);
+    for (size_t t = 0; t < nt; ++t)
+      for (int k = 0; k < 3; ++k) of_vertex[at[welded.triangles[t][k]]++] = static_cast<int>(t);
+  }
+  std::vector<int> seen(nt, -1);  // the pass that last looked at each triangle
+  int pass = 0;
   for (const Eigen::Vector3d& d : directions) {
     double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
     for (const Eigen::Vector3d& p : welded.vertices) {
@@ -236,7 +263,18 @@ std::vector<BorderCap> border_caps(const TriangleSoup& welded) {
       cap.box_min = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
       cap.box_max = -cap.box_min;
       std::vector<Eigen::Vector3d> corners;
-      for (size_t t = 0; t < nt; ++t) {
+      std::vector<int> near_end;  // the triangles of the vertices within reach of the end
+      for (size_t v = 0; v < nv; ++v) {
+        if (end - welded.vertices[v].dot(out) > kBorderReachMm) continue;
+        for (size_t i = first[v]; i < first[v + 1]; ++i)
+          if (seen[of_vertex[i]] != pass) {
+            seen[of_vertex[i]] = pass;
+            near_end.push_back(of_vertex[i]);
+          }
+      }
+      ++pass;
+      std::sort(near_end.begin(), near_end.end());  // in the triangles' order, as every pass
+      for (const int t : near_end) {
         if (area[t] == 0.0 || normal[t].dot(out) < facing) continue;
         const Eigen::Vector3i& f = welded.triangles[t];
         bool at_end = true;
@@ -498,6 +536,8 @@ MeshReport report_mesh(const SkullMesh& mesh) {
   r.watertight = r.boundary_edges == 0 && r.nonmanifold_edges == 0;
   return r;
 }
+
+std::vector<BorderCap> border_caps(const SkullMesh& mesh) { return border_caps(to_soup(mesh)); }
 
 bool is_watertight(const SkullMesh& mesh) {
   // A halfedge mesh holds each edge once with at most two faces; with no boundary every edge

@@ -87,9 +87,9 @@ std::vector<ScanBorder> scan_borders(const MeshReport& report) {
   for (const BoundaryLoop& loop : report.loops)
     if (loop.at_border) add(loop.border, loop.outward, loop.centroid);
   // A closed surface capped where the scan ended: the head's inside is open through the cap's
-  // plane as through an open cut, within the cap's own outline (a scan's field of view that
-  // clips the side of the head leaves a cap there, which rays through an opening elsewhere meet
-  // beside the head; a defect that breaks the cap's ring leaves its outline whole).
+  // plane as through an open cut, within the cap's own outline (rays through an opening beside
+  // the cap meet its plane beyond the head; a defect that breaks the cap's ring leaves its
+  // outline whole).
   for (const BorderCap& cap : report.caps)
     if (ScanBorder* b = add(cap.border, cap.outward, cap.centroid)) {
       b->box_min = cap.box_min;

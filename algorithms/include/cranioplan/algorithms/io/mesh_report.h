@@ -73,6 +73,10 @@ std::vector<std::string> describe_caps(const MeshReport& report);
 /// reader split to keep OpenMesh manifold are still reported as non-manifold.
 MeshReport report_mesh(const SkullMesh& mesh);
 
+/// report_mesh(mesh).caps alone, without welding, edges, loops and pieces: for a closed mesh,
+/// where the caps are all of its border there is.
+std::vector<BorderCap> border_caps(const SkullMesh& mesh);
+
 /// report_mesh(mesh).watertight alone (the same welding of identical positions), without the
 /// loops and pieces: for a flag on every implant built.
 bool is_watertight(const SkullMesh& mesh);
