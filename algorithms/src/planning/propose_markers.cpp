@@ -44,6 +44,15 @@ std::string describe_method(PlanMethod method, double mirror_coverage) {
 
 namespace {
 
+// Open somewhere: more than a few boundary edges (a reader splits a non-manifold vertex or two
+// of a closed surface, which leaves a handful).
+bool has_boundary(const SkullMesh& mesh) {
+  int count = 0;
+  for (auto heh : mesh.halfedges())
+    if (mesh.is_boundary(heh) && ++count > 20) return true;
+  return false;
+}
+
 // Along an ordered closed polyline, indices every `spacing` mm of arc length.
 std::vector<size_t> along(const std::vector<Eigen::Vector3d>& loop, double spacing) {
   std::vector<size_t> out;
@@ -98,7 +107,15 @@ Eigen::Vector3d rays_start(const SkullMesh& skull, const SurfaceLocator& bone, c
 DefectRegion detect_defect_near_plane(const SkullMesh& skull, const SurfaceLocator& bone,
                                       const Plane& plane, const DetectDefectParams& params) {
   DetectDefectParams framed = params;
-  if (framed.scan_borders.empty()) framed.scan_borders = scan_borders(report_mesh(skull));
+  if (framed.scan_borders.empty()) {
+    // A closed surface's border can only be a cap: the caps alone, not the whole report.
+    MeshReport report;
+    if (has_boundary(skull))
+      report = report_mesh(skull);
+    else
+      report.caps = border_caps(skull);
+    framed.scan_borders = scan_borders(report);
+  }
   const Eigen::Vector3d center =
       params.center ? *params.center : rays_start(skull, bone, plane, framed);
   if (!params.frame) framed.frame = skull_frame(skull, center, plane.normal);
