@@ -145,6 +145,19 @@ TEST(MeshReport, AScanEndClosedByPaddingIsACap) {
   EXPECT_EQ(said[0].rfind("closed by a flat cap at its lower border (z = ", 0), 0u) << said[0];
 }
 
+// A cut across solid bone (a field of view that shaves the side of the head, as on the sample)
+// is flat and at the end, but covers its whole outline and rings no opening: not a cap.
+TEST(MeshReport, ACutAcrossSolidBoneIsNotACap) {
+  const SkullMesh solid = test::make_symmetric_head(5);
+  const MeshReport whole = report_mesh(solid);
+  const double cut_z = whole.bbox_min.z() + 30.0;
+  const MeshReport r = report_mesh(
+      test::scanned_padded(solid, Eigen::Vector3d(0, 0, cut_z), Eigen::Vector3d::UnitZ()));
+  EXPECT_TRUE(r.watertight);
+  EXPECT_TRUE(r.caps.empty()) << r.caps.size() << " caps, the first " << r.caps[0].area_mm2
+                              << " mm²";
+}
+
 // The same head cut along a plane tilted 30° from the axial (a tilted gantry, or a skull that
 // came in turned): the cut is still the lower border, its outward normal the plane's.
 TEST(MeshReport, AnObliqueCutAtTheBorderIsFoundInItsOwnPlane) {
