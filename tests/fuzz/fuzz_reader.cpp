@@ -23,13 +23,24 @@ namespace {
 namespace fs = std::filesystem;
 using namespace cranioplan;
 
+// The process's own folder for the files it reads, removed when it exits (a replay runs once
+// per test; none is left behind in the system's temporary folder).
 const std::string& work_dir() {
-  static const std::string dir = [] {
-    const fs::path p = fs::temp_directory_path() / ("cranioplan-fuzz-" + std::to_string(getpid()));
-    fs::create_directories(p);
-    return p.string();
-  }();
-  return dir;
+  struct Dir {
+    std::string path;
+    Dir() {
+      const fs::path p =
+          fs::temp_directory_path() / ("cranioplan-fuzz-" + std::to_string(getpid()));
+      fs::create_directories(p);
+      path = p.string();
+    }
+    ~Dir() {
+      std::error_code ignored;
+      fs::remove_all(path, ignored);
+    }
+  };
+  static const Dir dir;
+  return dir.path;
 }
 
 void write(const std::string& path, std::string_view bytes) {

@@ -112,11 +112,19 @@ std::vector<BoundaryLoop> boundary_loops(const TriangleSoup& welded,
     l.at_border = true;
     l.border = name_border(l.outward);
   }
+  auto outline = [&](size_t i) {
+    std::vector<Eigen::Vector3d> points;
+    for (int v : members[i]) points.push_back(welded.vertices[v]);
+    loops[i].outline = hull_in_plane(std::move(points), loops[i].outward);
+  };
   // The cut also leaves small loops in its plane (around islands of bone the plane crosses, in
   // the orbits or the nose): each lying within reach of a border's plane is part of that cut.
   std::vector<size_t> cuts;
   for (size_t i = 0; i < loops.size(); ++i)
-    if (loops[i].at_border) cuts.push_back(i);
+    if (loops[i].at_border) {
+      cuts.push_back(i);
+      outline(i);
+    }
   for (size_t i = 0; i < loops.size(); ++i) {
     BoundaryLoop& l = loops[i];
     if (l.at_border) continue;
@@ -130,6 +138,7 @@ std::vector<BoundaryLoop> boundary_loops(const TriangleSoup& welded,
       l.at_border = true;
       l.border = cut.border;
       l.outward = cut.outward;
+      outline(i);
       break;
     }
   }
@@ -153,35 +162,6 @@ constexpr double kCapMajorMm = 60.0, kCapMinorMm = 30.0;
 // A ring: at least this much of its outline open (mm²), and its triangles covering at most this
 // fraction of it.
 constexpr double kCapOpenMm2 = 1000.0, kCapCoverage = 0.5;
-
-// The convex hull of `points` seen along `normal` (projected on its plane), counter-clockwise
-// about it: Andrew's monotone chain on the plane's coordinates.
-std::vector<Eigen::Vector3d> hull_in_plane(std::vector<Eigen::Vector3d> points,
-                                           const Eigen::Vector3d& normal) {
-  const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
-  auto uv = [&](const Eigen::Vector3d& p) { return Eigen::Vector2d(p.dot(u), p.dot(v)); };
-  std::sort(points.begin(), points.end(), [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-    const Eigen::Vector2d x = uv(a), y = uv(b);
-    return x.x() < y.x() || (x.x() == y.x() && x.y() < y.y());
-  });
-  if (points.size() < 3) return points;
-  auto turn = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
-    const Eigen::Vector2d p = uv(a) - uv(o), q = uv(b) - uv(o);
-    return p.x() * q.y() - p.y() * q.x();
-  };
-  std::vector<Eigen::Vector3d> hull(2 * points.size());
-  size_t k = 0;
-  for (size_t i = 0; i < points.size(); ++i) {  // lower chain
-    while (k >= 2 && turn(hull[k - 2], hull[k - 1], points[i]) <= 0.0) --k;
-    hull[k++] = points[i];
-  }
-  for (size_t i = points.size() - 1, lower = k + 1; i-- > 0;) {  // upper chain
-    while (k >= lower && turn(hull[k - 2], hull[k - 1], points[i]) <= 0.0) --k;
-    hull[k++] = points[i];
-  }
-  hull.resize(k - 1);  // the last point is the first
-  return hull;
-}
 
 // The flat caps where a closed surface ends (welded soup), tried along the axes (a volume's
 // slices) and along the directions that many triangles' normals share (in cells of 0.005: an
@@ -351,6 +331,34 @@ std::string plane_place(const Eigen::Vector3d& outward, const Eigen::Vector3d& t
 }
 
 }  // namespace
+
+// Andrew's monotone chain on the plane's coordinates.
+std::vector<Eigen::Vector3d> hull_in_plane(std::vector<Eigen::Vector3d> points,
+                                           const Eigen::Vector3d& normal) {
+  const Eigen::Vector3d u = normal.unitOrthogonal(), v = normal.cross(u);
+  auto uv = [&](const Eigen::Vector3d& p) { return Eigen::Vector2d(p.dot(u), p.dot(v)); };
+  std::sort(points.begin(), points.end(), [&](const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    const Eigen::Vector2d x = uv(a), y = uv(b);
+    return x.x() < y.x() || (x.x() == y.x() && x.y() < y.y());
+  });
+  if (points.size() < 3) return points;
+  auto turn = [&](const Eigen::Vector3d& o, const Eigen::Vector3d& a, const Eigen::Vector3d& b) {
+    const Eigen::Vector2d p = uv(a) - uv(o), q = uv(b) - uv(o);
+    return p.x() * q.y() - p.y() * q.x();
+  };
+  std::vector<Eigen::Vector3d> hull(2 * points.size());
+  size_t k = 0;
+  for (size_t i = 0; i < points.size(); ++i) {  // lower chain
+    while (k >= 2 && turn(hull[k - 2], hull[k - 1], points[i]) <= 0.0) --k;
+    hull[k++] = points[i];
+  }
+  for (size_t i = points.size() - 1, lower = k + 1; i-- > 0;) {  // upper chain
+    while (k >= lower && turn(hull[k - 2], hull[k - 1], points[i]) <= 0.0) --k;
+    hull[k++] = points[i];
+  }
+  hull.resize(k - 1);  // the last point is the first
+  return hull;
+}
 
 std::vector<std::string> describe_openings(const MeshReport& report) {
   std::vector<std::string> out;

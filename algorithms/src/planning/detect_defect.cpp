@@ -62,6 +62,7 @@ bool ScanBorder::reached_by(const Eigen::Vector3d& from, const Eigen::Vector3d& 
     if (hit[k] < box_min[k] - slack || hit[k] > box_max[k] + slack) return false;
   }
   // Within a convex outline counter-clockwise about the normal: left of every edge.
+  if (outline.size() < 3) return true;
   for (size_t i = 0; i < outline.size(); ++i) {
     const Eigen::Vector3d& a = outline[i];
     const Eigen::Vector3d& b = outline[(i + 1) % outline.size()];
@@ -72,24 +73,33 @@ bool ScanBorder::reached_by(const Eigen::Vector3d& from, const Eigen::Vector3d& 
 
 std::vector<ScanBorder> scan_borders(const MeshReport& report) {
   std::vector<ScanBorder> out;
-  std::vector<std::string> sides;
-  auto add = [&](const std::string& side, const Eigen::Vector3d& outward,
+  auto add = [&](const std::string& name, const Eigen::Vector3d& outward,
                  const Eigen::Vector3d& in_plane) -> ScanBorder* {
-    if (std::find(sides.begin(), sides.end(), side) != sides.end()) return nullptr;
-    sides.push_back(side);
+    for (ScanBorder& b : out)
+      if (b.side == name) return nullptr;
     ScanBorder& b = out.emplace_back();
+    b.side = name;
     b.normal = outward;
     b.offset = outward.dot(in_plane);
     b.box_min = report.bbox_min;
     b.box_max = report.bbox_max;
     return &b;
   };
+  // An open cut: reached within the convex outline of all its loops on that side (the bone's
+  // cross-section where the scan ended; rays through an opening beside the cut meet its plane
+  // beyond the head, as with a cap).
   for (const BoundaryLoop& loop : report.loops)
     if (loop.at_border) add(loop.border, loop.outward, loop.centroid);
+  for (ScanBorder& b : out) {
+    std::vector<Eigen::Vector3d> corners;
+    for (const BoundaryLoop& loop : report.loops)
+      if (loop.at_border && loop.border == b.side)
+        corners.insert(corners.end(), loop.outline.begin(), loop.outline.end());
+    b.outline = hull_in_plane(std::move(corners), b.normal);
+  }
   // A closed surface capped where the scan ended: the head's inside is open through the cap's
-  // plane as through an open cut, within the cap's own outline (rays through an opening beside
-  // the cap meet its plane beyond the head; a defect that breaks the cap's ring leaves its
-  // outline whole).
+  // plane as through an open cut, within the cap's own outline (a defect that breaks the cap's
+  // ring leaves its outline whole).
   for (const BorderCap& cap : report.caps)
     if (ScanBorder* b = add(cap.border, cap.outward, cap.centroid)) {
       b->box_min = cap.box_min;

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 
@@ -176,6 +177,24 @@ TEST(MeshReport, AnObliqueCutAtTheBorderIsFoundInItsOwnPlane) {
   EXPECT_TRUE(r.loops[0].at_border);
   EXPECT_EQ(r.loops[0].border, "lower");
   EXPECT_LT(std::acos(std::clamp(-r.loops[0].outward.dot(up), -1.0, 1.0)), 1e-3);
+  // Its outline: convex, counter-clockwise about the outward normal, around every vertex of the
+  // cut (seen along the normal), its corners in the cut's plane.
+  const std::vector<Eigen::Vector3d>& outline = r.loops[0].outline;
+  ASSERT_GE(outline.size(), 3u);
+  for (const Eigen::Vector3d& c : outline) EXPECT_NEAR((c - through).dot(up), 0.5, 1e-3);
+  int inside = 0;
+  for (auto vh : cut.vertices()) {
+    if (!cut.is_boundary(vh)) continue;
+    const Eigen::Vector3d p = to_eigen(cut.point(vh));
+    bool within = true;
+    for (size_t i = 0; i < outline.size(); ++i) {
+      const Eigen::Vector3d& a = outline[i];
+      const Eigen::Vector3d& b = outline[(i + 1) % outline.size()];
+      within = within && (b - a).cross(p - a).dot(r.loops[0].outward) >= -1e-6;
+    }
+    inside += within;
+  }
+  EXPECT_EQ(inside, r.loops[0].edges);  // a closed loop has as many vertices as edges
   const std::vector<std::string> said = describe_openings(r);
   ASSERT_EQ(said.size(), 1u);
   EXPECT_EQ(

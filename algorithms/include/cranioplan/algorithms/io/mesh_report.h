@@ -25,6 +25,9 @@ struct BoundaryLoop {
   /// Which border, in the patient's LPS frame, by the axis nearest `outward`: "lower" (−z),
   /// "upper" (+z), "front" (−y), "back" (+y), "right" (−x), "left" (+x); empty unless at_border.
   std::string border;
+  /// At the border: the convex hull of its vertices seen along `outward`, counter-clockwise
+  /// about it (hull_in_plane); empty otherwise.
+  std::vector<Eigen::Vector3d> outline;
 };
 
 /// A flat cap where a closed surface ends: triangles in one plane (within 0.5 mm) at the mesh's
@@ -58,6 +61,12 @@ struct MeshReport {
   std::vector<BoundaryLoop> loops;  ///< the boundary's chains, longest first
   std::vector<BorderCap> caps;      ///< flat caps at its border, largest first
 };
+
+/// The convex hull of `points` seen along `normal` (as projected on a plane across it),
+/// counter-clockwise about `normal`; the points themselves, not their projections. Fewer than
+/// three points are returned as they are.
+std::vector<Eigen::Vector3d> hull_in_plane(std::vector<Eigen::Vector3d> points,
+                                           const Eigen::Vector3d& normal);
 
 /// What a person should know of a skull mesh's openness, one sentence each (empty when it is
 /// closed): the flat cuts at its border ("open along a flat cut at its lower border (z = −1.0 mm):

@@ -24,11 +24,12 @@ struct ScanBorder {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
   double offset = 0.0;
   Eigen::Vector3d box_min = Eigen::Vector3d::Zero(), box_max = Eigen::Vector3d::Zero();
-  /// A cap's outline (BorderCap::outline, convex, counter-clockwise about `normal`); empty for
-  /// an open cut.
+  /// The cut's outline, convex and counter-clockwise about `normal`: the hull of an open cut's
+  /// loops on this side (BoundaryLoop::outline), or a cap's (BorderCap::outline).
   std::vector<Eigen::Vector3d> outline;
-  /// The ray from `from` along `dir` reaches the plane within the box's extent, and within the
-  /// outline when there is one.
+  std::string side;  ///< which border (BoundaryLoop::border)
+  /// The ray from `from` along `dir` reaches the plane within the box's extent and within the
+  /// outline (when it has three corners or more).
   bool reached_by(const Eigen::Vector3d& from, const Eigen::Vector3d& dir) const;
 };
 
