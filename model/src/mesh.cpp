@@ -14,6 +14,8 @@
 
 namespace cranioplan {
 
+Eigen::Vector3d FaceCorners::cross() const { return (p[1] - p[0]).cross(p[2] - p[0]); }
+
 namespace {
 
 using VH = SkullMesh::VertexHandle;

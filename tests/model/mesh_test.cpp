@@ -23,6 +23,26 @@ TEST(Mesh, BuildDropsDegenerateTrianglesAndCountsThem) {
   EXPECT_EQ(stats.degenerate_dropped, 2);
 }
 
+// A face's corners in its order, and their cross product: along the outward normal, twice the
+// area long.
+TEST(Mesh, FaceCornersAreInTheFacesOrder) {
+  TriangleSoup s;
+  s.vertices = {{5, 0, 0}, {0, 0, 1}, {3, 0, 0}, {3, 4, 0}};
+  s.triangles = {{2, 0, 3}};  // vertex 1 unused
+  const SkullMesh m = build_mesh(s);
+  ASSERT_EQ(m.n_faces(), 1u);
+  const FaceCorners f = face_corners(m, *m.faces().begin());
+  // The triangle's order (from whichever corner the face starts), each id its point's.
+  const Eigen::Vector3d want[3] = {{3, 0, 0}, {5, 0, 0}, {3, 4, 0}};
+  const int first = static_cast<int>(std::find(f.p.begin(), f.p.end(), want[0]) - f.p.begin());
+  ASSERT_LT(first, 3);
+  for (int k = 0; k < 3; ++k) {
+    EXPECT_EQ(f.p[(first + k) % 3], want[k]) << k;
+    EXPECT_EQ(to_eigen(m.point(SkullMesh::VertexHandle(f.ids[k]))), f.p[k]) << k;
+  }
+  EXPECT_EQ(f.cross(), Eigen::Vector3d(0, 0, 8));  // 2 × 4 mm, area 4 mm²
+}
+
 // The canonical form depends only on the triangles: the same surface listed with its vertices
 // in another order, a position given twice (as an STL has it once per triangle), triangles
 // starting at another corner and in another order all give the same soup; orientation is kept.
@@ -105,9 +125,8 @@ TEST(Mesh, SurfaceCentroidIsTheSameHoweverTheSurfaceIsTriangulated) {
       if (on_top) top.push_back(fh);
     }
     for (auto fh : top) {
-      Eigen::Vector3d c = Eigen::Vector3d::Zero();
-      for (auto vh : mesh.fv_range(fh)) c += to_eigen(mesh.point(vh)) / 3.0;
-      mesh.split(fh, to_point(c));
+      const FaceCorners f = face_corners(mesh, fh);
+      mesh.split(fh, to_point((f.p[0] + f.p[1] + f.p[2]) / 3.0));
     }
   }
   ASSERT_EQ(mesh.n_faces(), 10u + 162u);

@@ -10,15 +10,9 @@ namespace cranioplan {
 std::vector<Eigen::Vector3d> vertex_normals(const SkullMesh& mesh) {
   std::vector<Eigen::Vector3d> normals(mesh.n_vertices(), Eigen::Vector3d::Zero());
   for (auto fh : mesh.faces()) {
-    Eigen::Vector3d p[3];
-    int idx[3];
-    int k = 0;
-    for (auto vh : mesh.fv_range(fh)) {
-      idx[k] = vh.idx();
-      p[k++] = to_eigen(mesh.point(vh));
-    }
-    const Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]);  // length = 2·area
-    for (int i : idx) normals[i] += n;
+    const FaceCorners f = face_corners(mesh, fh);
+    const Eigen::Vector3d n = f.cross();  // length = 2·area
+    for (int i : f.ids) normals[i] += n;
   }
   for (auto& n : normals) {
     const double len = n.norm();

@@ -41,10 +41,9 @@ struct Faces {
 Faces classify(const SkullMesh& implant, const Eigen::Vector3d& inside) {
   Faces f;
   for (auto fh : implant.faces()) {
-    Eigen::Vector3d p[3];
-    int k = 0;
-    for (auto vh : implant.fv_range(fh)) p[k++] = to_eigen(implant.point(vh));
-    const Eigen::Vector3d cross = (p[1] - p[0]).cross(p[2] - p[0]);
+    const FaceCorners corners = face_corners(implant, fh);
+    const auto& p = corners.p;
+    const Eigen::Vector3d cross = corners.cross();
     if (cross.norm() == 0) continue;
     const Eigen::Vector3d c = (p[0] + p[1] + p[2]) / 3.0, n = cross.normalized();
     const double facing = n.dot((c - inside).normalized());

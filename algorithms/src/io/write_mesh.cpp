@@ -27,10 +27,9 @@ std::string encode_stl(const SkullMesh& mesh) {
   out += header;
   put<uint32_t>(out, static_cast<uint32_t>(mesh.n_faces()));
   for (auto fh : mesh.faces()) {
-    Eigen::Vector3d p[3];
-    int k = 0;
-    for (auto vh : mesh.fv_range(fh)) p[k++] = to_eigen(mesh.point(vh));
-    Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]);
+    const FaceCorners f = face_corners(mesh, fh);
+    const auto& p = f.p;
+    Eigen::Vector3d n = f.cross();
     if (n.norm() > 0) n.normalize();
     for (int c = 0; c < 3; ++c) put<float>(out, static_cast<float>(n[c]));
     for (int v = 0; v < 3; ++v)

@@ -132,13 +132,8 @@ std::vector<double> thickness_samples(const SkullMesh& implant, const SurfaceLoc
   std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> rays;  // from, inward normal
   for (auto fh : implant.faces()) {
     const bool measure = static_cast<size_t>(fh.idx()) % stride == 0;
-    Eigen::Vector3d p[3];
-    int ids[3], k = 0;
-    for (auto vh : implant.fv_range(fh)) {
-      ids[k] = vh.idx();
-      p[k++] = to_eigen(implant.point(vh));
-    }
-    Eigen::Vector3d n = (p[1] - p[0]).cross(p[2] - p[0]);
+    const FaceCorners f = face_corners(implant, fh);
+    Eigen::Vector3d n = f.cross();
     if (n.norm() == 0) continue;
     n.normalize();
     if (std::abs(n.dot(axis)) >= std::cos(M_PI / 4)) {
@@ -146,9 +141,9 @@ std::vector<double> thickness_samples(const SkullMesh& implant, const SurfaceLoc
       // Where the plate curves, a normal can leave it at a grazing angle and run along it (on
       // the sample's frontal implant up to 27 mm through a plate 8 mm at its thickest): the
       // thickness there is at most the diameter of the deepest ball the ray passes.
-      rays.emplace_back((p[0] + p[1] + p[2]) / 3.0, n);
+      rays.emplace_back((f.p[0] + f.p[1] + f.p[2]) / 3.0, n);
     } else {
-      wall_vertices.insert(wall_vertices.end(), ids, ids + 3);
+      wall_vertices.insert(wall_vertices.end(), f.ids.begin(), f.ids.end());
     }
   }
   // The rays on all threads, each thickness in its face's place.

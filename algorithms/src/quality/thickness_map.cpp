@@ -52,14 +52,9 @@ ThicknessMap thickness_map(const SkullMesh& implant, const SkullMesh* skull,
   // Area-weighted vertex normals (the face cross products summed).
   std::vector<Eigen::Vector3d> normal(n, Eigen::Vector3d::Zero());
   for (auto fh : implant.faces()) {
-    Eigen::Vector3d p[3];
-    int ids[3], k = 0;
-    for (auto vh : implant.fv_range(fh)) {
-      ids[k] = vh.idx();
-      p[k++] = to_eigen(implant.point(vh));
-    }
-    const Eigen::Vector3d a = (p[1] - p[0]).cross(p[2] - p[0]);
-    for (int id : ids) normal[static_cast<size_t>(id)] += a;
+    const FaceCorners f = face_corners(implant, fh);
+    const Eigen::Vector3d a = f.cross();
+    for (int id : f.ids) normal[static_cast<size_t>(id)] += a;
   }
   const auto [lo, hi] = mesh_bounds(implant);
   // Two voxels of margin: the grid's outermost layer counts as outside, and a plate reaching

@@ -21,9 +21,8 @@ struct Triangle {
 std::vector<Triangle> triangles(const SkullMesh& mesh) {
   std::vector<Triangle> out;
   for (auto fh : mesh.faces()) {
-    std::vector<Eigen::Vector3d> p;
-    for (auto vh : mesh.fv_range(fh)) p.push_back(to_eigen(mesh.point(vh)));
-    out.push_back({p[0], p[1], p[2]});
+    const FaceCorners f = face_corners(mesh, fh);
+    out.push_back({f.p[0], f.p[1], f.p[2]});
   }
   return out;
 }

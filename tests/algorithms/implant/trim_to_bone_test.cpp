@@ -171,12 +171,7 @@ TEST(TrimToBone, MeshesNoTriangleWithoutArea) {
   const SkullMesh implant = turned(build_mesh(gap_implant()), r);
   auto without_area = [](const SkullMesh& m) {
     int n = 0;
-    for (auto fh : m.faces()) {
-      Eigen::Vector3d p[3];
-      int k = 0;
-      for (auto vh : m.fv_range(fh)) p[k++] = to_eigen(m.point(vh));
-      n += 0.5 * (p[1] - p[0]).cross(p[2] - p[0]).norm() < 1e-8;
-    }
+    for (auto fh : m.faces()) n += 0.5 * face_corners(m, fh).cross().norm() < 1e-8;
     return n;
   };
   TrimToBoneParams then;

@@ -132,9 +132,8 @@ SkullMesh densified_below(SkullMesh mesh, int rounds) {
   const auto [lo, hi] = mesh_bounds(mesh);
   const double middle = 0.5 * (lo.z() + hi.z());
   auto centre = [&](SkullMesh::FaceHandle fh) {
-    Eigen::Vector3d c = Eigen::Vector3d::Zero();
-    for (auto vh : mesh.fv_range(fh)) c += to_eigen(mesh.point(vh)) / 3.0;
-    return c;
+    const FaceCorners f = face_corners(mesh, fh);
+    return Eigen::Vector3d((f.p[0] + f.p[1] + f.p[2]) / 3.0);
   };
   for (int round = 0; round < rounds; ++round) {
     std::vector<SkullMesh::FaceHandle> low;

@@ -2,6 +2,7 @@
 // Triangle meshes of skulls and implants: OpenMesh with double-precision points, lengths in mm.
 #include <Eigen/Core>
 #include <OpenMesh/Core/Mesh/TriMesh_ArrayKernelT.hh>
+#include <array>
 #include <vector>
 
 namespace cranioplan {
@@ -21,6 +22,24 @@ using SkullMesh = OpenMesh::TriMesh_ArrayKernelT<MeshTraits>;
 
 inline Eigen::Vector3d to_eigen(const OpenMesh::Vec3d& p) { return {p[0], p[1], p[2]}; }
 inline OpenMesh::Vec3d to_point(const Eigen::Vector3d& p) { return {p.x(), p.y(), p.z()}; }
+
+/// A triangle's corners in the face's order (counter-clockwise seen from outside): their
+/// vertex indices and positions.
+struct FaceCorners {
+  std::array<int, 3> ids;
+  std::array<Eigen::Vector3d, 3> p;
+  /// (p1 − p0) × (p2 − p0): along the face's normal, its length twice the area.
+  Eigen::Vector3d cross() const;
+};
+inline FaceCorners face_corners(const SkullMesh& mesh, SkullMesh::FaceHandle fh) {
+  FaceCorners c;
+  int k = 0;
+  for (auto vh : mesh.fv_range(fh)) {
+    c.ids[k] = vh.idx();
+    c.p[k++] = to_eigen(mesh.point(vh));
+  }
+  return c;
+}
 
 /// Indexed triangle soup: the plain form meshes take on their way in and out of files.
 struct TriangleSoup {
