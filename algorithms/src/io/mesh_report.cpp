@@ -10,6 +10,7 @@
 #include <limits>
 #include <map>
 #include <numeric>
+#include <optional>
 #include <unordered_map>
 #include <utility>
 
@@ -163,29 +164,44 @@ constexpr double kCapMajorMm = 60.0, kCapMinorMm = 30.0;
 // fraction of it.
 constexpr double kCapOpenMm2 = 1000.0, kCapCoverage = 0.5;
 
-// The flat caps where a closed surface ends (welded soup), tried along the axes (a volume's
-// slices) and along the directions that many triangles' normals share (in cells of 0.005: an
-// oblique volume's slices), either way: the triangles within 2 mm of the mesh's end along one and
-// facing out through it form a cap if they cover enough and are as wide as a cut.
-std::vector<BorderCap> border_caps(const TriangleSoup& welded) {
+// Each triangle's unit normal and area (zero for a triangle without area).
+struct Facets {
+  std::vector<Eigen::Vector3d> normal;
+  std::vector<double> area;
+};
+
+Facets facets_of(const TriangleSoup& welded) {
   const size_t nt = welded.triangles.size();
-  std::vector<Eigen::Vector3d> normal(nt, Eigen::Vector3d::Zero());
-  std::vector<double> area(nt, 0.0);
-  // Each triangle's direction cell (its normal either way, in cells of 0.005), sorted so that
-  // a cell's triangles are a run.
-  std::vector<std::pair<std::array<long, 3>, int>> cells;
-  cells.reserve(nt);
+  Facets f{std::vector<Eigen::Vector3d>(nt, Eigen::Vector3d::Zero()), std::vector<double>(nt)};
   for (size_t t = 0; t < nt; ++t) {
-    const Eigen::Vector3i& f = welded.triangles[t];
-    const Eigen::Vector3d c = (welded.vertices[f[1]] - welded.vertices[f[0]])
-                                  .cross(welded.vertices[f[2]] - welded.vertices[f[0]]);
-    const double twice = c.norm();
+    const Eigen::Vector3i& c = welded.triangles[t];
+    const Eigen::Vector3d x = (welded.vertices[c[1]] - welded.vertices[c[0]])
+                                  .cross(welded.vertices[c[2]] - welded.vertices[c[0]]);
+    const double twice = x.norm();
     if (!(twice > 0.0)) continue;
-    normal[t] = c / twice;
-    area[t] = 0.5 * twice;
-    int axis = 0;
-    normal[t].cwiseAbs().maxCoeff(&axis);
-    const Eigen::Vector3d n = normal[t][axis] < 0 ? -normal[t] : normal[t];
+    f.normal[t] = x / twice;
+    f.area[t] = 0.5 * twice;
+  }
+  return f;
+}
+
+// A normal taken either way: the one whose largest coordinate is positive.
+Eigen::Vector3d either_way(const Eigen::Vector3d& n) {
+  int axis = 0;
+  n.cwiseAbs().maxCoeff(&axis);
+  return n[axis] < 0 ? Eigen::Vector3d(-n) : n;
+}
+
+// The directions to look for caps along: the axes (a volume's slices), and every direction that
+// a quarter of a cap's least area of triangles share, either way (in cells of 0.005: an oblique
+// volume's slices), more than kAxisSnapDeg from those before.
+std::vector<Eigen::Vector3d> cap_directions(const Facets& f) {
+  // Each triangle's direction cell, sorted so that a cell's triangles are a run.
+  std::vector<std::pair<std::array<long, 3>, int>> cells;
+  cells.reserve(f.area.size());
+  for (size_t t = 0; t < f.area.size(); ++t) {
+    if (!(f.area[t] > 0.0)) continue;
+    const Eigen::Vector3d n = either_way(f.normal[t]);
     cells.push_back(
         {{std::lround(n.x() * 200.0), std::lround(n.y() * 200.0), std::lround(n.z() * 200.0)},
          static_cast<int>(t)});
@@ -200,10 +216,8 @@ std::vector<BorderCap> border_caps(const TriangleSoup& welded) {
     double total = 0.0;
     for (; j < cells.size() && cells[j].first == cells[i].first; ++j) {
       const int t = cells[j].second;
-      int axis = 0;
-      normal[t].cwiseAbs().maxCoeff(&axis);
-      sum += area[t] * (normal[t][axis] < 0 ? -normal[t] : normal[t]);
-      total += area[t];
+      sum += f.area[t] * either_way(f.normal[t]);
+      total += f.area[t];
     }
     i = j;
     const Eigen::Vector3d d = sum.normalized();
@@ -212,98 +226,131 @@ std::vector<BorderCap> border_caps(const TriangleSoup& welded) {
                      [&](const Eigen::Vector3d& e) { return std::abs(e.dot(d)) >= same; }))
       directions.push_back(d);
   }
-  std::vector<BorderCap> caps;
-  const double facing = std::cos(kCapFacingDeg * M_PI / 180.0);
-  // Each vertex's triangles (a compressed list), so that a direction looks only at the triangles
-  // of the vertices at its ends rather than at every triangle.
-  const size_t nv = welded.vertices.size();
-  std::vector<size_t> first(nv + 1, 0);
+  return directions;
+}
+
+// Each vertex's triangles, as a compressed list: those of vertex v are
+// of_vertex[first[v]] .. of_vertex[first[v + 1] - 1].
+struct VertexTriangles {
+  std::vector<size_t> first;
+  std::vector<int> of_vertex;
+};
+
+VertexTriangles vertex_triangles(const TriangleSoup& welded) {
+  const size_t nv = welded.vertices.size(), nt = welded.triangles.size();
+  VertexTriangles vt;
+  vt.first.assign(nv + 1, 0);
   for (const Eigen::Vector3i& f : welded.triangles)
-    for (int k = 0; k < 3; ++k) ++first[static_cast<size_t>(f[k]) + 1];
-  for (size_t v = 0; v < nv; ++v) first[v + 1] += first[v];
-  std::vector<int> of_vertex(first[nv]);
-  {
-    std::vector<size_t> at(first.begin(), first.end() - 1);
-    for (size_t t = 0; t < nt; ++t)
-      for (int k = 0; k < 3; ++k) of_vertex[at[welded.triangles[t][k]]++] = static_cast<int>(t);
+    for (int k = 0; k < 3; ++k) ++vt.first[static_cast<size_t>(f[k]) + 1];
+  for (size_t v = 0; v < nv; ++v) vt.first[v + 1] += vt.first[v];
+  vt.of_vertex.resize(vt.first[nv]);
+  std::vector<size_t> at(vt.first.begin(), vt.first.end() - 1);
+  for (size_t t = 0; t < nt; ++t)
+    for (int k = 0; k < 3; ++k) vt.of_vertex[at[welded.triangles[t][k]]++] = static_cast<int>(t);
+  return vt;
+}
+
+// As wide as a cut through the head: the corners' extent along the two principal axes of their
+// plane (across `out`, about `centroid`).
+bool wide_as_a_cut(const std::vector<Eigen::Vector3d>& corners, const Eigen::Vector3d& centroid,
+                   const Eigen::Vector3d& out) {
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& p : corners) {
+    const Eigen::Vector3d q = (p - centroid) - (p - centroid).dot(out) * out;
+    cov += q * q.transpose();
   }
-  std::vector<int> seen(nt, -1);  // the pass that last looked at each triangle
+  const Eigen::Matrix3d axes = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors();
+  double width[2] = {0.0, 0.0};
+  for (int a = 0; a < 2; ++a) {
+    const Eigen::Vector3d e = axes.col(a + 1);  // the two largest: in the plane
+    double lo = std::numeric_limits<double>::infinity(), hi = -lo;
+    for (const Eigen::Vector3d& p : corners) {
+      lo = std::min(lo, p.dot(e));
+      hi = std::max(hi, p.dot(e));
+    }
+    width[a] = hi - lo;
+  }
+  return std::max(width[0], width[1]) >= kCapMajorMm && std::min(width[0], width[1]) >= kCapMinorMm;
+}
+
+// A ring around the head's inside: the cap's outline encloses open space that its triangles do
+// not cover. A cap across solid bone (a field of view that shaves the side of the head) covers
+// most of its outline and closes no opening.
+bool rings_the_inside(const BorderCap& cap) {
+  double enclosed = 0.0;
+  for (size_t i = 1; i + 1 < cap.outline.size(); ++i)
+    enclosed += 0.5 * (cap.outline[i] - cap.outline[0])
+                          .cross(cap.outline[i + 1] - cap.outline[0])
+                          .dot(cap.outward);
+  return enclosed - cap.area_mm2 >= kCapOpenMm2 && cap.area_mm2 <= kCapCoverage * enclosed;
+}
+
+// The cap facing `out` at the mesh's end (`end`: out · p there), if its triangles make one: those
+// of the vertices within reach of the end (`seen`, `pass`: which triangles this pass has taken
+// already) that lie within reach of it and face out through it.
+std::optional<BorderCap> cap_at_end(const TriangleSoup& welded, const Facets& f,
+                                    const VertexTriangles& vt, const Eigen::Vector3d& out,
+                                    double end, std::vector<int>& seen, int pass) {
+  const double facing = std::cos(kCapFacingDeg * M_PI / 180.0);
+  BorderCap cap;
+  cap.outward = out;
+  cap.box_min = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
+  cap.box_max = -cap.box_min;
+  std::vector<int> near_end;
+  for (size_t v = 0; v < welded.vertices.size(); ++v) {
+    if (end - welded.vertices[v].dot(out) > kBorderReachMm) continue;
+    for (size_t i = vt.first[v]; i < vt.first[v + 1]; ++i)
+      if (seen[vt.of_vertex[i]] != pass) {
+        seen[vt.of_vertex[i]] = pass;
+        near_end.push_back(vt.of_vertex[i]);
+      }
+  }
+  std::sort(near_end.begin(), near_end.end());  // in the triangles' order, as every pass
+  std::vector<Eigen::Vector3d> corners;
+  for (const int t : near_end) {
+    if (f.area[t] == 0.0 || f.normal[t].dot(out) < facing) continue;
+    const Eigen::Vector3i& c = welded.triangles[t];
+    bool at_end = true;
+    for (int k = 0; k < 3 && at_end; ++k)
+      at_end = end - welded.vertices[c[k]].dot(out) <= kBorderReachMm;
+    if (!at_end) continue;
+    cap.area_mm2 += f.area[t];
+    for (int k = 0; k < 3; ++k) {
+      const Eigen::Vector3d& p = welded.vertices[c[k]];
+      cap.centroid += f.area[t] / 3.0 * p;
+      cap.box_min = cap.box_min.cwiseMin(p);
+      cap.box_max = cap.box_max.cwiseMax(p);
+      corners.push_back(p);
+    }
+  }
+  if (cap.area_mm2 < kCapMinAreaMm2) return std::nullopt;
+  cap.centroid /= cap.area_mm2;
+  if (!wide_as_a_cut(corners, cap.centroid, out)) return std::nullopt;
+  cap.outline = hull_in_plane(std::move(corners), cap.outward);
+  if (!rings_the_inside(cap)) return std::nullopt;
+  cap.border = name_border(cap.outward);
+  return cap;
+}
+
+// The flat caps where a closed surface ends (welded soup): along each of cap_directions, either
+// way, the triangles within 2 mm of the mesh's end and facing out through it form a cap if they
+// cover enough, are as wide as a cut and ring the head's inside.
+std::vector<BorderCap> border_caps(const TriangleSoup& welded) {
+  const Facets f = facets_of(welded);
+  const VertexTriangles vt = vertex_triangles(welded);
+  std::vector<int> seen(welded.triangles.size(), -1);  // the pass that last took each triangle
   int pass = 0;
-  for (const Eigen::Vector3d& d : directions) {
+  std::vector<BorderCap> caps;
+  for (const Eigen::Vector3d& d : cap_directions(f)) {
     double lowest = std::numeric_limits<double>::infinity(), highest = -lowest;
     for (const Eigen::Vector3d& p : welded.vertices) {
       lowest = std::min(lowest, p.dot(d));
       highest = std::max(highest, p.dot(d));
     }
     for (const double sign : {-1.0, 1.0}) {
-      const Eigen::Vector3d out = sign * d;
       const double end = sign < 0 ? -lowest : highest;  // out · p at the mesh's end
-      BorderCap cap;
-      cap.outward = out;
-      cap.box_min = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
-      cap.box_max = -cap.box_min;
-      std::vector<Eigen::Vector3d> corners;
-      std::vector<int> near_end;  // the triangles of the vertices within reach of the end
-      for (size_t v = 0; v < nv; ++v) {
-        if (end - welded.vertices[v].dot(out) > kBorderReachMm) continue;
-        for (size_t i = first[v]; i < first[v + 1]; ++i)
-          if (seen[of_vertex[i]] != pass) {
-            seen[of_vertex[i]] = pass;
-            near_end.push_back(of_vertex[i]);
-          }
-      }
-      ++pass;
-      std::sort(near_end.begin(), near_end.end());  // in the triangles' order, as every pass
-      for (const int t : near_end) {
-        if (area[t] == 0.0 || normal[t].dot(out) < facing) continue;
-        const Eigen::Vector3i& f = welded.triangles[t];
-        bool at_end = true;
-        for (int k = 0; k < 3 && at_end; ++k)
-          at_end = end - welded.vertices[f[k]].dot(out) <= kBorderReachMm;
-        if (!at_end) continue;
-        cap.area_mm2 += area[t];
-        for (int k = 0; k < 3; ++k) {
-          const Eigen::Vector3d& p = welded.vertices[f[k]];
-          cap.centroid += area[t] / 3.0 * p;
-          cap.box_min = cap.box_min.cwiseMin(p);
-          cap.box_max = cap.box_max.cwiseMax(p);
-          corners.push_back(p);
-        }
-      }
-      if (cap.area_mm2 < kCapMinAreaMm2) continue;
-      cap.centroid /= cap.area_mm2;
-      // Its width along the principal axes of its corners in its plane.
-      Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-      for (const Eigen::Vector3d& p : corners) {
-        const Eigen::Vector3d q = (p - cap.centroid) - (p - cap.centroid).dot(out) * out;
-        cov += q * q.transpose();
-      }
-      const Eigen::Matrix3d axes =
-          Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors();
-      double width[2] = {0.0, 0.0};
-      for (int a = 0; a < 2; ++a) {
-        const Eigen::Vector3d e = axes.col(a + 1);  // the two largest: in the plane
-        double lo = std::numeric_limits<double>::infinity(), hi = -lo;
-        for (const Eigen::Vector3d& p : corners) {
-          lo = std::min(lo, p.dot(e));
-          hi = std::max(hi, p.dot(e));
-        }
-        width[a] = hi - lo;
-      }
-      if (std::max(width[0], width[1]) < kCapMajorMm || std::min(width[0], width[1]) < kCapMinorMm)
-        continue;
-      // A ring around the head's inside: the outline encloses open space that the triangles
-      // do not cover. A cap across solid bone (a field of view that shaves the side of the
-      // head) covers most of its outline and closes no opening.
-      cap.outline = hull_in_plane(std::move(corners), cap.outward);
-      double enclosed = 0.0;
-      for (size_t i = 1; i + 1 < cap.outline.size(); ++i)
-        enclosed += 0.5 * (cap.outline[i] - cap.outline[0])
-                              .cross(cap.outline[i + 1] - cap.outline[0])
-                              .dot(cap.outward);
-      if (enclosed - cap.area_mm2 < kCapOpenMm2 || cap.area_mm2 > kCapCoverage * enclosed) continue;
-      cap.border = name_border(cap.outward);
-      caps.push_back(cap);
+      if (auto cap = cap_at_end(welded, f, vt, sign * d, end, seen, pass++))
+        caps.push_back(std::move(*cap));
     }
   }
   std::stable_sort(caps.begin(), caps.end(),
