@@ -4,7 +4,6 @@
 
 #include <Eigen/Geometry>
 #include <algorithm>
-#include <cstdio>
 #include <filesystem>
 
 #include "cranioplan/algorithms/alignment/mirror_mesh.h"
@@ -203,7 +202,6 @@ TEST(Autoplan, ADensePieceBelowTheSkullDoesNotMoveTheRaysStart) {
       detect_defect_near_plane(with_piece, SurfaceLocator(with_piece), midline, {});
   ASSERT_TRUE(a.found()) << a.message;
   ASSERT_TRUE(b.found()) << b.message;
-  std::printf("start moved %.3f mm\n", (a.center - b.center).norm());
   EXPECT_LT((a.center - b.center).norm(), 0.1);
   // The same opening; the rays' lattice, turned by the vertices' principal axes (skull_frame),
   // which the piece moves too, meets its edge a little differently (1.3 %).
