@@ -71,11 +71,6 @@ TEST(LoadSkull, ASkullInAnotherUnitIsRefusedNamingTheUnitAndReadInIt) {
   EXPECT_FALSE(length_unit_named("furlong"));
 }
 
-// Some exporters wind triangles the other way: the skull then encloses a negative volume and
-// its normals point in, which the detection reads as inner and outer tables swapped (the
-// sample turned inside out: "too little intact bone around the opening (0 rays)"). load_skull
-// turns it outward, with a warning, into the very mesh the outward file gives; load_surface
-// (an implant for the quality check) keeps it as it is.
 // A skull closed by the padding where its scan ended: the cap is a note of what the mesh has,
 // not a warning (the warnings are the repair report a plan records).
 TEST(LoadSkull, AFlatCapWhereTheScanEndedIsANoteNotAWarning) {
@@ -93,6 +88,11 @@ TEST(LoadSkull, AFlatCapWhereTheScanEndedIsANoteNotAWarning) {
   for (const std::string& w : loaded.warnings) EXPECT_EQ(w.find("cap"), std::string::npos) << w;
 }
 
+// Some exporters wind triangles the other way: the skull then encloses a negative volume and
+// its normals point in, which the detection reads as inner and outer tables swapped (the
+// sample turned inside out: "too little intact bone around the opening (0 rays)"). load_skull
+// turns it outward, with a warning, into the very mesh the outward file gives; load_surface
+// (an implant for the quality check) keeps it as it is.
 TEST(LoadSkull, ASkullThatWindsInwardIsTurnedOutward) {
   TempDir dir;
   const SkullMesh head =

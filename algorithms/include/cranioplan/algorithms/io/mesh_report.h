@@ -30,10 +30,12 @@ struct BoundaryLoop {
   std::vector<Eigen::Vector3d> outline;
 };
 
-/// A flat cap where a closed surface ends: triangles in one plane (within 0.5 mm) at the mesh's
-/// end along the plane's normal, at least 50 mm² of them spanning 30 mm or more. An importer that
-/// pads the volume (this program's, 3D Slicer's closed surfaces) leaves one where the scan ended:
-/// the bone's cross-section is closed there, and the head's inside is open through it.
+/// A flat cap where a closed surface ends: the triangles within 2 mm of the mesh's end along a
+/// direction and facing out through it within 30°, at least 200 mm² of them, 60 × 30 mm across
+/// or more, and a ring (their convex outline encloses 1,000 mm² or more that they do not cover,
+/// and they cover at most half of it). An importer that pads the volume (this program's, 3D
+/// Slicer's closed surfaces) leaves one where the scan ended: the bone's cross-section is closed
+/// there, and the head's inside is open through it.
 struct BorderCap {
   /// Unit normal out of the surface through the cap (an axis when within 1° of one).
   Eigen::Vector3d outward = Eigen::Vector3d::Zero();

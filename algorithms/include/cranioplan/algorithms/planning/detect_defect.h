@@ -18,8 +18,8 @@ namespace cranioplan {
 class SurfaceLocator;
 
 /// A side of the surface where the scan ended: the plane of a flat cut at the surface's border
-/// (`normal` points out of the surface; the plane is normal·x = offset) and the surface's
-/// bounding box; for a cap (a closed surface), the cap's own box and outline.
+/// (`normal` points out of the surface; the plane is normal·x = offset), the surface's bounding
+/// box (a cap's own box, for a closed surface) and the cut's outline.
 struct ScanBorder {
   Eigen::Vector3d normal = Eigen::Vector3d::UnitZ();
   double offset = 0.0;
