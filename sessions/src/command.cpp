@@ -242,7 +242,9 @@ int current_version(CommandType type) {
   // where the bone is first found goes on until it has (ImplantParams::fit_reaches_the_bone),
   // and the fit's field is meshed kept 1e-3 off the iso-level (TrimToBoneParams::iso_gap);
   // version 10 is made as it was.
-  if (type == CommandType::BuildImplant) return 11;
+  // build_implant 12: evenly placed tabs that stand off the bone by more than the quality
+  // report allows are placed again (TabParams::keep_on_bone); version 11 is made as it was.
+  if (type == CommandType::BuildImplant) return 12;
   if (type == CommandType::ExportImplant) return 2;
   // propose_markers 4: support markers only where the fitted surface describes the ring's bone
   // ("max_support_off_fit_mm"; versions 1 to 3 are read with 0, every ring point of the band).

@@ -43,6 +43,10 @@ constexpr double kFillFullMm = 1.0, kFillNoneMm = 2.0;
 constexpr double kEdgeRoundMm = 1.5;
 // The even placement spaces tabs by one per this much rim, mm.
 constexpr double kRimPerTabMm = 40.0;
+// The even placement places a tab again when it stands off the bone by more than this (the
+// quality report's default limit, QualityParams::max_tab_gap_mm), mm, at most this many times.
+constexpr double kRestsWithinMm = 0.2;
+constexpr int kPlacementRounds = 3;
 // The rim is sampled in this many sectors around the direction from the skull's inside to the
 // implant's centre.
 constexpr int kSectors = 360;
@@ -573,74 +577,21 @@ double tab_gap(const SurfaceLocator& self, const SurfaceLocator& bone, const Tab
 
 namespace {
 
-// add_fixation_tabs, the implant with its tabs meshed in `into` (the result's own mesh, or the
-// caller's).
-void tabs_into(const SkullMesh& implant, const SurfaceLocator& bone, const Eigen::Vector3d& inside,
-               const TabParams& p, TabResult& r, SkullMesh& into) {
-  assert(&into != &implant && "the tabs are meshed into another mesh than the implant");
-  const auto t0 = std::chrono::steady_clock::now();
-  auto fail = [&](const std::string& message) {
-    r.status = TabResult::Status::Failed;
-    r.message = message;
-    into = implant;
-    r.tabs.clear();
-    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-  };
-  if (const std::string problem = tab_problem(p); !problem.empty()) return fail(problem);
-  if (std::isnan(p.width_mm) || std::isnan(p.thickness_mm))
-    return fail("the tabs' width and thickness are not set");
-  const double sink = countersink_depth(p);
-  const SurfaceLocator self(implant);
-  const Rim rim = trace_rim(self, implant, bone, inside);
-  r.rim_length_mm = rim.length;
-  if (rim.points.size() < 12) return fail("the implant has no edge to put tabs on");
-
-  // Where the tabs go: the user's (each at the nearest rim sample), or evenly along the rim.
-  std::vector<Candidate> placed;
-  if (!p.positions.empty()) {
-    for (size_t k = 0; k < p.positions.size(); ++k) {
-      size_t at = 0;
-      for (size_t i = 1; i < rim.points.size(); ++i)
-        if ((rim.points[i] - p.positions[k]).squaredNorm() <
-            (rim.points[at] - p.positions[k]).squaredNorm())
-          at = i;
-      Candidate c = make_tab(rim, at, self, bone, inside, p);
-      if (!c.problem.empty())
-        return fail("tab " + std::to_string(k + 1) + ": " + c.problem +
-                    " (move it along the rim onto bone)");
-      c.tab.added = true;
-      placed.push_back(std::move(c));
-    }
-  } else {
-    const int count =
-        p.count > 0 ? p.count
-                    : std::clamp(static_cast<int>(std::lround(rim.length / kRimPerTabMm)), 3, 8);
-    std::vector<Candidate> all(rim.points.size());
-    std::vector<uint8_t> ok(rim.points.size());
-    parallel_for(
-        rim.points.size(),
-        [&](size_t begin, size_t end) {
-          for (size_t i = begin; i < end; ++i) {
-            all[i] = make_tab(rim, i, self, bone, inside, p);
-            ok[i] = allowed(all[i], p);
-          }
-        },
-        8);
-    for (size_t i : place_evenly(rim, ok, count)) placed.push_back(std::move(all[i]));
-    if (placed.empty())
-      return fail("no stretch of the rim has bone at least " + std::to_string(p.min_bone_mm) +
-                  " mm thick beyond it" + (p.midline ? " away from the midline" : std::string()));
-    if (static_cast<int>(placed.size()) < count)
-      r.message = "only " + std::to_string(placed.size()) + " of " + std::to_string(count) +
-                  " tabs find bone thick enough" + (p.midline ? " away from the midline" : "") +
-                  "; ";
-  }
+// Why tabs placed this close overlap, or empty.
+std::string overlap_problem(const std::vector<Candidate>& placed, const TabParams& p) {
   for (size_t i = 0; i < placed.size(); ++i)
     for (size_t j = i + 1; j < placed.size(); ++j)
       if ((placed[i].tab.rim - placed[j].tab.rim).norm() < p.width_mm + 1.0)
-        return fail("tabs " + std::to_string(i + 1) + " and " + std::to_string(j + 1) +
-                    " overlap: move one along the rim");
+        return "tabs " + std::to_string(i + 1) + " and " + std::to_string(j + 1) +
+               " overlap: move one along the rim";
+  return {};
+}
 
+// The implant with the tabs `placed` meshed in `into`: empty, or why they cannot be.
+std::string mesh_tabs(const SkullMesh& implant, const SurfaceLocator& self,
+                      const SurfaceLocator& bone, const std::vector<Candidate>& placed,
+                      const TabParams& p, SkullMesh& into) {
+  const double sink = countersink_depth(p);
   // Each tab as two height maps over its plane (along its normal, from its rim point): its
   // underside, the outermost of the bone (kUndersideMm above it) and the implant seen from
   // above, bridging narrow gaps (the clearance at the implant's edge) and no deeper than kPlugMm
@@ -724,7 +675,7 @@ void tabs_into(const SkullMesh& implant, const SurfaceLocator& bone, const Eigen
     }
   const ExtractBoneSurfaceResult mesh =
       surface_of_signed_distance(std::move(field), g, into, p.iso_gap);
-  if (!mesh.usable()) return fail("joining the tabs to the implant: " + mesh.message);
+  if (!mesh.usable()) return "joining the tabs to the implant: " + mesh.message;
   // The meshing keeps the largest piece: a tab that does not touch the implant would be gone
   // from the mesh while the result still counted it. Of six points inside each tab (a third,
   // half and two thirds along it, a third of its width to either side: off its screws and
@@ -748,9 +699,106 @@ void tabs_into(const SkullMesh& implant, const SurfaceLocator& bone, const Eigen
                 inside_joined(mid, mid + (maps[k].high - 0.5 * (under + top) + 20.0) * t.normal);
       }
     if (!joins)
-      return fail("tab " + std::to_string(k + 1) +
-                  " does not join the implant (it would stand apart from it): move it along the "
-                  "rim");
+      return "tab " + std::to_string(k + 1) +
+             " does not join the implant (it would stand apart from it): move it along the rim";
+  }
+  return {};
+}
+
+// add_fixation_tabs, the implant with its tabs meshed in `into` (the result's own mesh, or the
+// caller's).
+void tabs_into(const SkullMesh& implant, const SurfaceLocator& bone, const Eigen::Vector3d& inside,
+               const TabParams& p, TabResult& r, SkullMesh& into) {
+  assert(&into != &implant && "the tabs are meshed into another mesh than the implant");
+  const auto t0 = std::chrono::steady_clock::now();
+  auto fail = [&](const std::string& message) {
+    r.status = TabResult::Status::Failed;
+    r.message = message;
+    into = implant;
+    r.tabs.clear();
+    r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  };
+  if (const std::string problem = tab_problem(p); !problem.empty()) return fail(problem);
+  if (std::isnan(p.width_mm) || std::isnan(p.thickness_mm))
+    return fail("the tabs' width and thickness are not set");
+  const SurfaceLocator self(implant);
+  const Rim rim = trace_rim(self, implant, bone, inside);
+  r.rim_length_mm = rim.length;
+  if (rim.points.size() < 12) return fail("the implant has no edge to put tabs on");
+
+  // Where the tabs go: the user's (each at the nearest rim sample), or evenly along the rim.
+  std::vector<Candidate> placed;
+  if (!p.positions.empty()) {
+    for (size_t k = 0; k < p.positions.size(); ++k) {
+      size_t at = 0;
+      for (size_t i = 1; i < rim.points.size(); ++i)
+        if ((rim.points[i] - p.positions[k]).squaredNorm() <
+            (rim.points[at] - p.positions[k]).squaredNorm())
+          at = i;
+      Candidate c = make_tab(rim, at, self, bone, inside, p);
+      if (!c.problem.empty())
+        return fail("tab " + std::to_string(k + 1) + ": " + c.problem +
+                    " (move it along the rim onto bone)");
+      c.tab.added = true;
+      placed.push_back(std::move(c));
+    }
+    if (const std::string problem = overlap_problem(placed, p); !problem.empty())
+      return fail(problem);
+    if (const std::string problem = mesh_tabs(implant, self, bone, placed, p, into);
+        !problem.empty())
+      return fail(problem);
+  } else {
+    const int count =
+        p.count > 0 ? p.count
+                    : std::clamp(static_cast<int>(std::lround(rim.length / kRimPerTabMm)), 3, 8);
+    std::vector<Candidate> all(rim.points.size());
+    std::vector<uint8_t> ok(rim.points.size());
+    parallel_for(
+        rim.points.size(),
+        [&](size_t begin, size_t end) {
+          for (size_t i = begin; i < end; ++i) {
+            all[i] = make_tab(rim, i, self, bone, inside, p);
+            ok[i] = allowed(all[i], p);
+          }
+        },
+        8);
+    // Placed, meshed, and each tab's rest on the bone measured as the quality report measures
+    // it (tab_gap on the joined mesh): a tab standing off the bone by more than the report
+    // allows (over uneven fragments, a step down beyond the edge) is placed again away from
+    // there, its rim samples within a tab's width no longer used.
+    int moved = 0;
+    for (int round = 0;; ++round) {
+      placed.clear();
+      for (size_t i : place_evenly(rim, ok, count)) placed.push_back(all[i]);
+      if (placed.empty())
+        return fail("no stretch of the rim has bone at least " + std::to_string(p.min_bone_mm) +
+                    " mm thick beyond it" + (p.midline ? " away from the midline" : std::string()) +
+                    (moved > 0 ? " on which a tab rests" : ""));
+      if (const std::string problem = overlap_problem(placed, p); !problem.empty())
+        return fail(problem);
+      if (const std::string problem = mesh_tabs(implant, self, bone, placed, p, into);
+          !problem.empty())
+        return fail(problem);
+      if (!p.keep_on_bone || round == kPlacementRounds) break;
+      const SurfaceLocator joined(into);
+      bool again = false;
+      for (const Candidate& c : placed) {
+        if (!(tab_gap(joined, bone, c.tab) > kRestsWithinMm)) continue;
+        again = true;
+        ++moved;
+        for (size_t i = 0; i < rim.points.size(); ++i)
+          if ((rim.points[i] - c.tab.rim).norm() < p.width_mm) ok[i] = 0;
+      }
+      if (!again) break;
+    }
+    r.message.clear();
+    if (static_cast<int>(placed.size()) < count)
+      r.message = "only " + std::to_string(placed.size()) + " of " + std::to_string(count) +
+                  " tabs find bone thick enough" + (p.midline ? " away from the midline" : "") +
+                  "; ";
+    if (moved > 0)
+      r.message += std::to_string(moved) + (moved == 1 ? " tab" : " tabs") +
+                   " moved along the rim to rest on the bone; ";
   }
   for (Candidate& c : placed) r.tabs.push_back(std::move(c.tab));
   r.status = TabResult::Status::Added;

@@ -64,6 +64,12 @@ struct TabParams {
   /// from the bone), as plans saved before build_implant 10 were made (set from the session
   /// command's version, not recorded).
   bool on_implant_edge = true;
+  /// The even placement measures how each tab rests on the bone as the quality report does
+  /// (tab_gap) and places again, away from there, a tab that stands more than 0.2 mm off it
+  /// (over uneven fragments, or a step down beyond the implant's edge), up to three times.
+  /// False: placed once, as plans saved before build_implant 12 were made (set from the
+  /// session command's version, not recorded).
+  bool keep_on_bone = true;
   bool any() const { return automatic || !positions.empty(); }
 };
 /// Why the parameters cannot be used (a value out of its range), or empty.
