@@ -243,7 +243,9 @@ int current_version(CommandType type) {
   // and the fit's field is meshed kept 1e-3 off the iso-level (TrimToBoneParams::iso_gap);
   // version 10 is made as it was.
   // build_implant 12: evenly placed tabs that stand off the bone by more than the quality
-  // report allows are placed again (TabParams::keep_on_bone); version 11 is made as it was.
+  // report allows are placed again (TabParams::keep_on_bone), and pattern holes whose rim
+  // leaves a corner it refuses are left out (PerforationParams::sound_rims); version 11 is
+  // made as it was.
   if (type == CommandType::BuildImplant) return 12;
   if (type == CommandType::ExportImplant) return 2;
   // propose_markers 4: support markers only where the fitted surface describes the ring's bone

@@ -776,8 +776,9 @@ void apply_build(PlanState& s, const ParamReader& r, int version) {
   // Before version 11, a rim point fitted to the bone stayed where the bone was first found,
   // and the fit was meshed without the iso-level gap.
   params.fit_reaches_the_bone = params.trim.iso_gap = version >= 11;
-  // Before version 12, evenly placed tabs were placed once, whether they rested on the bone.
-  params.tabs.keep_on_bone = version >= 12;
+  // Before version 12, evenly placed tabs were placed once, whether they rested on the bone,
+  // and every pattern hole was drilled, whatever corner its rim left.
+  params.tabs.keep_on_bone = params.perforations.sound_rims = version >= 12;
   s.implant_params = params;
   unacknowledge(s, 8, "the implant was built again");
   rebuild_implant(s);

@@ -386,7 +386,8 @@ TEST(Commands, OlderBuildsMeshTheirTabsAndHolesAsTheyWereMade) {
 // Plans saved before build_implant 11 take their rims out to where the bone is first found and
 // mesh the fit as its field comes, as they were fitted; today's go on until the rim has crossed
 // the bone's surface and keep the field off the iso-level. Plans saved before build_implant 12
-// place their tabs once; today's place a tab off the bone again.
+// place their tabs once and drill every pattern hole; today's place a tab off the bone again
+// and leave out a hole whose rim would be too thin.
 TEST(Commands, OlderBuildsTakeTheirRimsOutAsTheyWereMade) {
   const Session planned = Session::open(test::planned_defect_case().session_path);
   const Json today = to_json(commands::build_implant(ImplantParams{}));
@@ -401,6 +402,7 @@ TEST(Commands, OlderBuildsTakeTheirRimsOutAsTheyWereMade) {
     EXPECT_EQ(out.state.implant_params->fit_reaches_the_bone, reaches);
     EXPECT_EQ(out.state.implant_params->trim.iso_gap, reaches);
     EXPECT_EQ(out.state.implant_params->tabs.keep_on_bone, keeps);
+    EXPECT_EQ(out.state.implant_params->perforations.sound_rims, keeps);
   }
 }
 

@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdio>
 
+#include "cranioplan/algorithms/geometry/distance_transform.h"
 #include "cranioplan/algorithms/geometry/mesh_distance_field.h"
 #include "cranioplan/algorithms/geometry/point_index.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
@@ -25,6 +26,12 @@ constexpr size_t kMaxHoles = 1000;
 // The holes' rims are rounded over this radius, mm: a sharp rim is a thin edge, and
 // deburring one is the first thing a workshop does.
 constexpr double kRimRoundMm = 1.0;
+// A pattern hole is left out when its rim leaves material thinner than the minimum reaching
+// more than this out of the thick material (the quality report's default limit for a corner,
+// QualityParams::max_corner_mm), mm, within this much of the rim's rounding, mm; the rest are
+// drilled again, at most this many times.
+constexpr double kCornerMm = 0.8, kCornerNearMm = 2.0;
+constexpr int kDrillRounds = 3;
 
 std::string range_problem(const char* what, double v, double lo, double hi) {
   return parameter_range_problem("the holes'", what, v, lo, hi);
@@ -189,6 +196,50 @@ Eigen::Vector3d mid_normal(const SurfaceLocator& self, const Hole& hole, double 
   return mid.norm() > 1e-6 ? mid.normalized() : hole.axis;
 }
 
+// Material of a field (positive inside) thinner than `min_thickness_mm` that reaches more than
+// kCornerMm out of the material a ball of that diameter fits in: a corner the quality report
+// refuses away from the bone (check_implant's measure of thin material, on this grid).
+std::vector<uint8_t> thin_corners(const std::vector<float>& field, const VoxelGrid& g,
+                                  double min_thickness_mm) {
+  std::vector<uint8_t> solid(field.size());
+  for (size_t c = 0; c < field.size(); ++c) solid[c] = field[c] > 0.0f;
+  const double r = 0.5 * min_thickness_mm;
+  const std::vector<uint8_t> centres = ball_centres(depth_in_mask(solid, g), g, r);
+  const std::vector<float> to_core = distance_to_mask(centres, g, r + g.spacing + kCornerMm + 1.0);
+  std::vector<uint8_t> thin(field.size(), 0);
+  for (size_t c = 0; c < field.size(); ++c) thin[c] = solid[c] && to_core[c] - r > kCornerMm;
+  return thin;
+}
+
+// Calls fn(i, j, k) for the voxels of `g` within `reach` mm of `center` along each axis (a
+// voxel more on the upper side).
+template <class Fn>
+void for_voxels_near(const VoxelGrid& g, const Eigen::Vector3d& center, double reach, Fn&& fn) {
+  const Eigen::Vector3d a = (center - Eigen::Vector3d::Constant(reach) - g.origin) / g.spacing,
+                        b = (center + Eigen::Vector3d::Constant(reach) - g.origin) / g.spacing;
+  for (int k = std::max(0, static_cast<int>(a.z()));
+       k <= std::min(g.dims[2] - 1, static_cast<int>(b.z()) + 1); ++k)
+    for (int j = std::max(0, static_cast<int>(a.y()));
+         j <= std::min(g.dims[1] - 1, static_cast<int>(b.y()) + 1); ++j)
+      for (int i = std::max(0, static_cast<int>(a.x()));
+           i <= std::min(g.dims[0] - 1, static_cast<int>(b.x()) + 1); ++i)
+        fn(i, j, k);
+}
+
+// Whether a voxel of `mask` lies within `reach` of the hole's axis, from 3 mm above its centre
+// to 16 mm below (as deep as plate_under looks).
+bool near_hole(const std::vector<uint8_t>& mask, const VoxelGrid& g, const Hole& hole,
+               double reach) {
+  bool near = false;
+  for_voxels_near(g, hole.center, 16.0 + reach, [&](int i, int j, int k) {
+    if (near || !mask[g.index(i, j, k)]) return;
+    const Eigen::Vector3d q = g.center(i, j, k) - hole.center;
+    const double t = q.dot(hole.axis);
+    near = t <= 3.0 && t >= -16.0 && (q - t * hole.axis).norm() <= reach;
+  });
+  return near;
+}
+
 // perforate, the drilled implant meshed in `into` (the result's own mesh, or the caller's).
 void perforate_into(const SkullMesh& implant, const Eigen::Vector3d& inside,
                     const PerforationParams& p, PerforateResult& r, SkullMesh& into) {
@@ -253,9 +304,8 @@ void perforate_into(const SkullMesh& implant, const Eigen::Vector3d& inside,
   const std::vector<uint8_t> solid = voxelize_mesh(implant, g);
   // The implant's signed distance (mm, positive inside): exact near its surface, ±10 mm (no
   // more than needed) elsewhere.
-  std::vector<float> field = signed_distance_near_surface(self, solid, g);
-  const int nx = g.dims[0], ny = g.dims[1], nz = g.dims[2];
-  for (const Hole& hole : r.holes) {
+  const std::vector<float> whole = signed_distance_near_surface(self, solid, g);
+  auto carve = [&](std::vector<float>& field, const Hole& hole) {
     // The drill goes from above the outer surface to below the inner one under all of it
     // (plate_under; as plans saved before mid_normal: at the centre), not on into another part
     // of a curved implant.
@@ -268,24 +318,39 @@ void perforate_into(const SkullMesh& implant, const Eigen::Vector3d& inside,
       span.depth = under ? under->distance : 15.0;
     }
     const double depth = span.depth + 1.0 + 2.0 * h, above = span.above + 1.0 + 2.0 * h;
-    const Eigen::Vector3d reach = Eigen::Vector3d::Constant(
-        p.mid_normal ? radius + kRimRoundMm + 2.0 * h + std::max(depth, above)
-                     : radius + 2.0 * h + 16.0);
-    const Eigen::Vector3d a = ((hole.center - reach) - g.origin) / h,
-                          b = ((hole.center + reach) - g.origin) / h;
-    for (int k = std::max(0, static_cast<int>(a.z()));
-         k <= std::min(nz - 1, static_cast<int>(b.z()) + 1); ++k)
-      for (int j = std::max(0, static_cast<int>(a.y()));
-           j <= std::min(ny - 1, static_cast<int>(b.y()) + 1); ++j)
-        for (int i = std::max(0, static_cast<int>(a.x()));
-             i <= std::min(nx - 1, static_cast<int>(b.x()) + 1); ++i) {
-          const Eigen::Vector3d q = g.center(i, j, k) - hole.center;
-          const double t = q.dot(hole.axis);
-          if (t > above || t < -depth) continue;
-          const double off_axis = (q - t * hole.axis).norm();
-          float& v = field[g.index(i, j, k)];
-          v = static_cast<float>(smooth_min(v, off_axis - radius, kRimRoundMm));
-        }
+    const double reach = p.mid_normal ? radius + kRimRoundMm + 2.0 * h + std::max(depth, above)
+                                      : radius + 2.0 * h + 16.0;
+    for_voxels_near(g, hole.center, reach, [&](int i, int j, int k) {
+      const Eigen::Vector3d q = g.center(i, j, k) - hole.center;
+      const double t = q.dot(hole.axis);
+      if (t > above || t < -depth) return;
+      const double off_axis = (q - t * hole.axis).norm();
+      float& v = field[g.index(i, j, k)];
+      v = static_cast<float>(smooth_min(v, off_axis - radius, kRimRoundMm));
+    });
+  };
+  // Drilled; then, with `sound_rims`, the pattern's holes whose rim leaves a corner thinner
+  // than the material allows, reaching further out of the material that is thick enough than
+  // the quality report allows (as it measures thin material), are left out and the rest
+  // drilled again, up to three times.
+  std::vector<float> field;
+  std::vector<uint8_t> before;
+  int left_out = 0;
+  for (int round = 0;; ++round) {
+    field = whole;
+    for (const Hole& hole : r.holes) carve(field, hole);
+    if (!p.sound_rims || !p.pattern || round == kDrillRounds) break;
+    // Only the corners the holes made: the implant's own thin edge may lie within reach.
+    if (before.empty()) before = thin_corners(whole, g, p.min_thickness_mm);
+    std::vector<uint8_t> made = thin_corners(field, g, p.min_thickness_mm);
+    for (size_t c = 0; c < made.size(); ++c) made[c] = made[c] && !before[c];
+    std::vector<Hole> kept;
+    for (const Hole& hole : r.holes)
+      if (hole.added || !near_hole(made, g, hole, radius + kRimRoundMm + kCornerNearMm))
+        kept.push_back(hole);
+    if (kept.size() == r.holes.size()) break;
+    left_out += static_cast<int>(r.holes.size() - kept.size());
+    r.holes = std::move(kept);
   }
   ExtractBoneSurfaceResult s = surface_of_signed_distance(std::move(field), g, into, p.iso_gap);
   if (!s.usable()) {
@@ -302,6 +367,10 @@ void perforate_into(const SkullMesh& implant, const Eigen::Vector3d& inside,
   std::snprintf(buf, sizeof(buf), "%zu holes of %.1f mm drilled", r.holes.size(), p.diameter_mm);
   r.message = buf;
   if (blocked > 0) r.message += " (" + std::to_string(blocked) + " do not go through)";
+  if (left_out > 0)
+    r.message += "; " + std::to_string(left_out) + " of the pattern's left out (" +
+                 (left_out == 1 ? "its rim" : "their rims") +
+                 " would leave a corner thinner than the material allows)";
   return done(r);
 }
 

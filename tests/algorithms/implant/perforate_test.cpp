@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <functional>
 
 #include "cranioplan/algorithms/geometry/self_intersections.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
@@ -59,23 +60,28 @@ TEST(Perforate, APatternOnAPlateGoesThroughEveryHole) {
   EXPECT_EQ(count_self_intersections(r.mesh), 0);
 }
 
-// A plate whose inner surface slopes 45° under a flat outer one (as where a curved implant
-// turns down): 4 mm thick (z 7 to 11) at x = 0, sloping down to x = 12 (16 mm thick), flat
-// on to x = 20; meshed from a mask as an implant is.
-SkullMesh sloping_plate() {
-  const double slope = std::tan(45.0 * M_PI / 180.0);
-  const VoxelGrid g = VoxelGrid::covering({-2, -2, -7.5}, {22, 32, 13}, 0.25);
+// A plate over x 0 to `length` and y 0 to 30, its outer surface flat at z = 11 and its inner
+// one at z = floor(x), meshed from a mask as an implant is (the grid reaches down to `lowest`).
+SkullMesh plate_over(double length, double lowest, const std::function<double(double)>& floor) {
+  const VoxelGrid g = VoxelGrid::covering({-2, -2, lowest - 2.0}, {length + 2, 32, 13}, 0.25);
   std::vector<uint8_t> inside(g.size(), 0);
   for (int k = 0; k < g.dims[2]; ++k)
     for (int j = 0; j < g.dims[1]; ++j)
       for (int i = 0; i < g.dims[0]; ++i) {
         const Eigen::Vector3d c = g.center(i, j, k);
-        inside[g.index(i, j, k)] = c.x() >= 0 && c.x() <= 20 && c.y() >= 0 && c.y() <= 30 &&
-                                   c.z() <= 11 && c.z() >= 7 - slope * std::min(c.x(), 12.0);
+        inside[g.index(i, j, k)] = c.x() >= 0 && c.x() <= length && c.y() >= 0 && c.y() <= 30 &&
+                                   c.z() <= 11 && c.z() >= floor(c.x());
       }
   ExtractBoneSurfaceParams mask;
   mask.threshold = 0.5;
   return extract_bone_surface(mask_volume(inside, g), mask).mesh;
+}
+
+// A plate whose inner surface slopes 45° under a flat outer one (as where a curved implant
+// turns down): 4 mm thick (z 7 to 11) at x = 0, sloping down to x = 12 (16 mm thick), flat
+// on to x = 20.
+SkullMesh sloping_plate() {
+  return plate_over(20.0, -5.5, [](double x) { return 7.0 - std::min(x, 12.0); });
 }
 
 // A hole through the slope: drilled along the plate's mid-normal (22.5° from the outer
@@ -110,10 +116,64 @@ TEST(Perforate, AHoleThroughASlopingPlateRunsAlongItsMidNormal) {
   }
 }
 
-// A single hole added where the user clicks (moved onto the surface), the pattern's holes near
-// it giving way; a pattern hole taken away; two added holes that would merge are refused.
-// Meshed into a mesh the caller gives, the drilled plate is what the result would hold (the
-// result's own mesh empty).
+// A 30 × 30 mm plate, its outer surface flat at z = 11, whose inner surface drops at 60° from
+// z = 7 at x = 14.5 to z = -4 at x = 20.9 and runs flat on, 15 mm below the outer surface (as
+// where an implant turns down into the frontal sinus).
+SkullMesh steep_plate() {
+  const double slope = std::tan(60.0 * M_PI / 180.0);
+  return plate_over(30.0, -4.0, [slope](double x) {
+    return std::max(-4.0, 7.0 - slope * std::max(0.0, x - 14.5));
+  });
+}
+
+// The pattern over the drop (kept 2 mm off the side walls, the drop's face among them): the
+// holes at the drop's foot (x = 21.9, their rims reaching back onto it), even along the
+// plate's mid-normal, leave rims thinner than PEEK's 2 mm reaching further than the quality
+// report allows (1.1 mm). Those holes are left out (the message says so), the rest drilled,
+// and the plate is printable (its thin corners 0.46 mm); drilled as plans saved before
+// build_implant 12 were, every pattern hole is drilled and the report refuses the plate.
+TEST(Perforate, APatternHoleThatWouldLeaveAThinCornerIsLeftOut) {
+  const SkullMesh plate = steep_plate();
+  const Eigen::Vector3d inside(15, 15, -80);
+  PerforationParams params;
+  params.pattern = true;
+  params.spacing_mm = 8.0;
+  params.edge_distance_mm = 2.0;
+  params.min_thickness_mm = 2.0;
+  QualityParams q;
+  q.min_thickness_mm = 2.0;
+  size_t before_the_foot = 0;
+  for (const bool sound : {false, true}) {
+    SCOPED_TRACE(sound ? "sound rims" : "every hole drilled");
+    params.sound_rims = sound;
+    const PerforateResult r = perforate(plate, inside, params);
+    ASSERT_TRUE(r.usable()) << r.message;
+    size_t at_the_foot = 0;
+    for (const Hole& h : r.holes) at_the_foot += h.center.x() > 20.0;
+    q.holes = r.holes;
+    const QualityReport report = check_implant(r.mesh, nullptr, q);
+    EXPECT_EQ(report.holes_blocked, 0);
+    EXPECT_EQ(test::genus(r.mesh), static_cast<long long>(r.holes.size()));
+    RecordProperty(sound ? "corner_sound_mm" : "corner_every_hole_mm",
+                   std::to_string(report.corner_reach_mm));
+    if (!sound) {
+      before_the_foot = r.holes.size() - at_the_foot;
+      EXPECT_GE(at_the_foot, 2u);
+      EXPECT_GE(before_the_foot, 6u);
+      EXPECT_FALSE(report.printable) << report.corner_reach_mm << " mm";
+      EXPECT_GT(report.corner_reach_mm, 0.8);
+      EXPECT_EQ(r.message.find("left out"), std::string::npos) << r.message;
+    } else {
+      EXPECT_EQ(at_the_foot, 0u);
+      EXPECT_EQ(r.holes.size(), before_the_foot) << "the others are drilled as before";
+      EXPECT_NE(r.message.find("of the pattern's left out"), std::string::npos) << r.message;
+      EXPECT_TRUE(report.printable)
+          << report.corner_reach_mm << " mm: " << (report.reasons.empty() ? "" : report.reasons[0]);
+      EXPECT_LE(report.corner_reach_mm, 0.8);
+    }
+  }
+}
+
 TEST(Perforate, MeshedIntoAGivenMeshAsItWouldBeReturned) {
   const SkullMesh p = plate();
   PerforationParams params;

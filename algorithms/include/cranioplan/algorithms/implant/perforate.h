@@ -43,6 +43,13 @@ struct PerforationParams {
   /// plans saved before this were drilled (set from the session command's version, not
   /// recorded).
   bool mid_normal = true;
+  /// A pattern hole whose rim leaves material thinner than `min_thickness_mm` reaching more
+  /// than 0.8 mm out of the material thick enough (a corner the quality report refuses away
+  /// from the bone: where a surface meets the hole's wall steeply slanted) is left out and the
+  /// rest drilled again, up to three times; the message says how many. The user's holes are
+  /// drilled as asked. False: every pattern hole drilled, as plans saved before build_implant
+  /// 12 were (set from the session command's version, not recorded).
+  bool sound_rims = true;
   bool any() const { return pattern || !added.empty(); }
 };
 /// Why the parameters cannot be used (a value out of its range), or empty.
