@@ -183,7 +183,7 @@ Json evaluate_case(const std::string& id, const std::string& defective,
     const auto t0 = std::chrono::steady_clock::now();
     const LoadedSkull loaded = load_skull(defective);
     const SkullMesh& skull = loaded.mesh;
-    const AutoplanResult r = autoplan(skull, Landmarks{}, params);
+    const AutoplanResult r = autoplan(skull, Landmarks{}, planning(params, loaded));
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     row["status"] = r.planned() ? "planned" : "failed";

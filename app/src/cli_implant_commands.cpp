@@ -625,13 +625,14 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
           return j;
         };
         if (!o->all_openings) {
-          const AutoplanResult r = autoplan(skull, lm, o->params);
+          const AutoplanResult r = autoplan(skull, lm, planning(o->params, loaded));
           print_result(with_warnings(write_autoplan(r, o->output, o->markers_out)), json);
           return r.planned() ? kOk : kUnusable;
         }
         // Every opening in turn; the first is the one planned without
         // --all-openings.
-        const std::vector<AutoplanResult> all = autoplan_all_openings(skull, lm, o->params);
+        const std::vector<AutoplanResult> all =
+            autoplan_all_openings(skull, lm, planning(o->params, loaded));
         if (!all.front().defect.found()) {  // no defect, or no plane
           print_result(with_warnings(write_autoplan(all.front(), o->output, o->markers_out)), json);
           return all.front().planned() ? kOk : kUnusable;

@@ -17,6 +17,12 @@ SkullMesh load_any(const std::string& path) {
   return load_surface(path, p).mesh;
 }
 
+AutoplanParams planning(const AutoplanParams& params, const LoadedSkull& skull) {
+  AutoplanParams out = params;
+  if (skull.report) out.propose.detect.scan_borders = scan_borders(*skull.report);
+  return out;
+}
+
 // --fit-to-bone MM: the automatic planner's implant built beyond the rim and trimmed by the bone.
 void add_fit_option(CLI::App* cmd, AutoplanParams& params) {
   cmd->add_option("--fit-to-bone", params.implant.fit_to_bone_mm,

@@ -9,12 +9,19 @@
 namespace CLI {
 class App;
 }
+namespace cranioplan {
+struct LoadedSkull;
+}
 
 namespace cranioplan::cli {
 
 /// Meshes, or label volumes (e.g. SkullFix NRRD masks) turned into surfaces with every piece
 /// kept.
 SkullMesh load_any(const std::string& path);
+
+/// `params` planning on `skull` as read: where its scan ended taken from the report made when
+/// it was read (a mesh), not found again.
+AutoplanParams planning(const AutoplanParams& params, const LoadedSkull& skull);
 
 /// --fit-to-bone MM and --local-registration MM of the automatic planner.
 void add_fit_option(CLI::App* cmd, AutoplanParams& params);

@@ -61,7 +61,7 @@ LoadedSkull load(const std::string& path, const ExtractBoneSurfaceParams& import
     }
     // Where a skull's surface is open, and what planning does about it.
     if (as_skull) {
-      const MeshReport report = report_mesh(out.mesh);
+      const MeshReport& report = out.report.emplace(report_mesh(out.mesh));
       for (const std::string& s : describe_openings(report))
         out.warnings.push_back(path + ": " + s);
       for (const std::string& s : describe_caps(report)) out.notes.push_back(path + ": " + s);

@@ -502,9 +502,10 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
   const RayFan fan = cast_fan(cast, std::clamp(params.directions, 2000, 200000), region.frame,
                               params.frame.has_value());
   region.up = fan.up;
-  const Openings openings = find_openings(fan, center, params.scan_borders);
+  const std::vector<ScanBorder> borders = params.scan_borders.value_or(std::vector<ScanBorder>{});
+  const Openings openings = find_openings(fan, center, borders);
   const size_t base =
-      skull_base(openings, region.up, region.frame, params.frame.has_value(), params.scan_borders);
+      skull_base(openings, region.up, region.frame, params.frame.has_value(), borders);
   // The defect is the largest of the others whose area, at the radius of its rim, is large
   // enough (or the one towards a point given); the rest are named by a ray through each.
   const std::vector<Candidate> candidates = defect_candidates(fan, openings, base, center, params);

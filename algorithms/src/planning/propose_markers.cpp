@@ -107,7 +107,7 @@ Eigen::Vector3d rays_start(const SkullMesh& skull, const SurfaceLocator& bone, c
 DefectRegion detect_defect_near_plane(const SkullMesh& skull, const SurfaceLocator& bone,
                                       const Plane& plane, const DetectDefectParams& params) {
   DetectDefectParams framed = params;
-  if (framed.scan_borders.empty()) {
+  if (!framed.scan_borders) {
     // A closed surface's border can only be a cap: the caps alone, not the whole report.
     MeshReport report;
     if (has_boundary(skull))

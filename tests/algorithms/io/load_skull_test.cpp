@@ -86,6 +86,11 @@ TEST(LoadSkull, AFlatCapWhereTheScanEndedIsANoteNotAWarning) {
   EXPECT_EQ(loaded.notes[0].rfind(path + ": closed by a flat cap at its lower border", 0), 0u)
       << loaded.notes[0];
   for (const std::string& w : loaded.warnings) EXPECT_EQ(w.find("cap"), std::string::npos) << w;
+  // The report the note came from is kept, for planning to take the scan's end from.
+  ASSERT_TRUE(loaded.report.has_value());
+  EXPECT_EQ(loaded.report->caps.size(), 1u);
+  EXPECT_TRUE(loaded.report->watertight);
+  EXPECT_FALSE(load_surface(path).report.has_value()) << "an implant is not a skull";
 }
 
 // Some exporters wind triangles the other way: the skull then encloses a negative volume and

@@ -234,6 +234,16 @@ TEST(SampleCase, AnExportOpenWhereTheScanEndsIsPlannedOnTheBone) {
   EXPECT_GT(c.dice, 0.88);
   RecordProperty("rim_gap_mm", std::to_string(r.quality.rim_gap_mm));
   RecordProperty("dice_vs_closed", std::to_string(c.dice));
+  // Given the scan's borders from the report made when the mesh was read (load_skull's, as
+  // `cranioplan-cli autoplan` gives them) instead of finding them again: the same plan.
+  AutoplanParams given;
+  given.propose.detect.scan_borders = scan_borders(rep);
+  ASSERT_FALSE(given.propose.detect.scan_borders->empty());
+  const AutoplanResult same = autoplan(open, Landmarks{}, given);
+  ASSERT_TRUE(same.planned()) << same.message;
+  EXPECT_EQ(same.implant.mesh.n_faces(), r.implant.mesh.n_faces());
+  EXPECT_DOUBLE_EQ(same.quality.volume_mm3, r.quality.volume_mm3);
+  EXPECT_EQ(same.defect.area_mm2, r.defect.area_mm2);
 }
 
 // Decimated much further (60,000 triangles, edges about 3.5 mm), the thin bone around the
@@ -305,17 +315,13 @@ TEST(SampleCase, ALargeDefectLowOnTheSideIsNotTakenForTheBase) {
   params.propose.detect.near = cut.center;  // the skull's own defect is there too
   // The sample's import is capped where the scan ended, and the defect's lowest rays go on
   // within the head's outline down to that cap: taken for the scan's end, they leave the
-  // opening seen 100° from the vault. Told of no scan's end (a border no ray reaches), every ray
+  // opening seen 100° from the vault. Told that the scan ended nowhere (no border), every ray
   // of the defect counts and the opening is seen beyond 105°, where the angle alone would take
   // it for the base.
-  ScanBorder none;
-  none.normal = Eigen::Vector3d::UnitX();
-  none.offset = 1e6;
-  none.box_min = none.box_max = Eigen::Vector3d::Constant(1e6);
   AutoplanParams untold = params;
-  untold.propose.detect.scan_borders = {none};
+  untold.propose.detect.scan_borders = std::vector<ScanBorder>{};
   for (const AutoplanParams& p : {untold, params}) {
-    const bool told = p.propose.detect.scan_borders.empty();
+    const bool told = !p.propose.detect.scan_borders.has_value();
     SCOPED_TRACE(told ? "the scan's end found" : "no scan's end");
     const AutoplanResult r = autoplan(d.defective, Landmarks{}, p);
     ASSERT_TRUE(r.planned()) << r.message;

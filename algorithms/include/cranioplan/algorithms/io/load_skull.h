@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
+#include "cranioplan/algorithms/io/mesh_report.h"
 #include "cranioplan/model/mesh.h"
 
 namespace cranioplan {
@@ -25,6 +26,10 @@ struct LoadedSkull {
   /// The frame the file declared and how it was brought to the patient's LPS (Volume::frame).
   std::string frame;
   long long pieces_dropped = 0;  ///< a mesh's pieces far from the skull (drop_far_pieces)
+  /// A skull mesh's report as read (report_mesh: where it is open, its caps), which planning
+  /// can take its scan's borders from (scan_borders) instead of finding them again; none for a
+  /// volume, or a surface not read as a skull.
+  std::optional<MeshReport> report;
   ExtractBoneSurfaceResult
       surface;  ///< details of the CT import (volumes only; its mesh is cleared)
   double seconds = 0.0;

@@ -64,8 +64,10 @@ struct DetectDefectParams {
   /// Where the scan ended (scan_borders). A ray that meets no bone and reaches such a border
   /// is closed there by the scan's end, not open in the bone: the cut is never planned as a
   /// defect, and a defect that reaches the cut keeps its own rays. Not a user's parameter:
-  /// detect_defect_near_plane takes them from the mesh.
-  std::vector<ScanBorder> scan_borders;
+  /// unset, detect_defect_near_plane finds them from the mesh; a caller that has the mesh's
+  /// report already (a skull mesh read by load_skull) gives them from it, and an empty list
+  /// says the scan ended nowhere. detect_defect takes unset as none.
+  std::optional<std::vector<ScanBorder>> scan_borders;
 };
 
 /// A stretch of the rim that no ray saw: between two consecutive rim points far apart, where
