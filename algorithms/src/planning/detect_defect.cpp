@@ -502,7 +502,8 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
   const RayFan fan = cast_fan(cast, std::clamp(params.directions, 2000, 200000), region.frame,
                               params.frame.has_value());
   region.up = fan.up;
-  const std::vector<ScanBorder> borders = params.scan_borders.value_or(std::vector<ScanBorder>{});
+  static const std::vector<ScanBorder> kNoBorder;
+  const std::vector<ScanBorder>& borders = params.scan_borders ? *params.scan_borders : kNoBorder;
   const Openings openings = find_openings(fan, center, borders);
   const size_t base =
       skull_base(openings, region.up, region.frame, params.frame.has_value(), borders);
