@@ -19,7 +19,7 @@ SkullMesh load_any(const std::string& path) {
 
 AutoplanParams planning(const AutoplanParams& params, const LoadedSkull& skull) {
   AutoplanParams out = params;
-  if (skull.report) out.propose.detect.scan_borders = scan_borders(*skull.report);
+  take_scan_borders(out.propose.detect, skull.report);
   return out;
 }
 

@@ -74,7 +74,9 @@ AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks&
     run(recorded(commands::register_mirror(params.registration), to_json(global), t.ms()));
   }
   const Stopwatch detect_time;
-  out.defect = autoplan_stages::detect(mesh, bone, plane, params);
+  AutoplanParams detecting = params;  // the scan's borders from the report made at load
+  take_scan_borders(detecting.propose.detect, skull->surface->loaded.report);
+  out.defect = autoplan_stages::detect(mesh, bone, plane, detecting);
   const double detect_ms = detect_time.ms();
   if (others_planned) out.defect.message = out.defect.describe(true);
   {

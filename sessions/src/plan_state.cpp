@@ -727,6 +727,7 @@ void apply_propose(PlanState& s, const ParamReader& r, Json& record) {
   ProposeParams params;
   params_from_json(ParamReader(r.value("params"), r.where() + " params"), params);
   if (!r.has("result")) {
+    take_scan_borders(params.detect, s.skull->surface->loaded.report);
     const SurfaceLocator& mirror = s.mirrored ? s.mirrored->locator : s.skull->surface->locator;
     record["result"] =
         proposal_result(propose_markers(s.skull->surface->mesh, s.skull->surface->locator, *s.plane,

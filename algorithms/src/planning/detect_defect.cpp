@@ -71,6 +71,10 @@ bool ScanBorder::reached_by(const Eigen::Vector3d& from, const Eigen::Vector3d& 
   return true;
 }
 
+void take_scan_borders(DetectDefectParams& params, const std::optional<MeshReport>& report) {
+  if (!params.scan_borders && report) params.scan_borders = scan_borders(*report);
+}
+
 std::vector<ScanBorder> scan_borders(const MeshReport& report) {
   std::vector<ScanBorder> out;
   auto add = [&](const std::string& name, const Eigen::Vector3d& outward,

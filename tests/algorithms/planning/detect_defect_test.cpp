@@ -112,6 +112,27 @@ TEST(ScanBorder, AHeadOpenWhereTheScanEndedHasOneBorderThere) {
   EXPECT_EQ(borders[0].box_max, report.bbox_max);
 }
 
+// A skull mesh's load report gives its borders to a detection that has none; borders already
+// given, or no report (a skull from a volume), are left as they are.
+TEST(ScanBorder, AreTakenFromTheLoadsReportUnlessGiven) {
+  const SkullMesh open = test::cut_open(test::make_symmetric_head(5), Eigen::Vector3d(0, 0, -30.0),
+                                        Eigen::Vector3d::UnitZ());
+  const std::optional<MeshReport> report = report_mesh(open);
+  DetectDefectParams taken;
+  take_scan_borders(taken, report);
+  ASSERT_TRUE(taken.scan_borders.has_value());
+  ASSERT_EQ(taken.scan_borders->size(), 1u);
+  EXPECT_EQ(taken.scan_borders->front().normal, scan_borders(*report).front().normal);
+  EXPECT_EQ(taken.scan_borders->front().offset, scan_borders(*report).front().offset);
+  DetectDefectParams given;
+  given.scan_borders.emplace();
+  take_scan_borders(given, report);
+  EXPECT_TRUE(given.scan_borders->empty()) << "the caller's borders are kept";
+  DetectDefectParams volume;
+  take_scan_borders(volume, std::nullopt);
+  EXPECT_FALSE(volume.scan_borders.has_value()) << "left to be found from the mesh";
+}
+
 // A thick head with a known defect, open on its right side where the scan (or an exporter's
 // crop) ended. Without the scan's border a deep cut is the largest opening and is planned; with
 // it the defect is the only opening, and a defect that reaches into the cut is found as itself,

@@ -70,6 +70,12 @@ struct DetectDefectParams {
   std::optional<std::vector<ScanBorder>> scan_borders;
 };
 
+/// Gives `params` the scan's borders from the report a skull mesh was read with
+/// (LoadedSkull::report), unless they are set already; without a report (a skull from a volume)
+/// they stay unset, to be found from the mesh. The same borders either way: this saves finding
+/// them again.
+void take_scan_borders(DetectDefectParams& params, const std::optional<MeshReport>& report);
+
 /// A stretch of the rim that no ray saw: between two consecutive rim points far apart, where
 /// the outline is interpolated (straight from one to the other).
 struct RimStretch {
