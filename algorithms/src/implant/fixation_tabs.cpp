@@ -803,8 +803,10 @@ void tabs_into(const SkullMesh& implant, const SurfaceLocator& bone, const Eigen
   for (Candidate& c : placed) r.tabs.push_back(std::move(c.tab));
   r.status = TabResult::Status::Added;
   char buf[160];
-  std::snprintf(buf, sizeof(buf), "%zu tabs with %zu screw holes of %.1f mm", r.tabs.size(),
-                r.tabs.size() * static_cast<size_t>(p.screws), p.screw_diameter_mm);
+  const size_t screws = r.tabs.size() * static_cast<size_t>(p.screws);
+  std::snprintf(buf, sizeof(buf), "%zu %s with %zu screw %s of %.1f mm", r.tabs.size(),
+                r.tabs.size() == 1 ? "tab" : "tabs", screws, screws == 1 ? "hole" : "holes",
+                p.screw_diameter_mm);
   r.message += buf;
   r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }

@@ -364,9 +364,12 @@ void perforate_into(const SkullMesh& implant, const Eigen::Vector3d& inside,
   for (const Hole& hole : r.holes) blocked += !hole_goes_through(drilled, hole);
   r.status = PerforateResult::Status::Drilled;
   char buf[160];
-  std::snprintf(buf, sizeof(buf), "%zu holes of %.1f mm drilled", r.holes.size(), p.diameter_mm);
+  std::snprintf(buf, sizeof(buf), "%zu %s of %.1f mm drilled", r.holes.size(),
+                r.holes.size() == 1 ? "hole" : "holes", p.diameter_mm);
   r.message = buf;
-  if (blocked > 0) r.message += " (" + std::to_string(blocked) + " do not go through)";
+  if (blocked > 0)
+    r.message +=
+        " (" + std::to_string(blocked) + (blocked == 1 ? " does" : " do") + " not go through)";
   if (left_out > 0)
     r.message += "; " + std::to_string(left_out) + " of the pattern's left out (" +
                  (left_out == 1 ? "its rim" : "their rims") +

@@ -426,11 +426,14 @@ void BuildPage::show_state(const PlanState& s) {
   if (s.implant_params && s.implant_params->material)
     text += "<br>" + QString::fromStdString(describe(*s.implant_params->material));
   if (s.implant && !s.implant->result().holes.empty())
-    text += "<br>" + tr("%1 holes of %2 mm.")
+    text += "<br>" + (s.implant->result().holes.size() == 1 ? tr("%1 hole of %2 mm.")
+                                                            : tr("%1 holes of %2 mm."))
                          .arg(s.implant->result().holes.size())
                          .arg(hole_diameter_->value(), 0, 'f', 1);
   if (s.implant && !s.implant->result().tabs.empty())
-    text += "<br>" + tr("%1 fixation tabs.").arg(s.implant->result().tabs.size());
+    text += "<br>" + (s.implant->result().tabs.size() == 1 ? tr("%1 fixation tab.")
+                                                           : tr("%1 fixation tabs."))
+                         .arg(s.implant->result().tabs.size());
   if (!zones_.empty())
     text += "<br>" + (zones_.size() == 1
                           ? tr("1 clearance zone on the rim (orange).")

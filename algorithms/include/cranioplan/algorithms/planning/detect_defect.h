@@ -44,8 +44,9 @@ struct DetectDefectParams {
   /// Width of the ring of intact bone around the rim on which support markers are proposed.
   double support_width_mm = 12.0;
   /// Rays whose inner and outer bone are farther apart than this met other bone on the way
-  /// (e.g. the orbital roof): not used for the rim or the support ring, mm.
-  double max_thickness_mm = 15.0;
+  /// (e.g. the orbital roof): not used for the rim or the support ring, mm. 20 mm: a ray
+  /// through both walls of the frontal sinus crosses 15–20 mm of the brow, and is the rim.
+  double max_thickness_mm = 20.0;
   /// Rays that only graze bone (at the cut face of a defect) pass through less than this; the
   /// rim is placed where rays still cross this much bone, mm.
   double min_thickness_mm = 1.5;

@@ -118,7 +118,7 @@ class DefectSurfaces {
   double scale_ = 1.0;                      // mm per unit of the gnomonic projection
   double max_cos_ = 0.0;                    // cosine of the cap's half-angle
   const SurfaceLocator* mirror_ = nullptr;  // prior (not owned); null: rim-only
-  double max_thickness_mm_ = 15.0;
+  double max_thickness_mm_ = 20.0;          // DetectDefectParams' default
   double mirror_footprint_mm_ = 0.0;
   ThinPlateSpline outer_, thickness_;
   std::optional<VaultSphere> vault_;  // set: outer_ fits the radius beyond this sphere
