@@ -167,6 +167,11 @@ std::optional<Eigen::Vector3d> trimmed_sphere(const std::vector<Eigen::Vector3d>
 
 }  // namespace
 
+// The vault's regular shell, whose inner table the centre is fitted to: rays through 1.5-15 mm
+// of bone. Not DetectDefectParams::max_thickness_mm (20 mm), which lets the rim also cross both
+// walls of the frontal sinus; the shell's rays face both tables within 45° anyway.
+constexpr double kVaultShellMaxMm = 15.0;
+
 std::optional<Eigen::Vector3d> vault_center(const SurfaceLocator& locator, const Plane& plane,
                                             const Eigen::Vector3d& start, double* radius_mm) {
   const std::vector<Eigen::Vector3d> dirs = fibonacci_sphere(4000);
@@ -176,7 +181,8 @@ std::optional<Eigen::Vector3d> vault_center(const SurfaceLocator& locator, const
     std::vector<std::optional<Eigen::Vector3d>> hit(dirs.size());
     parallel_for(dirs.size(), [&](size_t first, size_t last) {
       for (size_t i = first; i < last; ++i) {
-        const RayThroughBone h = cast_through_bone(locator, c, dirs[i], 400.0, 1.5, 15.0);
+        const RayThroughBone h =
+            cast_through_bone(locator, c, dirs[i], 400.0, 1.5, kVaultShellMaxMm);
         if (h.paired && h.outer_normal.dot(dirs[i]) > M_SQRT1_2 &&
             -h.inner_normal.dot(dirs[i]) > M_SQRT1_2)
           hit[i] = h.inner;

@@ -6,6 +6,8 @@
 #include <cmath>
 
 #include "cranioplan/algorithms/geometry/surface_locator.h"
+#include "cranioplan/algorithms/geometry/voxelize_mesh.h"
+#include "cranioplan/algorithms/io/extract_bone_surface.h"
 #include "cranioplan/algorithms/io/mesh_report.h"
 #include "cranioplan/algorithms/quality/inject_defect.h"
 #include "support/synthetic.h"
@@ -110,6 +112,80 @@ TEST(ScanBorder, AHeadOpenWhereTheScanEndedHasOneBorderThere) {
   EXPECT_GE(-borders[0].offset, -30.0);
   EXPECT_EQ(borders[0].box_min, report.bbox_min);
   EXPECT_EQ(borders[0].box_max, report.bbox_max);
+}
+
+// A spherical skull (tables 70 and 76 mm from the centre) with a round defect 20° wide about
+// `d0`, and below it (within 60° of −z about `d0`, from 20° to 34° off it) a frontal sinus: an
+// inner table 70–73 mm, air, and a front wall 84–87 mm, so that a ray there crosses 17 mm of
+// bone; walls 3–4° wide close it but on the defect's side, which opens into it. Meshed from a
+// 1 mm mask, as a CT's bone is.
+SkullMesh skull_with_a_sinus_under_its_defect(const Eigen::Vector3d& d0) {
+  const VoxelGrid g =
+      VoxelGrid::covering(Eigen::Vector3d::Constant(-92.0), Eigen::Vector3d::Constant(92.0), 1.0);
+  const Eigen::Vector3d down = (-Eigen::Vector3d::UnitZ() + d0.z() * d0).normalized();
+  std::vector<uint8_t> bone(g.size(), 0);
+  for (int k = 0; k < g.dims[2]; ++k)
+    for (int j = 0; j < g.dims[1]; ++j)
+      for (int i = 0; i < g.dims[0]; ++i) {
+        const Eigen::Vector3d p = g.center(i, j, k);
+        const double r = p.norm();
+        if (r < 69.0 || r > 88.0) continue;
+        const Eigen::Vector3d u = p / r;
+        const double off = angle_deg(u, d0);
+        if (off < 20.0) continue;  // the defect
+        const double side = angle_deg(u - u.dot(d0) * d0, down);
+        const bool sinus = off <= 34.0 && side <= 60.0;
+        const bool walls = off <= 37.0 && side <= 64.0;  // close it but on the defect's side
+        bone[g.index(i, j, k)] = sinus   ? (r >= 70.0 && r <= 73.0) || (r >= 84.0 && r <= 87.0)
+                                 : walls ? r >= 70.0 && r <= 87.0
+                                         : r >= 70.0 && r <= 76.0;
+      }
+  ExtractBoneSurfaceParams mask;
+  mask.threshold = 0.5;
+  return extract_bone_surface(mask_volume(bone, g), mask).mesh;
+}
+
+// A ray through both walls of a frontal sinus crosses 15–20 mm of bone, and the rim of a defect
+// that opens into the sinus is that bone. With rays that may cross 20 mm (the default) the rim
+// runs along the defect's edge over the sinus; with 15 mm no ray there crosses bone, and the
+// rim is not seen there.
+TEST(DetectDefect, TheRimRunsAlongAFrontalSinusTheDefectOpensInto) {
+  const Eigen::Vector3d d0 = Eigen::Vector3d(0.8, 0.3, 0.15).normalized();
+  const Eigen::Vector3d down = (-Eigen::Vector3d::UnitZ() + d0.z() * d0).normalized();
+  const SkullMesh skull = skull_with_a_sinus_under_its_defect(d0);
+  const SurfaceLocator locator(skull);
+  // The rim points over the sinus (within 50° of its middle, clear of its sides).
+  const auto over_the_sinus = [&](const DefectRegion& r) {
+    std::vector<double> off;
+    for (const Eigen::Vector3d& p : r.outer_rim) {
+      const Eigen::Vector3d u = p.normalized();
+      if (angle_deg(u - u.dot(d0) * d0, down) <= 50.0) off.push_back(angle_deg(u, d0));
+    }
+    return off;
+  };
+  const auto unseen_mm = [](const DefectRegion& r) {
+    double sum = 0.0;
+    for (const RimStretch& s : r.unseen_rim) sum += s.length_mm();
+    return sum;
+  };
+  DetectDefectParams params;
+  ASSERT_EQ(params.max_thickness_mm, 20.0);
+  const DefectRegion found = detect_defect(skull, locator, Eigen::Vector3d::Zero(), params);
+  ASSERT_TRUE(found.found()) << found.message;
+  EXPECT_LT(angle_deg(found.axis, d0), 3.0);
+  const std::vector<double> along = over_the_sinus(found);
+  EXPECT_GE(along.size(), 4u) << "the rim is seen along the sinus";
+  for (double off : along) EXPECT_LT(off, 23.0) << "at the defect's edge (20°), not beyond";
+  EXPECT_LT(unseen_mm(found), 10.0);
+  // The sinus spans about 55 mm of the rim: with 15 mm no ray there crosses bone, and all but
+  // a stray ray at the edge of its walls leave it unseen.
+  params.max_thickness_mm = 15.0;
+  const DefectRegion thin = detect_defect(skull, locator, Eigen::Vector3d::Zero(), params);
+  ASSERT_TRUE(thin.found()) << thin.message;
+  EXPECT_LE(over_the_sinus(thin).size(), 1u);
+  EXPECT_GT(unseen_mm(thin), 30.0);
+  RecordProperty("unseen_rim_mm_at_15", std::to_string(unseen_mm(thin)));
+  RecordProperty("unseen_rim_mm_at_20", std::to_string(unseen_mm(found)));
 }
 
 // A skull mesh's load report gives its borders to a detection that has none; borders already
