@@ -147,6 +147,11 @@ struct Row {
 constexpr double kMaxRimGapMm = 0.5, kMaxOverlapMm3 = 5.0, kTargetDice = 0.90;
 // The same defect planned (a plan of another opening has Dice 0 against it).
 constexpr double kSameDefectDice = 0.8;
+// The exports whose bone itself moved too far for the Dice target (450 HU, the strongest
+// smoothing: the tables thinner, the rim receded where thin bone at the edge is gone), measured
+// 0.883-0.892: a floor under them, so that a change that again loses the rim along the
+// frontal sinus (0.819-0.862 when a ray could cross only 15 mm of bone) fails here.
+constexpr double kMovedBoneDice = 0.87;
 // The own import's bone where the implant sits (bone_agreement): measured 0.980-1.000 on the
 // exports of its surface (re-meshed on 0.8 mm cells the lowest), 0.906-0.971 on other
 // thresholds and smoothings.
@@ -184,11 +189,11 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
     bool on_bone, meets_dice;
     // The own import's bone where the implant sits (bone_agreement ≥ kSameBone): planned with
     // the own plan's rays it meets the Dice target — all but where the rays start depends on
-    // the bone, not on its triangles (measured 0.957-0.988).
+    // the bone, not on its triangles (measured 0.932-0.990).
     bool same_bone;
   };
   const std::vector<Case> cases = {
-      {"open, 200 HU", [&] { return open(200.0); }, true, false, false},
+      {"open, 200 HU", [&] { return open(200.0); }, true, true, false},
       {"open, 226 HU (InVesalius bone)", [&] { return open(226.0); }, true, true, false},
       {"open, 300 HU", [&] { return open300; }, true, true, true},
       {"open, 400 HU", [&] { return open(400.0); }, true, true, false},
@@ -204,7 +209,7 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
          return to_polydata(load_skull(path, import).mesh);
        },
        true, false, false},
-      {"open, sinc pass band 0.1", [&] { return sinc_smoothed(open300, 0.1); }, true, false, false},
+      {"open, sinc pass band 0.1", [&] { return sinc_smoothed(open300, 0.1); }, true, true, false},
       {"open, sinc pass band 0.01", [&] { return sinc_smoothed(open300, 0.01); }, true, true,
        false},
       {"open, sinc pass band 0.001", [&] { return sinc_smoothed(open300, 0.001); }, true, false,
@@ -275,9 +280,7 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
       EXPECT_LE(row.overlap_mm3, kMaxOverlapMm3);
       EXPECT_GE(row.dice, kSameDefectDice);
     }
-    if (c.meets_dice) {
-      EXPECT_GE(row.dice, kTargetDice);
-    }
+    EXPECT_GE(row.dice, c.meets_dice ? kTargetDice : kMovedBoneDice);
     rows.push_back(row);
   }
   std::printf(
