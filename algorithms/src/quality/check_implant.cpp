@@ -32,6 +32,13 @@ std::string fmt1(const char* f, double a) {
   std::snprintf(buf, sizeof(buf), f, a);
   return buf;
 }
+// A measure over its limit, to a tenth of a millimetre, or finer where a tenth would read as
+// the limit itself ("for 2.0 mm; may be 2.0 mm").
+std::string over_limit(double value, double limit) {
+  for (const char* f : {"%.1f", "%.2f"})
+    if (fmt1(f, value) != fmt1(f, limit)) return fmt1(f, value);
+  return fmt1("%.3f", value);
+}
 // How near the bone thin material counts as the tapered edge of an implant resting on it, mm:
 // its own thinness, a voxel and a half, and the widest clearance asked.
 double on_bone_mm(const QualityParams& params, double h) {
@@ -275,18 +282,19 @@ void add_reasons(const MeshReport& rep, const QualityParams& params, bool with_b
     q.reasons.push_back(fmt("nowhere is the implant %.2f mm thick (thickest %.2f mm)",
                             params.min_thickness_mm, q.thickness_max_mm));
   if (q.corner_reach_mm > params.max_corner_mm)
-    q.reasons.push_back(
-        fmt(!with_bone ? "it is thinner than %.2f mm for %.1f mm"
-                       : "away from the bone it is thinner than %.2f mm for %.1f mm",
-            params.min_thickness_mm, q.corner_reach_mm) +
-        " (" + fmt1("%.1f", q.thin_off_bone_mm3) + " mm³; a sharp corner may be " +
-        fmt1("%.1f", params.max_corner_mm) + " mm" +
-        (!with_bone ? "; without the skull a tapered edge on the bone cannot be told"
-                      " from a corner: check with the skull)"
-                    : ")"));
+    q.reasons.push_back(fmt1(!with_bone ? "it is thinner than %.2f mm for "
+                                        : "away from the bone it is thinner than %.2f mm for ",
+                             params.min_thickness_mm) +
+                        over_limit(q.corner_reach_mm, params.max_corner_mm) + " mm" + " (" +
+                        fmt1("%.1f", q.thin_off_bone_mm3) + " mm³; a sharp corner may be " +
+                        fmt1("%.1f", params.max_corner_mm) + " mm" +
+                        (!with_bone
+                             ? "; without the skull a tapered edge on the bone cannot be told"
+                               " from a corner: check with the skull)"
+                             : ")"));
   if (q.taper_reach_mm > params.max_taper_mm)
-    q.reasons.push_back(fmt("its edge stays thinner than %.2f mm for %.1f mm",
-                            params.min_thickness_mm, q.taper_reach_mm) +
+    q.reasons.push_back(fmt1("its edge stays thinner than %.2f mm for ", params.min_thickness_mm) +
+                        over_limit(q.taper_reach_mm, params.max_taper_mm) + " mm" +
                         " (a tapered edge on the bone may be " + fmt1("%.1f", params.max_taper_mm) +
                         " mm wide)");
   if (!q.clearance_asked && q.rim_gap_mm > params.max_rim_gap_mm)

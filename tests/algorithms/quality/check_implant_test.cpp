@@ -108,6 +108,24 @@ TEST(CheckImplant, ATaperedEdgeOnTheBoneIsPrintableUpToItsWidth) {
   const QualityReport sharp = check_implant(wedge(15, 0), &bone);
   expect_reach(sharp.taper_reach_mm, 15);
   EXPECT_TRUE(has_reason(sharp, "its edge stays thinner than 1.00 mm"));
+  // Just over a limit that reads the same to a tenth, the measure is said finely enough not to
+  // read as the limit itself ("for 1.2 mm; may be 1.2 mm").
+  {
+    QualityParams close;
+    close.max_taper_mm = std::round(blunt.taper_reach_mm * 10.0) / 10.0 - 0.049;
+    ASSERT_LT(close.max_taper_mm, blunt.taper_reach_mm);
+    const QualityReport over = check_implant(wedge(40, 0), &bone, close);
+    ASSERT_FALSE(over.reasons.empty());
+    const std::string& said = over.reasons.front();
+    const size_t from = said.find(" for ") + 5, to = said.find(" mm (a tapered");
+    ASSERT_NE(to, std::string::npos) << said;
+    const std::string value = said.substr(from, to - from);
+    char limit[16];
+    std::snprintf(limit, sizeof(limit), "%.1f", close.max_taper_mm);
+    EXPECT_NE(value, limit) << said;
+    EXPECT_GT(std::stod(value), close.max_taper_mm) << said;
+    EXPECT_NEAR(std::stod(value), over.taper_reach_mm, 0.006) << said;
+  }
   // A 10° wedge's taper (5.2 mm) reaches past the distances the check first takes (as far as
   // the widest taper and corner allowed, and a millimetre): it is measured in full.
   const QualityReport sharper = check_implant(wedge(10, 0), &bone);
