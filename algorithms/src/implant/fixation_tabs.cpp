@@ -654,24 +654,17 @@ std::string mesh_tabs(const SkullMesh& implant, const SurfaceLocator& self,
     for (const Hole& s : c.tab.screws) {
       const double radius = 0.5 * p.screw_diameter_mm;
       const double below = p.thickness_mm + kUndersideMm + kPlugMm + 3.0;
-      const Eigen::Vector3d reach = Eigen::Vector3d::Constant(
-          std::max(0.5 * p.countersink_diameter_mm, radius) + 2.0 * h + below + 1.0);
-      const Eigen::Vector3d a = ((s.center - reach) - g.origin) / h,
-                            b = ((s.center + reach) - g.origin) / h;
-      for (int k = std::max(0, static_cast<int>(a.z()));
-           k <= std::min(g.dims[2] - 1, static_cast<int>(b.z()) + 1); ++k)
-        for (int j = std::max(0, static_cast<int>(a.y()));
-             j <= std::min(g.dims[1] - 1, static_cast<int>(b.y()) + 1); ++j)
-          for (int i = std::max(0, static_cast<int>(a.x()));
-               i <= std::min(g.dims[0] - 1, static_cast<int>(b.x()) + 1); ++i) {
-            const Eigen::Vector3d q = g.center(i, j, k) - s.center;
-            const double z = q.dot(s.axis);
-            if (z > 1.0 + 2.0 * h || z < -below) continue;
-            const double off_axis = (q - z * s.axis).norm();
-            const double open = radius + (sink > 0.0 ? std::max(0.0, z + sink) : 0.0);
-            float& f = field[g.index(i, j, k)];
-            f = std::min(f, static_cast<float>(off_axis - open));
-          }
+      const double reach =
+          std::max(0.5 * p.countersink_diameter_mm, radius) + 2.0 * h + below + 1.0;
+      for_voxels_near(g, s.center, reach, [&](int i, int j, int k) {
+        const Eigen::Vector3d q = g.center(i, j, k) - s.center;
+        const double z = q.dot(s.axis);
+        if (z > 1.0 + 2.0 * h || z < -below) return;
+        const double off_axis = (q - z * s.axis).norm();
+        const double open = radius + (sink > 0.0 ? std::max(0.0, z + sink) : 0.0);
+        float& f = field[g.index(i, j, k)];
+        f = std::min(f, static_cast<float>(off_axis - open));
+      });
     }
   const ExtractBoneSurfaceResult mesh =
       surface_of_signed_distance(std::move(field), g, into, p.iso_gap);

@@ -211,21 +211,6 @@ std::vector<uint8_t> thin_corners(const std::vector<float>& field, const VoxelGr
   return thin;
 }
 
-// Calls fn(i, j, k) for the voxels of `g` within `reach` mm of `center` along each axis (a
-// voxel more on the upper side).
-template <class Fn>
-void for_voxels_near(const VoxelGrid& g, const Eigen::Vector3d& center, double reach, Fn&& fn) {
-  const Eigen::Vector3d a = (center - Eigen::Vector3d::Constant(reach) - g.origin) / g.spacing,
-                        b = (center + Eigen::Vector3d::Constant(reach) - g.origin) / g.spacing;
-  for (int k = std::max(0, static_cast<int>(a.z()));
-       k <= std::min(g.dims[2] - 1, static_cast<int>(b.z()) + 1); ++k)
-    for (int j = std::max(0, static_cast<int>(a.y()));
-         j <= std::min(g.dims[1] - 1, static_cast<int>(b.y()) + 1); ++j)
-      for (int i = std::max(0, static_cast<int>(a.x()));
-           i <= std::min(g.dims[0] - 1, static_cast<int>(b.x()) + 1); ++i)
-        fn(i, j, k);
-}
-
 // Whether a voxel of `mask` lies within `reach` of the hole's axis, from 3 mm above its centre
 // to 16 mm below (as deep as plate_under looks).
 bool near_hole(const std::vector<uint8_t>& mask, const VoxelGrid& g, const Hole& hole,

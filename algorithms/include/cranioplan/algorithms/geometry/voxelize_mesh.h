@@ -2,6 +2,7 @@
 // Solid voxelisation of closed meshes on axis-aligned grids: the common ground of accuracy
 // metrics, overlap (penetration) checks and defect injection.
 #include <Eigen/Core>
+#include <algorithm>
 #include <array>
 #include <cstdint>
 #include <vector>
@@ -34,6 +35,21 @@ struct VoxelGrid {
   static VoxelGrid covering_at_most(const Eigen::Vector3d& lo, const Eigen::Vector3d& hi,
                                     double spacing, double max_voxels, int pad = 2);
 };
+
+/// Calls fn(i, j, k) for the voxels of `g` within `reach` mm of `center` along each axis (a
+/// voxel more on the upper side), clipped to the grid: the box a tool of that reach can touch.
+template <class Fn>
+void for_voxels_near(const VoxelGrid& g, const Eigen::Vector3d& center, double reach, Fn&& fn) {
+  const Eigen::Vector3d a = (center - Eigen::Vector3d::Constant(reach) - g.origin) / g.spacing,
+                        b = (center + Eigen::Vector3d::Constant(reach) - g.origin) / g.spacing;
+  for (int k = std::max(0, static_cast<int>(a.z()));
+       k <= std::min(g.dims[2] - 1, static_cast<int>(b.z()) + 1); ++k)
+    for (int j = std::max(0, static_cast<int>(a.y()));
+         j <= std::min(g.dims[1] - 1, static_cast<int>(b.y()) + 1); ++j)
+      for (int i = std::max(0, static_cast<int>(a.x()));
+           i <= std::min(g.dims[0] - 1, static_cast<int>(b.x()) + 1); ++i)
+        fn(i, j, k);
+}
 
 /// Bounding box of a mesh's vertices.
 std::pair<Eigen::Vector3d, Eigen::Vector3d> mesh_bounds(const SkullMesh& mesh);
