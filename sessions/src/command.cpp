@@ -252,7 +252,9 @@ int current_version(CommandType type) {
   // ("max_support_off_fit_mm"; versions 1 to 3 are read with 0, every ring point of the band).
   // propose_markers 5: the mirror read over a footprint around each ray
   // ("surfaces.mirror_footprint_mm"; versions 1 to 4 are read with 0, along the one ray).
-  if (type == CommandType::ProposeMarkers) return 5;
+  // propose_markers 6: mirror-guided, a fitting site of few rays smoothed more
+  // ("surfaces.weigh_sites_by_rays"; versions 1 to 5 are read with false, every site alike).
+  if (type == CommandType::ProposeMarkers) return 6;
   // load_skull 4: volumes in the patient's frame ("import.patient_frame"), a DICOM folder's
   // series ("import.dicom_series"), a mesh's far pieces dropped ("import.drop_far_pieces");
   // absent, as version 3 read them.
@@ -357,6 +359,7 @@ Json params_to_json(const ProposeParams& p) {
   j["smooth"] = params_to_json(p.smooth);
   j["surfaces"] = write_fields([](auto& v, auto& q) { surface_fit_fields(v, q); }, p.surfaces);
   j["surfaces"]["mirror_footprint_mm"] = p.surfaces.mirror_footprint_mm;
+  j["surfaces"]["weigh_sites_by_rays"] = p.surfaces.weigh_sites_by_rays;
   j["max_support_off_fit_mm"] = p.max_support_off_fit_mm;
   return j;
 }
@@ -591,14 +594,18 @@ void params_from_json(const ParamReader& r, ProposeParams& p) {
   if (detect.has("center")) p.detect.center = detect.vector3("center");
   params_from_json(ParamReader(r.value("smooth"), r.where() + " smooth"), p.smooth);
   // Version 1 (before the surfaces were fitted to the ring) has no "surfaces": the defaults.
-  // Versions 1 to 4 read the mirror along one ray: no footprint.
+  // Versions 1 to 4 read the mirror along one ray: no footprint. Versions 1 to 5 weigh every
+  // fitting site alike.
   p.surfaces.mirror_footprint_mm = 0.0;
+  p.surfaces.weigh_sites_by_rays = false;
   if (r.has("surfaces")) {
     const ParamReader surfaces(r.value("surfaces"), r.where() + " surfaces");
     Reader sv{surfaces};
     surface_fit_fields(sv, p.surfaces);
     if (surfaces.has("mirror_footprint_mm"))
       p.surfaces.mirror_footprint_mm = surfaces.number("mirror_footprint_mm");
+    if (surfaces.has("weigh_sites_by_rays"))
+      p.surfaces.weigh_sites_by_rays = surfaces.boolean("weigh_sites_by_rays");
   }
   // Versions 1 to 3 have none: support markers on every ring point of the band (0: off).
   p.max_support_off_fit_mm =

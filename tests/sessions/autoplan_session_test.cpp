@@ -43,7 +43,7 @@ TEST(AutoplanSession, TheProposalIsRecordedInItsCommand) {
   const auto at = test::first_command(s, CommandType::ProposeMarkers);
   ASSERT_TRUE(at);
   const Command propose = s.effective_commands()[*at];
-  EXPECT_EQ(propose.version, 5);
+  EXPECT_EQ(propose.version, 6);
   ASSERT_TRUE(propose.params.contains("result"));
   const Json& result = propose.params["result"];
   EXPECT_EQ(result["proposed"], true);

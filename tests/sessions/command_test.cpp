@@ -476,7 +476,8 @@ TEST(Commands, BuildImplant3FitsTheBoneAsItWasMadeTo) {
 // propose_markers 2 records how the surfaces are fitted and which opening was asked for; a
 // version-1 command (neither) is read with their defaults. Version 4 records how far support
 // markers may lie from the fitted surfaces; older ones are read without that rule. Version 5
-// records the footprint the mirror is read over; older ones read it along one ray.
+// records the footprint the mirror is read over; older ones read it along one ray. Version 6
+// records whether fitting sites of few rays are smoothed more; older ones weigh all alike.
 TEST(Commands, ProposeMarkersVersionTwoRoundTripsAndVersionOneGetsDefaults) {
   ProposeParams p;
   p.surfaces.ring_width_mm = 31.0;
@@ -485,13 +486,23 @@ TEST(Commands, ProposeMarkersVersionTwoRoundTripsAndVersionOneGetsDefaults) {
   p.max_support_off_fit_mm = 2.25;
   p.surfaces.mirror_footprint_mm = 2.5;
   const Json j = to_json(commands::propose_markers(p));
-  EXPECT_EQ(j["version"], 5);
+  EXPECT_EQ(j["version"], 6);
+  EXPECT_TRUE(p.surfaces.weigh_sites_by_rays) << "the default";
+  EXPECT_EQ(j["params"]["params"]["surfaces"]["weigh_sites_by_rays"], true);
   ProposeParams back;
   params_from_json(ParamReader(j["params"]["params"], "test"), back);
   EXPECT_EQ(back.surfaces.ring_width_mm, 31.0);
   EXPECT_EQ(back.surfaces.smoothing, 0.07);
   EXPECT_EQ(back.max_support_off_fit_mm, 2.25);
   EXPECT_EQ(back.surfaces.mirror_footprint_mm, 2.5);
+  EXPECT_TRUE(back.surfaces.weigh_sites_by_rays);
+  ProposeParams alike;
+  alike.surfaces.weigh_sites_by_rays = false;
+  ProposeParams alike_back;
+  params_from_json(
+      ParamReader(to_json(commands::propose_markers(alike))["params"]["params"], "test"),
+      alike_back);
+  EXPECT_FALSE(alike_back.surfaces.weigh_sites_by_rays);
   ASSERT_TRUE(back.detect.near.has_value());
   EXPECT_EQ(*back.detect.near, *p.detect.near);
   EXPECT_FALSE(j["params"]["params"]["detect"].contains("center")) << "unset: not written";
@@ -519,14 +530,25 @@ TEST(Commands, ProposeMarkersVersionTwoRoundTripsAndVersionOneGetsDefaults) {
   // Before version 4 support markers stood on every ring point of the band.
   EXPECT_EQ(old.max_support_off_fit_mm, 0.0);
   EXPECT_EQ(old.surfaces.mirror_footprint_mm, 0.0);
+  EXPECT_FALSE(old.surfaces.weigh_sites_by_rays);
   // Version 4 has the surfaces but no footprint: the mirror along one ray.
   Json v4 = j;
   v4["version"] = 4;
   v4["params"]["params"]["surfaces"].erase("mirror_footprint_mm");
+  v4["params"]["params"]["surfaces"].erase("weigh_sites_by_rays");
   ProposeParams four;
   params_from_json(ParamReader(command_from_json(v4, "old plan").params["params"], "test"), four);
   EXPECT_EQ(four.surfaces.ring_width_mm, 31.0);
   EXPECT_EQ(four.surfaces.mirror_footprint_mm, 0.0);
+  EXPECT_FALSE(four.surfaces.weigh_sites_by_rays);
+  // Version 5 has the footprint but weighs every site alike.
+  Json v5 = j;
+  v5["version"] = 5;
+  v5["params"]["params"]["surfaces"].erase("weigh_sites_by_rays");
+  ProposeParams five;
+  params_from_json(ParamReader(command_from_json(v5, "old plan").params["params"], "test"), five);
+  EXPECT_EQ(five.surfaces.mirror_footprint_mm, 2.5);
+  EXPECT_FALSE(five.surfaces.weigh_sites_by_rays);
 }
 
 TEST(Commands, UnknownTypeVersionAndMissingParameterAreNamed) {

@@ -147,10 +147,10 @@ struct Row {
 constexpr double kMaxRimGapMm = 0.5, kMaxOverlapMm3 = 5.0, kTargetDice = 0.90;
 // The same defect planned (a plan of another opening has Dice 0 against it).
 constexpr double kSameDefectDice = 0.8;
-// The exports whose bone itself moved too far for the Dice target (450 HU, the strongest
-// smoothing: the tables thinner, the rim receded where thin bone at the edge is gone), measured
-// 0.883-0.892: a floor under them, so that a change that again loses the rim along the
-// frontal sinus (0.819-0.862 when a ray could cross only 15 mm of bone) fails here.
+// The export whose bone itself moved too far for the Dice target (open at 450 HU: the tables
+// thinner, the opening 72 mm² larger where thin bone by the orbit is gone; with the own plan's
+// rays 0.877), measured 0.879: a floor under it, so that a change that again loses the rim
+// along the frontal sinus (0.843 when a ray could cross only 15 mm of bone) fails here.
 constexpr double kMovedBoneDice = 0.87;
 // The own import's bone where the implant sits (bone_agreement): measured 0.980-1.000 on the
 // exports of its surface (re-meshed on 0.8 mm cells the lowest), 0.906-0.971 on other
@@ -189,7 +189,7 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
     bool on_bone, meets_dice;
     // The own import's bone where the implant sits (bone_agreement ≥ kSameBone): planned with
     // the own plan's rays it meets the Dice target — all but where the rays start depends on
-    // the bone, not on its triangles (measured 0.932-0.990).
+    // the bone, not on its triangles (measured 0.943-0.992).
     bool same_bone;
   };
   const std::vector<Case> cases = {
@@ -208,11 +208,11 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
          import.threshold = 450.0;
          return to_polydata(load_skull(path, import).mesh);
        },
-       true, false, false},
+       true, true, false},
       {"open, sinc pass band 0.1", [&] { return sinc_smoothed(open300, 0.1); }, true, true, false},
       {"open, sinc pass band 0.01", [&] { return sinc_smoothed(open300, 0.01); }, true, true,
        false},
-      {"open, sinc pass band 0.001", [&] { return sinc_smoothed(open300, 0.001); }, true, false,
+      {"open, sinc pass band 0.001", [&] { return sinc_smoothed(open300, 0.001); }, true, true,
        false},
       {"open, decimated to 50 %", [&] { return decimated(open300, 0.5); }, true, true, true},
       {"open, decimated to 25 %", [&] { return decimated(open300, 0.25); }, true, true, true},
@@ -343,10 +343,10 @@ TEST(RobustnessCorpus, HowFarThePlanMovesWithItsOwnRays) {
     std::printf("| %s | %.3f | %.2f | %s |\n", m.name.c_str(), dice, r.quality.rim_gap_mm,
                 r.quality.printable ? "yes" : "no");
     EXPECT_TRUE(r.quality.printable) << (r.quality.reasons.empty() ? "" : r.quality.reasons[0]);
-    // Measured 0.911-0.963 (0.915-0.941 with rays that could cross only 15 mm of bone,
-    // 0.900-0.954 with the edge markers beside the orbit at the rim's last bone as well): a
-    // floor below it, so that a change that makes the plan follow its rays more fails here.
-    EXPECT_GE(dice, 0.905);
+    // Measured 0.938-0.972 (0.911-0.963 with every fitting site weighed alike, 0.915-0.941
+    // with rays that could cross only 15 mm of bone as well): a floor below it, so that a
+    // change that makes the plan follow its rays more fails here.
+    EXPECT_GE(dice, 0.925);
   }
   std::printf("mean Dice %.3f\n", sum / static_cast<double>(moves.size()));
 }

@@ -102,11 +102,14 @@ TEST(SampleCase, AutoplanFillsTheRealDefect) {
   // rim's unseen stretch by the orbit is 26 mm long and the rod forms (from the program's
   // own start, nearer the opening, it is 14 mm and the fill it leaves is thin enough anyway),
   // and their rays cross at most 15 mm of bone: with the default 20 mm the rim follows the
-  // frontal sinus's front wall and the fragment the rod reaches is no longer at the edge.
+  // frontal sinus's front wall and the fragment the rod reaches is no longer at the edge. Their
+  // fitting sites are weighed alike, as before propose_markers 6: weighed by their rays, these
+  // plans have no rod, and the two rules leave rim gaps within 0.01 mm of each other.
   {
     AutoplanParams kept;
     kept.propose.detect.center = r.plane.plane.project(vertex_centroid(skull.mesh));
     kept.propose.detect.max_thickness_mm = 15.0;
+    kept.propose.surfaces.weigh_sites_by_rays = false;
     kept.implant.trim.thin_fills_removed = false;
     const AutoplanResult rod = autoplan(skull.mesh, Landmarks{}, kept);
     ASSERT_TRUE(rod.planned()) << rod.message;
@@ -115,6 +118,7 @@ TEST(SampleCase, AutoplanFillsTheRealDefect) {
     AutoplanParams every_ring;
     every_ring.propose.detect.center = kept.propose.detect.center;
     every_ring.propose.detect.max_thickness_mm = 15.0;
+    every_ring.propose.surfaces.weigh_sites_by_rays = false;
     every_ring.propose.max_support_off_fit_mm = 0.0;
     const AutoplanResult clearance = autoplan(skull.mesh, Landmarks{}, every_ring);
     ASSERT_TRUE(clearance.planned()) << clearance.message;
@@ -368,8 +372,10 @@ TEST(SampleCase, RimOnlyPlanMeetsTheRealBone) {
 
 // The sample's PEEK plan, its rays crossing up to 20 mm of bone (the default, set here so that
 // the case stays the same: the rim then follows the frontal sinus's front wall;
-// docs/AUTOPLAN.md), made with today's rules and as build_implant 11 made it: `set(params, today)`
-// adds the tabs or holes and chooses the rule. Empty when the sample is not installed.
+// docs/AUTOPLAN.md) and every fitting site weighed alike (as propose_markers 5 fitted them; the
+// plan weighed by its sites' rays has neither the tab nor the hole these tests need), made with
+// today's rules and as build_implant 11 made it: `set(params, today)` adds the tabs or holes
+// and chooses the rule. Empty when the sample is not installed.
 std::vector<AutoplanResult> peek_plans_over_the_sinus(
     const std::function<void(ImplantParams&, bool)>& set) {
   const std::string path = sample_case_path();
@@ -379,6 +385,7 @@ std::vector<AutoplanResult> peek_plans_over_the_sinus(
   for (const bool today : {true, false}) {
     AutoplanParams params;
     params.propose.detect.max_thickness_mm = 20.0;
+    params.propose.surfaces.weigh_sites_by_rays = false;
     params.implant.material = material_preset("peek");
     set(params.implant, today);
     plans.push_back(autoplan(skull.mesh, Landmarks{}, params));
