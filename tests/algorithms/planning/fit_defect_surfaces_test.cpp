@@ -446,8 +446,8 @@ TEST(FitDefectSurfaces, VaultModelIsChosenByTheRingsBandNextToTheOpening) {
 // head as the mirror: the correction should be nothing, and the ring's roughness is what it
 // must not follow. Sites of a ray or two (where the ring is cut short) catch single bumps, and
 // which rays fall in them changes with where the rays start. Planned from the origin and from
-// 1 mm away along each axis, the fitted outer table lies nearer the truth on every start,
-// and its worst error over them is smaller (measured: median 0.082 against 0.089 mm on
+// 1 mm away along each axis, the fitted outer table lies as near the truth or nearer on every
+// start, and its worst error over them is smaller (measured: median 0.082 against 0.089 mm on
 // average, worst 0.33 against 0.36 mm).
 TEST(FitDefectSurfaces, MirrorGuidedSitesOfFewRaysBendTheCorrectionLess) {
   const Case& c = the_case();
