@@ -791,7 +791,8 @@ void tabs_into(const SkullMesh& implant, const SurfaceLocator& bone, const Eigen
                   "; ";
     if (moved > 0)
       r.message += std::to_string(moved) + (moved == 1 ? " tab" : " tabs") +
-                   " moved along the rim from where it would stand off the bone; ";
+                   " moved along the rim from where " + (moved == 1 ? "it" : "they") +
+                   " would stand off the bone; ";
   }
   for (Candidate& c : placed) r.tabs.push_back(std::move(c.tab));
   r.status = TabResult::Status::Added;

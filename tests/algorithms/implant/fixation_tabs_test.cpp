@@ -5,6 +5,7 @@
 #include <Eigen/Geometry>
 #include <cmath>
 #include <functional>
+#include <vector>
 
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
@@ -111,15 +112,17 @@ TEST(FixationTabs, EvenlyPlacedTabsLieOnTheBoneWithTheirScrewsThrough) {
 }
 
 // The bone of bone() with a pit 1.5 mm across and `depth` mm deep in its outer table, 1.4 to
-// 2.9 mm beyond the opening's edge at y = 70, 1 to 2.5 mm to the side of x = 50: under a tab at
-// the middle of that side, between the points at which the even placement looks at the bone
-// (a fragment's surface uneven at a finer scale than they see), wider than a crack the tab's
-// underside bridges.
-SkullMesh pitted_bone(double depth) {
+// 2.9 mm beyond the opening's edge at y = 70, from each x of `pits_from_x` (by default 1 to
+// 2.5 mm to the side of x = 50: under a tab at the middle of that side), between the points at
+// which the even placement looks at the bone (a fragment's surface uneven at a finer scale than
+// they see), wider than a crack the tab's underside bridges.
+SkullMesh pitted_bone(double depth, const std::vector<double>& pits_from_x = {51.0}) {
   return solid_of(
       [=](const Eigen::Vector3d& p) {
         const bool hole = p.x() > 30 && p.x() < 70 && p.y() > 30 && p.y() < 70;
-        const bool pit = p.x() > 51.0 && p.x() < 52.5 && p.y() > 71.4 && p.y() < 72.9;
+        bool pit = false;
+        for (const double x0 : pits_from_x)
+          pit = pit || (p.x() > x0 && p.x() < x0 + 1.5 && p.y() > 71.4 && p.y() < 72.9);
         return p.z() > 0 && p.z() < (pit ? 6.0 - depth : 6.0) && !hole;
       },
       {0, 0, 0}, {100, 100, 6});
@@ -173,6 +176,26 @@ TEST(FixationTabs, AnEvenlyPlacedTabThatWouldStandOffTheBoneIsPlacedAgain) {
     EXPECT_FALSE(over_pit(t)) << t.rim.transpose();
     EXPECT_LE(tab_gap(joined, on_bone, t), 0.2) << t.rim.transpose();
   }
+  const QualityReport report = report_with_tabs(r, skull);
+  EXPECT_TRUE(report.printable) << (report.reasons.empty() ? "" : report.reasons.front());
+  EXPECT_LE(report.tab_gap_mm, 0.2);
+}
+
+// A second pit where the first tab placed again would land (under the side's tab at x = 44):
+// the second round moves that one too. Two tabs moved, none over a pit, all four on the bone.
+TEST(FixationTabs, ATabPlacedAgainOntoAnotherPitIsPlacedOnceMore) {
+  const SkullMesh skull = pitted_bone(3.0, {51.0, 44.5}), implant = plug();
+  const SurfaceLocator on_bone(skull);
+  TabParams p = resolved(TabParams{}, std::nan(""));
+  p.automatic = true;
+  const TabResult r = add_fixation_tabs(implant, on_bone, kInside, p);
+  ASSERT_TRUE(r.usable()) << r.message;
+  ASSERT_EQ(r.tabs.size(), 4u);
+  EXPECT_NE(r.message.find("2 tabs moved along the rim from where they would stand off"),
+            std::string::npos)
+      << r.message;
+  const SurfaceLocator joined(r.mesh);
+  for (const Tab& t : r.tabs) EXPECT_LE(tab_gap(joined, on_bone, t), 0.2) << t.rim.transpose();
   const QualityReport report = report_with_tabs(r, skull);
   EXPECT_TRUE(report.printable) << (report.reasons.empty() ? "" : report.reasons.front());
   EXPECT_LE(report.tab_gap_mm, 0.2);
