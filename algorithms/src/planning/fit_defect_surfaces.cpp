@@ -339,7 +339,7 @@ struct DefectSurfaceFit {
     }
     std::vector<Eigen::Vector2d> uv;
     std::vector<double> h;
-    std::vector<int> rays;
+    std::vector<double> rays;
     for (const auto& [cell, sum] : cells) {
       const auto& [uv_sum, h_sum, count] = sum;
       uv.push_back(uv_sum / count);
@@ -350,11 +350,8 @@ struct DefectSurfaceFit {
     std::vector<double> lambda(uv.size(), std::max(0.0, smoothing));
     // Mirror-guided, a site of fewer rays than the median site is smoothed in proportion.
     if (s.mirror_guided && params.weigh_sites_by_rays && !rays.empty()) {
-      std::vector<int> sorted = rays;
-      std::nth_element(sorted.begin(), sorted.begin() + sorted.size() / 2, sorted.end());
-      const double typical = sorted[sorted.size() / 2];
-      for (size_t k = 0; k < rays.size(); ++k)
-        lambda[k] *= std::max(1.0, typical / static_cast<double>(rays[k]));
+      const double typical = median(rays);
+      for (size_t k = 0; k < rays.size(); ++k) lambda[k] *= std::max(1.0, typical / rays[k]);
     }
     return tps.fit(uv, h, lambda, 1e-3) ? static_cast<int>(uv.size()) : 0;
   }
