@@ -9,8 +9,10 @@
 #include "cranioplan/algorithms/alignment/fit_sagittal_plane.h"
 #include "cranioplan/algorithms/alignment/mirror_mesh.h"
 #include "cranioplan/algorithms/alignment/register_icp.h"
+#include "cranioplan/algorithms/geometry/mesh_components.h"
 #include "cranioplan/algorithms/io/load_skull.h"
 #include "cranioplan/algorithms/io/mesh_report.h"
+#include "cranioplan/algorithms/io/read_mesh.h"
 #include "cranioplan/algorithms/io/read_volume.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/algorithms/planning/autoplan.h"
@@ -100,14 +102,34 @@ Subcommand add_info(CLI::App& app, const bool& json) {
   auto* cmd = app.add_subcommand("info", "Report a mesh (or a volume's bone surface)");
   cmd->add_option("MESH", o->path, "mesh (.stl .ply .obj .off .vtp) or volume")->required();
   add_import_options(cmd, o->import);
-  return {cmd, [o, &json] {
-            const LoadedSkull s = load_surface(o->path, o->import.params());
-            Json r = to_json(report_mesh(s.mesh));
-            r["file"] = skull_json(s);
-            print_warnings(s.warnings, json);
-            print_result(r, json);
-            return kOk;
-          }};
+  return {
+      cmd, [o, &json] {
+        LoadedSkull s = load_surface(o->path, o->import.params());
+        Json r = to_json(report_mesh(s.mesh));
+        // The file as it is; read as a skull, its repeated triangles are dropped and its
+        // patches that wind against their neighbours turned (load_skull), in this order on
+        // the file's own triangles, which a non-manifold count alone would misname.
+        TriangleSoup soup = s.source_kind == "mesh" ? read_mesh_soup(o->path) : to_soup(s.mesh);
+        const long long repeated = drop_repeated_triangles(soup);
+        r["repeated_triangles"] = repeated;
+        if (repeated > 0)
+          s.warnings.push_back(o->path + ": " + format_count(repeated) +
+                               " triangles repeat another's three corners; read as a skull "
+                               "the copies are dropped");
+        const SoupOrientation wound = orient_consistently(soup);
+        r["wound_against_neighbours"] = {{"triangles", wound.triangles_turned},
+                                         {"patches", wound.patches_turned}};
+        if (wound.triangles_turned > 0)
+          s.warnings.push_back(o->path + ": " + format_count(wound.triangles_turned) +
+                               " triangles in " + format_count(wound.patches_turned) +
+                               (wound.patches_turned == 1 ? " patch wind" : " patches wind") +
+                               " against their neighbours (inconsistent winding); read as a skull "
+                               "(autoplan, pipeline, the wizard) they are turned to agree");
+        r["file"] = skull_json(s);
+        print_warnings(s.warnings, json);
+        print_result(r, json);
+        return kOk;
+      }};
 }
 
 // import-ct: a CT's or a label volume's bone surface, written as a mesh

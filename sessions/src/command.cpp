@@ -230,6 +230,9 @@ int current_version(CommandType type) {
   // clearance ("clearance_zones") and the holes drilled ("perforations"); version 5 is read
   // without them.
   // build_implant 7: fixation tabs ("tabs"); version 6 is read without them.
+  // load_skull 5: a mesh's repeated triangles dropped ("import.drop_repeated_triangles") and
+  // its patches that wind against their neighbours turned to agree
+  // ("import.orient_consistently"), neither when absent.
   // build_implant 8 and export_implant 2: tabs, holes and a mould meshed with field values kept
   // 1e-3 off the iso-level (no sliver triangles); earlier versions are meshed as they were.
   // build_implant 9: holes drilled along the plate's mid-normal and under their whole
@@ -258,7 +261,7 @@ int current_version(CommandType type) {
   // load_skull 4: volumes in the patient's frame ("import.patient_frame"), a DICOM folder's
   // series ("import.dicom_series"), a mesh's far pieces dropped ("import.drop_far_pieces");
   // absent, as version 3 read them.
-  if (type == CommandType::LoadSkull) return 4;
+  if (type == CommandType::LoadSkull) return 5;
   // register 2 and adjust_plane 2 record the registration they gave ("result"; adjust_plane:
   // "registration", when the mirror was registered again), which a replay applies.
   if (type == CommandType::FitPlane || type == CommandType::Register ||
@@ -320,6 +323,8 @@ Json params_to_json(const ExtractBoneSurfaceParams& p) {
   j["canonical"] = p.canonical;
   j["mesh_unit_mm"] = p.mesh_unit_mm;
   j["orient_outward"] = p.orient_outward;
+  j["orient_consistently"] = p.orient_consistently;
+  j["drop_repeated_triangles"] = p.drop_repeated_triangles;
   j["patient_frame"] = p.patient_frame;
   j["drop_far_pieces"] = p.drop_far_pieces;
   j["dicom_series"] = p.dicom_series;
@@ -543,6 +548,10 @@ void params_from_json(const ParamReader& r, ExtractBoneSurfaceParams& p) {
     throw SessionError(r.where(), "parameter 'mesh_unit_mm' must be a positive length in mm");
   // Nor did they turn a skull that winds inward outward.
   p.orient_outward = r.has("orient_outward") && r.boolean("orient_outward");
+  // Before load_skull 5, nor patches that wind against their neighbours turned to agree.
+  p.orient_consistently = r.has("orient_consistently") && r.boolean("orient_consistently");
+  p.drop_repeated_triangles =
+      r.has("drop_repeated_triangles") && r.boolean("drop_repeated_triangles");
   // Before load_skull 4, a NRRD's or NIfTI's positions were read as the file writes them (NIfTI
   // in RAS), and a mesh's far pieces were kept.
   p.patient_frame = r.has("patient_frame") && r.boolean("patient_frame");

@@ -30,6 +30,27 @@ TEST(Cli, InfoPlaneMirrorRegisterOnASyntheticHead) {
   const Json info = Json::parse(out);
   EXPECT_TRUE(info["watertight"].get<bool>());
   EXPECT_EQ(info["triangles"].get<long long>(), static_cast<long long>(head.n_faces()));
+  EXPECT_EQ(info["repeated_triangles"], 0);
+  EXPECT_EQ(info["wound_against_neighbours"]["triangles"], 0);
+  // The file as it is: a patch wound the other way, and a triangle written twice, counted
+  // (read as a skull they are repaired: LoadSkull tests).
+  TriangleSoup odd = to_soup(head);
+  long long turned = 0;
+  for (Eigen::Vector3i& t : odd.triangles)
+    if (odd.vertices[t[0]].z() > 60.0 && odd.vertices[t[1]].z() > 60.0 &&
+        odd.vertices[t[2]].z() > 60.0) {
+      std::swap(t[1], t[2]);
+      ++turned;
+    }
+  ASSERT_GT(turned, 0);
+  ASSERT_LT(2 * turned, static_cast<long long>(odd.triangles.size()));
+  odd.triangles.push_back(odd.triangles.front());
+  write_mesh(build_mesh(odd), dir.path("odd.stl"));
+  ASSERT_EQ(test::run_command(kCli + " info " + dir.path("odd.stl") + " --json", &out), 0);
+  const Json odd_info = Json::parse(out);
+  EXPECT_EQ(odd_info["repeated_triangles"], 1);
+  EXPECT_EQ(odd_info["wound_against_neighbours"]["triangles"], turned);
+  EXPECT_EQ(odd_info["wound_against_neighbours"]["patches"], 1);
 
   ASSERT_EQ(
       test::run_command(

@@ -473,6 +473,27 @@ void read_into(const std::string& path, const ReadMeshParams& params, MeshFile& 
   if (params.unit_mm != 1.0)
     for (auto& v : soup.vertices) v *= params.unit_mm;
   if (params.far_piece_mm > 0.0) drop_far_pieces(path, params.far_piece_mm, soup, out);
+  if (params.drop_repeated_triangles) {
+    out.repeated_dropped = drop_repeated_triangles(soup);
+    if (out.repeated_dropped > 0)
+      out.warnings.push_back(path + ": " + format_count(out.repeated_dropped) +
+                             " triangles repeat another's three corners (the surface written "
+                             "twice there); the copies were dropped");
+  }
+  if (params.orient_consistently) {
+    const SoupOrientation o = orient_consistently(soup);
+    out.triangles_turned = o.triangles_turned;
+    out.patches_turned = o.patches_turned;
+    if (o.triangles_turned > 0)
+      out.warnings.push_back(
+          path + ": " + format_count(o.triangles_turned) + " triangles in " +
+          format_count(o.patches_turned) + (o.patches_turned == 1 ? " patch" : " patches") +
+          " wound against their neighbours (inconsistent winding); they were turned to agree");
+    if (o.conflicts > 0)
+      out.warnings.push_back(path + ": " + format_count(o.conflicts) +
+                             (o.conflicts == 1 ? " edge where" : " edges where") +
+                             " the surface cannot wind one way (a twisted seam); left as read");
+  }
   if (params.orient_outward && enclosed_volume(soup) < 0.0) {
     for (auto& t : soup.triangles) std::swap(t[1], t[2]);
     out.turned_outward = true;

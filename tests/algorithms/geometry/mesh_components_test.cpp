@@ -67,5 +67,112 @@ TEST(MeshComponents, BoxesMeasureTheGapBetweenPieces) {
   EXPECT_NEAR(boxes[0].gap_to(corner), std::sqrt(27.0), 1e-12);
 }
 
+// Triangles whose centroid lies within `radius` of `centre` wound the other way.
+long long flip_patch(TriangleSoup& s, const Eigen::Vector3d& centre, double radius) {
+  long long n = 0;
+  for (Eigen::Vector3i& t : s.triangles)
+    if (((s.vertices[t[0]] + s.vertices[t[1]] + s.vertices[t[2]]) / 3.0 - centre).norm() < radius) {
+      std::swap(t[1], t[2]);
+      ++n;
+    }
+  return n;
+}
+
+// A head with a hole (open, as an export is) and two patches wound the other way, one across
+// the hole's rim: each is turned back, the rest left, and the soup is the head's again.
+TEST(MeshComponents, PatchesWoundAgainstTheirNeighboursAreTurnedBack) {
+  const Eigen::Vector3d rim = test::head_surface_point(Eigen::Vector3d(0.7, 0.1, 0.7).normalized());
+  const TriangleSoup head = to_soup(test::cut_hole(test::make_symmetric_head(4), rim, 25));
+  TriangleSoup s = head;
+  const long long near_rim = flip_patch(s, rim + Eigen::Vector3d(0, 20, 0), 20.0);
+  const long long behind =
+      flip_patch(s, test::head_surface_point(Eigen::Vector3d(-0.2, -1, 0.1).normalized()), 15.0);
+  ASSERT_GT(near_rim, 20);
+  ASSERT_GT(behind, 20);
+  const SoupOrientation o = orient_consistently(s);
+  EXPECT_EQ(o.triangles_turned, near_rim + behind);
+  EXPECT_EQ(o.patches_turned, 2);
+  EXPECT_EQ(o.conflicts, 0);
+  EXPECT_EQ(s.triangles, head.triangles);
+  // Already consistent: nothing turned, whichever way the whole surface winds.
+  TriangleSoup inward = head;
+  for (Eigen::Vector3i& t : inward.triangles) std::swap(t[1], t[2]);
+  const TriangleSoup inward_before = inward;
+  EXPECT_EQ(orient_consistently(inward).triangles_turned, 0);
+  EXPECT_EQ(inward.triangles, inward_before.triangles);
+  // The larger part by area keeps its winding: a patch over most of the head turns the rest.
+  TriangleSoup most = head;
+  const long long big = flip_patch(most, Eigen::Vector3d::Zero(), 1e9);
+  flip_patch(most, rim + Eigen::Vector3d(0, 20, 0), 20.0);
+  EXPECT_EQ(orient_consistently(most).triangles_turned, near_rim);
+  EXPECT_EQ(big, static_cast<long long>(head.triangles.size()));
+}
+
+// Unwelded (every triangle its own corners, as some OBJ and PLY exporters write): corners are
+// compared by position, so the same patch is found.
+TEST(MeshComponents, OrientationComparesCornersByPosition) {
+  const TriangleSoup head = to_soup(test::make_symmetric_head(3));
+  TriangleSoup loose;
+  for (const Eigen::Vector3i& t : head.triangles) {
+    const int n = static_cast<int>(loose.vertices.size());
+    for (int k = 0; k < 3; ++k) loose.vertices.push_back(head.vertices[t[k]]);
+    loose.triangles.emplace_back(n, n + 1, n + 2);
+  }
+  const TriangleSoup want = loose;
+  const long long flipped = flip_patch(
+      loose, test::head_surface_point(Eigen::Vector3d(0.3, 0.5, 0.8).normalized()), 25.0);
+  ASSERT_GT(flipped, 10);
+  const SoupOrientation o = orient_consistently(loose);
+  EXPECT_EQ(o.triangles_turned, flipped);
+  EXPECT_EQ(o.patches_turned, 1);
+  EXPECT_EQ(loose.triangles, want.triangles);
+}
+
+// A patch written twice (once as it is, once wound the other way) and a triangle three times:
+// every copy is dropped, the first of each kept, and the soup is the head's again.
+TEST(MeshComponents, RepeatedTrianglesAreDroppedWhicheverWayTheyWind) {
+  const TriangleSoup head = to_soup(test::make_symmetric_head(3));
+  TriangleSoup s = head;
+  long long copies = 0;
+  for (size_t t = 0; t < head.triangles.size(); t += 7) {
+    Eigen::Vector3i c = head.triangles[t];
+    if (t % 2 == 0) std::swap(c[1], c[2]);
+    s.triangles.push_back(c);
+    ++copies;
+  }
+  s.triangles.push_back(head.triangles[3]);
+  s.triangles.push_back(head.triangles[3]);
+  // A copy with its own vertices at the same positions is a copy too.
+  const int n = static_cast<int>(s.vertices.size());
+  for (int k = 0; k < 3; ++k) s.vertices.push_back(head.vertices[head.triangles[5][k]]);
+  s.triangles.emplace_back(n + 2, n, n + 1);
+  EXPECT_EQ(drop_repeated_triangles(s), copies + 3);
+  EXPECT_EQ(s.triangles, head.triangles);
+  EXPECT_EQ(drop_repeated_triangles(s), 0);
+}
+
+// A Möbius strip cannot wind one way: its seam is counted, and nothing is lost.
+TEST(MeshComponents, AMoebiusStripsSeamIsCounted) {
+  TriangleSoup strip;
+  const int n = 24;
+  for (int i = 0; i < n; ++i) {
+    const double a = 2.0 * M_PI * i / n, half = 0.5 * a;
+    for (double w : {-1.0, 1.0}) {
+      const double r = 10.0 + w * std::cos(half);
+      strip.vertices.emplace_back(r * std::cos(a), r * std::sin(a), w * std::sin(half));
+    }
+  }
+  for (int i = 0; i < n; ++i) {
+    const int a0 = 2 * i, a1 = 2 * i + 1;
+    // After a full turn the strip's two edges have swapped sides.
+    const int b0 = i + 1 < n ? 2 * (i + 1) : 1, b1 = i + 1 < n ? 2 * (i + 1) + 1 : 0;
+    strip.triangles.emplace_back(a0, b0, a1);
+    strip.triangles.emplace_back(a1, b0, b1);
+  }
+  const SoupOrientation o = orient_consistently(strip);
+  EXPECT_EQ(o.conflicts, 1);
+  EXPECT_EQ(strip.triangles.size(), static_cast<size_t>(2 * n));
+}
+
 }  // namespace
 }  // namespace cranioplan

@@ -127,6 +127,90 @@ TEST(LoadSkull, ASkullThatWindsInwardIsTurnedOutward) {
   EXPECT_LT(signed_volume(load_skull(dir.path("in.stl"), as_it_came).mesh), 0.0);
 }
 
+// Whether triangle `t`'s centroid lies within `radius` of `centre`.
+bool centroid_within(const TriangleSoup& s, const Eigen::Vector3i& t, const Eigen::Vector3d& centre,
+                     double radius) {
+  return ((s.vertices[t[0]] + s.vertices[t[1]] + s.vertices[t[2]]) / 3.0 - centre).norm() < radius;
+}
+
+// `clean` and `damaged` written as STL and read as skulls: the damaged file gives the clean
+// mesh (the same vertices and triangles in the same order) with one warning more, its first,
+// which names the file and says `says`. The damaged file's path.
+std::string expect_repaired(const TempDir& dir, const SkullMesh& clean, const TriangleSoup& damaged,
+                            const std::string& says) {
+  write_mesh(clean, dir.path("clean.stl"));
+  write_mesh(build_mesh(damaged), dir.path("damaged.stl"));
+  const LoadedSkull repaired = load_skull(dir.path("damaged.stl"));
+  const LoadedSkull as_clean = load_skull(dir.path("clean.stl"));
+  const TriangleSoup a = to_soup(repaired.mesh), b = to_soup(as_clean.mesh);
+  EXPECT_EQ(a.triangles, b.triangles);
+  EXPECT_EQ(a.vertices, b.vertices);
+  EXPECT_EQ(repaired.warnings.size(), as_clean.warnings.size() + 1);
+  EXPECT_FALSE(repaired.warnings.empty());
+  if (!repaired.warnings.empty())
+    EXPECT_NE(repaired.warnings[0].find("damaged.stl: " + says), std::string::npos)
+        << repaired.warnings[0];
+  return dir.path("damaged.stl");
+}
+
+// A patch wound against its neighbours (left by some exporters and repairs) cannot be joined
+// to them in a halfedge mesh: read as it came, its seam is split into holes next to the
+// defect's rim, reported as non-manifold, and the sample's plan with such a patch at its rim
+// agreed with its own at Dice 0.84. load_skull turns the patch back, with a warning, into the
+// very mesh the consistent file gives, so that every later stage is the same.
+TEST(LoadSkull, APatchWoundAgainstItsNeighboursIsTurnedBack) {
+  TempDir dir;
+  const Eigen::Vector3d rim = test::head_surface_point(Eigen::Vector3d(0.7, 0.1, 0.7).normalized());
+  const SkullMesh head = test::cut_hole(test::make_symmetric_head(4), rim, 25);
+  TriangleSoup patched = to_soup(head);
+  long long flipped = 0;
+  for (auto& t : patched.triangles)
+    if (centroid_within(patched, t, rim + Eigen::Vector3d(0, 20, 0), 20.0)) {
+      std::swap(t[1], t[2]);
+      ++flipped;
+    }
+  ASSERT_GT(flipped, 20);
+  const std::string file = expect_repaired(
+      dir, head, patched,
+      format_count(flipped) + " triangles in 1 patch wound against their neighbours");
+  // Read as it came (plans whose load_skull is version 1 to 4), the seam splits the mesh.
+  ExtractBoneSurfaceParams as_it_came;
+  as_it_came.orient_consistently = false;
+  const LoadedSkull split = load_skull(file, as_it_came);
+  EXPECT_GT(split.mesh.n_vertices(), head.n_vertices()) << "the seam's corners doubled";
+  bool nonmanifold = false;
+  for (const std::string& w : split.warnings)
+    nonmanifold |= w.find("non-manifold") != std::string::npos;
+  EXPECT_TRUE(nonmanifold);
+}
+
+// A patch of the skull written twice, once wound the other way (pieces that overlapped when an
+// exporter merged them): the copies are dropped, with a warning, and the mesh is the one the
+// file without them gives. Kept, they doubled every crossing there (the sample with its rim's
+// patch written twice: rim gap 0.86 mm, Dice 0.86 against its own plan).
+TEST(LoadSkull, ATriangleWrittenTwiceIsReadOnce) {
+  TempDir dir;
+  const Eigen::Vector3d rim = test::head_surface_point(Eigen::Vector3d(0.7, 0.1, 0.7).normalized());
+  const SkullMesh head = test::cut_hole(test::make_symmetric_head(4), rim, 25);
+  TriangleSoup twice = to_soup(head);
+  const size_t n = twice.triangles.size();
+  long long copies = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector3i t = twice.triangles[i];
+    if (centroid_within(twice, t, rim, 40.0)) {
+      twice.triangles.emplace_back(t[0], t[2], t[1]);
+      ++copies;
+    }
+  }
+  ASSERT_GT(copies, 20);
+  const std::string file = expect_repaired(
+      dir, head, twice, format_count(copies) + " triangles repeat another's three corners");
+  ExtractBoneSurfaceParams as_it_came;
+  as_it_came.drop_repeated_triangles = false;
+  EXPECT_EQ(load_skull(file, as_it_came).mesh.n_faces(),
+            head.n_faces() + static_cast<size_t>(copies));
+}
+
 // A CT export may carry the table, a clip or noise far from the head: the skull is its largest
 // piece and what lies near it, and the size check sees only that.
 TEST(LoadSkull, APieceFarFromTheSkullIsDroppedBeforeTheSizeCheck) {

@@ -22,6 +22,25 @@ TriangleSoup keep_largest_pieces(const TriangleSoup& soup, const SoupComponents&
 TriangleSoup keep_pieces(const TriangleSoup& soup, const SoupComponents& comps,
                          const std::vector<bool>& keep);
 
+/// Drops every triangle with the same three corners (by position) as one before it in the
+/// soup, whichever way it winds: the copies that exporters write where pieces overlapped or a
+/// surface was written twice. A copy is not a second surface: it would double every crossing
+/// there, and a halfedge mesh can join only one of them. Returns how many were dropped.
+long long drop_repeated_triangles(TriangleSoup& soup);
+
+/// What orient_consistently did.
+struct SoupOrientation {
+  long long triangles_turned = 0;  ///< triangles whose winding was reversed
+  long long patches_turned = 0;    ///< connected patches of them
+  long long conflicts = 0;         ///< edges no orientation can agree on (a Möbius-like seam)
+};
+/// Makes neighbouring triangles wind alike: across every edge that two triangles share (their
+/// corners compared by position, so unwelded copies count as one vertex), each must run the
+/// edge the other way. Triangles are reached from neighbour to neighbour over such edges (not
+/// over edges of three or more); in each patch reached, the triangles that disagree with the
+/// larger part by area are turned. Which way the whole surface winds is left as it was.
+SoupOrientation orient_consistently(TriangleSoup& soup);
+
 /// A piece's axis-aligned bounding box.
 struct PieceBox {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());

@@ -31,6 +31,14 @@ struct ExtractBoneSurfaceParams {
   /// surfaces are
   /// made outward.
   bool orient_outward = true;
+  /// Through load_skull, a mesh's patches that wind against their neighbours are turned to
+  /// agree (ReadMeshParams::orient_consistently, with a warning); false: as the file gives it,
+  /// as plans whose load_skull is version 1 to 4 read it.
+  bool orient_consistently = true;
+  /// Through load_skull, a mesh's triangles that repeat another's three corners are dropped
+  /// (ReadMeshParams::drop_repeated_triangles, with a warning); false: every triangle kept, as
+  /// plans whose load_skull is version 1 to 4 read it.
+  bool drop_repeated_triangles = true;
   /// Through load_skull, a volume's positions in the patient's LPS frame, whatever space the
   /// file declares (ReadVolumeParams::patient_frame); false: a NRRD's or NIfTI's positions as
   /// the file writes them, as plans saved before version 0.2 read them.
