@@ -230,9 +230,9 @@ int current_version(CommandType type) {
   // clearance ("clearance_zones") and the holes drilled ("perforations"); version 5 is read
   // without them.
   // build_implant 7: fixation tabs ("tabs"); version 6 is read without them.
-  // load_skull 5: a mesh's repeated triangles dropped ("import.drop_repeated_triangles") and
-  // its patches that wind against their neighbours turned to agree
-  // ("import.orient_consistently"), neither when absent.
+  // load_skull 5: a mesh's repeated triangles dropped ("import.drop_repeated_triangles"), its
+  // patches that wind against their neighbours turned to agree ("import.orient_consistently")
+  // and its small holes closed ("import.close_holes_mm"), none of them when absent.
   // build_implant 8 and export_implant 2: tabs, holes and a mould meshed with field values kept
   // 1e-3 off the iso-level (no sliver triangles); earlier versions are meshed as they were.
   // build_implant 9: holes drilled along the plate's mid-normal and under their whole
@@ -325,6 +325,7 @@ Json params_to_json(const ExtractBoneSurfaceParams& p) {
   j["orient_outward"] = p.orient_outward;
   j["orient_consistently"] = p.orient_consistently;
   j["drop_repeated_triangles"] = p.drop_repeated_triangles;
+  j["close_holes_mm"] = p.close_holes_mm;
   j["patient_frame"] = p.patient_frame;
   j["drop_far_pieces"] = p.drop_far_pieces;
   j["dicom_series"] = p.dicom_series;
@@ -552,6 +553,9 @@ void params_from_json(const ParamReader& r, ExtractBoneSurfaceParams& p) {
   p.orient_consistently = r.has("orient_consistently") && r.boolean("orient_consistently");
   p.drop_repeated_triangles =
       r.has("drop_repeated_triangles") && r.boolean("drop_repeated_triangles");
+  p.close_holes_mm = r.has("close_holes_mm") ? r.number("close_holes_mm") : 0.0;
+  if (!(p.close_holes_mm >= 0.0) || !std::isfinite(p.close_holes_mm))
+    throw SessionError(r.where(), "parameter 'close_holes_mm' must be a length ≥ 0 in mm");
   // Before load_skull 4, a NRRD's or NIfTI's positions were read as the file writes them (NIfTI
   // in RAS), and a mesh's far pieces were kept.
   p.patient_frame = r.has("patient_frame") && r.boolean("patient_frame");

@@ -302,11 +302,14 @@ TEST(Commands, TheLoadRecordsTheMeshesLengthUnit) {
   old_load.erase("orient_outward");
   old_load.erase("orient_consistently");
   old_load.erase("drop_repeated_triangles");
+  old_load.erase("close_holes_mm");
   params_from_json(ParamReader(old_load, "test"), import);
   EXPECT_EQ(import.mesh_unit_mm, 1.0);
   EXPECT_FALSE(import.orient_outward) << "load_skull 2 read the skull as it came";
   EXPECT_FALSE(import.orient_consistently) << "load_skull 4 read its patches as they came";
   EXPECT_FALSE(import.drop_repeated_triangles) << "and kept every triangle";
+  EXPECT_EQ(import.close_holes_mm, 0.0) << "and left every hole open";
+  EXPECT_EQ(load["params"]["import"]["close_holes_mm"], 15.0);
   EXPECT_EQ(load["params"]["import"]["drop_repeated_triangles"], true);
   EXPECT_EQ(load["params"]["import"]["orient_outward"], true);
   EXPECT_EQ(load["params"]["import"]["orient_consistently"], true);

@@ -1,5 +1,6 @@
 #include "cranioplan/algorithms/geometry/mesh_components.h"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <array>
@@ -100,17 +101,73 @@ namespace {
 // One id per position (the smallest index among the vertices at it, in sorted order): files
 // that list a vertex once per face still share corners.
 std::vector<int> position_ids(const TriangleSoup& soup) {
-  std::vector<int> order(soup.vertices.size());
-  std::iota(order.begin(), order.end(), 0);
-  auto less = [&](int a, int b) {
-    const Eigen::Vector3d &p = soup.vertices[a], &q = soup.vertices[b];
-    return std::lexicographical_compare(p.data(), p.data() + 3, q.data(), q.data() + 3);
+  struct Key {
+    std::array<double, 3> p;
+    int index;
   };
-  std::sort(order.begin(), order.end(), less);
+  std::vector<Key> keys(soup.vertices.size());
+  for (size_t i = 0; i < keys.size(); ++i)
+    keys[i] = {{soup.vertices[i].x(), soup.vertices[i].y(), soup.vertices[i].z()},
+               static_cast<int>(i)};
+  std::sort(keys.begin(), keys.end(), [](const Key& a, const Key& b) { return a.p < b.p; });
   std::vector<int> id(soup.vertices.size());
-  for (size_t k = 0; k < order.size(); ++k)
-    id[order[k]] = k > 0 && !less(order[k - 1], order[k]) ? id[order[k - 1]] : static_cast<int>(k);
+  for (size_t k = 0; k < keys.size(); ++k)
+    id[keys[k].index] =
+        k > 0 && keys[k - 1].p == keys[k].p ? id[keys[k - 1].index] : static_cast<int>(k);
   return id;
+}
+
+// Every triangle's edges, bucketed by their smaller position id (a counting sort) and sorted
+// in each bucket by the larger: the larger id, the triangle, the edge's place in it (edge k
+// runs from corner k to corner k + 1), and whether it runs from the smaller id to the larger.
+struct EdgeUse {
+  int other;
+  uint32_t tri;
+  int8_t k;
+  bool forward;
+};
+struct EdgeUses {
+  std::vector<int> first;  ///< bucket v is uses[first[v], first[v + 1])
+  std::vector<EdgeUse> uses;
+};
+EdgeUses edge_uses(const TriangleSoup& soup, const std::vector<int>& id) {
+  EdgeUses e;
+  e.first.assign(soup.vertices.size() + 1, 0);
+  for (const auto& f : soup.triangles)
+    for (int k = 0; k < 3; ++k) {
+      const int a = id[f[k]], b = id[f[(k + 1) % 3]];
+      if (a != b) ++e.first[std::min(a, b) + 1];
+    }
+  std::partial_sum(e.first.begin(), e.first.end(), e.first.begin());
+  e.uses.resize(static_cast<size_t>(e.first.back()));
+  std::vector<int> fill(e.first.begin(), e.first.end() - 1);
+  for (size_t t = 0; t < soup.triangles.size(); ++t)
+    for (int k = 0; k < 3; ++k) {
+      const int a = id[soup.triangles[t][k]], b = id[soup.triangles[t][(k + 1) % 3]];
+      if (a != b)
+        e.uses[fill[std::min(a, b)]++] = {std::max(a, b), static_cast<uint32_t>(t),
+                                          static_cast<int8_t>(k), a < b};
+    }
+  for (size_t v = 0; v + 1 < e.first.size(); ++v)
+    std::sort(e.uses.begin() + e.first[v], e.uses.begin() + e.first[v + 1],
+              [](const EdgeUse& x, const EdgeUse& y) {
+                return x.other != y.other ? x.other < y.other : x.tri < y.tri;
+              });
+  return e;
+}
+
+// Calls f(begin, end) for each group of uses of one undirected edge.
+template <class F>
+void for_each_edge(const EdgeUses& e, F&& f) {
+  for (size_t v = 0; v + 1 < e.first.size(); ++v) {
+    const EdgeUse* hi = e.uses.data() + e.first[v + 1];
+    for (const EdgeUse* i = e.uses.data() + e.first[v]; i != hi;) {
+      const EdgeUse* j = i;
+      while (j != hi && j->other == i->other) ++j;
+      f(i, j);
+      i = j;
+    }
+  }
 }
 }  // namespace
 
@@ -146,30 +203,6 @@ SoupOrientation orient_consistently(TriangleSoup& soup) {
   SoupOrientation out;
   const size_t nt = soup.triangles.size();
   const std::vector<int> id = position_ids(soup);
-  // Every triangle's edges, bucketed by their smaller position id (a counting sort); in a
-  // bucket, the larger id, the triangle, and whether it runs the edge from smaller to larger.
-  struct Use {
-    int other;
-    uint32_t tri;
-    bool forward;
-  };
-  std::vector<int> first(soup.vertices.size() + 1, 0);
-  for (const auto& f : soup.triangles)
-    for (int k = 0; k < 3; ++k) {
-      const int a = id[f[k]], b = id[f[(k + 1) % 3]];
-      if (a != b) ++first[std::min(a, b) + 1];
-    }
-  std::partial_sum(first.begin(), first.end(), first.begin());
-  std::vector<Use> uses(static_cast<size_t>(first.back()));
-  {
-    std::vector<int> fill(first.begin(), first.end() - 1);
-    for (size_t t = 0; t < nt; ++t)
-      for (int k = 0; k < 3; ++k) {
-        const int a = id[soup.triangles[t][k]], b = id[soup.triangles[t][(k + 1) % 3]];
-        if (a != b)
-          uses[fill[std::min(a, b)]++] = {std::max(a, b), static_cast<uint32_t>(t), a < b};
-      }
-  }
   // Each triangle's neighbours over its edges of exactly two triangles: the neighbour, and 1
   // when both run the edge alike (2 * neighbour + alike; -1 for none).
   std::vector<int64_t> links(3 * nt, -1);
@@ -177,22 +210,13 @@ SoupOrientation orient_consistently(TriangleSoup& soup) {
   auto link = [&](uint32_t t, uint32_t u, bool alike) {
     if (link_count[t] < 3) links[3 * t + link_count[t]++] = 2 * static_cast<int64_t>(u) + alike;
   };
-  for (size_t v = 0; v + 1 < first.size(); ++v) {
-    const auto lo = uses.begin() + first[v], hi = uses.begin() + first[v + 1];
-    std::sort(lo, hi, [](const Use& x, const Use& y) {
-      return x.other != y.other ? x.other < y.other : x.tri < y.tri;
-    });
-    for (auto i = lo; i != hi;) {
-      auto j = i;
-      while (j != hi && j->other == i->other) ++j;
-      if (j - i == 2 && i->tri != (i + 1)->tri) {
-        const bool alike = i->forward == (i + 1)->forward;
-        link(i->tri, (i + 1)->tri, alike);
-        link((i + 1)->tri, i->tri, alike);
-      }
-      i = j;
+  for_each_edge(edge_uses(soup, id), [&](const EdgeUse* i, const EdgeUse* j) {
+    if (j - i == 2 && i->tri != (i + 1)->tri) {
+      const bool alike = i->forward == (i + 1)->forward;
+      link(i->tri, (i + 1)->tri, alike);
+      link((i + 1)->tri, i->tri, alike);
     }
-  }
+  });
   auto area = [&](size_t t) {
     const Eigen::Vector3i& f = soup.triangles[t];
     return (soup.vertices[f[1]] - soup.vertices[f[0]])
@@ -251,6 +275,100 @@ SoupOrientation orient_consistently(TriangleSoup& soup) {
         }
       }
     }
+  }
+  return out;
+}
+
+HoleClosing close_small_holes(TriangleSoup& soup, double max_length_mm) {
+  HoleClosing out;
+  if (!(max_length_mm > 0.0)) return out;
+  const std::vector<int> id = position_ids(soup);
+  // Open edges (used by one triangle), as it runs them; from each corner (by position id) the
+  // open edge that leaves it, -2 where two do (loops that touch there).
+  struct Open {
+    int from, to;  // vertex indices
+    int to_id;
+  };
+  std::vector<Open> open;
+  std::vector<long> leaving(soup.vertices.size(), -1);
+  for_each_edge(edge_uses(soup, id), [&](const EdgeUse* i, const EdgeUse* j) {
+    if (j - i != 1) return;
+    const Eigen::Vector3i& t = soup.triangles[i->tri];
+    const int from = t[i->k], to = t[(i->k + 1) % 3];
+    long& slot = leaving[id[from]];
+    slot = slot == -1 ? static_cast<long>(open.size()) : -2;
+    open.push_back({from, to, id[to]});
+  });
+  if (open.empty()) return out;
+  std::vector<char> used(open.size(), 0);
+  // The chains of open edges: closed loops, or (through a corner where two leave) parts.
+  struct Chain {
+    std::vector<int> corners;
+    double length = 0.0;
+    bool loop = true;
+  };
+  std::vector<Chain> chains;
+  for (size_t start = 0; start < open.size(); ++start) {
+    if (used[start]) continue;
+    Chain c;
+    for (long e = static_cast<long>(start);;) {
+      used[e] = 1;
+      c.corners.push_back(open[e].from);
+      c.length += (soup.vertices[open[e].to] - soup.vertices[open[e].from]).norm();
+      const long n = leaving[open[e].to_id];
+      if (n == static_cast<long>(start)) break;
+      if (n < 0 || used[n]) {
+        c.loop = false;
+        break;
+      }
+      e = n;
+    }
+    chains.push_back(std::move(c));
+  }
+  // The planes of long flat chains: where the scan ended, or the surface was cropped. Small
+  // loops in such a plane (around bone the cut crosses) are part of that end and left open,
+  // so that a scan's end reads the same whatever else the surface lost.
+  constexpr double kFlatMm = 1.0;
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> ends;  // (a point, the normal)
+  for (const Chain& c : chains) {
+    if (c.length <= max_length_mm || c.corners.size() < 8) continue;
+    Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+    for (int v : c.corners) mean += soup.vertices[v];
+    mean /= static_cast<double>(c.corners.size());
+    Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+    for (int v : c.corners)
+      cov += (soup.vertices[v] - mean) * (soup.vertices[v] - mean).transpose();
+    const Eigen::Vector3d normal =
+        Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
+    double flatness = 0.0;
+    for (int v : c.corners)
+      flatness = std::max(flatness, std::abs((soup.vertices[v] - mean).dot(normal)));
+    if (flatness <= kFlatMm) ends.emplace_back(mean, normal);
+  }
+  for (const Chain& c : chains) {
+    const std::vector<int>& loop = c.corners;
+    if (!c.loop || loop.size() < 3 || c.length > max_length_mm) continue;
+    bool at_end = false;
+    for (const auto& [point, normal] : ends) {
+      bool in_plane = true;
+      for (int v : loop) in_plane &= std::abs((soup.vertices[v] - point).dot(normal)) <= kFlatMm;
+      at_end |= in_plane;
+    }
+    if (at_end) continue;
+    // The triangles around run the loop as `loop` lists it; the closing ones run it back.
+    if (loop.size() == 3) {
+      soup.triangles.emplace_back(loop[0], loop[2], loop[1]);
+    } else {
+      Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+      for (int v : loop) centre += soup.vertices[v];
+      soup.vertices.push_back(centre / static_cast<double>(loop.size()));
+      const int added = static_cast<int>(soup.vertices.size()) - 1;
+      for (size_t k = 0; k < loop.size(); ++k)
+        soup.triangles.emplace_back(loop[(k + 1) % loop.size()], loop[k], added);
+    }
+    ++out.closed;
+    out.triangles_added += loop.size() == 3 ? 1 : static_cast<long long>(loop.size());
+    out.largest_mm = std::max(out.largest_mm, c.length);
   }
   return out;
 }

@@ -494,6 +494,18 @@ void read_into(const std::string& path, const ReadMeshParams& params, MeshFile& 
                              (o.conflicts == 1 ? " edge where" : " edges where") +
                              " the surface cannot wind one way (a twisted seam); left as read");
   }
+  if (params.close_holes_mm > 0.0) {
+    const HoleClosing h = close_small_holes(soup, params.close_holes_mm);
+    out.holes_closed = h.closed;
+    if (h.closed > 0) {
+      char longest[32];
+      std::snprintf(longest, sizeof(longest), "%.1f", h.largest_mm);
+      out.warnings.push_back(path + ": " + format_count(h.closed) +
+                             (h.closed == 1 ? " small hole" : " small holes") + " (up to " +
+                             longest + " mm of open edge) closed with " +
+                             format_count(h.triangles_added) + " triangles");
+    }
+  }
   if (params.orient_outward && enclosed_volume(soup) < 0.0) {
     for (auto& t : soup.triangles) std::swap(t[1], t[2]);
     out.turned_outward = true;

@@ -151,6 +151,70 @@ TEST(MeshComponents, RepeatedTrianglesAreDroppedWhicheverWayTheyWind) {
   EXPECT_EQ(drop_repeated_triangles(s), 0);
 }
 
+// Holes a program left (triangles lost one or two at a time) are closed, wound as their
+// neighbours: a lost triangle comes back as itself, two lost side by side as a fan; the
+// defect's 25 mm hole, and two holes that touch at a corner, are left open.
+TEST(MeshComponents, SmallHolesAreClosedAndLargeOnesLeft) {
+  const Eigen::Vector3d rim = test::head_surface_point(Eigen::Vector3d(0.7, 0.1, 0.7).normalized());
+  const TriangleSoup head = to_soup(test::cut_hole(test::make_symmetric_head(4), rim, 25));
+  const double volume = signed_volume(head);
+  // Triangles that share no corner with one another, far from the defect, and far apart.
+  auto corner_shared = [](const Eigen::Vector3i& a, const Eigen::Vector3i& b) {
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j)
+        if (a[i] == b[j]) return true;
+    return false;
+  };
+  std::vector<size_t> lost;
+  for (size_t t = 0; t < head.triangles.size() && lost.size() < 12; t += 97) {
+    const Eigen::Vector3i& f = head.triangles[t];
+    if ((head.vertices[f[0]] - rim).norm() < 40.0) continue;
+    bool apart = true;
+    for (size_t u : lost)
+      apart &= !corner_shared(f, head.triangles[u]) &&
+               (head.vertices[f[0]] - head.vertices[head.triangles[u][0]]).norm() > 10.0;
+    if (apart) lost.push_back(t);
+  }
+  ASSERT_EQ(lost.size(), 12u);
+  // The first lost with a neighbour across an edge (a hole of four edges); the second with
+  // a triangle that touches it at one corner only (two loops through one corner).
+  auto neighbour = [&](size_t t, int shared) {
+    for (size_t u = 0; u < head.triangles.size(); ++u) {
+      int n = 0;
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) n += head.triangles[u][i] == head.triangles[t][j];
+      if (u != t && n == shared) return u;
+    }
+    return t;
+  };
+  std::vector<size_t> drop = lost;
+  drop.push_back(neighbour(lost[0], 2));
+  drop.push_back(neighbour(lost[1], 1));
+  TriangleSoup s;
+  s.vertices = head.vertices;
+  for (size_t t = 0; t < head.triangles.size(); ++t)
+    if (std::find(drop.begin(), drop.end(), t) == drop.end())
+      s.triangles.push_back(head.triangles[t]);
+  // The head's triangles are about 8 mm across (the sample's 1 mm): holes up to 60 mm around.
+  const HoleClosing h = close_small_holes(s, 60.0);
+  EXPECT_EQ(h.closed, 11) << "ten lost alone, one pair; not the two through one corner";
+  EXPECT_EQ(h.triangles_added, 10 + 4);
+  EXPECT_LT(h.largest_mm, 60.0);
+  for (size_t k = 2; k < lost.size(); ++k) {
+    Eigen::Vector3i f = head.triangles[lost[k]];
+    bool back = false;
+    for (const Eigen::Vector3i& t : s.triangles)
+      for (int r = 0; r < 3; ++r)
+        back |= t == Eigen::Vector3i(f[r], f[(r + 1) % 3], f[(r + 2) % 3]);
+    EXPECT_TRUE(back) << "lost triangle " << k << " back as it was";
+  }
+  // Wound as the surface: the volume is the head's but for the fan's and the open corner's.
+  EXPECT_NEAR(signed_volume(s), volume, 0.002 * std::abs(volume));
+  EXPECT_EQ(close_small_holes(s, 60.0).closed, 0) << "the defect and the corner left";
+  EXPECT_EQ(close_small_holes(s, 0.0).closed, 0);
+  EXPECT_EQ(close_small_holes(s, 1000.0).closed, 1) << "the defect itself, when asked";
+}
+
 // A Möbius strip cannot wind one way: its seam is counted, and nothing is lost.
 TEST(MeshComponents, AMoebiusStripsSeamIsCounted) {
   TriangleSoup strip;

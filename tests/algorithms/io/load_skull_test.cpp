@@ -211,6 +211,28 @@ TEST(LoadSkull, ATriangleWrittenTwiceIsReadOnce) {
             head.n_faces() + static_cast<size_t>(copies));
 }
 
+// Triangles lost here and there (some repairs and decimations leave such holes): a skull's
+// surface has no open edge of its own, so each small hole is closed, with a warning, and the
+// lines through it tell the bone's inside again. A scan's end or a defect is far longer.
+TEST(LoadSkull, SmallHolesAreClosed) {
+  TempDir dir;
+  const SkullMesh head = test::make_symmetric_head(5);  // triangles about 4 mm across
+  TriangleSoup holed = to_soup(head);
+  const size_t n = holed.triangles.size();
+  for (size_t k = 1; k <= 5; ++k) holed.triangles.erase(holed.triangles.begin() + k * n / 6);
+  write_mesh(build_mesh(holed), dir.path("holed.stl"));
+  const LoadedSkull closed = load_skull(dir.path("holed.stl"));
+  EXPECT_TRUE(report_mesh(closed.mesh).watertight);
+  EXPECT_EQ(closed.mesh.n_faces(), head.n_faces());
+  ASSERT_FALSE(closed.warnings.empty());
+  EXPECT_NE(closed.warnings[0].find("holed.stl: 5 small holes (up to "), std::string::npos)
+      << closed.warnings[0];
+  ExtractBoneSurfaceParams as_it_came;
+  as_it_came.close_holes_mm = 0.0;
+  const LoadedSkull open = load_skull(dir.path("holed.stl"), as_it_came);
+  EXPECT_EQ(report_mesh(open.mesh).boundary_edges, 15);
+}
+
 // A CT export may carry the table, a clip or noise far from the head: the skull is its largest
 // piece and what lies near it, and the size check sees only that.
 TEST(LoadSkull, APieceFarFromTheSkullIsDroppedBeforeTheSizeCheck) {

@@ -41,6 +41,23 @@ struct SoupOrientation {
 /// larger part by area are turned. Which way the whole surface winds is left as it was.
 SoupOrientation orient_consistently(TriangleSoup& soup);
 
+/// What close_small_holes did.
+struct HoleClosing {
+  long long closed = 0;           ///< holes closed
+  long long triangles_added = 0;  ///< triangles that close them
+  double largest_mm = 0.0;        ///< the longest closed hole's open edge, mm
+};
+/// Closes every hole in the surface whose loop of open edges (edges of one triangle, corners
+/// compared by position) is at most `max_length_mm` long: a triangle where three edges are
+/// open, otherwise a fan from the loop's centroid (a vertex added there), wound as the triangles
+/// around it. A skull's surface has no open edge of its own — a defect or a foramen is a
+/// tunnel through the bone, not a gap in its surface — so such loops are triangles a program
+/// lost; they are closed before anything asks what is inside the bone. Longer loops (the scan's
+/// end, a surface cropped or torn), loops that touch themselves at a corner, and small loops
+/// in the plane (within 1 mm) of a longer flat one (bone that the scan's end cuts across) are
+/// left.
+HoleClosing close_small_holes(TriangleSoup& soup, double max_length_mm);
+
 /// A piece's axis-aligned bounding box.
 struct PieceBox {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());

@@ -39,6 +39,12 @@ struct ExtractBoneSurfaceParams {
   /// (ReadMeshParams::drop_repeated_triangles, with a warning); false: every triangle kept, as
   /// plans whose load_skull is version 1 to 4 read it.
   bool drop_repeated_triangles = true;
+  /// Through load_skull, a mesh's holes whose open edge is at most this long (mm) are closed
+  /// (ReadMeshParams::close_holes_mm, with a warning): a skull's surface has no open edge of
+  /// its own, and a hole a smoothing or a decimation left misleads every line through it about
+  /// the bone's inside. The scan's end, a crop and a torn surface are longer. 0: left open, as
+  /// plans whose load_skull is version 1 to 4 read it.
+  double close_holes_mm = 15.0;
   /// Through load_skull, a volume's positions in the patient's LPS frame, whatever space the
   /// file declares (ReadVolumeParams::patient_frame); false: a NRRD's or NIfTI's positions as
   /// the file writes them, as plans saved before version 0.2 read them.

@@ -35,6 +35,11 @@ struct ReadMeshParams {
   /// patch written twice planned at Dice 0.86 against its own plan. Done before
   /// `orient_consistently`. false: as the file gives it.
   bool drop_repeated_triangles = false;
+  /// Holes whose loop of open edges is at most this long (mm) are closed, with a warning
+  /// (MeshFile::holes_closed; close_small_holes): triangles a program lost, through which a
+  /// line's crossings no longer tell the bone's inside. Done after `orient_consistently`, so
+  /// that the closing triangles wind as their neighbours. 0: left open.
+  double close_holes_mm = 0.0;
   /// Pieces whose bounding box lies more than this far from the largest piece's (mm) are
   /// dropped, with a warning (MeshFile::pieces_dropped): the CT table, a clip, noise far from
   /// the head. 0: every piece kept.
@@ -51,6 +56,7 @@ struct MeshFile {
   long long triangles_turned = 0;     ///< ReadMeshParams::orient_consistently turned them
   long long patches_turned = 0;       ///< in this many patches
   long long repeated_dropped = 0;     ///< ReadMeshParams::drop_repeated_triangles dropped them
+  long long holes_closed = 0;         ///< ReadMeshParams::close_holes_mm closed them
   long long pieces_dropped = 0;       ///< pieces far from the largest (far_piece_mm)
   long long triangles_dropped = 0;    ///< their triangles
   std::vector<std::string> warnings;  ///< one sentence each, naming the file
