@@ -118,12 +118,11 @@ std::vector<int> position_ids(const TriangleSoup& soup) {
 }
 
 // Every triangle's edges, bucketed by their smaller position id (a counting sort) and sorted
-// in each bucket by the larger: the larger id, the triangle, the edge's place in it (edge k
-// runs from corner k to corner k + 1), and whether it runs from the smaller id to the larger.
+// in each bucket by the larger: the two ids, the triangle, and whether it runs the edge from
+// the smaller id to the larger.
 struct EdgeUse {
-  int other;
+  int lo, other;  // the two position ids, lo < other
   uint32_t tri;
-  int8_t k;
   bool forward;
 };
 struct EdgeUses {
@@ -145,8 +144,8 @@ EdgeUses edge_uses(const TriangleSoup& soup, const std::vector<int>& id) {
     for (int k = 0; k < 3; ++k) {
       const int a = id[soup.triangles[t][k]], b = id[soup.triangles[t][(k + 1) % 3]];
       if (a != b)
-        e.uses[fill[std::min(a, b)]++] = {std::max(a, b), static_cast<uint32_t>(t),
-                                          static_cast<int8_t>(k), a < b};
+        e.uses[fill[std::min(a, b)]++] = {std::min(a, b), std::max(a, b), static_cast<uint32_t>(t),
+                                          a < b};
     }
   for (size_t v = 0; v + 1 < e.first.size(); ++v)
     std::sort(e.uses.begin() + e.first[v], e.uses.begin() + e.first[v + 1],
@@ -169,40 +168,55 @@ void for_each_edge(const EdgeUses& e, F&& f) {
     }
   }
 }
-}  // namespace
 
-long long drop_repeated_triangles(TriangleSoup& soup) {
-  const std::vector<int> id = position_ids(soup);
-  std::vector<std::pair<std::array<int, 3>, uint32_t>> keys(soup.triangles.size());
-  for (size_t t = 0; t < soup.triangles.size(); ++t) {
-    std::array<int, 3> k{id[soup.triangles[t][0]], id[soup.triangles[t][1]],
-                         id[soup.triangles[t][2]]};
+long long drop_repeated(TriangleSoup& soup, const std::vector<int>& id) {
+  // Triangles by their corners' position ids in order (a <= b <= c): counted out by a, each
+  // bucket (a few triangles) sorted by b and c, and then by the triangle's place in the soup.
+  const size_t nt = soup.triangles.size();
+  std::vector<std::array<int, 3>> sorted(nt);
+  std::vector<int> first(soup.vertices.size() + 1, 0);
+  for (size_t t = 0; t < nt; ++t) {
+    std::array<int, 3>& k = sorted[t];
+    k = {id[soup.triangles[t][0]], id[soup.triangles[t][1]], id[soup.triangles[t][2]]};
     std::sort(k.begin(), k.end());
-    keys[t] = {k, static_cast<uint32_t>(t)};
+    ++first[k[0] + 1];
   }
-  std::sort(keys.begin(), keys.end());
-  std::vector<char> keep(soup.triangles.size(), 1);
+  std::partial_sum(first.begin(), first.end(), first.begin());
+  std::vector<std::pair<uint64_t, uint32_t>> items(nt);  // (b << 32 | c, triangle)
+  {
+    std::vector<int> fill(first.begin(), first.end() - 1);
+    for (size_t t = 0; t < nt; ++t)
+      items[fill[sorted[t][0]]++] = {
+          (static_cast<uint64_t>(sorted[t][1]) << 32) | static_cast<uint32_t>(sorted[t][2]),
+          static_cast<uint32_t>(t)};
+  }
+  std::vector<char> keep(nt, 1);
   long long dropped = 0;
-  for (size_t i = 1; i < keys.size(); ++i)
-    // A repeat of the triangle before it (the first in the file's order is kept); triangles
-    // with a repeated corner are left to the mesh builder, which drops them as degenerate.
-    if (keys[i].first == keys[i - 1].first && keys[i].first[0] != keys[i].first[1] &&
-        keys[i].first[1] != keys[i].first[2]) {
-      keep[keys[i].second] = 0;
-      ++dropped;
+  for (size_t v = 0; v + 1 < first.size(); ++v) {
+    if (first[v + 1] - first[v] < 2) continue;
+    const auto lo = items.begin() + first[v], hi = items.begin() + first[v + 1];
+    std::sort(lo, hi);
+    for (auto i = lo + 1; i != hi; ++i) {
+      // A repeat of the triangle before it (the first in the soup's order is kept); triangles
+      // with a repeated corner are left to the mesh builder, which drops them as degenerate.
+      const std::array<int, 3>& k = sorted[i->second];
+      if (i->first == (i - 1)->first && k[0] != k[1] && k[1] != k[2]) {
+        keep[i->second] = 0;
+        ++dropped;
+      }
     }
+  }
   if (dropped == 0) return 0;
   size_t w = 0;
-  for (size_t t = 0; t < soup.triangles.size(); ++t)
+  for (size_t t = 0; t < nt; ++t)
     if (keep[t]) soup.triangles[w++] = soup.triangles[t];
   soup.triangles.resize(w);
   return dropped;
 }
 
-SoupOrientation orient_consistently(TriangleSoup& soup) {
+SoupOrientation orient(TriangleSoup& soup, const EdgeUses& uses) {
   SoupOrientation out;
   const size_t nt = soup.triangles.size();
-  const std::vector<int> id = position_ids(soup);
   // Each triangle's neighbours over its edges of exactly two triangles: the neighbour, and 1
   // when both run the edge alike (2 * neighbour + alike; -1 for none).
   std::vector<int64_t> links(3 * nt, -1);
@@ -210,7 +224,7 @@ SoupOrientation orient_consistently(TriangleSoup& soup) {
   auto link = [&](uint32_t t, uint32_t u, bool alike) {
     if (link_count[t] < 3) links[3 * t + link_count[t]++] = 2 * static_cast<int64_t>(u) + alike;
   };
-  for_each_edge(edge_uses(soup, id), [&](const EdgeUse* i, const EdgeUse* j) {
+  for_each_edge(uses, [&](const EdgeUse* i, const EdgeUse* j) {
     if (j - i == 2 && i->tri != (i + 1)->tri) {
       const bool alike = i->forward == (i + 1)->forward;
       link(i->tri, (i + 1)->tri, alike);
@@ -279,10 +293,10 @@ SoupOrientation orient_consistently(TriangleSoup& soup) {
   return out;
 }
 
-HoleClosing close_small_holes(TriangleSoup& soup, double max_length_mm) {
+HoleClosing close_holes(TriangleSoup& soup, const std::vector<int>& id, const EdgeUses& uses,
+                        double max_length_mm) {
   HoleClosing out;
   if (!(max_length_mm > 0.0)) return out;
-  const std::vector<int> id = position_ids(soup);
   // Open edges (used by one triangle), as it runs them; from each corner (by position id) the
   // open edge that leaves it, -2 where two do (loops that touch there).
   struct Open {
@@ -291,10 +305,13 @@ HoleClosing close_small_holes(TriangleSoup& soup, double max_length_mm) {
   };
   std::vector<Open> open;
   std::vector<long> leaving(soup.vertices.size(), -1);
-  for_each_edge(edge_uses(soup, id), [&](const EdgeUse* i, const EdgeUse* j) {
+  for_each_edge(uses, [&](const EdgeUse* i, const EdgeUse* j) {
     if (j - i != 1) return;
+    // As the triangle runs it now (orient may have turned it since the uses were listed).
     const Eigen::Vector3i& t = soup.triangles[i->tri];
-    const int from = t[i->k], to = t[(i->k + 1) % 3];
+    int k = 0;
+    while (k < 2 && std::minmax(id[t[k]], id[t[(k + 1) % 3]]) != std::minmax(i->lo, i->other)) ++k;
+    const int from = t[k], to = t[(k + 1) % 3];
     long& slot = leaving[id[from]];
     slot = slot == -1 ? static_cast<long>(open.size()) : -2;
     open.push_back({from, to, id[to]});
@@ -371,6 +388,39 @@ HoleClosing close_small_holes(TriangleSoup& soup, double max_length_mm) {
     out.largest_mm = std::max(out.largest_mm, c.length);
   }
   return out;
+}
+
+}  // namespace
+
+SoupRepair repair_soup(TriangleSoup& soup, const SoupRepairParams& params) {
+  SoupRepair out;
+  const bool close = params.close_holes_mm > 0.0;
+  if (!params.drop_repeated && !params.orient && !close) return out;
+  const std::vector<int> id = position_ids(soup);
+  if (params.drop_repeated) out.repeated_dropped = drop_repeated(soup, id);
+  if (!params.orient && !close) return out;
+  const EdgeUses uses = edge_uses(soup, id);
+  if (params.orient) out.orientation = orient(soup, uses);
+  if (close) out.holes = close_holes(soup, id, uses, params.close_holes_mm);
+  return out;
+}
+
+long long drop_repeated_triangles(TriangleSoup& soup) {
+  SoupRepairParams p;
+  p.drop_repeated = true;
+  return repair_soup(soup, p).repeated_dropped;
+}
+
+SoupOrientation orient_consistently(TriangleSoup& soup) {
+  SoupRepairParams p;
+  p.orient = true;
+  return repair_soup(soup, p).orientation;
+}
+
+HoleClosing close_small_holes(TriangleSoup& soup, double max_length_mm) {
+  SoupRepairParams p;
+  p.close_holes_mm = max_length_mm;
+  return repair_soup(soup, p).holes;
 }
 
 }  // namespace cranioplan

@@ -473,38 +473,37 @@ void read_into(const std::string& path, const ReadMeshParams& params, MeshFile& 
   if (params.unit_mm != 1.0)
     for (auto& v : soup.vertices) v *= params.unit_mm;
   if (params.far_piece_mm > 0.0) drop_far_pieces(path, params.far_piece_mm, soup, out);
-  if (params.drop_repeated_triangles) {
-    out.repeated_dropped = drop_repeated_triangles(soup);
-    if (out.repeated_dropped > 0)
-      out.warnings.push_back(path + ": " + format_count(out.repeated_dropped) +
-                             " triangles repeat another's three corners (the surface written "
-                             "twice there); the copies were dropped");
-  }
-  if (params.orient_consistently) {
-    const SoupOrientation o = orient_consistently(soup);
-    out.triangles_turned = o.triangles_turned;
-    out.patches_turned = o.patches_turned;
-    if (o.triangles_turned > 0)
-      out.warnings.push_back(
-          path + ": " + format_count(o.triangles_turned) + " triangles in " +
-          format_count(o.patches_turned) + (o.patches_turned == 1 ? " patch" : " patches") +
-          " wound against their neighbours (inconsistent winding); they were turned to agree");
-    if (o.conflicts > 0)
-      out.warnings.push_back(path + ": " + format_count(o.conflicts) +
-                             (o.conflicts == 1 ? " edge where" : " edges where") +
-                             " the surface cannot wind one way (a twisted seam); left as read");
-  }
-  if (params.close_holes_mm > 0.0) {
-    const HoleClosing h = close_small_holes(soup, params.close_holes_mm);
-    out.holes_closed = h.closed;
-    if (h.closed > 0) {
-      char longest[32];
-      std::snprintf(longest, sizeof(longest), "%.1f", h.largest_mm);
-      out.warnings.push_back(path + ": " + format_count(h.closed) +
-                             (h.closed == 1 ? " small hole" : " small holes") + " (up to " +
-                             longest + " mm of open edge) closed with " +
-                             format_count(h.triangles_added) + " triangles");
-    }
+  SoupRepairParams repairs;
+  repairs.drop_repeated = params.drop_repeated_triangles;
+  repairs.orient = params.orient_consistently;
+  repairs.close_holes_mm = params.close_holes_mm;
+  const SoupRepair done = repair_soup(soup, repairs);
+  out.repeated_dropped = done.repeated_dropped;
+  out.triangles_turned = done.orientation.triangles_turned;
+  out.patches_turned = done.orientation.patches_turned;
+  out.holes_closed = done.holes.closed;
+  if (done.repeated_dropped > 0)
+    out.warnings.push_back(path + ": " + format_count(done.repeated_dropped) +
+                           " triangles repeat another's three corners (the surface written "
+                           "twice there); the copies were dropped");
+  const SoupOrientation& o = done.orientation;
+  if (o.triangles_turned > 0)
+    out.warnings.push_back(
+        path + ": " + format_count(o.triangles_turned) + " triangles in " +
+        format_count(o.patches_turned) + (o.patches_turned == 1 ? " patch" : " patches") +
+        " wound against their neighbours (inconsistent winding); they were turned to agree");
+  if (o.conflicts > 0)
+    out.warnings.push_back(path + ": " + format_count(o.conflicts) +
+                           (o.conflicts == 1 ? " edge where" : " edges where") +
+                           " the surface cannot wind one way (a twisted seam); left as read");
+  const HoleClosing& h = done.holes;
+  if (h.closed > 0) {
+    char longest[32];
+    std::snprintf(longest, sizeof(longest), "%.1f", h.largest_mm);
+    out.warnings.push_back(path + ": " + format_count(h.closed) +
+                           (h.closed == 1 ? " small hole" : " small holes") + " (up to " + longest +
+                           " mm of open edge) closed with " + format_count(h.triangles_added) +
+                           " triangles");
   }
   if (params.orient_outward && enclosed_volume(soup) < 0.0) {
     for (auto& t : soup.triangles) std::swap(t[1], t[2]);

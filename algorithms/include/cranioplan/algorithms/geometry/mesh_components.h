@@ -58,6 +58,21 @@ struct HoleClosing {
 /// left.
 HoleClosing close_small_holes(TriangleSoup& soup, double max_length_mm);
 
+/// The three repairs above in one pass over the soup (corners compared by position once, the
+/// edges listed once): repeated triangles dropped, then patches turned, then small holes
+/// closed, each when asked for.
+struct SoupRepairParams {
+  bool drop_repeated = false;   ///< drop_repeated_triangles
+  bool orient = false;          ///< orient_consistently
+  double close_holes_mm = 0.0;  ///< close_small_holes; 0: none
+};
+struct SoupRepair {
+  long long repeated_dropped = 0;
+  SoupOrientation orientation;
+  HoleClosing holes;
+};
+SoupRepair repair_soup(TriangleSoup& soup, const SoupRepairParams& params);
+
 /// A piece's axis-aligned bounding box.
 struct PieceBox {
   Eigen::Vector3d lo = Eigen::Vector3d::Constant(std::numeric_limits<double>::infinity());
