@@ -98,7 +98,7 @@ double PieceBox::gap_to(const PieceBox& o) const {
 }
 
 namespace {
-// One id per position (the smallest index among the vertices at it, in sorted order): files
+// One id per position (the rank, in lexicographic order, of the first vertex there): files
 // that list a vertex once per face still share corners.
 std::vector<int> position_ids(const TriangleSoup& soup) {
   struct Key {
@@ -118,12 +118,14 @@ std::vector<int> position_ids(const TriangleSoup& soup) {
 }
 
 // Every triangle's edges, bucketed by their smaller position id (a counting sort) and sorted
-// in each bucket by the larger: the two ids, the triangle, and whether it runs the edge from
-// the smaller id to the larger.
+// in each bucket by the larger: the larger id, and the triangle with whether it runs the edge
+// from the smaller id to the larger (2 * triangle + forward; eight bytes a use, as the uses
+// are scattered into their buckets).
 struct EdgeUse {
-  int lo, other;  // the two position ids, lo < other
-  uint32_t tri;
-  bool forward;
+  int other;
+  uint32_t tri_forward;
+  uint32_t tri() const { return tri_forward >> 1; }
+  bool forward() const { return tri_forward & 1u; }
 };
 struct EdgeUses {
   std::vector<int> first;  ///< bucket v is uses[first[v], first[v + 1])
@@ -144,18 +146,18 @@ EdgeUses edge_uses(const TriangleSoup& soup, const std::vector<int>& id) {
     for (int k = 0; k < 3; ++k) {
       const int a = id[soup.triangles[t][k]], b = id[soup.triangles[t][(k + 1) % 3]];
       if (a != b)
-        e.uses[fill[std::min(a, b)]++] = {std::min(a, b), std::max(a, b), static_cast<uint32_t>(t),
-                                          a < b};
+        e.uses[fill[std::min(a, b)]++] = {std::max(a, b),
+                                          2u * static_cast<uint32_t>(t) + (a < b ? 1u : 0u)};
     }
   for (size_t v = 0; v + 1 < e.first.size(); ++v)
     std::sort(e.uses.begin() + e.first[v], e.uses.begin() + e.first[v + 1],
               [](const EdgeUse& x, const EdgeUse& y) {
-                return x.other != y.other ? x.other < y.other : x.tri < y.tri;
+                return x.other != y.other ? x.other < y.other : x.tri_forward < y.tri_forward;
               });
   return e;
 }
 
-// Calls f(begin, end) for each group of uses of one undirected edge.
+// Calls f(lo, begin, end) for each group of uses of one undirected edge (lo: its smaller id).
 template <class F>
 void for_each_edge(const EdgeUses& e, F&& f) {
   for (size_t v = 0; v + 1 < e.first.size(); ++v) {
@@ -163,7 +165,7 @@ void for_each_edge(const EdgeUses& e, F&& f) {
     for (const EdgeUse* i = e.uses.data() + e.first[v]; i != hi;) {
       const EdgeUse* j = i;
       while (j != hi && j->other == i->other) ++j;
-      f(i, j);
+      f(static_cast<int>(v), i, j);
       i = j;
     }
   }
@@ -218,17 +220,17 @@ SoupOrientation orient(TriangleSoup& soup, const EdgeUses& uses) {
   SoupOrientation out;
   const size_t nt = soup.triangles.size();
   // Each triangle's neighbours over its edges of exactly two triangles: the neighbour, and 1
-  // when both run the edge alike (2 * neighbour + alike; -1 for none).
-  std::vector<int64_t> links(3 * nt, -1);
+  // when both run the edge alike (2 * neighbour + alike; link_count of them).
+  std::vector<uint32_t> links(3 * nt, 0);
   std::vector<uint8_t> link_count(nt, 0);
   auto link = [&](uint32_t t, uint32_t u, bool alike) {
-    if (link_count[t] < 3) links[3 * t + link_count[t]++] = 2 * static_cast<int64_t>(u) + alike;
+    if (link_count[t] < 3) links[3 * t + link_count[t]++] = 2u * u + (alike ? 1u : 0u);
   };
-  for_each_edge(uses, [&](const EdgeUse* i, const EdgeUse* j) {
-    if (j - i == 2 && i->tri != (i + 1)->tri) {
-      const bool alike = i->forward == (i + 1)->forward;
-      link(i->tri, (i + 1)->tri, alike);
-      link((i + 1)->tri, i->tri, alike);
+  for_each_edge(uses, [&](int, const EdgeUse* i, const EdgeUse* j) {
+    if (j - i == 2 && i->tri() != (i + 1)->tri()) {
+      const bool alike = i->forward() == (i + 1)->forward();
+      link(i->tri(), (i + 1)->tri(), alike);
+      link((i + 1)->tri(), i->tri(), alike);
     }
   });
   auto area = [&](size_t t) {
@@ -254,7 +256,7 @@ SoupOrientation orient(TriangleSoup& soup, const EdgeUses& uses) {
       done[t] = 1;
       by_flip[flip[t]] += area(t);
       for (int k = 0; k < link_count[t]; ++k) {
-        const uint32_t other = static_cast<uint32_t>(links[3 * t + k] / 2);
+        const uint32_t other = links[3 * t + k] / 2;
         const int8_t want = static_cast<int8_t>(flip[t] ^ (links[3 * t + k] & 1));
         if (flip[other] < 0) {
           flip[other] = want;
@@ -281,7 +283,7 @@ SoupOrientation orient(TriangleSoup& soup, const EdgeUses& uses) {
         const uint32_t u = stack.back();
         stack.pop_back();
         for (int k = 0; k < link_count[u]; ++k) {
-          const uint32_t other = static_cast<uint32_t>(links[3 * u + k] / 2);
+          const uint32_t other = links[3 * u + k] / 2;
           if (flip[other] == 2) {
             flip[other] = 3;
             stack.push_back(other);
@@ -305,12 +307,12 @@ HoleClosing close_holes(TriangleSoup& soup, const std::vector<int>& id, const Ed
   };
   std::vector<Open> open;
   std::vector<long> leaving(soup.vertices.size(), -1);
-  for_each_edge(uses, [&](const EdgeUse* i, const EdgeUse* j) {
+  for_each_edge(uses, [&](int lo, const EdgeUse* i, const EdgeUse* j) {
     if (j - i != 1) return;
     // As the triangle runs it now (orient may have turned it since the uses were listed).
-    const Eigen::Vector3i& t = soup.triangles[i->tri];
+    const Eigen::Vector3i& t = soup.triangles[i->tri()];
     int k = 0;
-    while (k < 2 && std::minmax(id[t[k]], id[t[(k + 1) % 3]]) != std::minmax(i->lo, i->other)) ++k;
+    while (k < 2 && std::minmax(id[t[k]], id[t[(k + 1) % 3]]) != std::minmax(lo, i->other)) ++k;
     const int from = t[k], to = t[(k + 1) % 3];
     long& slot = leaving[id[from]];
     slot = slot == -1 ? static_cast<long>(open.size()) : -2;
