@@ -102,34 +102,30 @@ Subcommand add_info(CLI::App& app, const bool& json) {
   auto* cmd = app.add_subcommand("info", "Report a mesh (or a volume's bone surface)");
   cmd->add_option("MESH", o->path, "mesh (.stl .ply .obj .off .vtp) or volume")->required();
   add_import_options(cmd, o->import);
-  return {
-      cmd, [o, &json] {
-        LoadedSkull s = load_surface(o->path, o->import.params());
-        Json r = to_json(report_mesh(s.mesh));
-        // The file as it is; read as a skull, its repeated triangles are dropped and its
-        // patches that wind against their neighbours turned (load_skull), in this order on
-        // the file's own triangles, which a non-manifold count alone would misname.
-        TriangleSoup soup = s.source_kind == "mesh" ? read_mesh_soup(o->path) : to_soup(s.mesh);
-        const long long repeated = drop_repeated_triangles(soup);
-        r["repeated_triangles"] = repeated;
-        if (repeated > 0)
-          s.warnings.push_back(o->path + ": " + format_count(repeated) +
-                               " triangles repeat another's three corners; read as a skull "
-                               "the copies are dropped");
-        const SoupOrientation wound = orient_consistently(soup);
-        r["wound_against_neighbours"] = {{"triangles", wound.triangles_turned},
-                                         {"patches", wound.patches_turned}};
-        if (wound.triangles_turned > 0)
-          s.warnings.push_back(o->path + ": " + format_count(wound.triangles_turned) +
-                               " triangles in " + format_count(wound.patches_turned) +
-                               (wound.patches_turned == 1 ? " patch wind" : " patches wind") +
-                               " against their neighbours (inconsistent winding); read as a skull "
-                               "(autoplan, pipeline, the wizard) they are turned to agree");
-        r["file"] = skull_json(s);
-        print_warnings(s.warnings, json);
-        print_result(r, json);
-        return kOk;
-      }};
+  return {cmd, [o, &json] {
+            LoadedSkull s = load_surface(o->path, o->import.params());
+            Json r = to_json(report_mesh(s.mesh));
+            // The file as it is; read as a skull, it is repaired (load_skull) on the file's own
+            // triangles: what that would do, which a non-manifold count alone would misname.
+            TriangleSoup soup = s.source_kind == "mesh" ? read_mesh_soup(o->path) : to_soup(s.mesh);
+            const ExtractBoneSurfaceParams import = o->import.params();
+            SoupRepairParams as_skull;
+            as_skull.drop_repeated = import.drop_repeated_triangles;
+            as_skull.orient = import.orient_consistently;
+            as_skull.close_holes_mm = import.close_holes_mm;
+            const SoupRepair repairs = repair_soup(soup, as_skull);
+            r["repeated_triangles"] = repairs.repeated_dropped;
+            r["wound_against_neighbours"] = {{"triangles", repairs.orientation.triangles_turned},
+                                             {"patches", repairs.orientation.patches_turned}};
+            r["small_holes"] = repairs.holes.closed;
+            for (const std::string& sentence : describe_repairs(repairs))
+              s.warnings.push_back(
+                  o->path + ": read as a skull (autoplan, pipeline, the wizard), " + sentence);
+            r["file"] = skull_json(s);
+            print_warnings(s.warnings, json);
+            print_result(r, json);
+            return kOk;
+          }};
 }
 
 // import-ct: a CT's or a label volume's bone surface, written as a mesh

@@ -51,6 +51,7 @@ TEST(Cli, InfoPlaneMirrorRegisterOnASyntheticHead) {
   EXPECT_EQ(odd_info["repeated_triangles"], 1);
   EXPECT_EQ(odd_info["wound_against_neighbours"]["triangles"], turned);
   EXPECT_EQ(odd_info["wound_against_neighbours"]["patches"], 1);
+  EXPECT_EQ(odd_info["small_holes"], 0) << "the head's triangles are longer around than 15 mm";
 
   ASSERT_EQ(
       test::run_command(

@@ -298,7 +298,6 @@ SoupOrientation orient(TriangleSoup& soup, const EdgeUses& uses) {
 HoleClosing close_holes(TriangleSoup& soup, const std::vector<int>& id, const EdgeUses& uses,
                         double max_length_mm) {
   HoleClosing out;
-  if (!(max_length_mm > 0.0)) return out;
   // Open edges (used by one triangle), as it runs them; from each corner (by position id) the
   // open edge that leaves it, -2 where two do (loops that touch there).
   struct Open {

@@ -462,6 +462,32 @@ TriangleSoup read_mesh_soup(const std::string& path, std::string* format_out) {
   return soup;
 }
 
+std::vector<std::string> describe_repairs(const SoupRepair& done) {
+  std::vector<std::string> out;
+  if (done.repeated_dropped > 0)
+    out.push_back(format_count(done.repeated_dropped) +
+                  " triangles repeat another's three corners (the surface written twice there); "
+                  "the copies were dropped");
+  const SoupOrientation& o = done.orientation;
+  if (o.triangles_turned > 0)
+    out.push_back(format_count(o.triangles_turned) + " triangles in " +
+                  format_count(o.patches_turned) + (o.patches_turned == 1 ? " patch" : " patches") +
+                  " wound against their neighbours (inconsistent winding); they were turned to "
+                  "agree");
+  if (o.conflicts > 0)
+    out.push_back(format_count(o.conflicts) + (o.conflicts == 1 ? " edge where" : " edges where") +
+                  " the surface cannot wind one way (a twisted seam); left as read");
+  const HoleClosing& h = done.holes;
+  if (h.closed > 0) {
+    char longest[32];
+    std::snprintf(longest, sizeof(longest), "%.1f", h.largest_mm);
+    out.push_back(format_count(h.closed) + (h.closed == 1 ? " small hole" : " small holes") +
+                  " (up to " + longest + " mm of open edge) closed with " +
+                  format_count(h.triangles_added) + " triangles");
+  }
+  return out;
+}
+
 namespace {
 
 // The mesh built in `mesh` (out.mesh or another), the rest of what was read in `out`.
@@ -482,29 +508,8 @@ void read_into(const std::string& path, const ReadMeshParams& params, MeshFile& 
   out.triangles_turned = done.orientation.triangles_turned;
   out.patches_turned = done.orientation.patches_turned;
   out.holes_closed = done.holes.closed;
-  if (done.repeated_dropped > 0)
-    out.warnings.push_back(path + ": " + format_count(done.repeated_dropped) +
-                           " triangles repeat another's three corners (the surface written "
-                           "twice there); the copies were dropped");
-  const SoupOrientation& o = done.orientation;
-  if (o.triangles_turned > 0)
-    out.warnings.push_back(
-        path + ": " + format_count(o.triangles_turned) + " triangles in " +
-        format_count(o.patches_turned) + (o.patches_turned == 1 ? " patch" : " patches") +
-        " wound against their neighbours (inconsistent winding); they were turned to agree");
-  if (o.conflicts > 0)
-    out.warnings.push_back(path + ": " + format_count(o.conflicts) +
-                           (o.conflicts == 1 ? " edge where" : " edges where") +
-                           " the surface cannot wind one way (a twisted seam); left as read");
-  const HoleClosing& h = done.holes;
-  if (h.closed > 0) {
-    char longest[32];
-    std::snprintf(longest, sizeof(longest), "%.1f", h.largest_mm);
-    out.warnings.push_back(path + ": " + format_count(h.closed) +
-                           (h.closed == 1 ? " small hole" : " small holes") + " (up to " + longest +
-                           " mm of open edge) closed with " + format_count(h.triangles_added) +
-                           " triangles");
-  }
+  for (const std::string& sentence : describe_repairs(done))
+    out.warnings.push_back(path + ": " + sentence);
   if (params.orient_outward && enclosed_volume(soup) < 0.0) {
     for (auto& t : soup.triangles) std::swap(t[1], t[2]);
     out.turned_outward = true;

@@ -7,6 +7,8 @@
 
 namespace cranioplan {
 
+struct SoupRepair;
+
 struct ReadMeshParams {
   /// When true, any zero-area or repeated-vertex triangle makes the file an error instead of
   /// being dropped with a warning.
@@ -66,6 +68,12 @@ struct MeshFile {
 /// coordinates checked to be finite), before the halfedge mesh is built: the same product as
 /// VTK's readers give. `format` receives the format's name. Throws InputError like read_mesh.
 TriangleSoup read_mesh_soup(const std::string& path, std::string* format = nullptr);
+
+/// What the repairs of a skull's soup (ReadMeshParams: drop_repeated_triangles,
+/// orient_consistently, close_holes_mm) did, one sentence each, without the file's name; none
+/// when they found nothing ("12 triangles repeat another's three corners (the surface written
+/// twice there); the copies were dropped").
+std::vector<std::string> describe_repairs(const SoupRepair& done);
 
 /// Reads a mesh; STL vertices are welded (identical coordinates become one vertex).
 /// Throws InputError naming the file and the problem: missing, empty, truncated, garbage,
