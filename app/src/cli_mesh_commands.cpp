@@ -113,6 +113,7 @@ Subcommand add_info(CLI::App& app, const bool& json) {
             as_skull.drop_repeated = import.drop_repeated_triangles;
             as_skull.orient = import.orient_consistently;
             as_skull.close_holes_mm = import.close_holes_mm;
+            as_skull.through_corners = import.close_holes_through_corners;
             const SoupRepair repairs = repair_soup(soup, as_skull);
             r["repeated_triangles"] = repairs.repeated_dropped;
             r["wound_against_neighbours"] = {{"triangles", repairs.orientation.triangles_turned},

@@ -233,6 +233,8 @@ int current_version(CommandType type) {
   // load_skull 5: a mesh's repeated triangles dropped ("import.drop_repeated_triangles"), its
   // patches that wind against their neighbours turned to agree ("import.orient_consistently")
   // and its small holes closed ("import.close_holes_mm"), none of them when absent.
+  // load_skull 6: two small holes that touch at a corner closed as well
+  // ("import.close_holes_through_corners"); absent, both left open as version 5 left them.
   // build_implant 8 and export_implant 2: tabs, holes and a mould meshed with field values kept
   // 1e-3 off the iso-level (no sliver triangles); earlier versions are meshed as they were.
   // build_implant 9: holes drilled along the plate's mid-normal and under their whole
@@ -261,7 +263,7 @@ int current_version(CommandType type) {
   // load_skull 4: volumes in the patient's frame ("import.patient_frame"), a DICOM folder's
   // series ("import.dicom_series"), a mesh's far pieces dropped ("import.drop_far_pieces");
   // absent, as version 3 read them.
-  if (type == CommandType::LoadSkull) return 5;
+  if (type == CommandType::LoadSkull) return 6;
   // register 2 and adjust_plane 2 record the registration they gave ("result"; adjust_plane:
   // "registration", when the mirror was registered again), which a replay applies.
   if (type == CommandType::FitPlane || type == CommandType::Register ||
@@ -326,6 +328,7 @@ Json params_to_json(const ExtractBoneSurfaceParams& p) {
   j["orient_consistently"] = p.orient_consistently;
   j["drop_repeated_triangles"] = p.drop_repeated_triangles;
   j["close_holes_mm"] = p.close_holes_mm;
+  j["close_holes_through_corners"] = p.close_holes_through_corners;
   j["patient_frame"] = p.patient_frame;
   j["drop_far_pieces"] = p.drop_far_pieces;
   j["dicom_series"] = p.dicom_series;
@@ -556,6 +559,9 @@ void params_from_json(const ParamReader& r, ExtractBoneSurfaceParams& p) {
   p.close_holes_mm = r.has("close_holes_mm") ? r.number("close_holes_mm") : 0.0;
   if (!(p.close_holes_mm >= 0.0) || !std::isfinite(p.close_holes_mm))
     throw SessionError(r.where(), "parameter 'close_holes_mm' must be a length ≥ 0 in mm");
+  // Before load_skull 6, holes that touch another at a corner were left open.
+  p.close_holes_through_corners =
+      r.has("close_holes_through_corners") && r.boolean("close_holes_through_corners");
   // Before load_skull 4, a NRRD's or NIfTI's positions were read as the file writes them (NIfTI
   // in RAS), and a mesh's far pieces were kept.
   p.patient_frame = r.has("patient_frame") && r.boolean("patient_frame");

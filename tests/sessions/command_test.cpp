@@ -118,7 +118,7 @@ TEST(Commands, PlansSavedBeforeThePatientFrameReadTheirSkullAsThen) {
 // and read them back as recorded.
 TEST(Commands, OlderPlansReadTheSkullAndFitTheBoneAsTheyWereMade) {
   const Json load = to_json(commands::load_skull("skull.stl"));
-  EXPECT_EQ(load["version"], 5);
+  EXPECT_EQ(load["version"], 6);
   ExtractBoneSurfaceParams import;
   params_from_json(ParamReader(load["params"]["import"], "test"), import);
   EXPECT_TRUE(import.canonical);
@@ -303,17 +303,20 @@ TEST(Commands, TheLoadRecordsTheMeshesLengthUnit) {
   old_load.erase("orient_consistently");
   old_load.erase("drop_repeated_triangles");
   old_load.erase("close_holes_mm");
+  old_load.erase("close_holes_through_corners");
   params_from_json(ParamReader(old_load, "test"), import);
   EXPECT_EQ(import.mesh_unit_mm, 1.0);
   EXPECT_FALSE(import.orient_outward) << "load_skull 2 read the skull as it came";
   EXPECT_FALSE(import.orient_consistently) << "load_skull 4 read its patches as they came";
   EXPECT_FALSE(import.drop_repeated_triangles) << "and kept every triangle";
   EXPECT_EQ(import.close_holes_mm, 0.0) << "and left every hole open";
+  EXPECT_FALSE(import.close_holes_through_corners) << "load_skull 5 left holes touching open";
   EXPECT_EQ(load["params"]["import"]["close_holes_mm"], 15.0);
   EXPECT_EQ(load["params"]["import"]["drop_repeated_triangles"], true);
   EXPECT_EQ(load["params"]["import"]["orient_outward"], true);
   EXPECT_EQ(load["params"]["import"]["orient_consistently"], true);
-  EXPECT_EQ(load["version"], 5);
+  EXPECT_EQ(load["params"]["import"]["close_holes_through_corners"], true);
+  EXPECT_EQ(load["version"], 6);
   // The reader's warnings reach the load's message (the wizard's status bar): here a head whose
   // triangles wind inward, turned outward.
   TriangleSoup inward = to_soup(test::make_symmetric_head(3));

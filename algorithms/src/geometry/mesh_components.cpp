@@ -6,6 +6,7 @@
 #include <array>
 #include <cstdint>
 #include <numeric>
+#include <unordered_map>
 
 namespace cranioplan {
 namespace {
@@ -296,13 +297,14 @@ SoupOrientation orient(TriangleSoup& soup, const EdgeUses& uses) {
 }
 
 HoleClosing close_holes(TriangleSoup& soup, const std::vector<int>& id, const EdgeUses& uses,
-                        double max_length_mm) {
+                        double max_length_mm, bool through_corners) {
   HoleClosing out;
   // Open edges (used by one triangle), as it runs them; from each corner (by position id) the
-  // open edge that leaves it, -2 where two do (loops that touch there).
+  // open edge that leaves it, -2 where several do (holes that touch there).
   struct Open {
     int from, to;  // vertex indices
     int to_id;
+    uint32_t tri;
   };
   std::vector<Open> open;
   std::vector<long> leaving(soup.vertices.size(), -1);
@@ -315,11 +317,62 @@ HoleClosing close_holes(TriangleSoup& soup, const std::vector<int>& id, const Ed
     const int from = t[k], to = t[(k + 1) % 3];
     long& slot = leaving[id[from]];
     slot = slot == -1 ? static_cast<long>(open.size()) : -2;
-    open.push_back({from, to, id[to]});
+    open.push_back({from, to, id[to], i->tri()});
   });
   if (open.empty()) return out;
+  // Where two holes touch at a corner (two lost triangles sharing a vertex), two open edges
+  // leave it. Around the corner lie hole, fan of triangles, hole, fan: turning from the edge
+  // that arrived through its own fan (across shared edges) reaches the edge that leaves into
+  // the other hole, so the hole goes on along the other. More than two holes at a corner, or
+  // a fan that cannot be turned through (an edge of three triangles, patches wound against
+  // each other), are not followed.
+  std::unordered_map<int, std::vector<long>> leaving_at;
+  std::unordered_map<int, std::vector<uint32_t>> fan_at;
+  for (size_t e = 0; e < open.size(); ++e)
+    if (leaving[id[open[e].from]] == -2)
+      leaving_at[id[open[e].from]].push_back(static_cast<long>(e));
+  if (!through_corners) leaving_at.clear();
+  if (!leaving_at.empty())
+    for (size_t t = 0; t < soup.triangles.size(); ++t)
+      for (int k = 0; k < 3; ++k)
+        if (const auto at = leaving_at.find(id[soup.triangles[t][k]]); at != leaving_at.end())
+          fan_at[at->first].push_back(static_cast<uint32_t>(t));
+  auto corner_of = [&](uint32_t t, int p) {
+    const Eigen::Vector3i& f = soup.triangles[t];
+    int k = -1;
+    for (int c = 0; c < 3; ++c)
+      if (id[f[c]] == p) k = k < 0 ? c : 3;  // 3: the corner twice, a degenerate triangle
+    return k;
+  };
+  auto next_at_corner = [&](long arrived) -> long {
+    const int p = open[arrived].to_id;
+    const std::vector<uint32_t>& fan = fan_at[p];
+    const auto at = leaving_at.find(p);
+    if (at == leaving_at.end() || at->second.size() != 2) return -1;
+    const std::vector<long>& leave = at->second;
+    uint32_t t = open[arrived].tri;
+    for (size_t step = 0; step <= fan.size(); ++step) {
+      const int k = corner_of(t, p);
+      if (k < 0 || k > 2) return -1;
+      const int after = id[soup.triangles[t][(k + 1) % 3]];
+      for (int i = 0; i < 2; ++i)
+        if (open[leave[i]].tri == t && open[leave[i]].to_id == after) return leave[1 - i];
+      // The triangle across the edge from p to `after` runs it the other way.
+      long across = -1;
+      for (uint32_t s : fan) {
+        const int ks = s == t ? -1 : corner_of(s, p);
+        if (ks < 0 || ks > 2 || id[soup.triangles[s][(ks + 2) % 3]] != after) continue;
+        if (across >= 0) return -1;  // an edge of more than two triangles
+        across = s;
+      }
+      if (across < 0) return -1;
+      t = static_cast<uint32_t>(across);
+    }
+    return -1;
+  };
   std::vector<char> used(open.size(), 0);
-  // The chains of open edges: closed loops, or (through a corner where two leave) parts.
+  // The chains of open edges: closed loops, or parts where the way round a corner is not
+  // clear (an edge of three triangles there, or patches wound against each other).
   struct Chain {
     std::vector<int> corners;
     double length = 0.0;
@@ -333,7 +386,8 @@ HoleClosing close_holes(TriangleSoup& soup, const std::vector<int>& id, const Ed
       used[e] = 1;
       c.corners.push_back(open[e].from);
       c.length += (soup.vertices[open[e].to] - soup.vertices[open[e].from]).norm();
-      const long n = leaving[open[e].to_id];
+      long n = leaving[open[e].to_id];
+      if (n == -2) n = next_at_corner(e);
       if (n == static_cast<long>(start)) break;
       if (n < 0 || used[n]) {
         c.loop = false;
@@ -366,6 +420,11 @@ HoleClosing close_holes(TriangleSoup& soup, const std::vector<int>& id, const Ed
   for (const Chain& c : chains) {
     const std::vector<int>& loop = c.corners;
     if (!c.loop || loop.size() < 3 || c.length > max_length_mm) continue;
+    // A loop through the same corner twice would be closed by a fan folded there: left.
+    std::vector<int> ids(loop.size());
+    for (size_t k = 0; k < loop.size(); ++k) ids[k] = id[loop[k]];
+    std::sort(ids.begin(), ids.end());
+    if (std::adjacent_find(ids.begin(), ids.end()) != ids.end()) continue;
     bool at_end = false;
     for (const auto& [point, normal] : ends) {
       bool in_plane = true;
@@ -402,7 +461,7 @@ SoupRepair repair_soup(TriangleSoup& soup, const SoupRepairParams& params) {
   if (!params.orient && !close) return out;
   const EdgeUses uses = edge_uses(soup, id);
   if (params.orient) out.orientation = orient(soup, uses);
-  if (close) out.holes = close_holes(soup, id, uses, params.close_holes_mm);
+  if (close) out.holes = close_holes(soup, id, uses, params.close_holes_mm, params.through_corners);
   return out;
 }
 
@@ -418,9 +477,10 @@ SoupOrientation orient_consistently(TriangleSoup& soup) {
   return repair_soup(soup, p).orientation;
 }
 
-HoleClosing close_small_holes(TriangleSoup& soup, double max_length_mm) {
+HoleClosing close_small_holes(TriangleSoup& soup, double max_length_mm, bool through_corners) {
   SoupRepairParams p;
   p.close_holes_mm = max_length_mm;
+  p.through_corners = through_corners;
   return repair_soup(soup, p).holes;
 }
 

@@ -45,6 +45,7 @@ LoadedSkull load(const std::string& path, const ExtractBoneSurfaceParams& import
     read.orient_consistently = as_skull && import.orient_consistently;
     read.drop_repeated_triangles = as_skull && import.drop_repeated_triangles;
     read.close_holes_mm = as_skull ? import.close_holes_mm : 0.0;
+    read.close_holes_through_corners = import.close_holes_through_corners;
     read.far_piece_mm = as_skull && import.drop_far_pieces ? kFarPieceMm : 0.0;
     {
       // Built in place: OpenMesh meshes cannot be moved (assigning one copies it).

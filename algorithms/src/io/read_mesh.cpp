@@ -503,6 +503,7 @@ void read_into(const std::string& path, const ReadMeshParams& params, MeshFile& 
   repairs.drop_repeated = params.drop_repeated_triangles;
   repairs.orient = params.orient_consistently;
   repairs.close_holes_mm = params.close_holes_mm;
+  repairs.through_corners = params.close_holes_through_corners;
   const SoupRepair done = repair_soup(soup, repairs);
   out.repeated_dropped = done.repeated_dropped;
   out.triangles_turned = done.orientation.triangles_turned;

@@ -52,11 +52,15 @@ struct HoleClosing {
 /// open, otherwise a fan from the loop's centroid (a vertex added there), wound as the triangles
 /// around it. A skull's surface has no open edge of its own — a defect or a foramen is a
 /// tunnel through the bone, not a gap in its surface — so such loops are triangles a program
-/// lost; they are closed before anything asks what is inside the bone. Longer loops (the scan's
-/// end, a surface cropped or torn), loops that touch themselves at a corner, and small loops
-/// in the plane (within 1 mm) of a longer flat one (bone that the scan's end cuts across) are
-/// left.
-HoleClosing close_small_holes(TriangleSoup& soup, double max_length_mm);
+/// lost; they are closed before anything asks what is inside the bone. Two holes that touch at
+/// a corner (two lost triangles sharing a vertex) are told apart by turning about the corner
+/// through the triangles there, and each is closed on its own. Longer loops (the scan's end, a
+/// surface cropped or torn), loops through a corner where more than two holes meet or where
+/// the triangles cannot be turned through (an edge of three triangles, patches wound against
+/// each other), loops that pass a corner twice, and small loops in the plane (within 1 mm) of a
+/// longer flat one (bone that the scan's end cuts across) are left.
+HoleClosing close_small_holes(TriangleSoup& soup, double max_length_mm,
+                              bool through_corners = true);
 
 /// The three repairs above in one pass over the soup (corners compared by position once, the
 /// edges listed once): repeated triangles dropped, then patches turned, then small holes
@@ -65,6 +69,9 @@ struct SoupRepairParams {
   bool drop_repeated = false;   ///< drop_repeated_triangles
   bool orient = false;          ///< orient_consistently
   double close_holes_mm = 0.0;  ///< close_small_holes; 0: none
+  /// Two holes that touch at a corner are told apart and closed (close_small_holes); false:
+  /// both left open, as load_skull 5 read them.
+  bool through_corners = true;
 };
 struct SoupRepair {
   long long repeated_dropped = 0;

@@ -45,6 +45,10 @@ struct ExtractBoneSurfaceParams {
   /// the bone's inside. The scan's end, a crop and a torn surface are longer. 0: left open, as
   /// plans whose load_skull is version 1 to 4 read it.
   double close_holes_mm = 15.0;
+  /// With close_holes_mm, two holes that touch at a corner (two lost triangles sharing a
+  /// vertex) are told apart and each closed (close_small_holes); false: both left open, as
+  /// plans whose load_skull is version 1 to 5 read them.
+  bool close_holes_through_corners = true;
   /// Through load_skull, a volume's positions in the patient's LPS frame, whatever space the
   /// file declares (ReadVolumeParams::patient_frame); false: a NRRD's or NIfTI's positions as
   /// the file writes them, as plans saved before version 0.2 read them.

@@ -42,6 +42,9 @@ struct ReadMeshParams {
   /// line's crossings no longer tell the bone's inside. Done after `orient_consistently`, so
   /// that the closing triangles wind as their neighbours. 0: left open.
   double close_holes_mm = 0.0;
+  /// With close_holes_mm, two holes that touch at a corner are told apart and closed each
+  /// (SoupRepairParams::through_corners); false: both left open.
+  bool close_holes_through_corners = true;
   /// Pieces whose bounding box lies more than this far from the largest piece's (mm) are
   /// dropped, with a warning (MeshFile::pieces_dropped): the CT table, a clip, noise far from
   /// the head. 0: every piece kept.
