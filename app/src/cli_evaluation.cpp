@@ -192,7 +192,7 @@ Json evaluate_case(const std::string& id, const std::string& defective,
       const CompareResult c = compare_implants(r.implant.mesh, truth, &skull);
       if (!implants_out.empty()) {
         const std::string path = (fs::path(implants_out) / (id + "_planned_implant.stl")).string();
-        write_mesh(r.implant.mesh, path);
+        write_mesh(r.implant.mesh, path, loaded.file_space);
         row["implant"] = path;
       }
       add_scores(row, r, c);

@@ -191,13 +191,14 @@ int autoplan_sessions(const std::string& skull, const ExtractBoneSurfaceParams& 
   return all_planned ? kOk : kUnusable;
 }
 
-// Writes one automatic plan's markers (if asked for) and implant (if planned); its report.
+// Writes one automatic plan's markers (if asked for) and implant (if planned, in the
+// coordinates the skull's file gave: `space`); its report.
 Json write_autoplan(const AutoplanResult& r, const std::string& output,
-                    const std::string& markers_out) {
+                    const std::string& markers_out, MeshSpace space) {
   Json j = autoplan_json(r);
   if (!markers_out.empty() && !r.markers.empty()) write_markers_file(r.markers, markers_out);
   if (r.planned()) {
-    write_mesh(r.implant.mesh, output);
+    write_mesh(r.implant.mesh, output, space);
     j["output"] = output;
   }
   return j;
@@ -315,7 +316,7 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
           print_result(j, json);
           return kUnusable;
         }
-        write_mesh(r.mesh, o->output);
+        write_mesh(r.mesh, o->output, loaded.file_space);
         j["output"] = o->output;
         j["quality"] = to_json(check_implant(r.mesh, &skull, quality_params_for(o->params, r)));
         print_result(j, json);
@@ -383,16 +384,21 @@ Subcommand add_mould(CLI::App& app, const bool& json) {
           print_result(j, json);
           return kUnusable;
         }
+        // In the coordinates the skull's file gave (RAS where it declared so).
+        const MeshSpace space = skull.file_space;
         if (format == MeshFormat::ThreeMF) {
-          write_file_atomically(o->output, encode_3mf({{"implant", &implant},
-                                                       {"mould outer", &r.outer},
-                                                       {"mould inner", &r.inner}},
+          const SkullMesh implant_out = mesh_in_space(implant, space),
+                          outer = mesh_in_space(r.outer, space),
+                          inner = mesh_in_space(r.inner, space);
+          write_file_atomically(o->output, encode_3mf({{"implant", &implant_out},
+                                                       {"mould outer", &outer},
+                                                       {"mould inner", &inner}},
                                                       {{"Application", "Cranioplan"}}));
           j["output"] = o->output;
         } else {
           const std::string stem = o->output.substr(0, o->output.size() - 4);
-          write_mesh(r.outer, stem + "_outer.stl");
-          write_mesh(r.inner, stem + "_inner.stl");
+          write_mesh(r.outer, stem + "_outer.stl", space);
+          write_mesh(r.inner, stem + "_inner.stl", space);
           j["output"] = Json::array({stem + "_outer.stl", stem + "_inner.stl"});
         }
         print_result(j, json);
@@ -549,8 +555,8 @@ Subcommand add_inject_defect(CLI::App& app, const bool& json) {
                         print_result(j, json);
                         return kUnusable;
                       }
-                      write_mesh(r.defective, o->output);
-                      write_mesh(r.implant, o->implant);
+                      write_mesh(r.defective, o->output, loaded.file_space);
+                      write_mesh(r.implant, o->implant, loaded.file_space);
                       j["defective"] = o->output;
                       j["implant"] = o->implant;
                       print_result(j, json);
@@ -626,7 +632,8 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
         };
         if (!o->all_openings) {
           const AutoplanResult r = autoplan(skull, lm, planning(o->params, loaded));
-          print_result(with_warnings(write_autoplan(r, o->output, o->markers_out)), json);
+          print_result(
+              with_warnings(write_autoplan(r, o->output, o->markers_out, loaded.file_space)), json);
           return r.planned() ? kOk : kUnusable;
         }
         // Every opening in turn; the first is the one planned without
@@ -634,14 +641,16 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
         const std::vector<AutoplanResult> all =
             autoplan_all_openings(skull, lm, planning(o->params, loaded));
         if (!all.front().defect.found()) {  // no defect, or no plane
-          print_result(with_warnings(write_autoplan(all.front(), o->output, o->markers_out)), json);
+          print_result(with_warnings(write_autoplan(all.front(), o->output, o->markers_out,
+                                                    loaded.file_space)),
+                       json);
           return all.front().planned() ? kOk : kUnusable;
         }
         Json plans = Json::array();
         bool all_planned = true;
         for (size_t k = 0; k < all.size(); ++k) {
-          plans.push_back(with_warnings(
-              write_autoplan(all[k], numbered_path(o->output, k + 1), markers_path(k + 1))));
+          plans.push_back(with_warnings(write_autoplan(all[k], numbered_path(o->output, k + 1),
+                                                       markers_path(k + 1), loaded.file_space)));
           all_planned = all_planned && all[k].planned();
         }
         print_plans(plans, json);

@@ -212,7 +212,7 @@ Subcommand add_mirror(CLI::App& app, const bool& json) {
         const Plane p = read_plane_file(o->plane);
         const LoadedSkull s = load_skull(o->mesh, o->import.params());
         const SkullMesh m = mirror_mesh(s.mesh, p);
-        write_mesh(m, o->output);
+        write_mesh(m, o->output, s.file_space);
         Json r{{"o->output", o->output}, {"plane", to_json(p)}, {"mesh", to_json(report_mesh(m))}};
         if (!s.warnings.empty()) r["warnings"] = s.warnings;
         print_result(r, json);
@@ -262,7 +262,8 @@ Subcommand add_register(CLI::App& app, const bool& json) {
               return kUnusable;
             }
             if (!o->output.empty()) {
-              write_mesh(transform_mesh(moving.mesh, r.transform), o->output);
+              // Onto the fixed surface, in the coordinates its file gave.
+              write_mesh(transform_mesh(moving.mesh, r.transform), o->output, fixed.file_space);
               j["o->output"] = o->output;
             }
             print_result(j, json);
@@ -291,7 +292,10 @@ Subcommand add_pipeline(CLI::App& app, const bool& json) {
             std::filesystem::create_directories(o->output);
             const Pipeline p = run_pipeline(input, o->import, o->landmarks);
             const std::filesystem::path dir(o->output);
-            write_mesh(p.skull.mesh, (dir / "skull.stl").string());
+            // The meshes in the coordinates the input gave (RAS where it declared so), the plane
+            // and the transform in the plan's LPS frame.
+            const MeshSpace space = p.skull.file_space;
+            write_mesh(p.skull.mesh, (dir / "skull.stl").string(), space);
             Json r{{"input", input},
                    {"skull", skull_json(p.skull)},
                    {"mesh", to_json(report_mesh(p.skull.mesh))}};
@@ -301,14 +305,14 @@ Subcommand add_pipeline(CLI::App& app, const bool& json) {
               return kUnusable;
             }
             write_json_file(to_json(p.plane.plane), (dir / "plane.json").string());
-            write_mesh(p.mirrored, (dir / "mirrored.stl").string());
+            write_mesh(p.mirrored, (dir / "mirrored.stl").string(), space);
             r["registration"] = to_json(p.registration);
             if (!p.registration.usable()) {
               print_result(r, json);
               return kUnusable;
             }
             write_json_file(to_json(p.registration.transform), (dir / "transform.json").string());
-            write_mesh(p.registered, (dir / "mirrored_registered.stl").string());
+            write_mesh(p.registered, (dir / "mirrored_registered.stl").string(), space);
             r["outputs"] = {(dir / "skull.stl").string(), (dir / "plane.json").string(),
                             (dir / "mirrored.stl").string(), (dir / "transform.json").string(),
                             (dir / "mirrored_registered.stl").string()};

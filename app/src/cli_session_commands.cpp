@@ -64,7 +64,10 @@ std::vector<Subcommand> add_session_commands(CLI::App& app, const bool& json) {
                          print_result(j, json);
                          return kUnusable;
                        }
-                       write_mesh(s.state().implant->result().mesh, o->output);
+                       const auto& skull = s.state().skull;
+                       write_mesh(
+                           s.state().implant->result().mesh, o->output,
+                           skull ? skull->surface->loaded.file_space : MeshSpace::Undeclared);
                        j["output"] = o->output;
                      }
                      print_result(j, json);

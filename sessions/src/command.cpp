@@ -234,7 +234,9 @@ int current_version(CommandType type) {
   // patches that wind against their neighbours turned to agree ("import.orient_consistently")
   // and its small holes closed ("import.close_holes_mm"), none of them when absent.
   // load_skull 6: two small holes that touch at a corner closed as well
-  // ("import.close_holes_through_corners"); absent, both left open as version 5 left them.
+  // ("import.close_holes_through_corners"); absent, both left open as version 5 left them. And
+  // a mesh that declares its coordinates RAS read in LPS ("import.mesh_space_from_header");
+  // absent, taken as LPS.
   // build_implant 8 and export_implant 2: tabs, holes and a mould meshed with field values kept
   // 1e-3 off the iso-level (no sliver triangles); earlier versions are meshed as they were.
   // build_implant 9: holes drilled along the plate's mid-normal and under their whole
@@ -329,6 +331,7 @@ Json params_to_json(const ExtractBoneSurfaceParams& p) {
   j["drop_repeated_triangles"] = p.drop_repeated_triangles;
   j["close_holes_mm"] = p.close_holes_mm;
   j["close_holes_through_corners"] = p.close_holes_through_corners;
+  j["mesh_space_from_header"] = p.mesh_space_from_header;
   j["patient_frame"] = p.patient_frame;
   j["drop_far_pieces"] = p.drop_far_pieces;
   j["dicom_series"] = p.dicom_series;
@@ -562,6 +565,8 @@ void params_from_json(const ParamReader& r, ExtractBoneSurfaceParams& p) {
   // Before load_skull 6, holes that touch another at a corner were left open.
   p.close_holes_through_corners =
       r.has("close_holes_through_corners") && r.boolean("close_holes_through_corners");
+  // Nor did they read a mesh's declared RAS coordinates in LPS.
+  p.mesh_space_from_header = r.has("mesh_space_from_header") && r.boolean("mesh_space_from_header");
   // Before load_skull 4, a NRRD's or NIfTI's positions were read as the file writes them (NIfTI
   // in RAS), and a mesh's far pieces were kept.
   p.patient_frame = r.has("patient_frame") && r.boolean("patient_frame");

@@ -36,7 +36,9 @@ ImplantData::ImplantData(ImplantResult result, std::shared_ptr<const SkullInput>
 
 const std::string& ImplantData::stl_sha256() const {
   std::call_once(sha_once_, [this] {
-    stl_sha256_ = sha256_hex(encode_mesh(result_.mesh, MeshFormat::BinarySTL));
+    // As exported: in the coordinates the skull's file gave (export_bytes).
+    const MeshSpace space = skull_ ? skull_->surface->loaded.file_space : MeshSpace::Undeclared;
+    stl_sha256_ = sha256_hex(encode_mesh(result_.mesh, MeshFormat::BinarySTL, space));
   });
   return stl_sha256_;
 }
@@ -800,18 +802,28 @@ MouldResult mould_of(const SkullMesh& implant, const SkullMesh* skull, const Mou
 std::string export_bytes(const PlanState& s, const ExportSpec& spec, std::string* why) {
   const ImplantData& implant = *s.implant;
   const SkullMesh& mesh = implant.result().mesh;
+  // In the coordinates the skull's file gave: RAS where it declared so (LoadedSkull::file_space).
+  const MeshSpace space = s.skull ? s.skull->surface->loaded.file_space : MeshSpace::Undeclared;
   if (spec.format != "3mf")
-    return encode_mesh(mesh, spec.format == "stl" ? MeshFormat::BinarySTL : MeshFormat::BinaryPLY);
+    return encode_mesh(mesh, spec.format == "stl" ? MeshFormat::BinarySTL : MeshFormat::BinaryPLY,
+                       space);
   const std::vector<std::pair<std::string, std::string>> metadata = {
       {"Application", "Cranioplan"},
       {"Description", plan_description(spec.plan_sha256, implant.stl_sha256())}};
-  if (!spec.mould) return encode_3mf({{"implant", &mesh}}, metadata);
+  const bool turn = negates_x_and_y(space);
+  const SkullMesh turned = turn ? mesh_in_space(mesh, space) : SkullMesh();
+  const SkullMesh& implant_out = turn ? turned : mesh;
+  if (!spec.mould) return encode_3mf({{"implant", &implant_out}}, metadata);
   const MouldResult m = mould_of(mesh, s.skull ? &s.skull->surface->mesh : nullptr, *spec.mould);
   if (!m.usable()) {
     if (why) *why = "the mould could not be made: " + m.message;
     return {};
   }
-  return encode_3mf({{"implant", &mesh}, {"mould outer", &m.outer}, {"mould inner", &m.inner}},
+  if (!turn)
+    return encode_3mf({{"implant", &mesh}, {"mould outer", &m.outer}, {"mould inner", &m.inner}},
+                      metadata);
+  const SkullMesh outer = mesh_in_space(m.outer, space), inner = mesh_in_space(m.inner, space);
+  return encode_3mf({{"implant", &implant_out}, {"mould outer", &outer}, {"mould inner", &inner}},
                     metadata);
 }
 

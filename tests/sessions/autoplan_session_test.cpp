@@ -36,6 +36,43 @@ TEST(AutoplanSession, ReplayReproducesTheExportByteForByte) {
   for (const auto& check : v.checks) EXPECT_TRUE(check.ok) << check.name << ": " << check.detail;
 }
 
+// A skull from 3D Slicer in RAS (SPACE=RAS) is planned in the patient's LPS and its implant
+// exported back in the file's RAS, saying so: it lies in the defect of the file as given, in
+// Slicer and in any program that reads coordinates as they are. Here the synthetic case's
+// skull is written in RAS: read back into LPS it is the same skull, so the plan is the same,
+// and the export is the same implant, x and y negated, its STL header declaring RAS.
+TEST(AutoplanSession, AnImplantPlannedOnARasSkullIsExportedInRas) {
+  const PlannedCase& c = planned();
+  const std::string ras_skull = test::scratch_path("defect_ras.stl");
+  const std::string ras_implant = test::scratch_path("defect_ras_implant.stl");
+  write_mesh(load_skull(test::defect_skull_stl()).mesh, ras_skull, MeshSpace::RAS);
+  AutoplanSession a = autoplan_session(ras_skull, Landmarks{}, AutoplanParams{}, ras_implant,
+                                       SessionInfo{"synthetic", "expert", ""});
+  ASSERT_TRUE(a.planned()) << a.message;
+  // Both in the files' order (the canonical order depends on the coordinates).
+  ExtractBoneSurfaceParams raw;
+  raw.canonical = false;
+  const LoadedSkull lps_implant = load_surface(c.implant_path, raw);
+  raw.mesh_space_from_header = false;
+  const LoadedSkull as_written = load_surface(ras_implant, raw);
+  ASSERT_EQ(as_written.mesh.n_vertices(), lps_implant.mesh.n_vertices());
+  double off = 0.0;
+  for (auto vh : lps_implant.mesh.vertices()) {
+    const auto& p = lps_implant.mesh.point(vh);
+    const auto& q = as_written.mesh.point(SkullMesh::VertexHandle(vh.idx()));
+    off = std::max(off, (Eigen::Vector3d(-p[0], -p[1], p[2]) - to_eigen(q)).norm());
+  }
+  EXPECT_LT(off, 1e-5) << "the same implant, in RAS";
+  EXPECT_EQ(load_surface(ras_implant).file_space, MeshSpace::RAS);
+  EXPECT_EQ(a.session.state().implant->stl_sha256(), sha256_file(ras_implant))
+      << "the implant's STL checksum is the exported file's";
+  // Reopened, the plan replays to the same bytes.
+  const std::string session = test::scratch_path("defect_ras.json");
+  a.session.save(session);
+  const VerifyReport v = verify_session(session);
+  for (const auto& check : v.checks) EXPECT_TRUE(check.ok) << check.name << ": " << check.detail;
+}
+
 // The proposal is recorded in its command (what a replay applies): the markers, with their
 // ids, are those of the plan.
 TEST(AutoplanSession, TheProposalIsRecordedInItsCommand) {

@@ -47,12 +47,16 @@ LoadedSkull load(const std::string& path, const ExtractBoneSurfaceParams& import
     read.close_holes_mm = as_skull ? import.close_holes_mm : 0.0;
     read.close_holes_through_corners = import.close_holes_through_corners;
     read.far_piece_mm = as_skull && import.drop_far_pieces ? kFarPieceMm : 0.0;
+    read.space_from_header = import.mesh_space_from_header;
+    MeshSpace declared = MeshSpace::Undeclared;
     {
       // Built in place: OpenMesh meshes cannot be moved (assigning one copies it).
       MeshFile file = read_mesh(path, read, out.mesh);
       out.description = file.format;
       out.warnings = std::move(file.warnings);
       out.pieces_dropped = file.pieces_dropped;
+      declared = file.space;
+      if (file.turned_to_lps) out.file_space = MeshSpace::RAS;
     }
     out.source_kind = "mesh";
     if (import.mesh_unit_mm != 1.0) {
@@ -70,7 +74,23 @@ LoadedSkull load(const std::string& path, const ExtractBoneSurfaceParams& import
         out.warnings.push_back(path + ": " + s);
       for (const std::string& s : describe_caps(report)) out.notes.push_back(path + ": " + s);
     }
-    out.frame = "the file's own coordinates (a mesh file declares no frame), taken as LPS";
+    if (out.file_space == MeshSpace::RAS) {
+      out.frame =
+          "RAS, as the file declares (SPACE=RAS, as 3D Slicer writes it): read in the "
+          "patient's LPS frame (x and y negated); exports are written back in RAS";
+      out.notes.push_back(path +
+                          ": declares its coordinates RAS (SPACE=RAS, as 3D Slicer writes "
+                          "them); read in the patient's LPS frame, x and y negated, and "
+                          "exports of the plan are written back in RAS, saying SPACE=RAS");
+    } else if (declared == MeshSpace::RAS) {
+      out.frame =
+          "the file's own coordinates, taken as LPS (the file declares RAS, SPACE=RAS: "
+          "read as it was before such declarations were read)";
+    } else if (declared == MeshSpace::LPS) {
+      out.frame = "LPS, as the file declares (SPACE=LPS, as 3D Slicer writes it)";
+    } else {
+      out.frame = "the file's own coordinates (a mesh file declares no frame), taken as LPS";
+    }
   }
   out.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   return out;

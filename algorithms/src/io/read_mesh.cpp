@@ -1,8 +1,10 @@
 #include "cranioplan/algorithms/io/read_mesh.h"
 
+#include <vtkFieldData.h>
 #include <vtkNew.h>
 #include <vtkPolyData.h>
 #include <vtkSmartPointer.h>
+#include <vtkStringArray.h>
 #include <vtkXMLPolyDataReader.h>
 
 #include <algorithm>
@@ -13,6 +15,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <sstream>
+#include <string_view>
 
 #include "cranioplan/algorithms/geometry/mesh_components.h"
 #include "cranioplan/algorithms/io/file_io.h"
@@ -235,7 +238,7 @@ TriangleSoup parse_ascii_stl(const std::string& path, const std::string& bytes) 
   return soup;
 }
 
-TriangleSoup read_stl(const std::string& path, std::string& format) {
+TriangleSoup read_stl(const std::string& path, std::string& format, MeshSpace& space) {
   detail::FileReader file(path);
   const size_t size = file.size();
   std::string bytes(std::min<size_t>(size, 1024), '\0');  // enough to tell binary from text
@@ -248,6 +251,7 @@ TriangleSoup read_stl(const std::string& path, std::string& format) {
       !(n == 0 && looks_like_text(bytes))) {
     if (n == 0) fail(path, "binary STL declares 0 triangles");
     format = "binary STL";
+    space = space_in_text(std::string_view(bytes.data(), 80));
     return parse_binary_stl(path, file, bytes, n);
   }
   const size_t head = bytes.size();
@@ -255,6 +259,7 @@ TriangleSoup read_stl(const std::string& path, std::string& format) {
   file.read(bytes.data() + head, size - head);
   if (looks_like_text(bytes)) {
     format = "ASCII STL";
+    space = space_in_text(std::string_view(bytes).substr(0, bytes.find('\n')));
     return parse_ascii_stl(path, bytes);
   }
   if (size < 84) fail(path, "too short for an STL file (" + format_count(size) + " bytes)");
@@ -268,6 +273,17 @@ TriangleSoup read_stl(const std::string& path, std::string& format) {
 
 // ---------------------------------------------------------------------------------------------
 // OFF and OBJ (text, polygons are fan-triangulated)
+// The space declared in the file's comment lines ('#'), as 3D Slicer writes it into an OBJ.
+MeshSpace space_in_comments(const std::string& bytes) {
+  MeshSpace space = MeshSpace::Undeclared;
+  for (size_t at = 0; at < bytes.size() && space == MeshSpace::Undeclared;) {
+    const size_t eol = std::min(bytes.find('\n', at), bytes.size());
+    if (bytes[at] == '#') space = space_in_text(std::string_view(bytes).substr(at, eol - at));
+    at = eol + 1;
+  }
+  return space;
+}
+
 TriangleSoup read_off(const std::string& path, const std::string& bytes) {
   // Comments start with '#': blank them out of a copy for simple tokenizing.
   std::string text = bytes;
@@ -363,7 +379,7 @@ TriangleSoup read_obj(const std::string& path, const std::string& bytes) {
 // ---------------------------------------------------------------------------------------------
 // VTK's XML reader leaks on some malformed files and is not proved against crashing on them:
 // it runs in a child process (isolated_read.h), which sends the soup back.
-TriangleSoup read_vtp(const std::string& path) {
+TriangleSoup read_vtp(const std::string& path, MeshSpace& space) {
   const std::string bytes =
       detail::run_isolated(path, "VTK's VTP reader", [&](detail::ChildReport& report) {
         report.reading(path);
@@ -374,7 +390,13 @@ TriangleSoup read_vtp(const std::string& path) {
         const std::string error = errors.message();
         if (!error.empty()) fail(path, "not a readable VTP file (" + error + ")");
         const TriangleSoup soup = detail::soup_from_polydata(path, reader->GetOutput());
+        // 3D Slicer's declaration of the coordinate system: a string array "SPACE".
+        MeshSpace declared = MeshSpace::Undeclared;
+        if (vtkFieldData* fields = reader->GetOutput()->GetFieldData())
+          if (auto* tag = vtkStringArray::SafeDownCast(fields->GetAbstractArray("SPACE")))
+            if (tag->GetNumberOfValues() > 0) declared = space_in_text("SPACE=" + tag->GetValue(0));
         detail::ByteWriter w;
+        w.pod<uint8_t>(static_cast<uint8_t>(declared));
         w.pod<uint64_t>(soup.vertices.size());
         w.raw(soup.vertices.data(), soup.vertices.size() * sizeof(Eigen::Vector3d));
         w.pod<uint64_t>(soup.triangles.size());
@@ -382,6 +404,7 @@ TriangleSoup read_vtp(const std::string& path) {
         report.result(w.take());
       });
   detail::ByteReader r(bytes);
+  space = static_cast<MeshSpace>(r.pod<uint8_t>());
   TriangleSoup soup;
   soup.vertices.resize(r.pod<uint64_t>());
   r.raw(soup.vertices.data(), soup.vertices.size() * sizeof(Eigen::Vector3d));
@@ -428,28 +451,33 @@ void drop_far_pieces(const std::string& path, double far_mm, TriangleSoup& soup,
 
 }  // namespace
 
-TriangleSoup read_mesh_soup(const std::string& path, std::string* format_out) {
+TriangleSoup read_mesh_soup(const std::string& path, std::string* format_out,
+                            MeshSpace* space_out) {
   const std::string ext = detail::lower_extension(path);
   std::string format;
+  MeshSpace space = MeshSpace::Undeclared;
   TriangleSoup soup;
   // A binary STL is parsed as it is read; the other formats from the whole file.
   const std::string bytes = ext == ".stl" ? std::string() : read_file_bytes(path);
   if (ext == ".stl") {
-    soup = read_stl(path, format);
+    soup = read_stl(path, format, space);
   } else if (ext == ".off") {
     format = "OFF";
     soup = read_off(path, bytes);
+    space = space_in_comments(bytes);
   } else if (ext == ".obj") {
     format = "OBJ";
     soup = read_obj(path, bytes);
+    space = space_in_comments(bytes);
   } else if (ext == ".ply") {
     format = "PLY";
     soup = detail::read_ply(path, bytes);
+    space = space_in_text(std::string_view(bytes).substr(0, bytes.find("end_header")));
   } else if (ext == ".vtp") {
     format = "VTP";
     if (bytes.find("<VTKFile") == std::string::npos)
       fail(path, "not a VTP file (no <VTKFile> element)");
-    soup = read_vtp(path);
+    soup = read_vtp(path, space);
   } else {
     fail(path, "unknown mesh format '" + ext + "' (expected .stl, .ply, .obj, .off or .vtp)");
   }
@@ -459,6 +487,7 @@ TriangleSoup read_mesh_soup(const std::string& path, std::string* format_out) {
       for (int v = 0; v < 3; ++v)
         check_finite(path, soup.vertices[soup.triangles[t][v]], static_cast<long long>(t));
   if (format_out) *format_out = format;
+  if (space_out) *space_out = space;
   return soup;
 }
 
@@ -493,8 +522,16 @@ namespace {
 // The mesh built in `mesh` (out.mesh or another), the rest of what was read in `out`.
 void read_into(const std::string& path, const ReadMeshParams& params, MeshFile& out,
                SkullMesh& mesh) {
-  TriangleSoup soup = read_mesh_soup(path, &out.format);
+  TriangleSoup soup = read_mesh_soup(path, &out.format, &out.space);
   out.triangles_in_file = static_cast<long long>(soup.triangles.size());
+  // Into the patient's LPS: x and y negated, a turn about z that keeps the winding.
+  if (params.space_from_header && negates_x_and_y(out.space)) {
+    for (auto& v : soup.vertices) {
+      v.x() = -v.x();
+      v.y() = -v.y();
+    }
+    out.turned_to_lps = true;
+  }
   assert(params.unit_mm > 0.0 && std::isfinite(params.unit_mm) && "validated by the caller");
   if (params.unit_mm != 1.0)
     for (auto& v : soup.vertices) v *= params.unit_mm;

@@ -19,15 +19,22 @@ void put(std::string& out, T value) {
   out.append(buf, sizeof(T));
 }
 
-std::string encode_stl(const SkullMesh& mesh) {
+// From the patient's LPS to `space`'s coordinates (x and y negated for RAS).
+Eigen::Vector3d in_space(const Eigen::Vector3d& p, MeshSpace space) {
+  return negates_x_and_y(space) ? Eigen::Vector3d(-p.x(), -p.y(), p.z()) : p;
+}
+
+std::string encode_stl(const SkullMesh& mesh, MeshSpace space) {
   std::string out;
   out.reserve(84 + 50 * mesh.n_faces());
   std::string header = "binary STL written by Cranioplan, units mm";
+  if (negates_x_and_y(space)) header += std::string(", ") + space_tag(space);
   header.resize(80, ' ');
   out += header;
   put<uint32_t>(out, static_cast<uint32_t>(mesh.n_faces()));
   for (auto fh : mesh.faces()) {
-    const FaceCorners f = face_corners(mesh, fh);
+    FaceCorners f = face_corners(mesh, fh);
+    for (auto& corner : f.p) corner = in_space(corner, space);
     const auto& p = f.p;
     Eigen::Vector3d n = f.cross();
     if (n.norm() > 0) n.normalize();
@@ -39,14 +46,17 @@ std::string encode_stl(const SkullMesh& mesh) {
   return out;
 }
 
-std::string encode_ply(const SkullMesh& mesh) {
+std::string encode_ply(const SkullMesh& mesh, MeshSpace space) {
   std::string out = "ply\nformat binary_little_endian 1.0\ncomment Cranioplan, units mm\n";
+  if (negates_x_and_y(space)) out += std::string("comment ") + space_tag(space) + "\n";
   out += "element vertex " + std::to_string(mesh.n_vertices()) + "\n";
   out += "property double x\nproperty double y\nproperty double z\n";
   out += "element face " + std::to_string(mesh.n_faces()) + "\n";
   out += "property list uchar int vertex_indices\nend_header\n";
-  for (auto vh : mesh.vertices())
-    for (int c = 0; c < 3; ++c) put<double>(out, mesh.point(vh)[c]);
+  for (auto vh : mesh.vertices()) {
+    const Eigen::Vector3d p = in_space(to_eigen(mesh.point(vh)), space);
+    for (int c = 0; c < 3; ++c) put<double>(out, p[c]);
+  }
   for (auto fh : mesh.faces()) {
     put<uint8_t>(out, 3);
     for (auto vh : mesh.fv_range(fh)) put<int32_t>(out, vh.idx());
@@ -64,20 +74,36 @@ MeshFormat mesh_format_for_path(const std::string& path) {
   throw InputError(path, "cannot write '" + ext + "' meshes (use .stl, .ply or .3mf)");
 }
 
-std::string encode_mesh(const SkullMesh& mesh, MeshFormat format) {
+SkullMesh mesh_in_space(const SkullMesh& mesh, MeshSpace space) {
+  SkullMesh out = mesh;
+  if (negates_x_and_y(space))
+    for (auto vh : out.vertices()) {
+      auto& p = out.point(vh);
+      p[0] = -p[0];
+      p[1] = -p[1];
+    }
+  return out;
+}
+
+std::string encode_mesh(const SkullMesh& mesh, MeshFormat format, MeshSpace space) {
   switch (format) {
     case MeshFormat::BinarySTL:
-      return encode_stl(mesh);
+      return encode_stl(mesh, space);
     case MeshFormat::BinaryPLY:
-      return encode_ply(mesh);
-    case MeshFormat::ThreeMF:
-      return encode_3mf({{"implant", &mesh}}, {{"Application", "Cranioplan"}});
+      return encode_ply(mesh, space);
+    case MeshFormat::ThreeMF: {
+      if (!negates_x_and_y(space))
+        return encode_3mf({{"implant", &mesh}}, {{"Application", "Cranioplan"}});
+      const SkullMesh turned = mesh_in_space(mesh, space);
+      return encode_3mf({{"implant", &turned}}, {{"Application", "Cranioplan"}});
+    }
   }
   return {};
 }
 
-void write_mesh(const SkullMesh& mesh, const std::string& path, MeshFormat format) {
-  write_file_atomically(path, encode_mesh(mesh, format));
+void write_mesh(const SkullMesh& mesh, const std::string& path, MeshFormat format,
+                MeshSpace space) {
+  write_file_atomically(path, encode_mesh(mesh, format, space));
 }
 
 }  // namespace cranioplan

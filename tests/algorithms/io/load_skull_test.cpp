@@ -1,6 +1,8 @@
 #include "cranioplan/algorithms/io/load_skull.h"
 
 #include <gtest/gtest.h>
+#include <vtkNew.h>
+#include <vtkSTLWriter.h>
 
 #include <cmath>
 
@@ -9,6 +11,7 @@
 #include "cranioplan/model/error.h"
 #include "support/synthetic.h"
 #include "support/test_files.h"
+#include "support/vtk_meshes.h"
 
 namespace cranioplan {
 namespace {
@@ -256,6 +259,48 @@ TEST(LoadSkull, SmallHolesAreClosed) {
   as_it_came.close_holes_mm = 0.0;
   const LoadedSkull open = load_skull(dir.path("holed.stl"), as_it_came);
   EXPECT_EQ(report_mesh(open.mesh).boundary_edges, 21);
+}
+
+// A skull that 3D Slicer wrote in RAS (SPACE=RAS in the STL's header: how Slicer wrote models
+// until 2020, and still does when asked) is read in the patient's LPS: its defect on the
+// patient's left lies at +x, as the CT has it, and the load says what it did. Taken as LPS, as
+// before such declarations were read, the defect lay on the right (x < 0), and views and
+// reports named the sides the wrong way round.
+TEST(LoadSkull, ASkullDeclaredRasIsReadInThePatientsFrame) {
+  TempDir dir;
+  const Eigen::Vector3d left(0.7, 0.1, 0.7);  // +x: the patient's left, in LPS
+  const SkullMesh head =
+      test::cut_hole(test::make_symmetric_head(4), test::head_surface_point(left.normalized()), 25);
+  SkullMesh ras = head;
+  for (auto vh : ras.vertices()) {
+    ras.point(vh)[0] = -ras.point(vh)[0];
+    ras.point(vh)[1] = -ras.point(vh)[1];
+  }
+  vtkNew<vtkSTLWriter> w;
+  w->SetInputData(test::to_polydata(ras));
+  w->SetFileName(dir.path("slicer.stl").c_str());
+  w->SetFileTypeToBinary();
+  w->SetHeader("3D Slicer output. SPACE=RAS");
+  w->Write();
+  const LoadedSkull s = load_skull(dir.path("slicer.stl"));
+  EXPECT_EQ(s.file_space, MeshSpace::RAS);
+  const MeshReport r = report_mesh(s.mesh);
+  ASSERT_FALSE(r.loops.empty());
+  EXPECT_GT(r.loops[0].centroid.x(), 20.0) << "the defect on the patient's left";
+  EXPECT_NE(s.frame.find("RAS, as the file declares"), std::string::npos) << s.frame;
+  ASSERT_EQ(s.notes.size(), 1u);
+  EXPECT_NE(s.notes[0].find("slicer.stl: declares its coordinates RAS (SPACE=RAS"),
+            std::string::npos)
+      << s.notes[0];
+  EXPECT_TRUE(s.warnings.empty() || s.warnings[0].find("RAS") == std::string::npos)
+      << "a declaration read is no repair";
+  // Plans whose load_skull is version 5 or older took the file's coordinates as LPS.
+  ExtractBoneSurfaceParams as_before;
+  as_before.mesh_space_from_header = false;
+  const LoadedSkull old = load_skull(dir.path("slicer.stl"), as_before);
+  EXPECT_EQ(old.file_space, MeshSpace::Undeclared);
+  EXPECT_LT(report_mesh(old.mesh).loops[0].centroid.x(), -20.0);
+  EXPECT_NE(old.frame.find("the file declares RAS"), std::string::npos) << old.frame;
 }
 
 // A CT export may carry the table, a clip or noise far from the head: the skull is its largest

@@ -2,9 +2,13 @@
 
 #include <gtest/gtest.h>
 #include <vtkCellArray.h>
+#include <vtkFieldData.h>
 #include <vtkNew.h>
+#include <vtkPLYWriter.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
+#include <vtkSTLWriter.h>
+#include <vtkStringArray.h>
 #include <vtkXMLPolyDataWriter.h>
 
 #include <algorithm>
@@ -19,6 +23,7 @@
 #include "cranioplan/model/error.h"
 #include "support/synthetic.h"
 #include "support/test_files.h"
+#include "support/vtk_meshes.h"
 
 namespace cranioplan {
 namespace {
@@ -102,6 +107,120 @@ TEST(ReadMesh, AsciiStlObjOffAndVtp) {
   w->SetFileName(dir.path("t.vtp").c_str());
   w->Write();
   EXPECT_EQ(read_mesh(dir.path("t.vtp")).mesh.n_faces(), 1u);
+}
+
+// 3D Slicer declares a mesh file's coordinate system ("SPACE=RAS" or "SPACE=LPS") in an STL's
+// header, a PLY's or an OBJ's comment and a VTP's field data "SPACE", written here by VTK's own
+// writers as Slicer calls them. Declared RAS, the mesh is read in the patient's LPS when asked:
+// x and y negated, the winding (and so the enclosed volume) kept.
+Eigen::Vector3d lowest_corner(const SkullMesh& mesh) {
+  Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e30);
+  for (auto vh : mesh.vertices()) lo = lo.cwiseMin(to_eigen(mesh.point(vh)));
+  return lo;
+}
+Eigen::Vector3d highest_corner(const SkullMesh& mesh) {
+  Eigen::Vector3d hi = Eigen::Vector3d::Constant(-1e30);
+  for (auto vh : mesh.vertices()) hi = hi.cwiseMax(to_eigen(mesh.point(vh)));
+  return hi;
+}
+
+TEST(ReadMesh, TheSpaceAFileDeclaresIsReadAsSlicerWritesIt) {
+  TempDir dir;
+  SkullMesh head = test::make_symmetric_head(3);
+  for (auto vh : head.vertices()) head.point(vh) += SkullMesh::Point(30, 50, 10);  // off-centre
+  const vtkSmartPointer<vtkPolyData> pd = test::to_polydata(head);
+  auto stl = [&](const std::string& name, bool ascii, const char* header) {
+    vtkNew<vtkSTLWriter> w;
+    w->SetInputData(pd);
+    w->SetFileName(dir.path(name).c_str());
+    if (ascii)
+      w->SetFileTypeToASCII();
+    else
+      w->SetFileTypeToBinary();
+    w->SetHeader(header);
+    w->Write();
+    return dir.path(name);
+  };
+  auto ply = [&](const std::string& name, const char* comment) {
+    vtkNew<vtkPLYWriter> w;
+    w->SetInputData(pd);
+    w->SetFileName(dir.path(name).c_str());
+    w->AddComment(comment);
+    w->Write();
+    return dir.path(name);
+  };
+  auto vtp = [&](const std::string& name, const char* space) {
+    vtkNew<vtkPolyData> tagged;
+    tagged->ShallowCopy(pd);
+    vtkNew<vtkStringArray> tag;
+    tag->SetName("SPACE");
+    tag->InsertNextValue(space);
+    tagged->GetFieldData()->AddArray(tag);
+    vtkNew<vtkXMLPolyDataWriter> w;
+    w->SetInputData(tagged);
+    w->SetFileName(dir.path(name).c_str());
+    w->Write();
+    return dir.path(name);
+  };
+  auto obj = [&](const std::string& name, const char* comment) {
+    std::string text = std::string("# ") + comment + "\n";
+    char line[96];
+    for (auto vh : head.vertices()) {
+      const auto& p = head.point(vh);
+      std::snprintf(line, sizeof(line), "v %.9g %.9g %.9g\n", p[0], p[1], p[2]);
+      text += line;
+    }
+    for (auto fh : head.faces()) {
+      text += "f";
+      for (auto vh : head.fv_range(fh)) text += " " + std::to_string(vh.idx() + 1);
+      text += "\n";
+    }
+    test::write_bytes(dir.path(name), text);
+    return dir.path(name);
+  };
+  const std::vector<std::pair<std::string, MeshSpace>> files = {
+      {stl("ras_binary.stl", false, "3D Slicer output. SPACE=RAS"), MeshSpace::RAS},
+      {stl("ras_ascii.stl", true, "3D Slicer output. SPACE=RAS"), MeshSpace::RAS},
+      {ply("ras.ply", "SPACE=RAS"), MeshSpace::RAS},
+      {obj("ras.obj", "3D Slicer output. SPACE=RAS"), MeshSpace::RAS},
+      {vtp("ras.vtp", "RAS"), MeshSpace::RAS},
+      {stl("lps.stl", false, "3D Slicer output. SPACE=LPS"), MeshSpace::LPS},
+      {ply("lps.ply", "SPACE=LPS"), MeshSpace::LPS},
+      {vtp("lps.vtp", "LPS"), MeshSpace::LPS},
+      {stl("plain.stl", false, "Visualization Toolkit generated SLA File"), MeshSpace::Undeclared},
+      {obj("plain.obj", "made by hand"), MeshSpace::Undeclared}};
+  const Eigen::Vector3d lo = lowest_corner(head), hi = highest_corner(head);
+  const double volume = signed_volume(head);
+  for (const auto& [path, declared] : files) {
+    SCOPED_TRACE(path);
+    const MeshFile as_is = read_mesh(path);
+    EXPECT_EQ(as_is.space, declared);
+    EXPECT_FALSE(as_is.turned_to_lps);
+    EXPECT_LT((lowest_corner(as_is.mesh) - lo).norm(), 1e-4);
+    ReadMeshParams lps;
+    lps.space_from_header = true;
+    const MeshFile read = read_mesh(path, lps);
+    EXPECT_EQ(read.turned_to_lps, declared == MeshSpace::RAS);
+    const Eigen::Vector3d want_lo =
+        declared == MeshSpace::RAS ? Eigen::Vector3d(-hi.x(), -hi.y(), lo.z()) : lo;
+    EXPECT_LT((lowest_corner(read.mesh) - want_lo).norm(), 1e-4);
+    EXPECT_NEAR(signed_volume(read.mesh), volume, 1e-4 * volume) << "wound as before";
+  }
+  // What the project writes in RAS says so, and reads back where it was.
+  const std::string back = dir.path("back.stl");
+  write_mesh(head, back, MeshSpace::RAS);
+  ReadMeshParams lps;
+  lps.space_from_header = true;
+  const MeshFile round = read_mesh(back, lps);
+  EXPECT_EQ(round.space, MeshSpace::RAS);
+  EXPECT_LT((lowest_corner(round.mesh) - lo).norm(), 1e-4);
+  EXPECT_LT(
+      (lowest_corner(read_mesh(back).mesh) - Eigen::Vector3d(-hi.x(), -hi.y(), lo.z())).norm(),
+      1e-4);
+  EXPECT_NEAR(signed_volume(round.mesh), volume, 1e-4 * volume);
+  EXPECT_EQ(encode_mesh(head, MeshFormat::BinarySTL),
+            encode_mesh(head, MeshFormat::BinarySTL, MeshSpace::LPS))
+      << "nothing declared, nothing turned, but for RAS";
 }
 
 // An OBJ face counts its vertices from 1 (or back from the last): the message says so.

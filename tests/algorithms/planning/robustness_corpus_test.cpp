@@ -33,29 +33,12 @@
 #include "cranioplan/algorithms/quality/compare_implants.h"
 #include "support/synthetic.h"
 #include "support/test_files.h"
+#include "support/vtk_meshes.h"
 
 namespace cranioplan {
 namespace {
 
-vtkSmartPointer<vtkPolyData> to_polydata(const SkullMesh& mesh) {
-  vtkNew<vtkPoints> points;
-  points->SetDataTypeToDouble();
-  for (auto vh : mesh.vertices()) {
-    const auto& p = mesh.point(vh);
-    points->InsertNextPoint(p[0], p[1], p[2]);
-  }
-  vtkNew<vtkCellArray> polys;
-  for (auto fh : mesh.faces()) {
-    vtkIdType ids[3];
-    int k = 0;
-    for (auto vh : mesh.fv_range(fh)) ids[k++] = vh.idx();
-    polys->InsertNextCell(3, ids);
-  }
-  auto pd = vtkSmartPointer<vtkPolyData>::New();
-  pd->SetPoints(points);
-  pd->SetPolys(polys);
-  return pd;
-}
+using test::to_polydata;
 
 // As Slicer's model smoothing: a windowed-sinc filter, the boundary left in place.
 vtkSmartPointer<vtkPolyData> sinc_smoothed(vtkPolyData* in, double pass_band) {

@@ -49,6 +49,11 @@ struct ExtractBoneSurfaceParams {
   /// vertex) are told apart and each closed (close_small_holes); false: both left open, as
   /// plans whose load_skull is version 1 to 5 read them.
   bool close_holes_through_corners = true;
+  /// Through load_skull and load_surface, a mesh file that declares its coordinates RAS
+  /// ("SPACE=RAS", as 3D Slicer writes it; mesh_space.h) is read in the patient's LPS frame, x
+  /// and y negated, and what is planned on it is exported back in RAS; false: the file's
+  /// coordinates taken as LPS, as plans whose load_skull is version 1 to 5 read them.
+  bool mesh_space_from_header = true;
   /// Through load_skull, a volume's positions in the patient's LPS frame, whatever space the
   /// file declares (ReadVolumeParams::patient_frame); false: a NRRD's or NIfTI's positions as
   /// the file writes them, as plans saved before version 0.2 read them.

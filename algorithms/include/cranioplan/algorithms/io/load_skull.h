@@ -7,6 +7,7 @@
 
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
 #include "cranioplan/algorithms/io/mesh_report.h"
+#include "cranioplan/algorithms/io/mesh_space.h"
 #include "cranioplan/model/mesh.h"
 
 namespace cranioplan {
@@ -25,6 +26,10 @@ struct LoadedSkull {
   std::vector<std::string> notes;
   /// The frame the file declared and how it was brought to the patient's LPS (Volume::frame).
   std::string frame;
+  /// The coordinates a mesh file gave, when they were not the patient's LPS: RAS for a file
+  /// that declares so (mesh_space.h), read in LPS; exports of what is planned on it are written
+  /// back in RAS (encode_mesh's `space`). Undeclared otherwise (a volume: LPS).
+  MeshSpace file_space = MeshSpace::Undeclared;
   long long pieces_dropped = 0;  ///< a mesh's pieces far from the skull (drop_far_pieces)
   /// A skull mesh's report as read (report_mesh: where it is open, its caps), which planning
   /// can take its scan's borders from (scan_borders) instead of finding them again; none for a

@@ -3,6 +3,7 @@
 #include <string>
 #include <vector>
 
+#include "cranioplan/algorithms/io/mesh_space.h"
 #include "cranioplan/model/mesh.h"
 
 namespace cranioplan {
@@ -16,6 +17,10 @@ struct ReadMeshParams {
   /// The mesh in canonical form (make_canonical): vertices and triangles in an order that
   /// depends only on the triangles. false: in the file's order.
   bool canonical = true;
+  /// A file that declares its coordinates RAS (mesh_space.h: "SPACE=RAS", as 3D Slicer
+  /// writes it) is read into the patient's LPS, x and y negated (MeshFile::turned_to_lps).
+  /// false: as the file gives them.
+  bool space_from_header = false;
   /// The file's length unit in millimetres: coordinates are multiplied by it (before the
   /// canonical form's rounding). 1: the file is in mm.
   double unit_mm = 1.0;
@@ -53,7 +58,9 @@ struct ReadMeshParams {
 
 struct MeshFile {
   SkullMesh mesh;
-  std::string format;                 ///< "binary STL", "ASCII STL", "PLY", "OBJ", "OFF", "VTP"
+  std::string format;  ///< "binary STL", "ASCII STL", "PLY", "OBJ", "OFF", "VTP"
+  MeshSpace space = MeshSpace::Undeclared;  ///< the coordinate system the file declares
+  bool turned_to_lps = false;  ///< declared RAS, read in LPS (ReadMeshParams::space_from_header)
   long long triangles_in_file = 0;    ///< triangles (after fan triangulation of polygons)
   long long degenerate_dropped = 0;   ///< zero-area triangles removed
   long long nonmanifold_split = 0;    ///< triangles added on duplicated vertices
@@ -69,8 +76,10 @@ struct MeshFile {
 
 /// The file as an indexed triangle soup (polygons fan-triangulated, STL vertices welded,
 /// coordinates checked to be finite), before the halfedge mesh is built: the same product as
-/// VTK's readers give. `format` receives the format's name. Throws InputError like read_mesh.
-TriangleSoup read_mesh_soup(const std::string& path, std::string* format = nullptr);
+/// VTK's readers give, in the file's own coordinates. `format` receives the format's name,
+/// `space` the coordinate system the file declares. Throws InputError like read_mesh.
+TriangleSoup read_mesh_soup(const std::string& path, std::string* format = nullptr,
+                            MeshSpace* space = nullptr);
 
 /// What the repairs of a skull's soup (ReadMeshParams: drop_repeated_triangles,
 /// orient_consistently, close_holes_mm) did, one sentence each, without the file's name; none
