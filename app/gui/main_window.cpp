@@ -180,7 +180,7 @@ void MainWindow::build_menus() {
   QAction* open = file->addAction(tr("Open mesh or CT…"), this, [this] {
     const QString path = QFileDialog::getOpenFileName(
         this, tr("Open a skull"), QString(),
-        tr("Skull (*.stl *.ply *.obj *.off *.vtp *.inv3 *.nrrd *.nhdr *.nii *.nii.gz);;All (*)"));
+        tr("Skull (*.stl *.ply *.obj *.off *.vtk *.vtp *.inv3 *.nrrd *.nhdr *.nii *.nii.gz);;All (*)"));
     if (!path.isEmpty()) open_input(path);
   });
   open->setObjectName("openInput");

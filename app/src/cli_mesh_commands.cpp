@@ -100,7 +100,7 @@ Subcommand add_info(CLI::App& app, const bool& json) {
   };
   auto o = std::make_shared<Opts>();
   auto* cmd = app.add_subcommand("info", "Report a mesh (or a volume's bone surface)");
-  cmd->add_option("MESH", o->path, "mesh (.stl .ply .obj .off .vtp) or volume")->required();
+  cmd->add_option("MESH", o->path, "mesh (.stl .ply .obj .off .vtk .vtp) or volume")->required();
   add_import_options(cmd, o->import);
   return {cmd, [o, &json] {
             LoadedSkull s = load_surface(o->path, o->import.params());

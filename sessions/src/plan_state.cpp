@@ -79,7 +79,7 @@ std::optional<AttachedCt> plan_ct(const PlanState& s) {
 const std::array<WizardStep, 9>& wizard_steps() {
   static const std::array<WizardStep, 9> steps = {{
       {1, "Load skull",
-       "Open the patient's skull: a surface mesh (STL, PLY, OBJ, OFF, VTP) or a CT (InVesalius "
+       "Open the patient's skull: a surface mesh (STL, PLY, OBJ, OFF, VTK, VTP) or a CT (InVesalius "
        ".inv3, NRRD, NIfTI, DICOM folder), which is turned into a bone surface at the threshold "
        "you choose. Done when a skull is loaded."},
       {2, "Landmarks and midsagittal plane",

@@ -68,7 +68,8 @@ std::string dicom_folder(std::string_view data) {
 void read(std::string_view data) {
   const std::string reader = CRANIOPLAN_FUZZ_READER;
   const std::string base = work_dir() + "/input";
-  if (reader == "stl" || reader == "ply" || reader == "obj" || reader == "off" || reader == "vtp") {
+  if (reader == "stl" || reader == "ply" || reader == "obj" || reader == "off" || reader == "vtk" ||
+      reader == "vtp") {
     write(base + "." + reader, data);
     read_mesh(base + "." + reader);
   } else if (reader == "nrrd" || reader == "nii" || reader == "inv3") {

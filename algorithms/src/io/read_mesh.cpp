@@ -3,6 +3,7 @@
 #include <vtkFieldData.h>
 #include <vtkNew.h>
 #include <vtkPolyData.h>
+#include <vtkPolyDataReader.h>
 #include <vtkSmartPointer.h>
 #include <vtkStringArray.h>
 #include <vtkXMLPolyDataReader.h>
@@ -14,6 +15,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <sstream>
 #include <string_view>
 
@@ -377,24 +379,18 @@ TriangleSoup read_obj(const std::string& path, const std::string& bytes) {
 }
 
 // ---------------------------------------------------------------------------------------------
-// VTK's XML reader leaks on some malformed files and is not proved against crashing on them:
-// it runs in a child process (isolated_read.h), which sends the soup back.
-TriangleSoup read_vtp(const std::string& path, MeshSpace& space) {
+// VTK's XML and legacy readers leak on some malformed files and are not proved against crashing
+// on them: they run in a child process (isolated_read.h), which sends the soup back with the
+// coordinate system the file declares. `read(declared)` reads the polydata in the child.
+template <class Read>
+TriangleSoup read_isolated(const std::string& path, const char* reader_name, MeshSpace& space,
+                           Read read) {
   const std::string bytes =
-      detail::run_isolated(path, "VTK's VTP reader", [&](detail::ChildReport& report) {
+      detail::run_isolated(path, reader_name, [&](detail::ChildReport& report) {
         report.reading(path);
-        vtkNew<vtkXMLPolyDataReader> reader;
-        const detail::VtkErrorCatcher errors(reader);
-        reader->SetFileName(path.c_str());
-        reader->Update();
-        const std::string error = errors.message();
-        if (!error.empty()) fail(path, "not a readable VTP file (" + error + ")");
-        const TriangleSoup soup = detail::soup_from_polydata(path, reader->GetOutput());
-        // 3D Slicer's declaration of the coordinate system: a string array "SPACE".
         MeshSpace declared = MeshSpace::Undeclared;
-        if (vtkFieldData* fields = reader->GetOutput()->GetFieldData())
-          if (auto* tag = vtkStringArray::SafeDownCast(fields->GetAbstractArray("SPACE")))
-            if (tag->GetNumberOfValues() > 0) declared = space_in_text("SPACE=" + tag->GetValue(0));
+        const vtkSmartPointer<vtkPolyData> pd = read(declared);
+        const TriangleSoup soup = detail::soup_from_polydata(path, pd);
         detail::ByteWriter w;
         w.pod<uint8_t>(static_cast<uint8_t>(declared));
         w.pod<uint64_t>(soup.vertices.size());
@@ -411,6 +407,52 @@ TriangleSoup read_vtp(const std::string& path, MeshSpace& space) {
   soup.triangles.resize(r.pod<uint64_t>());
   r.raw(soup.triangles.data(), soup.triangles.size() * sizeof(Eigen::Vector3i));
   return soup;
+}
+
+TriangleSoup read_vtp(const std::string& path, MeshSpace& space) {
+  return read_isolated(path, "VTK's VTP reader", space, [&](MeshSpace& declared) {
+    vtkNew<vtkXMLPolyDataReader> reader;
+    const detail::VtkErrorCatcher errors(reader);
+    reader->SetFileName(path.c_str());
+    reader->Update();
+    const std::string error = errors.message();
+    if (!error.empty()) fail(path, "not a readable VTP file (" + error + ")");
+    // 3D Slicer's declaration of the coordinate system: a string array "SPACE".
+    if (vtkFieldData* fields = reader->GetOutput()->GetFieldData())
+      if (auto* tag = vtkStringArray::SafeDownCast(fields->GetAbstractArray("SPACE")))
+        if (tag->GetNumberOfValues() > 0) declared = space_in_text("SPACE=" + tag->GetValue(0));
+    return vtkSmartPointer<vtkPolyData>(reader->GetOutput());
+  });
+}
+
+// VTK's legacy format, 3D Slicer's default for models (ASCII or binary; Slicer writes version
+// 4.2 with "3D Slicer output. SPACE=RAS" or "SPACE=LPS" as the header line).
+TriangleSoup read_legacy_vtk(const std::string& path, MeshSpace& space) {
+  // The data is not compressed: its polydata and the soup made from it take a few times the
+  // file's bytes. A header that announces more points or cells than the file holds (VTK's
+  // reader believes it) fails to allocate at once rather than filling the memory.
+  std::error_code ec;
+  const double file_bytes = static_cast<double>(std::filesystem::file_size(path, ec));
+  const double budget = 256.0 * 1024 * 1024 + 40.0 * (ec ? 0.0 : file_bytes);
+  return read_isolated(path, "VTK's legacy reader", space, [&](MeshSpace& declared) {
+    const detail::AddressSpaceBudget memory(budget);
+    vtkNew<vtkPolyDataReader> reader;
+    const detail::VtkErrorCatcher errors(reader);
+    reader->SetFileName(path.c_str());
+    if (!reader->IsFilePolyData()) {
+      const std::string error = errors.message();
+      fail(path,
+           "not a VTK polygonal data file" +
+               (error.empty() ? std::string(" (another kind of VTK data, e.g. an unstructured "
+                                            "grid or an image, or no VTK file)")
+                              : " (" + error + ")"));
+    }
+    reader->Update();
+    const std::string error = errors.message();
+    if (!error.empty()) fail(path, "not a readable VTK file (" + error + ")");
+    if (const char* header = reader->GetHeader()) declared = space_in_text(header);
+    return vtkSmartPointer<vtkPolyData>(reader->GetOutput());
+  });
 }
 
 // The volume the triangles enclose, taken about the vertices' centroid (for a surface with
@@ -473,13 +515,16 @@ TriangleSoup read_mesh_soup(const std::string& path, std::string* format_out,
     format = "PLY";
     soup = detail::read_ply(path, bytes);
     space = space_in_text(std::string_view(bytes).substr(0, bytes.find("end_header")));
+  } else if (ext == ".vtk") {
+    format = "VTK";
+    soup = read_legacy_vtk(path, space);
   } else if (ext == ".vtp") {
     format = "VTP";
     if (bytes.find("<VTKFile") == std::string::npos)
       fail(path, "not a VTP file (no <VTKFile> element)");
     soup = read_vtp(path, space);
   } else {
-    fail(path, "unknown mesh format '" + ext + "' (expected .stl, .ply, .obj, .off or .vtp)");
+    fail(path, "unknown mesh format '" + ext + "' (expected .stl, .ply, .obj, .off, .vtk or .vtp)");
   }
   if (soup.triangles.empty()) fail(path, "contains no triangles");
   if (format != "binary STL" && format != "ASCII STL")  // STL parsers check as they read

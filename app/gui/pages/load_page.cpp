@@ -15,7 +15,7 @@ LoadPage::LoadPage(PageHost& host) : StepPage(1, host) {
   connect(open, &QPushButton::clicked, this, [this] {
     const QString path = QFileDialog::getOpenFileName(
         this, tr("Open a skull"), QString(),
-        tr("Skull (*.stl *.ply *.obj *.off *.vtp *.inv3 *.nrrd *.nhdr *.nii *.nii.gz);;All "
+        tr("Skull (*.stl *.ply *.obj *.off *.vtk *.vtp *.inv3 *.nrrd *.nhdr *.nii *.nii.gz);;All "
            "(*)"));
     if (!path.isEmpty()) host_.open_skull(path);
   });

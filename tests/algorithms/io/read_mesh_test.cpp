@@ -7,6 +7,7 @@
 #include <vtkPLYWriter.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
+#include <vtkPolyDataWriter.h>
 #include <vtkSTLWriter.h>
 #include <vtkStringArray.h>
 #include <vtkXMLPolyDataWriter.h>
@@ -110,7 +111,8 @@ TEST(ReadMesh, AsciiStlObjOffAndVtp) {
 }
 
 // 3D Slicer declares a mesh file's coordinate system ("SPACE=RAS" or "SPACE=LPS") in an STL's
-// header, a PLY's or an OBJ's comment and a VTP's field data "SPACE", written here by VTK's own
+// header, a legacy VTK file's header line (Slicer's default model format), a PLY's or an OBJ's
+// comment and a VTP's field data "SPACE", written here by VTK's own
 // writers as Slicer calls them. Declared RAS, the mesh is read in the patient's LPS when asked:
 // x and y negated, the winding (and so the enclosed volume) kept.
 Eigen::Vector3d lowest_corner(const SkullMesh& mesh) {
@@ -162,6 +164,19 @@ TEST(ReadMesh, TheSpaceAFileDeclaresIsReadAsSlicerWritesIt) {
     w->Write();
     return dir.path(name);
   };
+  auto legacy = [&](const std::string& name, bool binary, const char* header) {
+    vtkNew<vtkPolyDataWriter> w;  // as Slicer writes its default model format
+    w->SetInputData(pd);
+    w->SetFileName(dir.path(name).c_str());
+    w->SetFileVersion(42);
+    if (binary)
+      w->SetFileTypeToBinary();
+    else
+      w->SetFileTypeToASCII();
+    w->SetHeader(header);
+    w->Write();
+    return dir.path(name);
+  };
   auto obj = [&](const std::string& name, const char* comment) {
     std::string text = std::string("# ") + comment + "\n";
     char line[96];
@@ -184,6 +199,9 @@ TEST(ReadMesh, TheSpaceAFileDeclaresIsReadAsSlicerWritesIt) {
       {ply("ras.ply", "SPACE=RAS"), MeshSpace::RAS},
       {obj("ras.obj", "3D Slicer output. SPACE=RAS"), MeshSpace::RAS},
       {vtp("ras.vtp", "RAS"), MeshSpace::RAS},
+      {legacy("ras_binary.vtk", true, "3D Slicer output. SPACE=RAS"), MeshSpace::RAS},
+      {legacy("ras_ascii.vtk", false, "3D Slicer output. SPACE=RAS"), MeshSpace::RAS},
+      {legacy("lps.vtk", true, "3D Slicer output. SPACE=LPS"), MeshSpace::LPS},
       {stl("lps.stl", false, "3D Slicer output. SPACE=LPS"), MeshSpace::LPS},
       {ply("lps.ply", "SPACE=LPS"), MeshSpace::LPS},
       {vtp("lps.vtp", "LPS"), MeshSpace::LPS},
@@ -256,11 +274,22 @@ TEST(ReadMesh, BadInputsGiveOneClearMessage) {
 
   std::string garbage(5000, '\0');
   for (size_t i = 0; i < garbage.size(); ++i) garbage[i] = static_cast<char>((i * 7919) % 251);
-  for (const char* ext : {".stl", ".ply", ".obj", ".off", ".vtp"}) {
+  for (const char* ext : {".stl", ".ply", ".obj", ".off", ".vtk", ".vtp"}) {
     const std::string p = dir.path(std::string("garbage") + ext);
     test::write_bytes(p, garbage);
     EXPECT_THROW(read_mesh(p), InputError) << ext;
   }
+  expect_bad(dir.path("garbage.vtk"), "not a VTK polygonal data file");
+  // A legacy VTK file of another kind (Slicer also writes unstructured grids as .vtk).
+  test::write_bytes(dir.path("grid.vtk"),
+                    "# vtk DataFile Version 4.2\ngrid\nASCII\nDATASET UNSTRUCTURED_GRID\n"
+                    "POINTS 3 float\n0 0 0 1 0 0 0 1 0\nCELLS 1 4\n3 0 1 2\nCELL_TYPES 1\n5\n");
+  expect_bad(dir.path("grid.vtk"), "not a VTK polygonal data file");
+  // Cut short after its points.
+  test::write_bytes(dir.path("cut.vtk"),
+                    "# vtk DataFile Version 4.2\ncut\nASCII\nDATASET POLYDATA\n"
+                    "POINTS 3 float\n0 0 0 1 0 0 0 1 0\nPOLYGONS 1 4\n3 0 1\n");
+  EXPECT_THROW(read_mesh(dir.path("cut.vtk")), InputError);
   test::write_bytes(dir.path("x.xyz"), "1 2 3");
   expect_bad(dir.path("x.xyz"), "unknown mesh format");
   test::write_bytes(dir.path("bad.off"), "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
@@ -276,6 +305,23 @@ TEST(ReadMesh, ABrokenVtpIsOneMessageAndVtkPrintsNothing) {
   testing::internal::CaptureStderr();
   expect_bad(dir.path("cut.vtp"), "not a readable VTP file (Error parsing input file.");
   // VTK's executive and XML parser log errors of their own; the user sees ours alone.
+  EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+}
+
+// A binary legacy VTK file cut short crashes VTK's reader: in its child process, so the user
+// gets one message naming the file, and VTK prints nothing.
+TEST(ReadMesh, ABrokenLegacyVtkIsOneMessageAndVtkPrintsNothing) {
+  TempDir dir;
+  vtkNew<vtkPolyDataWriter> w;
+  w->SetInputData(test::to_polydata(test::make_symmetric_head(4)));
+  w->SetFileName(dir.path("whole.vtk").c_str());
+  w->SetFileTypeToBinary();
+  w->Write();
+  const std::string bytes = test::read_bytes(dir.path("whole.vtk"));
+  test::write_bytes(dir.path("cut.vtk"), bytes.substr(0, bytes.size() / 2));
+  EXPECT_EQ(read_mesh(dir.path("whole.vtk")).format, "VTK");
+  testing::internal::CaptureStderr();
+  EXPECT_THROW(read_mesh(dir.path("cut.vtk")), InputError);
   EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
 }
 

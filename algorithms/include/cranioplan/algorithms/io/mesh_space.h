@@ -1,7 +1,8 @@
 #pragma once
 // The coordinate system a mesh file declares. Mesh formats carry none of their own; 3D Slicer
 // writes one into the header ("SPACE=RAS" or "SPACE=LPS": an STL's 80-byte header or the text
-// after "solid", a PLY's or OBJ's comment, a VTP's field data "SPACE"), and reads a file
+// after "solid", a legacy VTK file's header line, a PLY's or OBJ's comment, a VTP's field data
+// "SPACE"), and reads a file
 // without it as LPS. Slicer wrote RAS until 2020 and still does when asked: such a skull,
 // taken as LPS, has the patient's left and right, front and back swapped (a turn of 180° about
 // the head's long axis; not a mirror image), and an implant written back without saying so

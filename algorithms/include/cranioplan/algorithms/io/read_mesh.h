@@ -1,5 +1,6 @@
 #pragma once
-// Reading surface meshes: STL (binary or ASCII, told apart by content), PLY, OBJ, OFF, VTP.
+// Reading surface meshes: STL (binary or ASCII, told apart by content), PLY, OBJ, OFF, VTK
+// (legacy polygonal data, ASCII or binary: 3D Slicer's default for models), VTP.
 #include <string>
 #include <vector>
 
@@ -58,7 +59,7 @@ struct ReadMeshParams {
 
 struct MeshFile {
   SkullMesh mesh;
-  std::string format;  ///< "binary STL", "ASCII STL", "PLY", "OBJ", "OFF", "VTP"
+  std::string format;  ///< "binary STL", "ASCII STL", "PLY", "OBJ", "OFF", "VTK", "VTP"
   MeshSpace space = MeshSpace::Undeclared;  ///< the coordinate system the file declares
   bool turned_to_lps = false;  ///< declared RAS, read in LPS (ReadMeshParams::space_from_header)
   long long triangles_in_file = 0;    ///< triangles (after fan triangulation of polygons)
