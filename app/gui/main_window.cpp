@@ -178,9 +178,10 @@ MainWindow::~MainWindow() = default;
 void MainWindow::build_menus() {
   QMenu* file = menuBar()->addMenu(tr("&File"));
   QAction* open = file->addAction(tr("Open mesh or CT…"), this, [this] {
-    const QString path = QFileDialog::getOpenFileName(
-        this, tr("Open a skull"), QString(),
-        tr("Skull (*.stl *.ply *.obj *.off *.vtk *.vtp *.inv3 *.nrrd *.nhdr *.nii *.nii.gz);;All (*)"));
+    const QString path =
+        QFileDialog::getOpenFileName(this, tr("Open a skull"), QString(),
+                                     tr("Skull (*.stl *.ply *.obj *.off *.vtk *.vtp *.inv3 *.nrrd "
+                                        "*.nhdr *.nii *.nii.gz);;All (*)"));
     if (!path.isEmpty()) open_input(path);
   });
   open->setObjectName("openInput");

@@ -10,6 +10,7 @@
 
 #include <algorithm>
 #include <cassert>
+#include <cctype>
 #include <cmath>
 #include <cstdint>
 #include <cstdio>
@@ -425,9 +426,106 @@ TriangleSoup read_vtp(const std::string& path, MeshSpace& space) {
   });
 }
 
-// VTK's legacy format, 3D Slicer's default for models (ASCII or binary; Slicer writes version
-// 4.2 with "3D Slicer output. SPACE=RAS" or "SPACE=LPS" as the header line).
-TriangleSoup read_legacy_vtk(const std::string& path, MeshSpace& space) {
+// A binary legacy VTK file's geometry sections hold exactly the bytes their counts announce.
+// VTK's reader does not check that a section is whole: a file cut short reads on past its end
+// (and gives other triangles on each run). Checked here, before VTK sees the file: POINTS, then
+// VERTICES, LINES, POLYGONS and TRIANGLE_STRIPS as version 4.2 writes them (int32 ids) or as
+// 5.1 does (OFFSETS and CONNECTIVITY arrays), up to the first attribute data. ASCII files are
+// read by VTK as text, which fails where it ends.
+void check_legacy_binary_sections(const std::string& path, const std::string& bytes) {
+  size_t at = 0;
+  auto next_line = [&]() -> std::vector<std::string> {
+    while (at < bytes.size() && std::isspace(static_cast<unsigned char>(bytes[at]))) ++at;
+    const size_t eol = std::min(bytes.find('\n', at), bytes.size());
+    std::istringstream words(bytes.substr(at, eol - at));
+    at = std::min(eol + 1, bytes.size());
+    std::vector<std::string> out;
+    for (std::string w; words >> w;) out.push_back(w);
+    return out;
+  };
+  auto upper = [](std::string w) {
+    for (char& c : w) c = static_cast<char>(std::toupper(static_cast<unsigned char>(c)));
+    return w;
+  };
+  auto type_bytes = [&](const std::string& type) -> double {
+    const std::string t = upper(type);
+    if (t == "BIT" || t == "CHAR" || t == "UNSIGNED_CHAR") return 1;
+    if (t == "SHORT" || t == "UNSIGNED_SHORT") return 2;
+    if (t == "INT" || t == "UNSIGNED_INT" || t == "FLOAT") return 4;
+    if (t == "LONG" || t == "UNSIGNED_LONG" || t == "DOUBLE" || t == "VTKTYPEINT64" ||
+        t == "VTKTYPEUINT64")
+      return 8;
+    return 0;  // unknown: left to VTK
+  };
+  auto count = [](const std::string& w) {
+    char* end = nullptr;
+    const double n = std::strtod(w.c_str(), &end);
+    return end != w.c_str() && *end == '\0' && n >= 0 ? n : -1.0;
+  };
+  // Skips `n` bytes of binary data, or fails naming the section.
+  auto skip = [&](double n, const std::string& section) {
+    if (n > static_cast<double>(bytes.size() - at))
+      fail(path, "cut short: its " + section + " announce " +
+                     format_count(static_cast<long long>(std::min(n, 9e18))) +
+                     " bytes of data, and the file ends " + format_count(bytes.size() - at) +
+                     " bytes after their header");
+    at += static_cast<size_t>(n);
+  };
+  // The version line and the title (which may be empty) as they are; then ASCII or BINARY.
+  for (int line = 0; line < 2; ++line) at = std::min(bytes.find('\n', at), bytes.size()) + 1;
+  if (at >= bytes.size()) return;
+  const std::vector<std::string> kind = next_line();
+  if (kind.empty() || upper(kind[0]) != "BINARY") return;  // ASCII: VTK's to read
+  const std::vector<std::string> dataset = next_line();
+  if (dataset.size() < 2 || upper(dataset[0]) != "DATASET" || upper(dataset[1]) != "POLYDATA")
+    return;
+  while (at < bytes.size()) {
+    const std::vector<std::string> w = next_line();
+    if (w.empty()) continue;
+    const std::string key = upper(w[0]);
+    if (key == "METADATA") {  // a block of lines that ends with an empty line
+      while (at < bytes.size()) {
+        const size_t eol = std::min(bytes.find('\n', at), bytes.size());
+        const bool empty = eol == at || (eol == at + 1 && bytes[at] == '\r');
+        at = std::min(eol + 1, bytes.size());
+        if (empty) break;
+      }
+      continue;
+    }
+    if (key == "POINTS" && w.size() >= 3) {
+      const double n = count(w[1]), size = type_bytes(w[2]);
+      if (n < 0 || size == 0) return;
+      skip(n * 3 * size, "POINTS");
+      continue;
+    }
+    if ((key == "VERTICES" || key == "LINES" || key == "POLYGONS" || key == "TRIANGLE_STRIPS") &&
+        w.size() >= 3) {
+      const double a = count(w[1]), b = count(w[2]);
+      if (a < 0 || b < 0) return;
+      const size_t before = at;
+      const std::vector<std::string> offsets = next_line();
+      if (!offsets.empty() && upper(offsets[0]) == "OFFSETS" && offsets.size() >= 2) {
+        const double size = type_bytes(offsets[1]);
+        if (size == 0) return;
+        skip(a * size, key);
+        const std::vector<std::string> conn = next_line();
+        if (conn.size() < 2 || upper(conn[0]) != "CONNECTIVITY" || type_bytes(conn[1]) == 0) return;
+        skip(b * type_bytes(conn[1]), key);
+      } else {
+        at = before;  // version 4.2: the ids follow at once, int32
+        skip(b * 4, key);
+      }
+      continue;
+    }
+    return;  // attribute data, or a section this check does not know: VTK's to read
+  }
+}
+
+// VTK's legacy format, 3D Slicer's default for models// VTK's legacy format, 3D Slicer's default
+// for models (ASCII or binary; Slicer writes version 4.2 with "3D Slicer output. SPACE=RAS" or
+// "SPACE=LPS" as the header line).
+TriangleSoup read_legacy_vtk(const std::string& path, const std::string& bytes, MeshSpace& space) {
+  check_legacy_binary_sections(path, bytes);
   // The data is not compressed: its polydata and the soup made from it take a few times the
   // file's bytes. A header that announces more points or cells than the file holds (VTK's
   // reader believes it) fails to allocate at once rather than filling the memory.
@@ -517,7 +615,7 @@ TriangleSoup read_mesh_soup(const std::string& path, std::string* format_out,
     space = space_in_text(std::string_view(bytes).substr(0, bytes.find("end_header")));
   } else if (ext == ".vtk") {
     format = "VTK";
-    soup = read_legacy_vtk(path, space);
+    soup = read_legacy_vtk(path, bytes, space);
   } else if (ext == ".vtp") {
     format = "VTP";
     if (bytes.find("<VTKFile") == std::string::npos)
