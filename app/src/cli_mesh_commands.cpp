@@ -59,6 +59,14 @@ Json skull_json(const LoadedSkull& s) {
          {"format", s.description},
          {"frame", s.frame},
          {"load_s", s.seconds}};
+  // The coordinate system a mesh file declares (3D Slicer's SPACE=), and whether it was
+  // turned to LPS on reading (and so is written back in it).
+  if (s.source_kind == "mesh") {
+    j["space"] = s.declared_space == MeshSpace::RAS   ? "RAS"
+                 : s.declared_space == MeshSpace::LPS ? "LPS"
+                                                      : "undeclared";
+    j["turned_to_lps"] = s.file_space == MeshSpace::RAS;
+  }
   if (s.pieces_dropped > 0) j["pieces_dropped"] = s.pieces_dropped;
   if (s.source_kind == "volume") {
     j["threshold"] = s.surface.threshold_used;
@@ -66,6 +74,7 @@ Json skull_json(const LoadedSkull& s) {
     j["pieces_kept"] = s.surface.pieces_kept;
   }
   if (!s.warnings.empty()) j["warnings"] = s.warnings;
+  if (!s.notes.empty()) j["notes"] = s.notes;
   return j;
 }
 

@@ -52,6 +52,16 @@ TEST(Cli, InfoPlaneMirrorRegisterOnASyntheticHead) {
   EXPECT_EQ(odd_info["wound_against_neighbours"]["triangles"], turned);
   EXPECT_EQ(odd_info["wound_against_neighbours"]["patches"], 1);
   EXPECT_EQ(odd_info["small_holes"], 0) << "the head's triangles are longer around than 15 mm";
+  EXPECT_EQ(odd_info["file"]["space"], "undeclared");
+  EXPECT_EQ(odd_info["file"]["turned_to_lps"], false);
+  // A file that declares RAS, as 3D Slicer writes it: said, and read in LPS.
+  write_mesh(head, dir.path("ras.stl"), MeshSpace::RAS);
+  ASSERT_EQ(test::run_command(kCli + " info " + dir.path("ras.stl") + " --json", &out), 0);
+  const Json ras_info = Json::parse(out);
+  EXPECT_EQ(ras_info["file"]["space"], "RAS") << out;
+  EXPECT_EQ(ras_info["file"]["turned_to_lps"], true);
+  ASSERT_EQ(ras_info["file"]["notes"].size(), 1u) << out;
+  EXPECT_NE(ras_info["file"]["notes"][0].get<std::string>().find("SPACE=RAS"), std::string::npos);
 
   ASSERT_EQ(
       test::run_command(

@@ -55,7 +55,7 @@ LoadedSkull load(const std::string& path, const ExtractBoneSurfaceParams& import
       out.description = file.format;
       out.warnings = std::move(file.warnings);
       out.pieces_dropped = file.pieces_dropped;
-      declared = file.space;
+      declared = out.declared_space = file.space;
       if (file.turned_to_lps) out.file_space = MeshSpace::RAS;
     }
     out.source_kind = "mesh";

@@ -30,6 +30,8 @@ struct LoadedSkull {
   /// that declares so (mesh_space.h), read in LPS; exports of what is planned on it are written
   /// back in RAS (encode_mesh's `space`). Undeclared otherwise (a volume: LPS).
   MeshSpace file_space = MeshSpace::Undeclared;
+  /// The coordinate system a mesh file declares (mesh_space.h), whether or not it was read so.
+  MeshSpace declared_space = MeshSpace::Undeclared;
   long long pieces_dropped = 0;  ///< a mesh's pieces far from the skull (drop_far_pieces)
   /// A skull mesh's report as read (report_mesh: where it is open, its caps), which planning
   /// can take its scan's borders from (scan_borders) instead of finding them again; none for a
