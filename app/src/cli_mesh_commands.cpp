@@ -117,13 +117,7 @@ Subcommand add_info(CLI::App& app, const bool& json) {
             // The file as it is; read as a skull, it is repaired (load_skull) on the file's own
             // triangles: what that would do, which a non-manifold count alone would misname.
             TriangleSoup soup = s.source_kind == "mesh" ? read_mesh_soup(o->path) : to_soup(s.mesh);
-            const ExtractBoneSurfaceParams import = o->import.params();
-            SoupRepairParams as_skull;
-            as_skull.drop_repeated = import.drop_repeated_triangles;
-            as_skull.orient = import.orient_consistently;
-            as_skull.close_holes_mm = import.close_holes_mm;
-            as_skull.through_corners = import.close_holes_through_corners;
-            const SoupRepair repairs = repair_soup(soup, as_skull);
+            const SoupRepair repairs = repair_soup(soup, skull_repairs(o->import.params()));
             r["repeated_triangles"] = repairs.repeated_dropped;
             r["wound_against_neighbours"] = {{"triangles", repairs.orientation.triangles_turned},
                                              {"patches", repairs.orientation.patches_turned}};

@@ -85,6 +85,34 @@ TEST(Cli, InfoPlaneMirrorRegisterOnASyntheticHead) {
   const Json reg = Json::parse(out);
   EXPECT_EQ(reg["rotation"].size(), 3u);
   EXPECT_LT(reg["rms_mm"].get<double>(), 0.1);
+  // Meshes made from a file that declares RAS are written back in it, saying so: the mirror
+  // of ras.stl (read in LPS: the head itself) is the head's mirror with x and y negated, and
+  // what is registered onto it lies in its RAS too.
+  ASSERT_EQ(test::run_command(kCli + " mirror " + dir.path("ras.stl") + " --plane " +
+                                  dir.path("plane.json") + " -o " + dir.path("ras_m.stl"),
+                              &out),
+            0);
+  EXPECT_NE(test::read_bytes(dir.path("ras_m.stl")).substr(0, 80).find("SPACE=RAS"),
+            std::string::npos);
+  auto corners = [](const SkullMesh& m) {
+    Eigen::Vector3d lo = Eigen::Vector3d::Constant(1e30), hi = -lo;
+    for (auto vh : m.vertices()) {
+      lo = lo.cwiseMin(to_eigen(m.point(vh)));
+      hi = hi.cwiseMax(to_eigen(m.point(vh)));
+    }
+    return std::make_pair(lo, hi);
+  };
+  const auto [lo, hi] = corners(read_mesh(dir.path("m.ply")).mesh);
+  const auto [ras_lo, ras_hi] = corners(read_mesh(dir.path("ras_m.stl")).mesh);  // as written
+  EXPECT_LT((ras_lo - Eigen::Vector3d(-hi.x(), -hi.y(), lo.z())).norm(), 1e-3);
+  EXPECT_LT((ras_hi - Eigen::Vector3d(-lo.x(), -lo.y(), hi.z())).norm(), 1e-3);
+  ASSERT_EQ(
+      test::run_command(kCli + " register " + dir.path("m.ply") + " " + dir.path("ras.stl") +
+                            " -o " + dir.path("ras_r.stl") + " --roi-center 0,80,0 --roi-radius 80",
+                        &out),
+      0);
+  EXPECT_NE(test::read_bytes(dir.path("ras_r.stl")).substr(0, 80).find("SPACE=RAS"),
+            std::string::npos);
 }
 
 // The programs run with malloc in transparent huge pages (huge_pages.h): started by their

@@ -19,6 +19,15 @@ std::string sample_case_path() {
   return "/usr/share/doc/invesalius-examples/examples/Cranium.inv3";
 }
 
+SoupRepairParams skull_repairs(const ExtractBoneSurfaceParams& import) {
+  SoupRepairParams p;
+  p.drop_repeated = import.drop_repeated_triangles;
+  p.orient = import.orient_consistently;
+  p.close_holes_mm = import.close_holes_mm;
+  p.through_corners = import.close_holes_through_corners;
+  return p;
+}
+
 namespace {
 
 // A skull (`as_skull`: turned outward when the file winds it inward) or any surface.
@@ -42,10 +51,7 @@ LoadedSkull load(const std::string& path, const ExtractBoneSurfaceParams& import
     read.canonical = import.canonical;
     read.unit_mm = import.mesh_unit_mm;
     read.orient_outward = as_skull && import.orient_outward;
-    read.orient_consistently = as_skull && import.orient_consistently;
-    read.drop_repeated_triangles = as_skull && import.drop_repeated_triangles;
-    read.close_holes_mm = as_skull ? import.close_holes_mm : 0.0;
-    read.close_holes_through_corners = import.close_holes_through_corners;
+    if (as_skull) read.repairs = skull_repairs(import);
     read.far_piece_mm = as_skull && import.drop_far_pieces ? kFarPieceMm : 0.0;
     read.space_from_header = import.mesh_space_from_header;
     MeshSpace declared = MeshSpace::Undeclared;

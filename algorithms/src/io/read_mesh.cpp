@@ -679,12 +679,7 @@ void read_into(const std::string& path, const ReadMeshParams& params, MeshFile& 
   if (params.unit_mm != 1.0)
     for (auto& v : soup.vertices) v *= params.unit_mm;
   if (params.far_piece_mm > 0.0) drop_far_pieces(path, params.far_piece_mm, soup, out);
-  SoupRepairParams repairs;
-  repairs.drop_repeated = params.drop_repeated_triangles;
-  repairs.orient = params.orient_consistently;
-  repairs.close_holes_mm = params.close_holes_mm;
-  repairs.through_corners = params.close_holes_through_corners;
-  const SoupRepair done = repair_soup(soup, repairs);
+  const SoupRepair done = repair_soup(soup, params.repairs);
   out.repeated_dropped = done.repeated_dropped;
   out.triangles_turned = done.orientation.triangles_turned;
   out.patches_turned = done.orientation.patches_turned;

@@ -5,6 +5,7 @@
 #include <string>
 #include <vector>
 
+#include "cranioplan/algorithms/geometry/mesh_components.h"
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
 #include "cranioplan/algorithms/io/mesh_report.h"
 #include "cranioplan/algorithms/io/mesh_space.h"
@@ -51,6 +52,10 @@ LoadedSkull load_surface(const std::string& path, const ExtractBoneSurfaceParams
 /// warning; `import.orient_outward`), and a surface that cannot be a skull in millimetres by
 /// its size is an InputError as well (check_skull_size).
 LoadedSkull load_skull(const std::string& path, const ExtractBoneSurfaceParams& import = {});
+
+/// The repairs load_skull makes to a skull mesh's soup (ReadMeshParams::repairs), as `import`
+/// asks for them; `info` reports what they would do to a file.
+SoupRepairParams skull_repairs(const ExtractBoneSurfaceParams& import);
 
 /// A length unit a mesh file may be written in.
 struct LengthUnit {
