@@ -115,6 +115,75 @@ TEST(Cli, InfoPlaneMirrorRegisterOnASyntheticHead) {
             std::string::npos);
 }
 
+// Every mesh the commands make from a file that declares RAS (3D Slicer's SPACE=RAS) is written
+// back in RAS and says so, and is the mesh they make from the same skull in LPS with x and y
+// negated: the implant of `autoplan -o` without a session, the mould's halves, the defective
+// skull and ground truth of `inject-defect`, and the meshes of `pipeline`. (The session's
+// exports: AutoplanSession.AnImplantPlannedOnARasSkullIsExportedInRas.)
+TEST(Cli, MeshesMadeFromARasFileAreWrittenInRas) {
+  test::TempDir dir;
+  // The thick head's defect for autoplan; a plate on a block for the mould (as
+  // Cli.MouldWritesTwoHalvesOrOne3mf); the light symmetric head for inject-defect and pipeline.
+  const test::ThickHeadDefect& thick = test::thick_head_defect();
+  const SkullMesh head = test::make_symmetric_head(4);
+  const std::vector<std::pair<std::string, SkullMesh>> inputs = {
+      {"d", thick.defective},
+      {"plate", test::mask_meshed_box({0, 0, 7}, {30, 30, 11})},
+      {"block", build_mesh(test::box_soup({-50, -50, -50}, {50, 50, 0}))},
+      {"h", head}};
+  for (const auto& [name, mesh] : inputs) {
+    write_mesh(mesh, dir.path(name + ".stl"));
+    write_mesh(mesh, dir.path(name + "_ras.stl"), MeshSpace::RAS);
+  }
+  const Eigen::Vector3d top = test::head_surface_point(Eigen::Vector3d(0.4, 0.2, 0.9).normalized());
+  char center[96];
+  std::snprintf(center, sizeof(center), "%.3f,%.3f,%.3f", top.x(), top.y(), top.z());
+  std::string out;
+  for (const std::string s : {"", "_ras"}) {
+    auto in = [&](const std::string& name) { return dir.path(name + s + ".stl"); };
+    ASSERT_EQ(test::run_command(kCli + " autoplan " + in("d") + " -o " + in("i")), 0) << s;
+    ASSERT_EQ(
+        test::run_command(
+            kCli + " mould " + in("plate") + " --skull " + in("block") + " -o " + in("m"), &out),
+        0)
+        << s << out;
+    ASSERT_EQ(test::run_command(kCli + " inject-defect " + in("h") + " --center " + center +
+                                    " --size 40 -o " + in("x") + " --implant " + in("t"),
+                                &out),
+              0)
+        << s << out;
+    ASSERT_EQ(test::run_command(kCli + " pipeline " + in("h") + " -o " + dir.path("p" + s), &out),
+              0)
+        << s << out;
+  }
+  std::vector<std::pair<std::string, std::string>> pairs = {{"i.stl", "i_ras.stl"},
+                                                            {"m_outer.stl", "m_ras_outer.stl"},
+                                                            {"m_inner.stl", "m_ras_inner.stl"},
+                                                            {"x.stl", "x_ras.stl"},
+                                                            {"t.stl", "t_ras.stl"}};
+  for (const auto& entry : std::filesystem::directory_iterator(dir.path("p")))
+    if (entry.path().extension() == ".stl")
+      pairs.emplace_back("p/" + entry.path().filename().string(),
+                         "p_ras/" + entry.path().filename().string());
+  ASSERT_GE(pairs.size(), 7u) << "the pipeline writes its meshes";
+  for (const auto& [lps, ras] : pairs) {
+    SCOPED_TRACE(ras);
+    ASSERT_TRUE(std::filesystem::exists(dir.path(ras)));
+    EXPECT_EQ(test::read_bytes(dir.path(lps)).substr(0, 80).find("SPACE=RAS"), std::string::npos);
+    EXPECT_NE(test::read_bytes(dir.path(ras)).substr(0, 80).find("SPACE=RAS"), std::string::npos);
+    // As written: the same triangles with x and y negated.
+    const TriangleSoup a = to_soup(read_mesh(dir.path(lps)).mesh);
+    const TriangleSoup b = to_soup(read_mesh(dir.path(ras)).mesh);
+    ASSERT_EQ(a.triangles.size(), b.triangles.size());
+    Eigen::Vector3d sum_a = Eigen::Vector3d::Zero(), sum_b = Eigen::Vector3d::Zero();
+    for (const Eigen::Vector3d& v : a.vertices) sum_a += v;
+    for (const Eigen::Vector3d& v : b.vertices) sum_b += v;
+    ASSERT_EQ(a.vertices.size(), b.vertices.size());
+    const double n = static_cast<double>(a.vertices.size());
+    EXPECT_LT((sum_b / n - Eigen::Vector3d(-sum_a.x(), -sum_a.y(), sum_a.z()) / n).norm(), 1e-3);
+  }
+}
+
 // The programs run with malloc in transparent huge pages (huge_pages.h): started by their
 // launchers (what bin holds, the CLI kCli names) or starting themselves again when run directly.
 // That changes the allocations, not the arithmetic: a CT's surface is the same bytes through the
