@@ -1,5 +1,6 @@
 #include "cranioplan/algorithms/io/read_mesh.h"
 
+#include <unistd.h>
 #include <vtkFieldData.h>
 #include <vtkNew.h>
 #include <vtkPolyData.h>
@@ -17,6 +18,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <new>
 #include <sstream>
 #include <string_view>
 
@@ -410,12 +412,78 @@ TriangleSoup read_isolated(const std::string& path, const char* reader_name, Mes
   return soup;
 }
 
-TriangleSoup read_vtp(const std::string& path, MeshSpace& space) {
+// What a VTP file's pieces declare, summed over them: their points and their cells of every
+// kind. Read from the XML before the appended data (raw bytes that may hold anything); VTK reads
+// no more than this, failing on an array shorter than its piece declares.
+struct VtpDeclared {
+  double points = 0.0;
+  double cells = 0.0;
+};
+
+VtpDeclared vtp_declared(const std::string& bytes) {
+  const std::string_view xml = std::string_view(bytes).substr(0, bytes.find("<AppendedData"));
+  VtpDeclared d;
+  auto attribute = [](std::string_view element, std::string_view name) {
+    const std::string key = " " + std::string(name) + "=\"";
+    const size_t at = element.find(key);
+    if (at == std::string_view::npos) return 0.0;
+    const std::string value(element.substr(at + key.size(), 24));
+    const double n = std::strtod(value.c_str(), nullptr);
+    return std::isfinite(n) && n > 0.0 ? n : 0.0;
+  };
+  for (size_t at = xml.find("<Piece"); at != std::string_view::npos;
+       at = xml.find("<Piece", at + 1)) {
+    const std::string_view element = xml.substr(at, xml.find('>', at) - at);
+    d.points += attribute(element, "NumberOfPoints");
+    for (const char* kind : {"NumberOfVerts", "NumberOfLines", "NumberOfStrips", "NumberOfPolys"})
+      d.cells += attribute(element, kind);
+  }
+  return d;
+}
+
+// The memory a read of so many points and cells may take: VTK's arrays (the points, a few
+// arrays of point data such as normals, the cells' offsets and connectivity, as double and
+// 64-bit ids), the soup made from them and the copy sent back, with room to spare; and the file
+// itself a few times (base64 and decompression buffers).
+double vtp_read_bytes(const VtpDeclared& d, double file_bytes) {
+  return 256.0 * 1024 * 1024 + 4.0 * file_bytes + 256.0 * (d.points + d.cells);
+}
+
+// "1 point", "200,000 points".
+std::string counted(double n, const char* what) {
+  const long long k = static_cast<long long>(std::min(n, 9e18));
+  return format_count(k) + " " + what + (k == 1 ? "" : "s");
+}
+
+TriangleSoup read_vtp(const std::string& path, const std::string& bytes, MeshSpace& space) {
+  // A VTP's arrays are compressed (zlib, LZ4 or LZMA): a file of a megabyte may declare a
+  // billion points of zeros, and its size says nothing of what reading it takes. Its pieces'
+  // counts do: a file that would take more than half of the machine's memory is refused before
+  // it is read, and the reader's child may map no more than those counts need.
+  const VtpDeclared declared_counts = vtp_declared(bytes);
+  const double budget = vtp_read_bytes(declared_counts, static_cast<double>(bytes.size()));
+  const double memory =
+      static_cast<double>(::sysconf(_SC_PHYS_PAGES)) * static_cast<double>(::sysconf(_SC_PAGESIZE));
+  if (memory > 0.0 && budget > 0.5 * memory)
+    fail(path, "declares " + counted(declared_counts.points, "point") + " and " +
+                   counted(declared_counts.cells, "cell") +
+                   ": reading them would take more than half of this machine's memory (" +
+                   format_count(static_cast<long long>(memory / (1024.0 * 1024 * 1024))) +
+                   " GB); a skull needs a few million triangles at most (decimate the mesh)");
   return read_isolated(path, "VTK's VTP reader", space, [&](MeshSpace& declared) {
+    const detail::AddressSpaceBudget memory_budget(budget);
     vtkNew<vtkXMLPolyDataReader> reader;
     const detail::VtkErrorCatcher errors(reader);
     reader->SetFileName(path.c_str());
-    reader->Update();
+    try {
+      reader->Update();
+    } catch (const std::bad_alloc&) {
+      fail(path, "its arrays take more memory than a mesh of " +
+                     counted(declared_counts.points, "point") + " and " +
+                     counted(declared_counts.cells, "cell") + " does (" +
+                     format_count(static_cast<long long>(budget / (1024.0 * 1024))) +
+                     " MB): many or large arrays of point or cell data besides the geometry");
+    }
     const std::string error = errors.message();
     if (!error.empty()) fail(path, "not a readable VTP file (" + error + ")");
     // 3D Slicer's declaration of the coordinate system: a string array "SPACE".
@@ -521,9 +589,8 @@ void check_legacy_binary_sections(const std::string& path, const std::string& by
   }
 }
 
-// VTK's legacy format, 3D Slicer's default for models// VTK's legacy format, 3D Slicer's default
-// for models (ASCII or binary; Slicer writes version 4.2 with "3D Slicer output. SPACE=RAS" or
-// "SPACE=LPS" as the header line).
+// VTK's legacy format, 3D Slicer's default for models (ASCII or binary; Slicer writes version 4.2
+// with "3D Slicer output. SPACE=RAS" or "SPACE=LPS" as the header line).
 TriangleSoup read_legacy_vtk(const std::string& path, const std::string& bytes, MeshSpace& space) {
   check_legacy_binary_sections(path, bytes);
   // The data is not compressed: its polydata and the soup made from it take a few times the
@@ -620,7 +687,7 @@ TriangleSoup read_mesh_soup(const std::string& path, std::string* format_out,
     format = "VTP";
     if (bytes.find("<VTKFile") == std::string::npos)
       fail(path, "not a VTP file (no <VTKFile> element)");
-    soup = read_vtp(path, space);
+    soup = read_vtp(path, bytes, space);
   } else {
     fail(path, "unknown mesh format '" + ext + "' (expected .stl, .ply, .obj, .off, .vtk or .vtp)");
   }

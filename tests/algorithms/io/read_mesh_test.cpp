@@ -2,9 +2,11 @@
 
 #include <gtest/gtest.h>
 #include <vtkCellArray.h>
+#include <vtkDoubleArray.h>
 #include <vtkFieldData.h>
 #include <vtkNew.h>
 #include <vtkPLYWriter.h>
+#include <vtkPointData.h>
 #include <vtkPoints.h>
 #include <vtkPolyData.h>
 #include <vtkPolyDataWriter.h>
@@ -13,8 +15,10 @@
 #include <vtkXMLPolyDataWriter.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <cstring>
+#include <filesystem>
 #include <functional>
 #include <limits>
 
@@ -306,6 +310,59 @@ TEST(ReadMesh, ABrokenVtpIsOneMessageAndVtkPrintsNothing) {
   expect_bad(dir.path("cut.vtp"), "not a readable VTP file (Error parsing input file.");
   // VTK's executive and XML parser log errors of their own; the user sees ours alone.
   EXPECT_EQ(testing::internal::GetCapturedStderr(), "");
+}
+
+// A VTP's arrays are compressed, so its size says nothing of what reading it takes: its pieces'
+// counts do. A file that declares more points than half the machine's memory can read is
+// refused before it is read, at once; one whose point data takes more than a mesh of its points
+// and cells does (one array of 300 doubles a point: 480 MB of zeros in a file of 2 MB) ends its
+// reader's child with a message, not the machine's memory. The head itself reads as before.
+TEST(ReadMesh, AVtpThatWouldFillTheMemoryIsRefused) {
+  TempDir dir;
+  const SkullMesh head = test::make_symmetric_head(3);
+  vtkNew<vtkXMLPolyDataWriter> w;
+  w->SetInputData(test::to_polydata(head));
+  w->SetFileName(dir.path("head.vtp").c_str());
+  w->SetDataModeToAppended();
+  w->Write();
+  EXPECT_EQ(read_mesh(dir.path("head.vtp")).mesh.n_faces(), head.n_faces());
+  std::string bytes = test::read_bytes(dir.path("head.vtp"));
+  const std::string declared = "NumberOfPoints=\"" + std::to_string(head.n_vertices()) + "\"";
+  const size_t at = bytes.find(declared);
+  ASSERT_NE(at, std::string::npos);
+  bytes.replace(at, declared.size(), "NumberOfPoints=\"100000000000\"");
+  test::write_bytes(dir.path("huge.vtp"), bytes);
+  const auto t0 = std::chrono::steady_clock::now();
+  expect_bad(dir.path("huge.vtp"), "declares 100,000,000,000 points");
+  EXPECT_LT(std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count(), 30.0)
+      << "refused before it is read";
+
+  const vtkIdType n = 200000;
+  vtkNew<vtkPoints> points;
+  points->SetDataTypeToDouble();
+  points->SetNumberOfPoints(n);
+  points->GetData()->Fill(0.0);
+  for (vtkIdType i = 0; i < 3; ++i) points->SetPoint(i, i == 1, i == 2, 0.0);
+  vtkNew<vtkCellArray> polys;
+  const vtkIdType ids[3] = {0, 1, 2};
+  polys->InsertNextCell(3, ids);
+  vtkNew<vtkDoubleArray> data;
+  data->SetName("data");
+  data->SetNumberOfComponents(300);
+  data->SetNumberOfTuples(n);
+  data->Fill(0.0);
+  vtkNew<vtkPolyData> pd;
+  pd->SetPoints(points);
+  pd->SetPolys(polys);
+  pd->GetPointData()->AddArray(data);
+  vtkNew<vtkXMLPolyDataWriter> bomb;
+  bomb->SetInputData(pd);
+  bomb->SetFileName(dir.path("arrays.vtp").c_str());
+  bomb->SetDataModeToAppended();
+  bomb->Write();
+  EXPECT_LT(std::filesystem::file_size(dir.path("arrays.vtp")), 20u * 1024 * 1024);
+  expect_bad(dir.path("arrays.vtp"),
+             "its arrays take more memory than a mesh of 200,000 points and 1 cell does");
 }
 
 // A binary legacy VTK file cut short: VTK's reader reads on past its end (other triangles on
