@@ -4,6 +4,8 @@
 // the plan on the project's own import. The table it prints is docs/AUTOPLAN.md's.
 #include <gtest/gtest.h>
 #include <vtkCellArray.h>
+#include <vtkDiscreteFlyingEdges3D.h>
+#include <vtkImageData.h>
 #include <vtkLinearSubdivisionFilter.h>
 #include <vtkNew.h>
 #include <vtkPoints.h>
@@ -64,8 +66,9 @@ vtkSmartPointer<vtkPolyData> decimated(vtkPolyData* in, double keep) {
   return f->GetOutput();
 }
 
-// Re-meshed: vertex clustering on a 300³ grid (about 0.8 mm cells over the sample), new
-// triangles that follow the bone but none of the CT's.
+// Re-meshed: vertex clustering on a grid of up to 300³ cells (VTK coarsens it to the number of
+// points: the sample's triangles come out 2.2 mm long on average), new triangles that follow
+// the bone but none of the CT's.
 vtkSmartPointer<vtkPolyData> remeshed(vtkPolyData* in) {
   vtkNew<vtkQuadricClustering> f;
   f->SetInputData(in);
@@ -85,6 +88,47 @@ vtkSmartPointer<vtkPolyData> subdivided(vtkPolyData* in) {
   f->SetNumberOfSubdivisions(1);
   f->Update();
   return f->GetOutput();
+}
+
+// As 3D Slicer's Segment Editor makes a skull model: the CT thresholded into a binary
+// labelmap, padded by a voxel (so the surface closes where the scan ends), its boundary by
+// discrete flying edges in voxel coordinates, smoothed there as Slicer's closed-surface
+// conversion does (a windowed sinc of 20 iterations, pass band 10^(-4 × smoothing factor);
+// Slicer's default factor is 0.5) and moved to the patient's frame by the volume's geometry.
+vtkSmartPointer<vtkPolyData> segmentation_model(const Volume& ct, double threshold,
+                                                double smoothing_factor) {
+  vtkNew<vtkImageData> labelmap;
+  labelmap->SetDimensions(ct.dims[0] + 2, ct.dims[1] + 2, ct.dims[2] + 2);
+  labelmap->AllocateScalars(VTK_UNSIGNED_CHAR, 1);
+  auto* label = static_cast<unsigned char*>(labelmap->GetScalarPointer());
+  std::fill(label, label + labelmap->GetNumberOfPoints(), static_cast<unsigned char>(0));
+  for (int k = 0; k < ct.dims[2]; ++k)
+    for (int j = 0; j < ct.dims[1]; ++j)
+      for (int i = 0; i < ct.dims[0]; ++i)
+        if (ct.at(i, j, k) >= threshold)
+          label[(static_cast<size_t>(k + 1) * (ct.dims[1] + 2) + (j + 1)) * (ct.dims[0] + 2) +
+                (i + 1)] = 1;
+  vtkNew<vtkDiscreteFlyingEdges3D> surface;
+  surface->SetInputData(labelmap);
+  surface->SetValue(0, 1.0);
+  surface->ComputeNormalsOff();
+  surface->ComputeGradientsOff();
+  surface->Update();
+  vtkSmartPointer<vtkPolyData> pd = surface->GetOutput();
+  if (smoothing_factor > 0.0) pd = sinc_smoothed(pd, std::pow(10.0, -4.0 * smoothing_factor));
+  vtkNew<vtkPoints> world;
+  world->SetDataTypeToDouble();
+  world->SetNumberOfPoints(pd->GetNumberOfPoints());
+  for (vtkIdType p = 0; p < pd->GetNumberOfPoints(); ++p) {
+    double ijk[3];
+    pd->GetPoint(p, ijk);
+    const Eigen::Vector3d w = ct.world(Eigen::Vector3d(ijk[0] - 1.0, ijk[1] - 1.0, ijk[2] - 1.0));
+    world->SetPoint(p, w.x(), w.y(), w.z());
+  }
+  vtkNew<vtkPolyData> out;
+  out->SetPoints(world);
+  out->SetPolys(pd->GetPolys());
+  return out;
 }
 
 // Written as a binary STL by VTK and read back as a user's file.
@@ -165,6 +209,7 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
         test::cut_open(closed, Eigen::Vector3d(0, 0, -1e-3), Eigen::Vector3d::UnitZ()));
   };
   const vtkSmartPointer<vtkPolyData> open300 = open(300.0);
+  const Volume ct = read_volume(path);
   struct Case {
     std::string name;
     std::function<vtkSmartPointer<vtkPolyData>()> make;
@@ -194,6 +239,16 @@ TEST(RobustnessCorpus, ExportsOfTheSampleArePlannedOnTheBone) {
          return to_polydata(load_skull(path, import).mesh);
        },
        true, true, false},
+      // The CT segmented and made a model in 3D Slicer (closed, stair-stepped then smoothed):
+      // at 300 HU and at InVesalius's bone threshold, Slicer's default smoothing. At 300 HU
+      // the plan stands 1.07 mm off the bone over one 5° arc, at the implant's lower medial
+      // corner by the frontal sinus, and is refused (limit 1 mm); built 3, 5 or 6 mm over the
+      // bone instead of 4 it meets it (0.09 mm), and so does the same segmentation meshed
+      // from the rows in the other order: measured, not yet mended (docs/AUTOPLAN.md).
+      {"3D Slicer segmentation, 300 HU, smoothing 0.5",
+       [&] { return segmentation_model(ct, 300.0, 0.5); }, false, true, false},
+      {"3D Slicer segmentation, 226 HU, smoothing 0.5",
+       [&] { return segmentation_model(ct, 226.0, 0.5); }, true, true, false},
       {"open, sinc pass band 0.1", [&] { return sinc_smoothed(open300, 0.1); }, true, true, false},
       {"open, sinc pass band 0.01", [&] { return sinc_smoothed(open300, 0.01); }, true, true,
        false},
