@@ -354,6 +354,7 @@ struct SkullView::Impl {
       cursor{sphere(1.8), {0.0, 0.85, 1.0}},         // the slice views' shared cursor
       zones{sphere(1.0), {1.0, 0.55, 0.0}},          // clearance zones, scaled to their radius
       handle_balls{sphere(1.3), {0.15, 0.45, 1.0}},  // tabs and holes that can be dragged
+      rim_gap{sphere(2.6), {1.0, 0.02, 0.02}},       // where the implant stands off the bone
       handle_drop{sphere(1.8), {1.0, 0.95, 0.1}};    // where the dragged one would go
   vtkNew<vtkPlaneSource> plane_source;
   vtkNew<vtkPolyDataMapper> plane_mapper;
@@ -507,6 +508,11 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
   }
   d.unseen_actor->SetVisibility(false);
   d.overlay->AddActor(d.unseen_actor);
+  // The rim gap's ball on the same layer: it sits on the implant's edge by the bone, where the
+  // bone or the mirror would hide it.
+  d.rim_gap.actor->SetVisibility(false);
+  d.rim_gap.actor->GetProperty()->SetAmbient(0.6);
+  d.overlay->AddActor(d.rim_gap.actor);
   // Thickness 0 (red) to 6 mm (blue); the bone's gap to the implant 0 (white) to 3 mm (dark
   // violet), the bone's colour beyond the map's reach. Both in mm.
   d.thickness_colors->SetRange(0.0, 6.0);
@@ -593,10 +599,11 @@ void SkullView::paintGL() {
         a->SetVisibility(false);
         hidden.push_back(a);
       }
-    if (d.unseen_actor->GetVisibility()) {
-      d.unseen_actor->SetVisibility(false);
-      hidden.push_back(d.unseen_actor.Get());
-    }
+    for (vtkActor* a : {d.unseen_actor.Get(), d.rim_gap.actor.Get()})
+      if (a->GetVisibility()) {
+        a->SetVisibility(false);
+        hidden.push_back(a);
+      }
   }
   d.window->Render();
   for (vtkActor* a : hidden) a->SetVisibility(true);
@@ -998,6 +1005,13 @@ int SkullView::coarse_layers_drawn() const {
     n += layer->visible() && layer->actor->GetMapper() == layer->coarse_mapper.Get();
   return n;
 }
+
+void SkullView::set_rim_gap(const std::optional<Eigen::Vector3d>& at) {
+  d_->rim_gap.set(at ? std::vector<Eigen::Vector3d>{*at} : std::vector<Eigen::Vector3d>{});
+  update();
+}
+
+bool SkullView::rim_gap_shown() const { return d_->rim_gap.actor->GetVisibility(); }
 
 int SkullView::unseen_rim_shown() const {
   return d_->unseen_actor->GetVisibility() ? static_cast<int>(d_->unseen_data->GetNumberOfLines())

@@ -79,6 +79,10 @@ class SkullView : public QOpenGLWidget {
   int selected_marker() const;
   /// How many stretches of the rim no ray saw are drawn (the last proposal's).
   int unseen_rim_shown() const;
+  /// A ball where the implant's edge stands furthest off the bone (the quality report's worst
+  /// rim arc), drawn over the scene; none with nullopt.
+  void set_rim_gap(const std::optional<Eigen::Vector3d>& at);
+  bool rim_gap_shown() const;
 
   /// While the camera moves, meshes of more than 150,000 triangles are drawn from coarse copies
   /// (quadric clustering, 3 mm): a drag of the camera, a wheel turn or a drag of a marker or

@@ -451,7 +451,13 @@ std::string quality_report_html(const QualityReport& r, const SoftTissueCheck* t
                                       : fixed(r.thin_volume_mm3, 1) + " mm³: edge on the bone " +
                                             fixed(r.taper_reach_mm, 1) + " mm wide, elsewhere " +
                                             fixed(r.corner_reach_mm, 1) + " mm");
-  if (r.rim_gap_mm >= 0) row("Gap to bone (rim)", fixed(r.rim_gap_mm, 2) + " mm");
+  if (r.rim_gap_mm >= 0)
+    row("Gap to bone (rim)",
+        fixed(r.rim_gap_mm, 2) + " mm" +
+            (r.rim_gap_mm > kRimGapTargetMm && r.rim_gap_at
+                 ? " at (" + fixed(r.rim_gap_at->x(), 1) + ", " + fixed(r.rim_gap_at->y(), 1) +
+                       ", " + fixed(r.rim_gap_at->z(), 1) + ") mm"
+                 : std::string()));
   if (r.clearance_asked && r.rim_gap_mm >= 0) {
     auto signed_mm = [&](double v) { return (v >= 0 ? "+" : "−") + fixed(std::abs(v), 2); };
     row("Edge gap per 5° arc, less the clearance asked",

@@ -136,6 +136,11 @@ Json to_json(const QualityReport& q) {
     j["clearance_low_mm"] = q.clearance_low_mm;
     j["clearance_high_mm"] = q.clearance_high_mm;
   }
+  auto xyz = [](const Eigen::Vector3d& p) { return Json::array({p.x(), p.y(), p.z()}); };
+  if (q.rim_gap_at && q.rim_gap_bone) {
+    j["rim_gap_at_mm"] = xyz(*q.rim_gap_at);
+    j["rim_gap_bone_mm"] = xyz(*q.rim_gap_bone);
+  }
   return j;
 }
 

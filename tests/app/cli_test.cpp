@@ -381,7 +381,17 @@ TEST(Cli, AutoplanAndQaWithAMaterial) {
                               &out),
             0)
       << out;
-  EXPECT_NEAR(Json::parse(out)["rim_gap_mm"].get<double>(), 1.5, 0.2);
+  const Json checked = Json::parse(out);
+  EXPECT_NEAR(checked["rim_gap_mm"].get<double>(), 1.5, 0.2);
+  // Where the worst arc is: a wall point and the bone point it faces, the gap apart.
+  ASSERT_EQ(checked["rim_gap_at_mm"].size(), 3u) << out;
+  ASSERT_EQ(checked["rim_gap_bone_mm"].size(), 3u) << out;
+  Eigen::Vector3d wall, bone;
+  for (int k = 0; k < 3; ++k) {
+    wall[k] = checked["rim_gap_at_mm"][k].get<double>();
+    bone[k] = checked["rim_gap_bone_mm"][k].get<double>();
+  }
+  EXPECT_NEAR((wall - bone).norm(), checked["rim_gap_mm"].get<double>(), 1e-6);
   // Checked against a 3 mm clearance it would not go in.
   ASSERT_EQ(test::run_command(kCli + " qa --json " + dir.path("i.stl") + " --skull " +
                                   dir.path("skull.stl") + " --material pmma --clearance 3",

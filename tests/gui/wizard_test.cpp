@@ -790,6 +790,58 @@ TEST(WizardThickness, TheThicknessMapColoursTheImplantAndTheBoneAroundIt) {
   EXPECT_FALSE(w.view().thickness_shown());
 }
 
+// Where the implant's edge stands off the bone: a ball where the quality report's worst rim arc
+// is, when it is wider than automatic plans aim for (or beyond a clearance asked), drawn over
+// the scene; none on a plan whose edge meets the bone. The rule on constructed reports, then
+// the ball on the screen.
+TEST(WizardRimGap, TheWorstRimArcIsMarkedWhereTheReportSaysItIs) {
+  QualityReport meets;
+  meets.rim_gap_mm = 0.09;
+  meets.rim_gap_at = Eigen::Vector3d(1, 2, 3);
+  EXPECT_FALSE(shown_rim_gap(meets));
+  QualityReport off = meets;
+  off.rim_gap_mm = 1.07;
+  ASSERT_TRUE(shown_rim_gap(off));
+  EXPECT_EQ(*shown_rim_gap(off), Eigen::Vector3d(1, 2, 3));
+  QualityReport asked = off;  // 1.07 mm is what a clearance of 1 mm asks for
+  asked.clearance_asked = true;
+  asked.clearance_high_mm = 0.07;
+  asked.clearance_high_at = Eigen::Vector3d(4, 5, 6);
+  EXPECT_FALSE(shown_rim_gap(asked));
+  asked.clearance_high_mm = 0.8;
+  ASSERT_TRUE(shown_rim_gap(asked));
+  EXPECT_EQ(*shown_rim_gap(asked), Eigen::Vector3d(4, 5, 6));
+
+  MainWindow w;
+  ASSERT_TRUE(shown(w, QSize(1280, 800)));
+  ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
+  w.controller().wait();
+  ASSERT_TRUE(w.plan().implant);
+  w.view().look_at_markers();
+  w.wait_quality();
+  const QualityReport& report = w.plan().implant->quality();
+  EXPECT_EQ(w.view().rim_gap_shown(), shown_rim_gap(report).has_value())
+      << "rim gap " << report.rim_gap_mm;
+  auto marked = [&] {  // the ball's red
+    QTest::qWait(50);
+    const QImage image = w.view().grabFramebuffer().convertToFormat(QImage::Format_RGB32);
+    int n = 0;
+    for (int y = 0; y < image.height(); ++y)
+      for (int x = 0; x < image.width(); ++x) {
+        const QRgb p = image.pixel(x, y);
+        n += qRed(p) > 150 && qGreen(p) < 50 && qBlue(p) < 50;
+      }
+    return n;
+  };
+  const int before = marked();
+  ASSERT_TRUE(report.rim_gap_at);
+  w.view().set_rim_gap(report.rim_gap_at);
+  EXPECT_TRUE(w.view().rim_gap_shown());
+  EXPECT_GT(marked(), before + 30) << "drawn over the bone and the mirror";
+  w.view().set_rim_gap(std::nullopt);
+  EXPECT_FALSE(w.view().rim_gap_shown());
+}
+
 // A window showing the planned sample case at `step`, for the tests that edit its implant.
 void open_planned_at_step(MainWindow& w, int step, const QSize& size) {
   ASSERT_TRUE(shown(w, size));

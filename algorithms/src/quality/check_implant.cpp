@@ -8,6 +8,7 @@
 #include <deque>
 #include <future>
 #include <memory>
+#include <tuple>
 #include <utility>
 
 #include "cranioplan/algorithms/geometry/distance_transform.h"
@@ -30,6 +31,13 @@ std::string fmt(const char* f, double a, double b) {
 std::string fmt1(const char* f, double a) {
   char buf[64];
   std::snprintf(buf, sizeof(buf), f, a);
+  return buf;
+}
+
+// " at (x, y, z) mm": where on the implant a reason applies.
+std::string at_point(const Eigen::Vector3d& p) {
+  char buf[96];
+  std::snprintf(buf, sizeof(buf), " at (%.1f, %.1f, %.1f) mm", p.x(), p.y(), p.z());
   return buf;
 }
 // A measure over its limit, to a tenth of a millimetre, or finer where a tenth would read as
@@ -91,38 +99,50 @@ void measure_thin_material(const std::vector<uint8_t>& solid, const std::vector<
 }  // namespace
 
 double worst_arc_gap(const std::vector<double>& angle, const std::vector<double>& distance,
-                     double arc_rad) {
+                     double arc_rad, size_t* where) {
   const size_t n = std::min(angle.size(), distance.size());
   if (n == 0) return 0.0;
-  std::vector<std::pair<double, double>> at(n);  // (angle in [0, 2π), distance)
+  struct Point {
+    double angle;  // in [0, 2π)
+    double distance;
+    size_t index;  // in the caller's arrays
+    bool operator<(const Point& o) const {
+      return std::tie(angle, distance, index) < std::tie(o.angle, o.distance, o.index);
+    }
+  };
+  std::vector<Point> at(n);
   for (size_t i = 0; i < n; ++i) {
     const double a = std::fmod(angle[i], 2 * M_PI);
-    at[i] = {a < 0 ? a + 2 * M_PI : a, distance[i]};
+    at[i] = {a < 0 ? a + 2 * M_PI : a, distance[i], i};
   }
   std::sort(at.begin(), at.end());
   const double w = std::clamp(arc_rad, 0.0, 2 * M_PI);
-  auto angle_of = [&](size_t k) { return at[k % n].first + (k >= n ? 2 * M_PI : 0.0); };
+  auto angle_of = [&](size_t k) { return at[k % n].angle + (k >= n ? 2 * M_PI : 0.0); };
   // An arc's points are a run of the sorted points; the arcs whose minimum can be the largest
   // hold the smallest runs: an arc that begins just past point j, (a_j, a_j + w], and, where
   // the next point lies more than w further on, that point alone. Their minima by a sliding
   // window (a deque of increasing distances) over the points taken twice around.
   double worst = 0.0;
+  size_t worst_at = at[0].index;
+  auto consider = [&](size_t k) {
+    if (at[k % n].distance > worst) {
+      worst = at[k % n].distance;
+      worst_at = at[k % n].index;
+    }
+  };
   std::deque<size_t> window;
   size_t next = 1;  // the first point not yet in the window
   for (size_t j = 0; j < n; ++j) {
     while (!window.empty() && window.front() <= j) window.pop_front();
     if (next <= j) next = j + 1;
     while (next < j + n && angle_of(next) <= angle_of(j) + w) {
-      while (!window.empty() && at[window.back() % n].second >= at[next % n].second)
+      while (!window.empty() && at[window.back() % n].distance >= at[next % n].distance)
         window.pop_back();
       window.push_back(next++);
     }
-    if (!window.empty()) {
-      worst = std::max(worst, at[window.front() % n].second);
-    } else {
-      worst = std::max(worst, at[(j + 1) % n].second);  // the next point, alone
-    }
+    consider(window.empty() ? j + 1 : window.front());  // else the next point, alone
   }
+  if (where) *where = worst_at;
   return worst;
 }
 
@@ -240,7 +260,12 @@ std::vector<float> measure_against_bone(const SkullMesh& implant, const SkullMes
         }
       },
       256);
-  q.rim_gap_mm = worst_arc_gap(angle, distance, M_PI / 36);
+  size_t gap_at = 0;
+  q.rim_gap_mm = worst_arc_gap(angle, distance, M_PI / 36, &gap_at);
+  if (walls > 0) {
+    q.rim_gap_at = to_eigen(implant.point(SkullMesh::VertexHandle(wall_vertices[gap_at])));
+    q.rim_gap_bone = nearest[gap_at];
+  }
   if (params.edge_clearance_mm > 0.0 || !params.clearance_zones.empty()) {
     // The excess of each wall vertex's gap over the clearance asked at the bone it faces: the
     // worst arc's (its nearest vertex to the bone) and the smallest of all.
@@ -255,7 +280,11 @@ std::vector<float> measure_against_bone(const SkullMesh& implant, const SkullMes
                                                        params.clearance_zones);
     }
     q.clearance_asked = true;
-    q.clearance_high_mm = worst_arc_gap(angle, excess, M_PI / 36);
+    size_t high_at = 0;
+    q.clearance_high_mm = worst_arc_gap(angle, excess, M_PI / 36, &high_at);
+    if (walls > 0)
+      q.clearance_high_at =
+          to_eigen(implant.point(SkullMesh::VertexHandle(wall_vertices[high_at])));
     q.clearance_low_mm = excess.empty() ? 0.0 : *std::min_element(excess.begin(), excess.end());
   }
   const std::vector<uint8_t> b = voxelize_mesh(skull, grid);
@@ -299,12 +328,13 @@ void add_reasons(const MeshReport& rep, const QualityParams& params, bool with_b
                         " mm wide)");
   if (!q.clearance_asked && q.rim_gap_mm > params.max_rim_gap_mm)
     q.reasons.push_back(fmt("gap of %.2f mm between the rim and the bone (limit %.2f mm)",
-                            q.rim_gap_mm, params.max_rim_gap_mm));
+                            q.rim_gap_mm, params.max_rim_gap_mm) +
+                        (q.rim_gap_at ? at_point(*q.rim_gap_at) : std::string()));
   if (q.clearance_asked && q.clearance_high_mm > params.max_rim_gap_mm)
-    q.reasons.push_back(
-        fmt("a gap %.2f mm wider than the clearance asked between the rim and "
-            "the bone (limit %.2f mm)",
-            q.clearance_high_mm, params.max_rim_gap_mm));
+    q.reasons.push_back(fmt("a gap %.2f mm wider than the clearance asked between the rim and "
+                            "the bone (limit %.2f mm)",
+                            q.clearance_high_mm, params.max_rim_gap_mm) +
+                        (q.clearance_high_at ? at_point(*q.clearance_high_at) : std::string()));
   if (q.clearance_asked && q.clearance_low_mm < -params.clearance_tolerance_mm)
     q.reasons.push_back(
         fmt("the edge comes %.2f mm nearer the bone than the clearance asked "

@@ -2,6 +2,8 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
 #include "support/synthetic.h"
@@ -164,6 +166,12 @@ TEST(CheckImplant, TheRimGapIsTheWorstArcWhereverItLies) {
   // Over 7° from 101.25° (14 vertices) the wall stands 1.2 mm off, and 1.5 mm in the middle.
   for (int k = 203; k < 217; ++k) distance[k] = k == 210 ? 1.5 : 1.2;
   EXPECT_DOUBLE_EQ(worst_arc_gap(angle, distance, 5 * deg), 1.2);
+  // Where: a point of the stretch whose distance is the gap.
+  size_t where = 0;
+  EXPECT_DOUBLE_EQ(worst_arc_gap(angle, distance, 5 * deg, &where), 1.2);
+  EXPECT_GE(where, 203u);
+  EXPECT_LT(where, 217u);
+  EXPECT_DOUBLE_EQ(distance[where], 1.2);
   double fixed_sectors = 0.0;  // the old measure, sectors beginning at 0°
   for (int s = 0; s < 72; ++s) {
     double nearest = 1e9;
@@ -223,6 +231,18 @@ TEST(CheckImplant, AClearanceAskedButNotKeptIsNotPrintable) {
   EXPECT_FALSE(plain.clearance_asked);
   EXPECT_NEAR(plain.rim_gap_mm, 2.5, 0.05);
   EXPECT_TRUE(has_reason(plain, "gap of 2.50 mm between the rim and the bone"));
+  // Where: on the implant's right wall (x = 27.5), facing the right plate's cut face (x = 30),
+  // and named in the reason.
+  ASSERT_TRUE(plain.rim_gap_at && plain.rim_gap_bone);
+  EXPECT_NEAR(plain.rim_gap_at->x(), 27.5, 1e-6);
+  EXPECT_NEAR(plain.rim_gap_bone->x(), 30.0, 1e-6);
+  EXPECT_NEAR((*plain.rim_gap_bone - *plain.rim_gap_at).norm(), plain.rim_gap_mm, 1e-9);
+  char at[64];
+  std::snprintf(at, sizeof(at), " at (%.1f, %.1f, %.1f) mm", plain.rim_gap_at->x(),
+                plain.rim_gap_at->y(), plain.rim_gap_at->z());
+  EXPECT_TRUE(has_reason(plain, at)) << at;
+  ASSERT_TRUE(q.clearance_high_at);
+  EXPECT_NEAR(q.clearance_high_at->x(), 27.5, 1e-6) << "the right side is 1.5 mm too wide";
   EXPECT_FALSE(has_reason(plain, "clearance"));
   EXPECT_EQ(plain.mass_g, 0.0);
 

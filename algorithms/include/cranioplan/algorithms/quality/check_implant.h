@@ -58,6 +58,10 @@ struct ImplantResult;
 /// it drilled and the tabs it added with their limits.
 QualityParams quality_params_for(const ImplantParams& params, const ImplantResult& result);
 
+/// The rim gap automatic plans aim for (mm): a larger one is shown and located (the wizard's
+/// view, the report's row); over QualityParams::max_rim_gap_mm the implant is not printable.
+inline constexpr double kRimGapTargetMm = 0.5;
+
 struct QualityReport {
   bool watertight = false;
   bool manifold = false;
@@ -73,10 +77,15 @@ struct QualityReport {
   /// away from it (corners); −1 when no part is thick.
   double taper_reach_mm = 0.0, corner_reach_mm = 0.0;
   double rim_gap_mm = -1.0;  ///< −1 without a skull
+  /// Where the rim gap is: the worst arc's side-wall point nearest the bone, and the bone point
+  /// it faces (rim_gap_mm is their distance). Unset without a skull.
+  std::optional<Eigen::Vector3d> rim_gap_at, rim_gap_bone;
   /// With a clearance asked: over every 5° arc of the rim, the arc's gap less the clearance
   /// asked there; the smallest and the largest over the arcs (0 and 0: every arc exactly as
   /// asked). Both 0 without a skull or without a clearance asked.
   double clearance_low_mm = 0.0, clearance_high_mm = 0.0;
+  /// The worst arc's side-wall point for clearance_high_mm (unset without a clearance asked).
+  std::optional<Eigen::Vector3d> clearance_high_at;
   bool clearance_asked = false;      ///< a clearance (or zone) was asked
   double mass_g = 0.0;               ///< volume × density (0 without a density)
   int holes = 0, holes_blocked = 0;  ///< perforations, and those that do not go through
@@ -96,9 +105,10 @@ struct QualityReport {
 /// range) inside it; the largest over the arcs that hold a point. 0 without points. It is the
 /// same for the points turned by any angle: fixed sectors would start at the mesh's first wall
 /// vertex, so the same implant would give other gaps with its vertices listed in another order,
-/// and a gap straddling two sectors could hide in both.
+/// and a gap straddling two sectors could hide in both. `where`, when given, receives the index
+/// of the point whose distance is the result (the worst arc's nearest point).
 double worst_arc_gap(const std::vector<double>& angle, const std::vector<double>& distance,
-                     double arc_rad);
+                     double arc_rad, size_t* where = nullptr);
 
 /// Checks an implant, optionally against the (defective) skull it is made for.
 ///
