@@ -23,6 +23,7 @@
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
+#include <functional>
 #include <thread>
 
 #include "cranioplan/algorithms/geometry/slices.h"
@@ -759,26 +760,35 @@ TEST(WizardOrientation, TheCubeShowsTheFaceTheCameraLooksAt) {
   }
 }
 
-// View → Thickness map: once the implant's report is in, the implant is coloured by its
-// thickness and the skull around it by its gap, with legends; off again, the plain colours.
-TEST(WizardThickness, TheThicknessMapColoursTheImplantAndTheBoneAroundIt) {
-  MainWindow w;
+// A window showing the planned defect case's implant, its quality report in.
+void open_planned_with_report(MainWindow& w) {
   ASSERT_TRUE(shown(w, QSize(1280, 800)));
   ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
   w.controller().wait();
   ASSERT_TRUE(w.plan().implant);
   w.view().look_at_markers();
   w.wait_quality();
-  auto coloured = [&] {  // pixels far from grey, white and the bone's and implant's colours
-    QTest::qWait(50);
-    const QImage image = w.view().grabFramebuffer().convertToFormat(QImage::Format_RGB32);
-    int n = 0;
-    for (int y = 0; y < image.height(); y += 2)
-      for (int x = 0; x < image.width(); x += 2) {
-        const QRgb p = image.pixel(x, y);
-        n += qBlue(p) > qRed(p) + 60 && qBlue(p) > qGreen(p) + 20;  // the thick part's blue
-      }
-    return n;
+}
+
+// How many of the view's pixels (every `step`-th along both axes) `is` picks, once drawn.
+int view_pixels(SkullView& view, const std::function<bool(QRgb)>& is, int step = 1) {
+  QTest::qWait(50);
+  const QImage image = view.grabFramebuffer().convertToFormat(QImage::Format_RGB32);
+  int n = 0;
+  for (int y = 0; y < image.height(); y += step)
+    for (int x = 0; x < image.width(); x += step) n += is(image.pixel(x, y));
+  return n;
+}
+
+// View → Thickness map: once the implant's report is in, the implant is coloured by its
+// thickness and the skull around it by its gap, with legends; off again, the plain colours.
+TEST(WizardThickness, TheThicknessMapColoursTheImplantAndTheBoneAroundIt) {
+  MainWindow w;
+  open_planned_with_report(w);
+  if (HasFatalFailure()) return;
+  auto coloured = [&] {  // pixels of the thick part's blue, far from the bone's and implant's
+    return view_pixels(
+        w.view(), [](QRgb p) { return qBlue(p) > qRed(p) + 60 && qBlue(p) > qGreen(p) + 20; }, 2);
   };
   const int before = coloured();
   EXPECT_FALSE(w.view().thickness_shown());
@@ -813,25 +823,14 @@ TEST(WizardRimGap, TheWorstRimArcIsMarkedWhereTheReportSaysItIs) {
   EXPECT_EQ(*shown_rim_gap(asked), Eigen::Vector3d(4, 5, 6));
 
   MainWindow w;
-  ASSERT_TRUE(shown(w, QSize(1280, 800)));
-  ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
-  w.controller().wait();
-  ASSERT_TRUE(w.plan().implant);
-  w.view().look_at_markers();
-  w.wait_quality();
+  open_planned_with_report(w);
+  if (HasFatalFailure()) return;
   const QualityReport& report = w.plan().implant->quality();
   EXPECT_EQ(w.view().rim_gap_shown(), shown_rim_gap(report).has_value())
       << "rim gap " << report.rim_gap_mm;
   auto marked = [&] {  // the ball's red
-    QTest::qWait(50);
-    const QImage image = w.view().grabFramebuffer().convertToFormat(QImage::Format_RGB32);
-    int n = 0;
-    for (int y = 0; y < image.height(); ++y)
-      for (int x = 0; x < image.width(); ++x) {
-        const QRgb p = image.pixel(x, y);
-        n += qRed(p) > 150 && qGreen(p) < 50 && qBlue(p) < 50;
-      }
-    return n;
+    return view_pixels(w.view(),
+                       [](QRgb p) { return qRed(p) > 150 && qGreen(p) < 50 && qBlue(p) < 50; });
   };
   const int before = marked();
   ASSERT_TRUE(report.rim_gap_at);
