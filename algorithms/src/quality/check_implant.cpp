@@ -40,6 +40,7 @@ std::string at_point(const Eigen::Vector3d& p) {
   std::snprintf(buf, sizeof(buf), " at (%.1f, %.1f, %.1f) mm", p.x(), p.y(), p.z());
   return buf;
 }
+
 // A measure over its limit, to a tenth of a millimetre, or finer where a tenth would read as
 // the limit itself ("for 2.0 mm; may be 2.0 mm").
 std::string over_limit(double value, double limit) {
