@@ -760,15 +760,6 @@ void MainWindow::refresh_history() {
   history_->setCurrentRow(static_cast<int>(session.index()));
 }
 
-std::optional<Eigen::Vector3d> shown_rim_gap(const QualityReport& report) {
-  // Where the edge stands off the bone more than automatic plans aim for (0.5 mm; over the
-  // report's limit the plan is refused), or, with a clearance asked, more than that clearance.
-  if (!report.clearance_asked && report.rim_gap_mm > kRimGapTargetMm) return report.rim_gap_at;
-  if (report.clearance_asked && report.clearance_high_mm > kRimGapTargetMm)
-    return report.clearance_high_at;
-  return std::nullopt;
-}
-
 void MainWindow::refresh_quality() {
   const PlanState& s = controller_->state();
   view_->set_rim_gap(std::nullopt);  // of the implant before, if any
@@ -812,7 +803,7 @@ void MainWindow::show_quality() {
     if (v->implant != controller_->state().implant) return;  // the plan moved on
     slices_->set_highlight(v->intrusion);
     view_->set_thickness_map(&v->implant->result().mesh, v->thickness);
-    view_->set_rim_gap(shown_rim_gap(v->implant->quality()));
+    view_->set_rim_gap(rim_gap_to_mark(v->implant->quality()));
     quality_->setHtml(v->html);
     for (StepPage* page : step_pages_) page->show_quality(v->html);
   });

@@ -43,11 +43,6 @@ namespace cranioplan::gui {
 
 class LoadPage;
 
-/// Where the view marks the implant's edge off the bone, from its quality report: the worst
-/// rim arc when it is wider than automatic plans aim for (kRimGapTargetMm), or with a clearance
-/// asked, the arc furthest beyond it; nothing otherwise.
-std::optional<Eigen::Vector3d> shown_rim_gap(const QualityReport& report);
-
 class MainWindow : public QMainWindow, public PageHost {
   Q_OBJECT
 

@@ -451,17 +451,19 @@ std::string quality_report_html(const QualityReport& r, const SoftTissueCheck* t
                                       : fixed(r.thin_volume_mm3, 1) + " mm³: edge on the bone " +
                                             fixed(r.taper_reach_mm, 1) + " mm wide, elsewhere " +
                                             fixed(r.corner_reach_mm, 1) + " mm");
+  // Where the edge stands off the bone more than automatic plans aim for, on the row that
+  // judges it.
+  const std::optional<Eigen::Vector3d> mark = rim_gap_to_mark(r);
+  const std::string where = mark ? " at (" + fixed(mark->x(), 1) + ", " + fixed(mark->y(), 1) +
+                                       ", " + fixed(mark->z(), 1) + ") mm"
+                                 : std::string();
   if (r.rim_gap_mm >= 0)
     row("Gap to bone (rim)",
-        fixed(r.rim_gap_mm, 2) + " mm" +
-            (r.rim_gap_mm > kRimGapTargetMm && r.rim_gap_at
-                 ? " at (" + fixed(r.rim_gap_at->x(), 1) + ", " + fixed(r.rim_gap_at->y(), 1) +
-                       ", " + fixed(r.rim_gap_at->z(), 1) + ") mm"
-                 : std::string()));
+        fixed(r.rim_gap_mm, 2) + " mm" + (r.clearance_asked ? std::string() : where));
   if (r.clearance_asked && r.rim_gap_mm >= 0) {
     auto signed_mm = [&](double v) { return (v >= 0 ? "+" : "−") + fixed(std::abs(v), 2); };
     row("Edge gap per 5° arc, less the clearance asked",
-        signed_mm(r.clearance_low_mm) + " to " + signed_mm(r.clearance_high_mm) + " mm");
+        signed_mm(r.clearance_low_mm) + " to " + signed_mm(r.clearance_high_mm) + " mm" + where);
   }
   if (r.penetration_mm3 >= 0) row("Overlap with skull", fixed(r.penetration_mm3, 1) + " mm³");
   if (r.holes > 0)

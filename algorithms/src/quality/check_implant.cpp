@@ -147,6 +147,13 @@ double worst_arc_gap(const std::vector<double>& angle, const std::vector<double>
   return worst;
 }
 
+std::optional<Eigen::Vector3d> rim_gap_to_mark(const QualityReport& report) {
+  if (!report.clearance_asked && report.rim_gap_mm > kRimGapTargetMm) return report.rim_gap_at;
+  if (report.clearance_asked && report.clearance_high_mm > kRimGapTargetMm)
+    return report.clearance_high_at;
+  return std::nullopt;
+}
+
 namespace {
 
 // Thickness across the plate from at most 60,000 faces spread evenly over the implant (one ray

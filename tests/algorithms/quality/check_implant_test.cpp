@@ -203,6 +203,28 @@ TEST(CheckImplant, TheRimGapIsTheWorstArcWhereverItLies) {
   EXPECT_DOUBLE_EQ(worst_arc_gap({2.0}, {0.7}, 5 * deg), 0.7);
 }
 
+// What a person is shown of a rim gap (the wizard's ball, the report's row): the worst arc when
+// it is over the 0.5 mm automatic plans aim for; with a clearance asked, the arc furthest beyond
+// it when that is over 0.5 mm (a gap the clearance asked for is no fault).
+TEST(CheckImplant, TheRimGapToMarkIsOverTheTargetOrBeyondTheClearance) {
+  QualityReport meets;
+  meets.rim_gap_mm = 0.09;
+  meets.rim_gap_at = Eigen::Vector3d(1, 2, 3);
+  EXPECT_FALSE(rim_gap_to_mark(meets));
+  QualityReport off = meets;
+  off.rim_gap_mm = 1.07;
+  ASSERT_TRUE(rim_gap_to_mark(off));
+  EXPECT_EQ(*rim_gap_to_mark(off), Eigen::Vector3d(1, 2, 3));
+  QualityReport asked = off;  // 1.07 mm is what a clearance of 1 mm asks for
+  asked.clearance_asked = true;
+  asked.clearance_high_mm = 0.07;
+  asked.clearance_high_at = Eigen::Vector3d(4, 5, 6);
+  EXPECT_FALSE(rim_gap_to_mark(asked));
+  asked.clearance_high_mm = 0.8;
+  ASSERT_TRUE(rim_gap_to_mark(asked));
+  EXPECT_EQ(*rim_gap_to_mark(asked), Eigen::Vector3d(4, 5, 6));
+}
+
 // A clearance asked and not kept, on a constructed case: bone plates with a 10 mm gap, an
 // implant 0.3 mm off the left cut face and 2.5 mm off the right. Asked 1 mm, the left edge
 // would not go in and the right leaves a gap 1.5 mm too wide: not printable, for both reasons.

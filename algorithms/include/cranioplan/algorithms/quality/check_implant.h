@@ -129,6 +129,12 @@ double worst_arc_gap(const std::vector<double>& angle, const std::vector<double>
 QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
                             const QualityParams& params = {});
 
+/// Where a report's edge stands off the bone enough to show a person: the worst rim arc's point
+/// when its gap is over kRimGapTargetMm, or, with a clearance asked, the arc furthest beyond the
+/// clearance when that is over kRimGapTargetMm; nothing otherwise (the wizard's mark, the
+/// report's row).
+std::optional<Eigen::Vector3d> rim_gap_to_mark(const QualityReport& report);
+
 class SurfaceLocator;
 /// The same with the skull's locator built once by the caller (building it for a skull of two
 /// million triangles costs more than the rest of the check).
