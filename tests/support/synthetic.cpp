@@ -282,4 +282,17 @@ const ThickHeadDefect& thick_head_defect() {
   return c;
 }
 
+::testing::AssertionResult on_the_patients_right_in_front(const Plane& plane,
+                                                          const DefectRegion& defect) {
+  const Eigen::Vector3d c = plane.project(defect.center);
+  const double side = plane.signed_distance(c + 100.0 * defect.axis) * plane.normal.x();
+  if (side >= 0.0)
+    return ::testing::AssertionFailure()
+           << "the defect lies on the patient's left (" << side << " mm along x from the plane)";
+  if (defect.axis.y() >= 0.0)
+    return ::testing::AssertionFailure()
+           << "the defect faces the back (axis y " << defect.axis.y() << ")";
+  return ::testing::AssertionSuccess();
+}
+
 }  // namespace cranioplan::test

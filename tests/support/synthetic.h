@@ -1,5 +1,7 @@
 #pragma once
 // Shapes whose truth is known by construction, for known-answer tests.
+#include <gtest/gtest.h>
+
 #include "cranioplan/algorithms/planning/detect_defect.h"
 #include "cranioplan/model/landmarks.h"
 #include "cranioplan/model/marker.h"
@@ -86,5 +88,10 @@ SkullMesh make_thick_head(double inner_scale = 0.93, double voxel_mm = 0.5);
 std::vector<Marker> round_defect_markers(const Eigen::Vector3d& center, double radius,
                                          double inner_scale = 0.93, int edge_count = 16,
                                          int surface_rings = 3);
+
+/// The sample case's defect, where it is in the patient: on the right (−x in LPS, the side of
+/// `plane` away from +x) and in front (−y). A reader or a plan that mirrored the skull fails.
+::testing::AssertionResult on_the_patients_right_in_front(const Plane& plane,
+                                                          const DefectRegion& defect);
 
 }  // namespace cranioplan::test

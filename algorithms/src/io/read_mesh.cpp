@@ -596,9 +596,7 @@ TriangleSoup read_legacy_vtk(const std::string& path, const std::string& bytes, 
   // The data is not compressed: its polydata and the soup made from it take a few times the
   // file's bytes. A header that announces more points or cells than the file holds (VTK's
   // reader believes it) fails to allocate at once rather than filling the memory.
-  std::error_code ec;
-  const double file_bytes = static_cast<double>(std::filesystem::file_size(path, ec));
-  const double budget = 256.0 * 1024 * 1024 + 40.0 * (ec ? 0.0 : file_bytes);
+  const double budget = 256.0 * 1024 * 1024 + 40.0 * static_cast<double>(bytes.size());
   return read_isolated(path, "VTK's legacy reader", space, [&](MeshSpace& declared) {
     const detail::AddressSpaceBudget memory(budget);
     vtkNew<vtkPolyDataReader> reader;

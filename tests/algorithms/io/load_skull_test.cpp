@@ -150,9 +150,10 @@ std::string expect_repaired(const TempDir& dir, const SkullMesh& clean, const Tr
   EXPECT_EQ(a.vertices, b.vertices);
   EXPECT_EQ(repaired.warnings.size(), as_clean.warnings.size() + 1);
   EXPECT_FALSE(repaired.warnings.empty());
-  if (!repaired.warnings.empty())
+  if (!repaired.warnings.empty()) {
     EXPECT_NE(repaired.warnings[0].find("damaged.stl: " + says), std::string::npos)
         << repaired.warnings[0];
+  }
   return dir.path("damaged.stl");
 }
 
