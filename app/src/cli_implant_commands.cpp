@@ -67,6 +67,7 @@ Json implant_json(const ImplantResult& r) {
               {"thickness_used_mm", r.thickness_used_mm},
               {"rim_marker_error_mm", r.rim_marker_error_mm},
               {"rim_points", r.rim_points},
+              {"fit_to_bone_used_mm", r.fit_to_bone_used_mm},
               {"seconds", r.seconds}};
 }
 

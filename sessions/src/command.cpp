@@ -253,7 +253,11 @@ int current_version(CommandType type) {
   // report allows are placed again (TabParams::keep_on_bone), and pattern holes whose rim
   // leaves a corner it refuses are left out (PerforationParams::sound_rims); version 11 is
   // made as it was.
-  if (type == CommandType::BuildImplant) return 12;
+  // build_implant 13: fitted to the bone, an implant whose edge stands off the bone by more
+  // than kRimGapTargetMm over an arc is fitted again from other margins
+  // (ImplantParams::fit_margin_search); the parameters recorded are unchanged, and version 12
+  // is made as it was.
+  if (type == CommandType::BuildImplant) return 13;
   if (type == CommandType::ExportImplant) return 2;
   // propose_markers 4: support markers only where the fitted surface describes the ring's bone
   // ("max_support_off_fit_mm"; versions 1 to 3 are read with 0, every ring point of the band).

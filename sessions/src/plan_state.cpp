@@ -782,6 +782,8 @@ void apply_build(PlanState& s, const ParamReader& r, int version) {
   // Before version 12, evenly placed tabs were placed once, whether they rested on the bone,
   // and every pattern hole was drilled, whatever corner its rim left.
   params.tabs.keep_on_bone = params.perforations.sound_rims = version >= 12;
+  // Before version 13, the fit to the bone used the margin asked, whatever gap it left.
+  params.fit_margin_search = version >= 13;
   s.implant_params = params;
   unacknowledge(s, 8, "the implant was built again");
   rebuild_implant(s);

@@ -84,7 +84,7 @@ TEST(Commands, EveryTypeRoundTripsThroughJson) {
 // read as recorded, built without the fit.
 TEST(Commands, BuildImplantVersionOneIsReadByItsOwnRules) {
   Json v1 = to_json(commands::build_implant());
-  EXPECT_EQ(v1["version"], 12);
+  EXPECT_EQ(v1["version"], 13);
   v1["version"] = 1;
   v1["params"]["params"].erase("trim");
   v1["params"]["params"].erase("fit_to_bone_mm");
@@ -131,7 +131,7 @@ TEST(Commands, OlderPlansReadTheSkullAndFitTheBoneAsTheyWereMade) {
   p.trim.min_feature_mm = 1.7;
   p.trim.bridge_mm = 0.8;
   const Json build = to_json(commands::build_implant(p));
-  EXPECT_EQ(build["version"], 12);
+  EXPECT_EQ(build["version"], 13);
   ImplantParams back;
   params_from_json(ParamReader(build["params"]["params"], "test"), back);
   EXPECT_EQ(back.trim.min_feature_mm, 1.7);
@@ -177,7 +177,7 @@ TEST(Commands, TheBuildRecordsItsMaterialAndClearanceZones) {
   p.perforations.added = {Eigen::Vector3d(4, 5, 6)};
   p.perforations.removed = {Eigen::Vector3d(7, 8, 9)};
   const Json build = to_json(commands::build_implant(p));
-  EXPECT_EQ(build["version"], 12);
+  EXPECT_EQ(build["version"], 13);
   const Json& recorded = build["params"]["params"];
   EXPECT_EQ(recorded["material"]["name"], "PMMA");
   EXPECT_TRUE(recorded["material"]["thickness_mm"].is_null()) << "follows the bone";
@@ -400,18 +400,21 @@ TEST(Commands, OlderBuildsMeshTheirTabsAndHolesAsTheyWereMade) {
 // mesh the fit as its field comes, as they were fitted; today's go on until the rim has crossed
 // the bone's surface and keep the field off the iso-level. Plans saved before build_implant 12
 // place their tabs once and drill every pattern hole; today's place a tab off the bone again
-// and leave out a hole whose rim would be too thin.
+// and leave out a hole whose rim would be too thin. Plans saved before build_implant 13 keep
+// the fit's margin as asked; today's try others where the edge stands off the bone.
 TEST(Commands, OlderBuildsTakeTheirRimsOutAsTheyWereMade) {
   const Session planned = Session::open(test::planned_defect_case().session_path);
   const Json today = to_json(commands::build_implant(ImplantParams{}));
-  EXPECT_EQ(today["version"], 12);
-  for (const auto& [version, reaches, keeps] :
-       {std::tuple{12, true, true}, std::tuple{11, true, false}, std::tuple{10, false, false}}) {
+  EXPECT_EQ(today["version"], 13);
+  for (const auto& [version, reaches, keeps, searches] :
+       {std::tuple{13, true, true, true}, std::tuple{12, true, true, false},
+        std::tuple{11, true, false, false}, std::tuple{10, false, false, false}}) {
     SCOPED_TRACE(version);
     Json json = today;
     json["version"] = version;
     const ApplyOutcome out = apply_command(planned.state(), command_from_json(json, "test"));
     ASSERT_TRUE(out.state.implant_params.has_value()) << out.message;
+    EXPECT_EQ(out.state.implant_params->fit_margin_search, searches);
     EXPECT_EQ(out.state.implant_params->fit_reaches_the_bone, reaches);
     EXPECT_EQ(out.state.implant_params->trim.iso_gap, reaches);
     EXPECT_EQ(out.state.implant_params->tabs.keep_on_bone, keeps);

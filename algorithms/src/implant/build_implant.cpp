@@ -21,6 +21,7 @@
 
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/thin_plate_spline.h"
+#include "cranioplan/algorithms/implant/rim_gap.h"
 #include "cranioplan/algorithms/implant/trim_to_bone.h"
 #include "cranioplan/algorithms/io/mesh_report.h"
 #include "cranioplan/model/error.h"
@@ -45,6 +46,10 @@ constexpr size_t kMaxClearanceZones = 100;
 constexpr double kOnlaySearchMm = 20.0;
 // Fitting to the bone seeks the bone to meet up to this many times the margin beyond the rim.
 constexpr double kFitReach = 3.0;
+// ImplantParams::fit_margin_search: the margins tried after the one asked, in this order, as
+// steps from it (mm), and the range they are kept in.
+constexpr double kFitMarginSteps[] = {1.0, -1.0, 2.0, -2.0};
+constexpr double kMinSearchedMarginMm = 1.0, kMaxSearchedMarginMm = 10.0;
 
 // The parametrisation of the defect's surfaces as height fields h(u, v).
 // Planar: (u, v) in the plane of the outer markers, h along its normal n.
@@ -838,6 +843,62 @@ std::string finishing_problem(const ImplantParams& params, const SkullMesh* skul
   return {};
 }
 
+// A margin in millimetres as the messages write it ("4", "4.5").
+std::string margin_text(double mm) {
+  char buf[32];
+  std::snprintf(buf, sizeof(buf), "%.1f", mm);
+  std::string t = buf;
+  if (t.size() > 2 && t.compare(t.size() - 2, 2, ".0") == 0) t.resize(t.size() - 2);
+  return t;
+}
+
+// The fit to the bone again from other margins, when the fitted implant's edge stands off the
+// bone by more than kRimGapTargetMm over an arc (ImplantParams::fit_margin_search). `fitted`
+// holds the fit from params.fit_to_bone_mm and receives the one kept; `r` (the shell's result)
+// takes the kept shell's figures and says which margin was used and why.
+void search_fit_margin(const std::vector<Marker>& markers, const SkullMesh& skull,
+                       const SurfaceLocator* skull_locator, const ImplantParams& params,
+                       ImplantResult& r, SkullMesh& fitted) {
+  std::unique_ptr<SurfaceLocator> own;
+  if (!skull_locator) own = std::make_unique<SurfaceLocator>(skull);
+  const SurfaceLocator& bone = skull_locator ? *skull_locator : *own;
+  // The gap as the quality report judges it: with a clearance asked, its excess over it.
+  const double clearance = params.material ? params.material->edge_clearance_mm : 0.0;
+  const bool asked = clearance > 0.0 || !params.clearance_zones.empty();
+  const RimGap first = rim_gap(fitted, bone, asked, clearance, params.clearance_zones);
+  if (first.mm <= kRimGapTargetMm) return;
+  const double asked_margin = params.fit_to_bone_mm;
+  for (const double step : kFitMarginSteps) {
+    const double margin = asked_margin + step;
+    if (margin < kMinSearchedMarginMm || margin > kMaxSearchedMarginMm) continue;
+    ImplantParams other = params;
+    other.fit_to_bone_mm = margin;
+    SkullMesh shell, trimmed;
+    ImplantResult s = build_shell(markers, &skull, &bone, other, &shell);
+    if (!s.usable()) continue;
+    const TrimToBoneResult t = trim_to_bone(shell, skull, other.trim, trimmed, &bone);
+    if (!t.usable()) continue;
+    const RimGap gap = rim_gap(trimmed, bone, asked, clearance, params.clearance_zones);
+    if (gap.mm > kRimGapTargetMm) continue;
+    fitted = trimmed;
+    r.thickness_used_mm = s.thickness_used_mm;
+    r.rim_marker_error_mm = s.rim_marker_error_mm;
+    r.rim_points = s.rim_points;
+    r.fit_to_bone_used_mm = margin;
+    const Eigen::Vector3d at = first.at.value_or(Eigen::Vector3d::Zero());
+    char why[240];
+    std::snprintf(why, sizeof(why),
+                  "; built %s mm over the bone instead of %s: at %s mm its edge stood %.2f mm "
+                  "%s at (%.1f, %.1f, %.1f) mm",
+                  margin_text(margin).c_str(), margin_text(asked_margin).c_str(),
+                  margin_text(asked_margin).c_str(), first.mm,
+                  asked ? "further off the bone than the clearance asked" : "off the bone", at.x(),
+                  at.y(), at.z());
+    r.message += why;
+    return;
+  }
+}
+
 }  // namespace
 
 ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh* skull,
@@ -890,6 +951,11 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
       r.stage_seconds.emplace_back("fit: " + stage, seconds);
     if (t.usable()) {
       current = &out;
+      r.fit_to_bone_used_mm = params.fit_to_bone_mm;
+      if (params.fit_margin_search && !(params.material && params.material->onlay_mm > 0.0)) {
+        search_fit_margin(used, *skull, skull_locator, params, r, out);
+        clock.mark("fit margins");
+      }
       r.watertight = is_watertight(out);
     } else {
       r.status = ImplantResult::Status::Failed;

@@ -1,14 +1,11 @@
 #include "cranioplan/algorithms/quality/check_implant.h"
 
-#include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <deque>
 #include <future>
 #include <memory>
-#include <tuple>
 #include <utility>
 
 #include "cranioplan/algorithms/geometry/distance_transform.h"
@@ -99,54 +96,6 @@ void measure_thin_material(const std::vector<uint8_t>& solid, const std::vector<
 
 }  // namespace
 
-double worst_arc_gap(const std::vector<double>& angle, const std::vector<double>& distance,
-                     double arc_rad, size_t* where) {
-  const size_t n = std::min(angle.size(), distance.size());
-  if (n == 0) return 0.0;
-  struct Point {
-    double angle;  // in [0, 2π)
-    double distance;
-    size_t index;  // in the caller's arrays
-    bool operator<(const Point& o) const {
-      return std::tie(angle, distance, index) < std::tie(o.angle, o.distance, o.index);
-    }
-  };
-  std::vector<Point> at(n);
-  for (size_t i = 0; i < n; ++i) {
-    const double a = std::fmod(angle[i], 2 * M_PI);
-    at[i] = {a < 0 ? a + 2 * M_PI : a, distance[i], i};
-  }
-  std::sort(at.begin(), at.end());
-  const double w = std::clamp(arc_rad, 0.0, 2 * M_PI);
-  auto angle_of = [&](size_t k) { return at[k % n].angle + (k >= n ? 2 * M_PI : 0.0); };
-  // An arc's points are a run of the sorted points; the arcs whose minimum can be the largest
-  // hold the smallest runs: an arc that begins just past point j, (a_j, a_j + w], and, where
-  // the next point lies more than w further on, that point alone. Their minima by a sliding
-  // window (a deque of increasing distances) over the points taken twice around.
-  double worst = 0.0;
-  size_t worst_at = at[0].index;
-  auto consider = [&](size_t k) {
-    if (at[k % n].distance > worst) {
-      worst = at[k % n].distance;
-      worst_at = at[k % n].index;
-    }
-  };
-  std::deque<size_t> window;
-  size_t next = 1;  // the first point not yet in the window
-  for (size_t j = 0; j < n; ++j) {
-    while (!window.empty() && window.front() <= j) window.pop_front();
-    if (next <= j) next = j + 1;
-    while (next < j + n && angle_of(next) <= angle_of(j) + w) {
-      while (!window.empty() && at[window.back() % n].distance >= at[next % n].distance)
-        window.pop_back();
-      window.push_back(next++);
-    }
-    consider(window.empty() ? j + 1 : window.front());  // else the next point, alone
-  }
-  if (where) *where = worst_at;
-  return worst;
-}
-
 std::optional<Eigen::Vector3d> rim_gap_to_mark(const QualityReport& report) {
   if (!report.clearance_asked && report.rim_gap_mm > kRimGapTargetMm) return report.rim_gap_at;
   if (report.clearance_asked && report.clearance_high_mm > kRimGapTargetMm)
@@ -171,7 +120,7 @@ std::vector<double> thickness_samples(const SkullMesh& implant, const SurfaceLoc
     Eigen::Vector3d n = f.cross();
     if (n.norm() == 0) continue;
     n.normalize();
-    if (std::abs(n.dot(axis)) >= std::cos(M_PI / 4)) {
+    if (across_plate(n, axis)) {
       if (!measure) continue;
       // Where the plate curves, a normal can leave it at a grazing angle and run along it (on
       // the sample's frontal implant up to 27 mm through a plate 8 mm at its thickest): the
@@ -249,50 +198,30 @@ std::vector<float> measure_against_bone(const SkullMesh& implant, const SkullMes
                                         const Eigen::Vector3d& axis, std::vector<int> wall_vertices,
                                         const std::vector<uint8_t>& solid, const VoxelGrid& grid,
                                         const QualityParams& params, QualityReport& q) {
-  std::sort(wall_vertices.begin(), wall_vertices.end());
-  wall_vertices.erase(std::unique(wall_vertices.begin(), wall_vertices.end()), wall_vertices.end());
-  const Eigen::Vector3d e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
-  const size_t walls = wall_vertices.size();
-  std::vector<double> angle(walls), distance(walls);
-  std::vector<Eigen::Vector3d> nearest(walls);  // the bone point each wall vertex faces
-  parallel_for(
-      walls,
-      [&](size_t first, size_t last) {
-        for (size_t i = first; i < last; ++i) {
-          const Eigen::Vector3d p =
-              to_eigen(implant.point(SkullMesh::VertexHandle(wall_vertices[i])));
-          angle[i] = std::atan2((p - c).dot(e2), (p - c).dot(e1));
-          const auto near = bone.closest(p);
-          distance[i] = near.distance;
-          nearest[i] = near.point;
-        }
-      },
-      256);
+  const RimSamples s = rim_samples(implant, bone, c, axis, std::move(wall_vertices));
   size_t gap_at = 0;
-  q.rim_gap_mm = worst_arc_gap(angle, distance, M_PI / 36, &gap_at);
-  if (walls > 0) {
-    q.rim_gap_at = to_eigen(implant.point(SkullMesh::VertexHandle(wall_vertices[gap_at])));
-    q.rim_gap_bone = nearest[gap_at];
+  q.rim_gap_mm = worst_arc_gap(s.angle, s.distance, kRimArcRad, &gap_at);
+  if (!s.vertices.empty()) {
+    q.rim_gap_at = to_eigen(implant.point(SkullMesh::VertexHandle(s.vertices[gap_at])));
+    q.rim_gap_bone = s.nearest[gap_at];
   }
   if (params.edge_clearance_mm > 0.0 || !params.clearance_zones.empty()) {
     // The excess of each wall vertex's gap over the clearance asked at the bone it faces: the
-    // worst arc's (its nearest vertex to the bone) and the smallest of all.
-    std::vector<double> excess(distance.size());
-    // The edge a tab bridges (with 1 mm to spare on each side) is as asked: the tab holds it.
-    for (size_t i = 0; i < distance.size(); ++i) {
-      const Eigen::Vector3d p = to_eigen(implant.point(SkullMesh::VertexHandle(wall_vertices[i])));
-      const bool bridged = std::any_of(params.tabs.begin(), params.tabs.end(),
-                                       [&](const Tab& t) { return under_tab(t, p); });
-      excess[i] = bridged ? 0.0
-                          : distance[i] - clearance_at(nearest[i], params.edge_clearance_mm,
-                                                       params.clearance_zones);
+    // worst arc's (its nearest vertex to the bone) and the smallest of all. The edge a tab
+    // bridges (with 1 mm to spare on each side) is as asked: the tab holds it.
+    std::vector<bool> bridged(s.vertices.size());
+    for (size_t i = 0; i < bridged.size(); ++i) {
+      const Eigen::Vector3d p = to_eigen(implant.point(SkullMesh::VertexHandle(s.vertices[i])));
+      bridged[i] = std::any_of(params.tabs.begin(), params.tabs.end(),
+                               [&](const Tab& t) { return under_tab(t, p); });
     }
+    const std::vector<double> excess =
+        clearance_excess(s, params.edge_clearance_mm, params.clearance_zones, bridged);
     q.clearance_asked = true;
     size_t high_at = 0;
-    q.clearance_high_mm = worst_arc_gap(angle, excess, M_PI / 36, &high_at);
-    if (walls > 0)
-      q.clearance_high_at =
-          to_eigen(implant.point(SkullMesh::VertexHandle(wall_vertices[high_at])));
+    q.clearance_high_mm = worst_arc_gap(s.angle, excess, kRimArcRad, &high_at);
+    if (!s.vertices.empty())
+      q.clearance_high_at = to_eigen(implant.point(SkullMesh::VertexHandle(s.vertices[high_at])));
     q.clearance_low_mm = excess.empty() ? 0.0 : *std::min_element(excess.begin(), excess.end());
   }
   const std::vector<uint8_t> b = voxelize_mesh(skull, grid);
@@ -418,13 +347,7 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
 
   // Principal axes of the implant's vertices: the thinnest one is across the plate.
   const Eigen::Vector3d c = vertex_centroid(implant);
-  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
-  for (auto vh : implant.vertices()) {
-    const Eigen::Vector3d d = to_eigen(implant.point(vh)) - c;
-    cov += d * d.transpose();
-  }
-  const Eigen::Vector3d axis =
-      Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
+  const Eigen::Vector3d axis = plate_axis(implant, c);
 
   // The implant as a solid on a grid: its depth bounds the thickness, and it gives the thin
   // material and, with a skull, the overlap.

@@ -216,7 +216,9 @@ TEST(BuildImplant, ItsStagesCarryTheFitsStages) {
   EXPECT_EQ(r.stage_seconds[0].first, "shell");
   EXPECT_EQ(r.stage_seconds[1].first, "fit");
   EXPECT_EQ(r.stage_seconds[2].first, "fit: voxels");
-  EXPECT_EQ(r.stage_seconds.back().first, "fit: meshing");
+  // The fit's parts, then the check of its edge against the bone (fit_margin_search).
+  EXPECT_EQ(r.stage_seconds[r.stage_seconds.size() - 2].first, "fit: meshing");
+  EXPECT_EQ(r.stage_seconds.back().first, "fit margins");
   double whole = 0.0, parts = 0.0;
   for (const auto& [stage, seconds] : r.stage_seconds) {
     EXPECT_GE(seconds, 0.0) << stage;

@@ -46,6 +46,15 @@ struct ImplantParams {
   /// surface, up to six times fit_to_bone_mm; false: it stays where the bone was first found
   /// (build_implant commands before version 11).
   bool fit_reaches_the_bone = true;
+  /// Fit to the bone: when the fitted implant's edge stands off the bone by more than
+  /// kRimGapTargetMm over an arc (rim_gap.h; with a clearance asked, further than it), the
+  /// shell is built again 1 mm further over the bone, 1 mm less, 2 mm further, 2 mm less (1 to
+  /// 10 mm), and the first fit whose edge meets the bone within that is kept; none: the one
+  /// asked. The trim's voxels are coarse against ragged thin bone (an orbital roof, a sinus
+  /// wall), where whether the rim's last piece of shell reaches a fragment or stops a
+  /// millimetre short of it turns on the margin. false: the margin asked only (build_implant
+  /// commands before version 13).
+  bool fit_margin_search = true;
   TrimToBoneParams trim;  ///< how the shell is fitted to the bone (when fit_to_bone_mm > 0)
   /// What the implant is made of (none: the plan's surfaces as they are). A thickness of the
   /// material's replaces the inner surface (inner markers are not used); its under-contour sets
@@ -79,8 +88,11 @@ struct ImplantResult {
   double thickness_used_mm = 0.0;    ///< shell without inner markers: the offset applied
   double rim_marker_error_mm = 0.0;  ///< largest distance from an edge marker to its rim
   int rim_points = 0;                ///< samples along each rim
-  std::vector<Hole> holes;           ///< the perforations drilled
-  std::vector<Tab> tabs;             ///< the fixation tabs added
+  /// The margin the implant was fitted to the bone with (ImplantParams::fit_margin_search), mm;
+  /// 0 when not fitted.
+  double fit_to_bone_used_mm = 0.0;
+  std::vector<Hole> holes;  ///< the perforations drilled
+  std::vector<Tab> tabs;    ///< the fixation tabs added
   double seconds = 0.0;
   /// Where the time went, in the order it ran, s: "shell", "fit" (the whole fit to the bone)
   /// followed by its parts ("fit: opening", ...: TrimToBoneResult::stage_seconds), "tabs",

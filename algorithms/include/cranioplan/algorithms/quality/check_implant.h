@@ -6,6 +6,7 @@
 
 #include "cranioplan/algorithms/implant/fixation_tabs.h"
 #include "cranioplan/algorithms/implant/perforate.h"
+#include "cranioplan/algorithms/implant/rim_gap.h"
 #include "cranioplan/model/material.h"
 #include "cranioplan/model/mesh.h"
 
@@ -58,10 +59,6 @@ struct ImplantResult;
 /// it drilled and the tabs it added with their limits.
 QualityParams quality_params_for(const ImplantParams& params, const ImplantResult& result);
 
-/// The rim gap automatic plans aim for (mm): a larger one is shown and located (the wizard's
-/// view, the report's row); over QualityParams::max_rim_gap_mm the implant is not printable.
-inline constexpr double kRimGapTargetMm = 0.5;
-
 struct QualityReport {
   bool watertight = false;
   bool manifold = false;
@@ -99,16 +96,6 @@ struct QualityReport {
   bool printable = false;
   std::vector<std::string> reasons;  ///< why not printable, one sentence each
 };
-
-/// The rim gap over arcs of the rim: for every arc `arc_rad` wide around the circle (sliding,
-/// not fixed sectors), the smallest of `distance[i]` over the points `angle[i]` (radians, any
-/// range) inside it; the largest over the arcs that hold a point. 0 without points. It is the
-/// same for the points turned by any angle: fixed sectors would start at the mesh's first wall
-/// vertex, so the same implant would give other gaps with its vertices listed in another order,
-/// and a gap straddling two sectors could hide in both. `where`, when given, receives the index
-/// of the point whose distance is the result (the worst arc's nearest point).
-double worst_arc_gap(const std::vector<double>& angle, const std::vector<double>& distance,
-                     double arc_rad, size_t* where = nullptr);
 
 /// Checks an implant, optionally against the (defective) skull it is made for.
 ///
