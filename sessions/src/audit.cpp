@@ -559,8 +559,13 @@ std::string design_report_html(const Session& session, const std::vector<ReportI
     row("Mass", fixed(q.volume_mm3 * 1e-3 * st.implant_params->material->density_g_cm3, 1) + " g");
   }
   row("Triangles", std::to_string(mesh.n_faces()));
-  h += "</table><h2>Quality</h2>" + quality_report_html(q);
   const ImplantResult& built = implant.result();
+  if (built.fit_to_bone_used_mm > 0.0)
+    row("Fitted to the bone",
+        fixed(built.fit_to_bone_used_mm, 1) + " mm over it" +
+            (built.fit_margin_note.empty() ? std::string()
+                                           : " (" + html_escape(built.fit_margin_note) + ")"));
+  h += "</table><h2>Quality</h2>" + quality_report_html(q);
   if (!built.holes.empty()) {
     h += "<h2>Perforations</h2><table><tr><th>#</th><th>Centre (mm)</th><th>Axis</th>"
          "<th>Placed</th></tr>";

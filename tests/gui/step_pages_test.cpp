@@ -205,6 +205,37 @@ TEST(StepPages, BuildPushesTheParametersTheControlsShow) {
   EXPECT_DOUBLE_EQ(p.at("fit_to_bone_mm").get<double>(), 4.0);
 }
 
+// An implant fitted from another margin than the one asked: the field keeps the margin asked,
+// the panel says which one was used and why.
+TEST(StepPages, AFitFromAnotherMarginIsSaid) {
+  RecordingHost host;
+  BuildPage page(host);
+  ImplantParams asked;
+  asked.fit_to_bone_mm = 4.0;
+  host.state.implant_params = asked;
+  ImplantResult built;
+  built.status = ImplantResult::Status::Built;
+  built.fit_to_bone_used_mm = 5.0;
+  built.fit_margin_note =
+      "built 5 mm over the bone instead of 4: at 4 mm its edge stood 1.07 mm off the bone at "
+      "(100.0, 52.7, 80.5) mm";
+  host.state.implant = std::make_shared<const ImplantData>(built, nullptr);
+  page.show_state(host.state);
+  EXPECT_DOUBLE_EQ(child<QDoubleSpinBox>(page, "implantFit")->value(), 4.0);
+  QLabel* note = child<QLabel>(page, "fitNote");
+  ASSERT_TRUE(note);
+  EXPECT_FALSE(note->isHidden());
+  EXPECT_EQ(note->text().toStdString(),
+            "Built 5 mm over the bone instead of 4: at 4 mm its edge stood 1.07 mm off the bone "
+            "at (100.0, 52.7, 80.5) mm.");
+  // Fitted as asked: nothing said.
+  built.fit_to_bone_used_mm = 4.0;
+  built.fit_margin_note.clear();
+  host.state.implant = std::make_shared<const ImplantData>(built, nullptr);
+  page.show_state(host.state);
+  EXPECT_TRUE(note->isHidden());
+}
+
 // A material chosen fills its values and is built with them (the fit to the bone turned on for
 // its clearance); with "mark a wider clearance" on, a click on the rim adds a clearance zone
 // and builds again; the zone is removed the same way. A plan built with a material shows it.

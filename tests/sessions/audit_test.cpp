@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
 #include <filesystem>
 
 #include "cranioplan/algorithms/io/file_io.h"
@@ -155,6 +156,13 @@ TEST(DesignReport, NamesTheImplantItsProvenanceAndItsSignOff) {
         s.state().implant->stl_sha256(), s.journal().back().hash,
         s.effective_commands().front().params["sha256"].get<std::string>()})
     EXPECT_NE(html.find(want), std::string::npos) << want;
+  // The margin the implant was fitted to the bone with (the planned case's is fitted).
+  const ImplantResult& built = s.state().implant->result();
+  ASSERT_GT(built.fit_to_bone_used_mm, 0.0);
+  char fitted[96];
+  std::snprintf(fitted, sizeof(fitted), "Fitted to the bone</th><td>%.1f mm over it",
+                built.fit_to_bone_used_mm);
+  EXPECT_NE(html.find(fitted), std::string::npos) << fitted;
   push_ok(s, commands::approve("Dr <B>", "neurosurgeon"));
   html = design_report_html(s, {}, "9.9.9");
   EXPECT_NE(html.find("Approved</b> by Dr &lt;B&gt; (neurosurgeon)"), std::string::npos);

@@ -888,13 +888,14 @@ void search_fit_margin(const std::vector<Marker>& markers, const SkullMesh& skul
     const Eigen::Vector3d at = first.at.value_or(Eigen::Vector3d::Zero());
     char why[240];
     std::snprintf(why, sizeof(why),
-                  "; built %s mm over the bone instead of %s: at %s mm its edge stood %.2f mm "
+                  "built %s mm over the bone instead of %s: at %s mm its edge stood %.2f mm "
                   "%s at (%.1f, %.1f, %.1f) mm",
                   margin_text(margin).c_str(), margin_text(asked_margin).c_str(),
                   margin_text(asked_margin).c_str(), first.mm,
                   asked ? "further off the bone than the clearance asked" : "off the bone", at.x(),
                   at.y(), at.z());
-    r.message += why;
+    r.fit_margin_note = why;
+    r.message += "; " + r.fit_margin_note;
     return;
   }
 }

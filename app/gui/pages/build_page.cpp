@@ -40,6 +40,11 @@ BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
   form_->addRow(tr("Resolution"), resolution_);
   form_->addRow(tr("Thickness without inner markers"), thickness_);
   form_->addRow(tr("Fit to the bone"), fit_);
+  fit_note_ = new QLabel(this);
+  fit_note_->setObjectName("fitNote");
+  fit_note_->setWordWrap(true);
+  fit_note_->hide();
+  form_->addRow(fit_note_);
 
   // The material: a preset fills its values, which may then be changed.
   material_ = new QComboBox(this);
@@ -418,6 +423,14 @@ void BuildPage::show_state(const PlanState& s) {
     tab_positions_ = p.tabs.positions;
   }
   remove_zone_->setEnabled(!zones_.empty());
+  // The margin field shows the one asked; under it, which one the build used and why.
+  const bool other_margin = s.implant && !s.implant->result().fit_margin_note.empty();
+  if (other_margin) {
+    QString note = QString::fromStdString(s.implant->result().fit_margin_note);
+    note[0] = note[0].toUpper();
+    fit_note_->setText(note + ".");
+  }
+  fit_note_->setVisible(other_margin);
   QString text =
       s.implant ? tr("Implant: %1 triangles, %2")
                       .arg(s.implant->result().mesh.n_faces())

@@ -144,6 +144,7 @@ class BuildPage : public StepPage {
   QDoubleSpinBox* resolution_;
   QDoubleSpinBox* thickness_;
   QDoubleSpinBox* fit_;
+  QLabel* fit_note_;  ///< the margin the implant was fitted with, when not the one asked
   QComboBox* material_;
   QDoubleSpinBox *clearance_, *under_contour_, *min_thickness_, *plate_, *density_;
   QPushButton* mark_zone_;

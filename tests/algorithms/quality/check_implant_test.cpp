@@ -4,6 +4,7 @@
 
 #include <cstdio>
 
+#include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
 #include "support/synthetic.h"
@@ -225,17 +226,22 @@ TEST(CheckImplant, TheRimGapToMarkIsOverTheTargetOrBeyondTheClearance) {
   EXPECT_EQ(*rim_gap_to_mark(asked), Eigen::Vector3d(4, 5, 6));
 }
 
-// A clearance asked and not kept, on a constructed case: bone plates with a 10 mm gap, an
-// implant 0.3 mm off the left cut face and 2.5 mm off the right. Asked 1 mm, the left edge
-// would not go in and the right leaves a gap 1.5 mm too wide: not printable, for both reasons.
-// Asked nothing, only the 2.5 mm gap is judged, as before. Its mass is volume × density.
-TEST(CheckImplant, AClearanceAskedButNotKeptIsNotPrintable) {
+// Two 20 × 20 × 5 mm plates of bone, 10 mm apart along x (cut faces at x = 20 and 30).
+SkullMesh two_plates() {
   TriangleSoup plates = test::box_soup({0, 0, 0}, {20, 20, 5});
   const TriangleSoup right = test::box_soup({30, 0, 0}, {50, 20, 5});
   const int n = static_cast<int>(plates.vertices.size());
   plates.vertices.insert(plates.vertices.end(), right.vertices.begin(), right.vertices.end());
   for (auto t : right.triangles) plates.triangles.push_back({t[0] + n, t[1] + n, t[2] + n});
-  const SkullMesh bone = build_mesh(plates);
+  return build_mesh(plates);
+}
+
+// A clearance asked and not kept, on a constructed case: bone plates with a 10 mm gap, an
+// implant 0.3 mm off the left cut face and 2.5 mm off the right. Asked 1 mm, the left edge
+// would not go in and the right leaves a gap 1.5 mm too wide: not printable, for both reasons.
+// Asked nothing, only the 2.5 mm gap is judged, as before. Its mass is volume × density.
+TEST(CheckImplant, AClearanceAskedButNotKeptIsNotPrintable) {
+  const SkullMesh bone = two_plates();
   const SkullMesh implant = box({20.3, 0, 0}, {27.5, 20, 5});
   QualityParams asked;
   asked.edge_clearance_mm = 1.0;
@@ -274,6 +280,31 @@ TEST(CheckImplant, AClearanceAskedButNotKeptIsNotPrintable) {
   EXPECT_LE(zoned.clearance_high_mm, 0.2);
   EXPECT_FALSE(has_reason(zoned, "wider than the clearance asked"));
   EXPECT_TRUE(has_reason(zoned, "nearer the bone than the clearance asked"));
+}
+
+// The fit to the bone judges its edge with rim_gap (fit_margin_search), the report with its
+// own pass over the same side wall: the two agree, gap and place, with and without a clearance
+// (the implant 2.5 mm from the right plate's cut face, 0.3 mm from the left one's).
+TEST(CheckImplant, TheFitMeasuresItsEdgeAsTheReportDoes) {
+  const SkullMesh bone = two_plates();
+  const SurfaceLocator locator(bone);
+  const SkullMesh implant = box({20.3, 0, 0}, {27.5, 20, 5});
+  const QualityReport plain = check_implant(implant, &bone);
+  const RimGap gap = rim_gap(implant, locator, false, 0.0, {});
+  EXPECT_NEAR(gap.mm, 2.5, 0.05);
+  EXPECT_DOUBLE_EQ(gap.mm, plain.rim_gap_mm);
+  ASSERT_TRUE(gap.at && plain.rim_gap_at);
+  EXPECT_EQ(*gap.at, *plain.rim_gap_at);
+  QualityParams asked;
+  asked.edge_clearance_mm = 1.0;
+  const QualityReport q = check_implant(implant, &bone, asked);
+  const RimGap excess = rim_gap(implant, locator, true, 1.0, {});
+  EXPECT_NEAR(excess.mm, 1.5, 0.05) << "2.5 mm where 1 mm was asked";
+  EXPECT_DOUBLE_EQ(excess.mm, q.clearance_high_mm);
+  ASSERT_TRUE(excess.at && q.clearance_high_at);
+  EXPECT_EQ(*excess.at, *q.clearance_high_at);
+  // No side wall, no gap.
+  EXPECT_EQ(rim_gap(SkullMesh{}, locator, false, 0.0, {}).mm, 0.0);
 }
 
 }  // namespace

@@ -91,6 +91,10 @@ struct ImplantResult {
   /// The margin the implant was fitted to the bone with (ImplantParams::fit_margin_search), mm;
   /// 0 when not fitted.
   double fit_to_bone_used_mm = 0.0;
+  /// Why another margin than the one asked was used ("built 5 mm over the bone instead of 4: at
+  /// 4 mm its edge stood 1.07 mm off the bone at (x, y, z) mm"), also in `message`; empty when
+  /// the margin asked was used.
+  std::string fit_margin_note;
   std::vector<Hole> holes;  ///< the perforations drilled
   std::vector<Tab> tabs;    ///< the fixation tabs added
   double seconds = 0.0;
