@@ -15,6 +15,11 @@ binary STLs:
                 segmentation smoothed before export)
   cluster250    open, re-meshed by vertex clustering on a 250^3 grid (holes, non-manifold
                 edges and folded triangles, as clustering decimation leaves them)
+  slicer05      as 3D Slicer's Segment Editor makes a model of a segment: the mask as a binary
+                labelmap padded by a voxel (closed), discrete flying edges, a windowed-sinc
+                smoothing of 20 iterations with pass band 10^(-4 x factor), factor 0.5 (its
+                default)
+  slicer10      the same with smoothing factor 1 (the strongest of the common settings)
 Needs Debian's python3-vtk9 (scripts/skullfix-exports installs it).
 """
 import gzip
@@ -121,6 +126,40 @@ def main():
     triangles.SetInputData(cluster.GetOutput())
     triangles.Update()
     write(triangles.GetOutput(), "cluster250")
+    # 3D Slicer's closed surface of a segment: the labelmap padded so that the surface closes
+    # (the padded image keeps index coordinates: its extent starts at -1), its boundary by
+    # discrete flying edges, smoothed as Slicer's "Smoothing factor" does.
+    label = vtk.vtkImageThreshold()
+    label.SetInputData(image)
+    label.ThresholdByUpper(0.5)
+    label.SetInValue(1)
+    label.SetOutValue(0)
+    label.SetOutputScalarTypeToUnsignedChar()
+    label.Update()
+    extent = label.GetOutput().GetExtent()
+    pad = vtk.vtkImageConstantPad()
+    pad.SetInputData(label.GetOutput())
+    pad.SetOutputWholeExtent(extent[0] - 1, extent[1] + 1, extent[2] - 1, extent[3] + 1,
+                             extent[4] - 1, extent[5] + 1)
+    pad.SetConstant(0)
+    pad.Update()
+    boundary = vtk.vtkDiscreteFlyingEdges3D()
+    boundary.SetInputData(pad.GetOutput())
+    boundary.SetValue(0, 1)
+    boundary.ComputeNormalsOff()
+    boundary.ComputeGradientsOff()
+    boundary.Update()
+    for factor, variant in ((0.5, "slicer05"), (1.0, "slicer10")):
+        slicer = vtk.vtkWindowedSincPolyDataFilter()
+        slicer.SetInputData(boundary.GetOutput())
+        slicer.SetNumberOfIterations(20)
+        slicer.SetPassBand(10.0 ** (-4.0 * factor))
+        slicer.NormalizeCoordinatesOn()
+        slicer.BoundarySmoothingOff()
+        slicer.FeatureEdgeSmoothingOff()
+        slicer.NonManifoldSmoothingOn()
+        slicer.Update()
+        write(slicer.GetOutput(), variant)
 
 
 if __name__ == "__main__":
