@@ -454,9 +454,7 @@ std::string quality_report_html(const QualityReport& r, const SoftTissueCheck* t
   // Where the edge stands off the bone more than automatic plans aim for, on the row that
   // judges it.
   const std::optional<Eigen::Vector3d> mark = rim_gap_to_mark(r);
-  const std::string where = mark ? " at (" + fixed(mark->x(), 1) + ", " + fixed(mark->y(), 1) +
-                                       ", " + fixed(mark->z(), 1) + ") mm"
-                                 : std::string();
+  const std::string where = mark ? at_point_text(*mark) : std::string();
   if (r.rim_gap_mm >= 0)
     row("Gap to bone (rim)",
         fixed(r.rim_gap_mm, 2) + " mm" + (r.clearance_asked ? std::string() : where));

@@ -802,7 +802,8 @@ TEST(WizardThickness, TheThicknessMapColoursTheImplantAndTheBoneAroundIt) {
 
 // Where the implant's edge stands off the bone: a ball where rim_gap_to_mark says (the rule:
 // CheckImplant.TheRimGapToMarkIsOverTheTargetOrBeyondTheClearance), drawn over the scene; none on
-// a plan whose edge meets the bone.
+// a plan whose edge meets the bone, put there by the window once a rebuilt implant's edge
+// stands off it.
 TEST(WizardRimGap, TheWorstRimArcIsMarkedWhereTheReportSaysItIs) {
   MainWindow w;
   open_planned_with_report(w);
@@ -821,6 +822,27 @@ TEST(WizardRimGap, TheWorstRimArcIsMarkedWhereTheReportSaysItIs) {
   EXPECT_GT(marked(), before + 30) << "drawn over the bone and the mirror";
   w.view().set_rim_gap(std::nullopt);
   EXPECT_FALSE(w.view().rim_gap_shown());
+  // Built again without the fit to the bone (rims through the edge markers), with the edge
+  // markers drawn 3 mm into the opening, the edge stands off the bone: once its report is in,
+  // the window puts the ball there of itself.
+  ImplantParams unfitted = *w.plan().implant_params;
+  unfitted.fit_to_bone_mm = 0.0;
+  ASSERT_TRUE(w.controller().push(commands::build_implant(unfitted)));
+  Eigen::Vector3d centre = Eigen::Vector3d::Zero();
+  std::vector<Marker> edge;
+  for (const Marker& m : w.plan().markers)
+    if (is_edge(m.type)) edge.push_back(m);
+  ASSERT_FALSE(edge.empty());
+  for (const Marker& m : edge) centre += m.position / static_cast<double>(edge.size());
+  for (const Marker& m : edge)
+    ASSERT_TRUE(w.controller().push(
+        commands::move_marker(m.id, m.position + 3.0 * (centre - m.position).normalized())));
+  w.controller().wait();
+  w.wait_quality();
+  const QualityReport& off = w.plan().implant->quality();
+  ASSERT_GT(off.rim_gap_mm, kRimGapTargetMm);
+  EXPECT_TRUE(w.view().rim_gap_shown());
+  EXPECT_GT(marked(), before + 30);
 }
 
 // A window showing the planned sample case at `step`, for the tests that edit its implant.

@@ -885,16 +885,13 @@ void search_fit_margin(const std::vector<Marker>& markers, const SkullMesh& skul
     r.rim_marker_error_mm = s.rim_marker_error_mm;
     r.rim_points = s.rim_points;
     r.fit_to_bone_used_mm = margin;
-    const Eigen::Vector3d at = first.at.value_or(Eigen::Vector3d::Zero());
-    char why[240];
+    char why[200];
     std::snprintf(why, sizeof(why),
-                  "built %s mm over the bone instead of %s: at %s mm its edge stood %.2f mm "
-                  "%s at (%.1f, %.1f, %.1f) mm",
+                  "built %s mm over the bone instead of %s: at %s mm its edge stood %.2f mm %s",
                   margin_text(margin).c_str(), margin_text(asked_margin).c_str(),
                   margin_text(asked_margin).c_str(), first.mm,
-                  asked ? "further off the bone than the clearance asked" : "off the bone", at.x(),
-                  at.y(), at.z());
-    r.fit_margin_note = why;
+                  asked ? "further off the bone than the clearance asked" : "off the bone");
+    r.fit_margin_note = why + (first.at ? at_point_text(*first.at) : std::string());
     r.message += "; " + r.fit_margin_note;
     return;
   }

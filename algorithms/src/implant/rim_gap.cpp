@@ -3,6 +3,7 @@
 #include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <deque>
 #include <tuple>
 
@@ -10,6 +11,12 @@
 #include "cranioplan/model/parallel.h"
 
 namespace cranioplan {
+
+std::string at_point_text(const Eigen::Vector3d& p) {
+  char buf[96];
+  std::snprintf(buf, sizeof(buf), " at (%.1f, %.1f, %.1f) mm", p.x(), p.y(), p.z());
+  return buf;
+}
 
 double worst_arc_gap(const std::vector<double>& angle, const std::vector<double>& distance,
                      double arc_rad, size_t* where) {

@@ -31,13 +31,6 @@ std::string fmt1(const char* f, double a) {
   return buf;
 }
 
-// " at (x, y, z) mm": where on the implant a reason applies.
-std::string at_point(const Eigen::Vector3d& p) {
-  char buf[96];
-  std::snprintf(buf, sizeof(buf), " at (%.1f, %.1f, %.1f) mm", p.x(), p.y(), p.z());
-  return buf;
-}
-
 // A measure over its limit, to a tenth of a millimetre, or finer where a tenth would read as
 // the limit itself ("for 2.0 mm; may be 2.0 mm").
 std::string over_limit(double value, double limit) {
@@ -266,12 +259,13 @@ void add_reasons(const MeshReport& rep, const QualityParams& params, bool with_b
   if (!q.clearance_asked && q.rim_gap_mm > params.max_rim_gap_mm)
     q.reasons.push_back(fmt("gap of %.2f mm between the rim and the bone (limit %.2f mm)",
                             q.rim_gap_mm, params.max_rim_gap_mm) +
-                        (q.rim_gap_at ? at_point(*q.rim_gap_at) : std::string()));
+                        (q.rim_gap_at ? at_point_text(*q.rim_gap_at) : std::string()));
   if (q.clearance_asked && q.clearance_high_mm > params.max_rim_gap_mm)
-    q.reasons.push_back(fmt("a gap %.2f mm wider than the clearance asked between the rim and "
-                            "the bone (limit %.2f mm)",
-                            q.clearance_high_mm, params.max_rim_gap_mm) +
-                        (q.clearance_high_at ? at_point(*q.clearance_high_at) : std::string()));
+    q.reasons.push_back(
+        fmt("a gap %.2f mm wider than the clearance asked between the rim and "
+            "the bone (limit %.2f mm)",
+            q.clearance_high_mm, params.max_rim_gap_mm) +
+        (q.clearance_high_at ? at_point_text(*q.clearance_high_at) : std::string()));
   if (q.clearance_asked && q.clearance_low_mm < -params.clearance_tolerance_mm)
     q.reasons.push_back(
         fmt("the edge comes %.2f mm nearer the bone than the clearance asked "

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <cstddef>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "cranioplan/model/material.h"
@@ -22,6 +23,10 @@ inline constexpr double kRimGapTargetMm = 0.5;
 
 /// The arcs the rim gap is judged over (radians): 5°.
 inline constexpr double kRimArcRad = 3.14159265358979323846 / 36.0;
+
+/// Where on the implant a gap is, as the messages and reports write it: " at (x, y, z) mm" to a
+/// tenth of a millimetre (the quality report's reasons and row, the fit's margin note).
+std::string at_point_text(const Eigen::Vector3d& p);
 
 /// The rim gap over arcs of the rim: for every arc `arc_rad` wide around the circle (sliding,
 /// not fixed sectors), the smallest of `distance[i]` over the points `angle[i]` (radians, any
