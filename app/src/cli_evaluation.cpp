@@ -7,13 +7,17 @@
 #include <iostream>
 #include <map>
 #include <memory>
+#include <optional>
 
 #include "cli_output.h"
 #include "cli_planning.h"
+#include "cranioplan/algorithms/alignment/mirror_mesh.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
+#include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/load_skull.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/algorithms/quality/compare_implants.h"
+#include "cranioplan/algorithms/quality/flap_defect.h"
 #include "cranioplan/algorithms/quality/inject_defect.h"
 #include "cranioplan/model/error.h"
 
@@ -62,6 +66,11 @@ void make_rows_folder(const std::string& folder) {
   std::error_code ec;
   fs::create_directories(folder, ec);
   if (!fs::is_directory(folder)) throw InputError(folder, "cannot be made a folder (--rows-out)");
+}
+
+// FOLDER/K_<what>.stl for `study --cases-out`.
+std::string case_file(const std::string& folder, int k, const char* what) {
+  return (fs::path(folder) / (std::to_string(k) + "_" + what + ".stl")).string();
 }
 
 // A scored plan's row (evaluate, study): the method it used and its agreement with the truth.
@@ -128,21 +137,26 @@ Json evaluate_summary(const Json& rows) {
 }
 
 Json study_summary(const Json& rows) {
-  std::vector<double> dsc, hd95;
+  std::vector<double> dsc, bdsc, hd95, secs;
   int printable = 0;
   for (const Json& row : rows) {
     if (row.contains("dice")) {
       dsc.push_back(row.at("dice"));
+      bdsc.push_back(row.at("boundary_dice"));
       hd95.push_back(row.at("hd95_mm"));
       printable += row.at("printable").get<bool>();
     } else {
       dsc.push_back(0.0);
+      bdsc.push_back(0.0);
     }
+    if (row.contains("seconds")) secs.push_back(row.at("seconds"));
   }
   return Json{{"defects", rows.size()},
               {"printable", printable},
               {"median_dice", median(dsc)},
-              {"median_hd95_mm", median(hd95)}};
+              {"median_boundary_dice", median(bdsc)},
+              {"median_hd95_mm", median(hd95)},
+              {"median_seconds", median_or_null(secs)}};
 }
 
 // Every case is in the table; the exit code says whether all of them were planned.
@@ -260,70 +274,234 @@ Subcommand add_evaluate(CLI::App& app, const bool& json) {
                     }};
 }
 
+// The sphere defects of `study`: directions on the upper vault, alternately left and right,
+// spread by the golden angle; each defect's centre in the middle of the bone along that ray
+// from the vertex centroid, its diameter between the sizes asked.
+std::optional<InjectDefectParams> sphere_defect(const SkullMesh& skull, const SurfaceLocator& bone,
+                                                int k, double min_size, double max_size) {
+  const Eigen::Vector3d centroid = vertex_centroid(skull);
+  const double side = k % 2 == 0 ? 1.0 : -1.0;
+  const double phi = 2.39996 * k, up = 0.25 + 0.5 * std::fmod(0.618034 * k, 1.0);
+  const Eigen::Vector3d dir =
+      Eigen::Vector3d(side * (0.55 + 0.25 * std::abs(std::cos(phi))), 0.6 * std::sin(phi), up)
+          .normalized();
+  const auto out_hit = bone.first_hit(centroid + 400.0 * dir, centroid);
+  const auto in_hit = bone.first_hit(centroid, centroid + 400.0 * dir);
+  if (!out_hit || !in_hit) return std::nullopt;
+  InjectDefectParams ip;
+  ip.center = 0.5 * (out_hit->point + in_hit->point);
+  ip.size_mm = min_size + (max_size - min_size) * std::fmod(0.381966 * (k + 1), 1.0);
+  ip.voxel_mm = 0.5;
+  return ip;
+}
+
+// The flaps of `study --shape flap|bifrontal`: the k-th of a series whose sizes, sides and
+// margins are spread by the golden ratio over a decompressive craniectomy's: one-sided 130-150
+// mm front to back and 100-120 mm high, 15-20 mm off the midline, 5-15° in front of the vault's
+// centre, alternately left and right; bifrontal 180-220 mm side to side and 90-110 mm front to
+// back, alternately in one piece and with a 20 mm bar over the midline.
+FlapPlacementParams flap_series(bool bifrontal, int k) {
+  const double a = std::fmod(0.381966 * (k + 1), 1.0), b = std::fmod(0.618034 * (k + 1), 1.0);
+  FlapPlacementParams p;
+  if (bifrontal) {
+    p.kind = FlapPlacementParams::Kind::Bifrontal;
+    p.length_mm = 180.0 + 40.0 * a;
+    p.width_mm = 90.0 + 20.0 * b;
+    p.midline_margin_mm = k % 2 == 0 ? 0.0 : 10.0;
+    p.above_floor_mm = 10.0;
+  } else {
+    p.side = k % 2 == 0 ? 1 : -1;
+    p.length_mm = 130.0 + 20.0 * a;
+    p.width_mm = 100.0 + 20.0 * b;
+    p.midline_margin_mm = 15.0 + 5.0 * b;
+    p.forward_deg = 5.0 + 10.0 * a;
+  }
+  return p;
+}
+
+// The points a user would click to choose the flap's openings: its centre, or, with a bar over
+// the midline, the centre of each half.
+std::vector<Eigen::Vector3d> flap_points(const FlapPlacement& placed) {
+  const FlapCut& cut = *placed.cut;
+  const double r = placed.outer_radius_mm;
+  if (cut.one_side != 0 || cut.midline_margin_mm <= 0.0) return {cut.apex + r * cut.axis};
+  std::vector<Eigen::Vector3d> points;
+  for (double s : {-0.5, 0.5}) {
+    const double angle = s * cut.half_length_rad;
+    points.push_back(cut.apex +
+                     r * (std::cos(angle) * cut.axis + std::sin(angle) * cut.along).normalized());
+  }
+  return points;
+}
+
+// The registered mirror of the complete skull within the defect's shape against the removed
+// bone (Dice on a 0.5 mm grid): an implant that followed the healthy side exactly, with the rim
+// exactly where the cut was, would score this. What stands between it and 1 is the skull's own
+// asymmetry (and the registration's error).
+double mirror_oracle_dice(const SkullMesh& complete, const AutoplanResult& r,
+                          const InjectDefectParams& shape, const SkullMesh& truth) {
+  const SkullMesh mirrored =
+      transform_mesh(mirror_mesh(complete, r.plane.plane), r.registration.transform);
+  auto [lo, hi] = mesh_bounds(truth);
+  const VoxelGrid grid = VoxelGrid::covering(lo - Eigen::Vector3d::Constant(5.0),
+                                             hi + Eigen::Vector3d::Constant(5.0), 0.5);
+  const std::vector<uint8_t> t = voxelize_mesh(truth, grid), m = voxelize_mesh(mirrored, grid);
+  double both = 0.0, sum = 0.0;
+  for (int k = 0; k < grid.dims[2]; ++k)
+    for (int j = 0; j < grid.dims[1]; ++j)
+      for (int i = 0; i < grid.dims[0]; ++i) {
+        const size_t idx = grid.index(i, j, k);
+        const bool mirror_in = m[idx] && in_defect(shape, grid.center(i, j, k));
+        both += mirror_in && t[idx];
+        sum += mirror_in + (t[idx] != 0);
+      }
+  return sum > 0.0 ? 2.0 * both / sum : 0.0;
+}
+
+// The meshes as one (their vertices and triangles side by side).
+SkullMesh joined(const std::vector<const SkullMesh*>& meshes) {
+  TriangleSoup all;
+  for (const SkullMesh* m : meshes) {
+    const TriangleSoup s = to_soup(*m);
+    const int base = static_cast<int>(all.vertices.size());
+    all.vertices.insert(all.vertices.end(), s.vertices.begin(), s.vertices.end());
+    for (auto t : s.triangles) {
+      for (auto& v : t) v += base;
+      all.triangles.push_back(t);
+    }
+  }
+  return build_mesh(all);
+}
+
 Subcommand add_study(CLI::App& app, const bool& json) {
   struct Opts {
-    std::string skull;
+    std::string skull, shape = "sphere", cases_out, method = "auto";
     int count = 10;
-    double min_size = 30.0, max_size = 50.0;
+    std::optional<double> min_size, max_size;
     AutoplanParams params;
     Shard shard;
     std::string rows_out;
   };
   auto o = std::make_shared<Opts>();
   auto* cmd = app.add_subcommand(
-      "study", "Inject one-sided defects into a healthy skull, autoplan and score each");
+      "study",
+      "Cut defects out of a healthy skull (spheres, or the flaps of decompressive "
+      "craniectomies), autoplan and score each");
   cmd->add_option("SKULL", o->skull, "healthy skull (mesh or volume)")->required();
   cmd->add_option("--count", o->count, "number of defects (default 10)")->check(CLI::Range(1, 100));
-  cmd->add_option("--min-size", o->min_size, "smallest sphere diameter (mm)")
+  cmd->add_option("--shape", o->shape,
+                  "sphere (one-sided, on the upper vault), flap (a one-sided decompressive "
+                  "craniectomy: 130-150 x 100-120 mm, 15-20 mm off the midline, down to the "
+                  "temporal floor) or bifrontal (across the forehead, in one piece or two)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"sphere", "flap", "bifrontal"}));
+  cmd->add_option("--min-size", o->min_size, "smallest sphere diameter (mm; default 30)")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--max-size", o->max_size, "largest sphere diameter (mm)")
+  cmd->add_option("--max-size", o->max_size, "largest sphere diameter (mm; default 50)")
       ->check(CLI::PositiveNumber);
+  cmd->add_option("--method", o->method, "auto, mirror or rim-only (as autoplan's)")
+      ->capture_default_str()
+      ->check(CLI::IsMember({"auto", "mirror", "rim-only"}));
+  cmd->add_option("--cases-out", o->cases_out,
+                  "folder to write each defective skull, its truth and its plan to "
+                  "(K_defective.stl, K_truth.stl, K_planned.stl)");
   add_shard_options(cmd, o->shard, o->rows_out);
   add_fit_option(cmd, o->params);
   return Subcommand{
       cmd, [o, &json] {
+        const bool spheres = o->shape == "sphere";
+        plan_method_from_string(o->method, o->params.propose.method);
+        if (!spheres && (o->min_size || o->max_size))
+          throw CLI::ValidationError("--min-size/--max-size", "are sizes of --shape sphere");
+        if (!o->cases_out.empty()) make_rows_folder(o->cases_out);
         const LoadedSkull loaded = load_skull(o->skull);
         const SkullMesh& skull = loaded.mesh;
         const SurfaceLocator bone(skull);
-        // Directions on the upper vault, alternately left and right, spread by the golden angle;
-        // each defect's centre is in the middle of the bone along that ray from the centroid.
-        const Eigen::Vector3d centroid = vertex_centroid(skull);
+        std::optional<Plane> plane;
+        if (!spheres) {
+          const PlaneFit fit = fit_sagittal_plane(skull, Landmarks{});
+          if (!fit.usable()) throw InputError(o->skull, "midsagittal plane: " + fit.message);
+          plane = fit.plane;
+        }
         make_rows_folder(o->rows_out);
         Json rows = Json::array();
         for (int k = 0; k < o->count; ++k) {
           if (!o->shard.takes(static_cast<size_t>(k))) continue;
-          const double side = k % 2 == 0 ? 1.0 : -1.0;
-          const double phi = 2.39996 * k, up = 0.25 + 0.5 * std::fmod(0.618034 * k, 1.0);
-          const Eigen::Vector3d dir =
-              Eigen::Vector3d(side * (0.55 + 0.25 * std::abs(std::cos(phi))), 0.6 * std::sin(phi),
-                              up)
-                  .normalized();
-          const auto out_hit = bone.first_hit(centroid + 400.0 * dir, centroid);
-          const auto in_hit = bone.first_hit(centroid, centroid + 400.0 * dir);
-          if (!out_hit || !in_hit) continue;
+          Json row{{"defect", k}};
+          std::vector<Eigen::Vector3d> points;
           InjectDefectParams ip;
-          ip.center = 0.5 * (out_hit->point + in_hit->point);
-          ip.size_mm =
-              o->min_size + (o->max_size - o->min_size) * std::fmod(0.381966 * (k + 1), 1.0);
-          ip.voxel_mm = 0.5;
+          if (spheres) {
+            const auto sphere =
+                sphere_defect(skull, bone, k, o->min_size.value_or(30.0), o->max_size.value_or(50.0));
+            if (!sphere) continue;
+            ip = *sphere;
+            points = {ip.center};
+            row["center"] = to_json(ip.center);
+            row["size_mm"] = ip.size_mm;
+          } else {
+            const FlapPlacementParams fp = flap_series(o->shape == "bifrontal", k);
+            const FlapPlacement placed = place_flap(skull, bone, *plane, fp);
+            if (!placed.cut) throw InputError(o->skull, placed.message);
+            ip.shape = InjectDefectParams::Shape::Flap;
+            ip.flap = *placed.cut;
+            ip.voxel_mm = 0.5;
+            points = flap_points(placed);
+            row["flap"] = placed.message;
+            row["length_mm"] = fp.length_mm;
+            row["width_mm"] = fp.width_mm;
+            row["midline_margin_mm"] = placed.cut->midline_margin_mm;
+          }
           const InjectDefectResult d = inject_defect(skull, ip);
           if (!d.usable()) continue;
           // The skull may have a defect of its own (the sample has): the planner is told
-          // which opening is meant, as a user would point at it.
-          AutoplanParams params = o->params;
-          params.propose.detect.near = ip.center;
-          const AutoplanResult r = autoplan(d.defective, Landmarks{}, params);
-          Json row{{"defect", k},
-                   {"center", to_json(ip.center)},
-                   {"size_mm", ip.size_mm},
-                   {"message", r.message}};
-          if (r.planned())
-            add_scores(row, r, compare_implants(r.implant.mesh, d.implant, &d.defective));
+          // which opening is meant, as a user would point at it (at each, for two).
+          std::vector<AutoplanResult> plans;
+          const auto t0 = std::chrono::steady_clock::now();
+          for (const Eigen::Vector3d& point : points) {
+            AutoplanParams params = o->params;
+            params.propose.detect.near = point;
+            plans.push_back(autoplan(d.defective, Landmarks{}, params));
+          }
+          row["seconds"] =
+              std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+          std::string message;
+          std::vector<const SkullMesh*> implants;
+          bool all_planned = true, all_printable = true;
+          double worst_gap = 0.0;
+          for (const AutoplanResult& r : plans) {
+            message += (message.empty() ? "" : " | ") + r.message;
+            all_planned = all_planned && r.planned();
+            if (!r.planned()) continue;
+            implants.push_back(&r.implant.mesh);
+            all_printable = all_printable && r.quality.printable;
+            worst_gap = std::max(worst_gap, r.quality.rim_gap_mm);
+          }
+          row["message"] = message;
+          row["implants"] = plans.size();
+          if (all_planned) {
+            const SkullMesh implant = implants.size() == 1 ? *implants.front() : joined(implants);
+            add_scores(row, plans.front(), compare_implants(implant, d.implant, &d.defective));
+            row["mirror_dice"] = mirror_oracle_dice(skull, plans.front(), ip, d.implant);
+            row["printable"] = all_printable;
+            row["rim_gap_mm"] = worst_gap;
+            Json why = Json::array();
+            for (const AutoplanResult& r : plans)
+              for (const std::string& reason : r.quality.reasons) why.push_back(reason);
+            if (!all_printable) row["not_printable_because"] = why;
+            if (!o->cases_out.empty())
+              write_mesh(implant, case_file(o->cases_out, k, "planned"), loaded.file_space);
+          }
+          if (!o->cases_out.empty()) {
+            write_mesh(d.defective, case_file(o->cases_out, k, "defective"), loaded.file_space);
+            write_mesh(d.implant, case_file(o->cases_out, k, "truth"), loaded.file_space);
+          }
           if (!json)
-            std::cout << k << "  size " << ip.size_mm << " mm  " << row.value("method", "-")
-                      << "  DSC " << row.value("dice", 0.0) << "  HD95 "
-                      << row.value("hd95_mm", 0.0) << " mm  " << printable_text(row) << r.message
-                      << std::endl;
+            std::cout << k << "  " << (spheres ? "size " + std::to_string(ip.size_mm) + " mm"
+                                              : row["flap"].get<std::string>())
+                      << "  " << row.value("method", "-") << "  DSC " << row.value("dice", 0.0)
+                      << "  bDSC " << row.value("boundary_dice", 0.0) << "  HD95 "
+                      << row.value("hd95_mm", 0.0) << " mm  " << row["seconds"].get<double>()
+                      << " s  " << printable_text(row) << message << std::endl;
           write_row(o->rows_out, "study", std::to_string(k), row);
           rows.push_back(row);
         }

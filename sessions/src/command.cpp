@@ -257,7 +257,11 @@ int current_version(CommandType type) {
   // than kRimGapTargetMm over an arc is fitted again from other margins
   // (ImplantParams::fit_margin_search); the parameters recorded are unchanged, and version 12
   // is made as it was.
-  if (type == CommandType::BuildImplant) return 13;
+  // build_implant 14: fitted to the bone, the shell at least half a millimetre thicker than the
+  // fit's smallest feature (ImplantParams::fit_keeps_shell_thick), and the implant ends where
+  // the scan ended across the opening ("scan_ends", none when absent); version 13 is made as
+  // it was.
+  if (type == CommandType::BuildImplant) return 14;
   if (type == CommandType::ExportImplant) return 2;
   // propose_markers 4: support markers only where the fitted surface describes the ring's bone
   // ("max_support_off_fit_mm"; versions 1 to 3 are read with 0, every ring point of the band).
@@ -265,7 +269,12 @@ int current_version(CommandType type) {
   // ("surfaces.mirror_footprint_mm"; versions 1 to 4 are read with 0, along the one ray).
   // propose_markers 6: mirror-guided, a fitting site of few rays smoothed more
   // ("surfaces.weigh_sites_by_rays"; versions 1 to 5 are read with false, every site alike).
-  if (type == CommandType::ProposeMarkers) return 6;
+  // propose_markers 7: the rim of a large opening, of one whose rim the rays left unseen over
+  // a long stretch, or of one reaching the scan's end traced on the bone ("detect":
+  // "trace_rim_on_bone", "trace_from_area_mm2", "trace_from_unseen_mm"; versions 1 to 6 are
+  // read without: the rim the rays saw), and inner support markers only on one layer of the
+  // ring's bone ("max_support_layers"; versions 1 to 6 are read with 0, no limit).
+  if (type == CommandType::ProposeMarkers) return 7;
   // load_skull 4: volumes in the patient's frame ("import.patient_frame"), a DICOM folder's
   // series ("import.dicom_series"), a mesh's far pieces dropped ("import.drop_far_pieces");
   // absent, as version 3 read them.
@@ -372,11 +381,15 @@ Json params_to_json(const ProposeParams& p) {
   // Written only when set (no plan made in the program sets it), so the commands of every
   // other plan keep their bytes.
   if (p.detect.center) j["detect"]["center"] = to_json(*p.detect.center);
+  j["detect"]["trace_rim_on_bone"] = p.detect.trace_rim_on_bone;
+  j["detect"]["trace_from_area_mm2"] = p.detect.trace_from_area_mm2;
+  j["detect"]["trace_from_unseen_mm"] = p.detect.trace_from_unseen_mm;
   j["smooth"] = params_to_json(p.smooth);
   j["surfaces"] = write_fields([](auto& v, auto& q) { surface_fit_fields(v, q); }, p.surfaces);
   j["surfaces"]["mirror_footprint_mm"] = p.surfaces.mirror_footprint_mm;
   j["surfaces"]["weigh_sites_by_rays"] = p.surfaces.weigh_sites_by_rays;
   j["max_support_off_fit_mm"] = p.max_support_off_fit_mm;
+  j["max_support_layers"] = p.max_support_layers;
   return j;
 }
 
@@ -394,6 +407,7 @@ Json params_to_json(const ImplantParams& p) {
   for (const ClearanceZone& z : p.clearance_zones) j["clearance_zones"].push_back(to_json(z));
   j["perforations"] = to_json(p.perforations);
   j["tabs"] = to_json(p.tabs);
+  j["scan_ends"] = to_json(p.scan_ends);
   return j;
 }
 
@@ -620,6 +634,13 @@ void params_from_json(const ParamReader& r, ProposeParams& p) {
   if (detect.has("near") && !detect.value("near").is_null()) p.detect.near = detect.vector3("near");
   p.detect.center.reset();
   if (detect.has("center")) p.detect.center = detect.vector3("center");
+  // Versions 1 to 6 have none: the rim the rays saw, never traced on the bone.
+  p.detect.trace_rim_on_bone =
+      detect.has("trace_rim_on_bone") && detect.boolean("trace_rim_on_bone");
+  if (detect.has("trace_from_area_mm2"))
+    p.detect.trace_from_area_mm2 = detect.number("trace_from_area_mm2");
+  if (detect.has("trace_from_unseen_mm"))
+    p.detect.trace_from_unseen_mm = detect.number("trace_from_unseen_mm");
   params_from_json(ParamReader(r.value("smooth"), r.where() + " smooth"), p.smooth);
   // Version 1 (before the surfaces were fitted to the ring) has no "surfaces": the defaults.
   // Versions 1 to 4 read the mirror along one ray: no footprint. Versions 1 to 5 weigh every
@@ -638,6 +659,8 @@ void params_from_json(const ParamReader& r, ProposeParams& p) {
   // Versions 1 to 3 have none: support markers on every ring point of the band (0: off).
   p.max_support_off_fit_mm =
       r.has("max_support_off_fit_mm") ? r.number("max_support_off_fit_mm") : 0.0;
+  // Versions 1 to 6 have none: inner support markers however thick the ring's bone (0: off).
+  p.max_support_layers = r.has("max_support_layers") ? r.number("max_support_layers") : 0.0;
 }
 
 void params_from_json(const ParamReader& r, ImplantParams& p) {
@@ -696,6 +719,9 @@ void params_from_json(const ParamReader& r, ImplantParams& p) {
   // build_implant 6 and before have no tabs.
   p.tabs = TabParams{};
   if (r.has("tabs")) p.tabs = tabs_from_json(ParamReader(r.value("tabs"), r.where() + " tabs"));
+  // build_implant 13 and before have no scan ends.
+  p.scan_ends.clear();
+  if (r.has("scan_ends")) p.scan_ends = planes_from_json(r.value("scan_ends"), r.where());
   p.clearance_zones.clear();
   if (r.has("clearance_zones")) {
     const Json& zones = r.value("clearance_zones");

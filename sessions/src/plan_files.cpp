@@ -21,6 +21,12 @@ Json to_json(const Plane& plane) {
   return Json{{"normal", to_json(plane.normal)}, {"offset_mm", plane.offset}};
 }
 
+Json to_json(const std::vector<Plane>& planes) {
+  Json j = Json::array();
+  for (const Plane& p : planes) j.push_back(to_json(p));
+  return j;
+}
+
 Json to_json(const RigidTransform& t) {
   Json rows = Json::array();
   for (int r = 0; r < 3; ++r) rows.push_back(to_json(Eigen::Vector3d(t.rotation.row(r))));
@@ -188,6 +194,13 @@ Plane plane_from_json(const Json& j, const std::string& source) {
   if (!j["offset_mm"].is_number()) throw InputError(source, "'offset_mm' must be a number");
   const double scale = n.norm();
   return Plane{n / scale, j["offset_mm"].get<double>() / scale};
+}
+
+std::vector<Plane> planes_from_json(const Json& j, const std::string& source) {
+  if (!j.is_array()) throw InputError(source, "a list of planes must be a list");
+  std::vector<Plane> planes;
+  for (const Json& one : j) planes.push_back(plane_from_json(one, source));
+  return planes;
 }
 
 RigidTransform transform_from_json(const Json& j, const std::string& source) {

@@ -298,6 +298,7 @@ void rebuild_implant(PlanState& s) {
   if (!s.implant_params) return;
   ImplantParams p = *s.implant_params;
   if (!p.radial_center && s.defect_center) p.radial_center = s.defect_center;
+  if (p.scan_ends.empty()) p.scan_ends = s.scan_ends;
   auto built = std::make_shared<const ImplantData>(
       [&] {
         return build_implant(s.markers, &s.skull->surface->mesh, &s.skull->surface->locator, p);
@@ -709,6 +710,8 @@ bool apply_proposal_result(PlanState& s, const Json& j, const std::string& where
   if (!result.value("defect_center").is_null()) s.defect_center = result.vector3("defect_center");
   s.proposal_message = result.string("message");
   // Results recorded by older plans may have none.
+  s.scan_ends.clear();
+  if (result.has("scan_ends")) s.scan_ends = planes_from_json(result.value("scan_ends"), where);
   s.unseen_rim.clear();
   if (result.has("unseen_rim")) {
     const Json& stretches = result.value("unseen_rim");
@@ -784,6 +787,8 @@ void apply_build(PlanState& s, const ParamReader& r, int version) {
   params.tabs.keep_on_bone = params.perforations.sound_rims = version >= 12;
   // Before version 13, the fit to the bone used the margin asked, whatever gap it left.
   params.fit_margin_search = version >= 13;
+  // Before version 14, the shell fitted to the bone kept the surfaces' own thickness.
+  params.fit_keeps_shell_thick = version >= 14;
   s.implant_params = params;
   unacknowledge(s, 8, "the implant was built again");
   rebuild_implant(s);
@@ -899,6 +904,7 @@ Json proposal_result(const MarkerProposal& p) {
                 {"markers", Json::array()},
                 {"defect_center", nullptr},
                 {"unseen_rim", Json::array()},
+                {"scan_ends", Json::array()},
                 {"message", "no markers proposed: " + p.message}};
   const std::string proposed = std::to_string(p.markers.size()) + " markers proposed, " +
                                describe_method(p.method_used, p.mirror_coverage) + "; ";
@@ -909,6 +915,7 @@ Json proposal_result(const MarkerProposal& p) {
               {"markers", markers_to_json(p.markers)["markers"]},
               {"defect_center", to_json(p.defect.center)},
               {"unseen_rim", unseen},
+              {"scan_ends", to_json(p.defect.scan_ends)},
               {"message", proposed + p.message + "; " + p.surfaces_message}};
 }
 

@@ -80,7 +80,7 @@ TEST(AutoplanSession, TheProposalIsRecordedInItsCommand) {
   const auto at = test::first_command(s, CommandType::ProposeMarkers);
   ASSERT_TRUE(at);
   const Command propose = s.effective_commands()[*at];
-  EXPECT_EQ(propose.version, 6);
+  EXPECT_EQ(propose.version, 7);
   ASSERT_TRUE(propose.params.contains("result"));
   const Json& result = propose.params["result"];
   EXPECT_EQ(result["proposed"], true);

@@ -84,7 +84,7 @@ TEST(Commands, EveryTypeRoundTripsThroughJson) {
 // read as recorded, built without the fit.
 TEST(Commands, BuildImplantVersionOneIsReadByItsOwnRules) {
   Json v1 = to_json(commands::build_implant());
-  EXPECT_EQ(v1["version"], 13);
+  EXPECT_EQ(v1["version"], 14);
   v1["version"] = 1;
   v1["params"]["params"].erase("trim");
   v1["params"]["params"].erase("fit_to_bone_mm");
@@ -131,7 +131,7 @@ TEST(Commands, OlderPlansReadTheSkullAndFitTheBoneAsTheyWereMade) {
   p.trim.min_feature_mm = 1.7;
   p.trim.bridge_mm = 0.8;
   const Json build = to_json(commands::build_implant(p));
-  EXPECT_EQ(build["version"], 13);
+  EXPECT_EQ(build["version"], 14);
   ImplantParams back;
   params_from_json(ParamReader(build["params"]["params"], "test"), back);
   EXPECT_EQ(back.trim.min_feature_mm, 1.7);
@@ -177,7 +177,7 @@ TEST(Commands, TheBuildRecordsItsMaterialAndClearanceZones) {
   p.perforations.added = {Eigen::Vector3d(4, 5, 6)};
   p.perforations.removed = {Eigen::Vector3d(7, 8, 9)};
   const Json build = to_json(commands::build_implant(p));
-  EXPECT_EQ(build["version"], 13);
+  EXPECT_EQ(build["version"], 14);
   const Json& recorded = build["params"]["params"];
   EXPECT_EQ(recorded["material"]["name"], "PMMA");
   EXPECT_TRUE(recorded["material"]["thickness_mm"].is_null()) << "follows the bone";
@@ -405,15 +405,17 @@ TEST(Commands, OlderBuildsMeshTheirTabsAndHolesAsTheyWereMade) {
 TEST(Commands, OlderBuildsTakeTheirRimsOutAsTheyWereMade) {
   const Session planned = Session::open(test::planned_defect_case().session_path);
   const Json today = to_json(commands::build_implant(ImplantParams{}));
-  EXPECT_EQ(today["version"], 13);
-  for (const auto& [version, reaches, keeps, searches] :
-       {std::tuple{13, true, true, true}, std::tuple{12, true, true, false},
-        std::tuple{11, true, false, false}, std::tuple{10, false, false, false}}) {
+  EXPECT_EQ(today["version"], 14);
+  for (const auto& [version, reaches, keeps, searches, thick] :
+       {std::tuple{14, true, true, true, true}, std::tuple{13, true, true, true, false},
+        std::tuple{12, true, true, false, false}, std::tuple{11, true, false, false, false},
+        std::tuple{10, false, false, false, false}}) {
     SCOPED_TRACE(version);
     Json json = today;
     json["version"] = version;
     const ApplyOutcome out = apply_command(planned.state(), command_from_json(json, "test"));
     ASSERT_TRUE(out.state.implant_params.has_value()) << out.message;
+    EXPECT_EQ(out.state.implant_params->fit_keeps_shell_thick, thick);
     EXPECT_EQ(out.state.implant_params->fit_margin_search, searches);
     EXPECT_EQ(out.state.implant_params->fit_reaches_the_bone, reaches);
     EXPECT_EQ(out.state.implant_params->trim.iso_gap, reaches);
@@ -501,8 +503,9 @@ TEST(Commands, ProposeMarkersVersionTwoRoundTripsAndVersionOneGetsDefaults) {
   p.detect.near = Eigen::Vector3d(1.5, -2.0, 70.25);
   p.max_support_off_fit_mm = 2.25;
   p.surfaces.mirror_footprint_mm = 2.5;
+  p.detect.trace_from_area_mm2 = 2500.0;
   const Json j = to_json(commands::propose_markers(p));
-  EXPECT_EQ(j["version"], 6);
+  EXPECT_EQ(j["version"], 7);
   EXPECT_TRUE(p.surfaces.weigh_sites_by_rays) << "the default";
   EXPECT_EQ(j["params"]["params"]["surfaces"]["weigh_sites_by_rays"], true);
   ProposeParams back;
@@ -565,6 +568,21 @@ TEST(Commands, ProposeMarkersVersionTwoRoundTripsAndVersionOneGetsDefaults) {
   params_from_json(ParamReader(command_from_json(v5, "old plan").params["params"], "test"), five);
   EXPECT_EQ(five.surfaces.mirror_footprint_mm, 2.5);
   EXPECT_FALSE(five.surfaces.weigh_sites_by_rays);
+  // Version 7 traces the rim on the bone, with its limits recorded.
+  EXPECT_TRUE(back.detect.trace_rim_on_bone);
+  EXPECT_EQ(back.detect.trace_from_area_mm2, 2500.0);
+  EXPECT_EQ(back.detect.trace_from_unseen_mm, DetectDefectParams{}.trace_from_unseen_mm);
+  Json v6 = j;
+  v6["version"] = 6;
+  for (const char* key : {"trace_rim_on_bone", "trace_from_area_mm2", "trace_from_unseen_mm"})
+    v6["params"]["params"]["detect"].erase(key);
+  ProposeParams six;
+  params_from_json(ParamReader(command_from_json(v6, "old plan").params["params"], "test"), six);
+  EXPECT_FALSE(six.detect.trace_rim_on_bone);
+  EXPECT_EQ(back.max_support_layers, ProposeParams{}.max_support_layers);
+  v6["params"]["params"].erase("max_support_layers");
+  params_from_json(ParamReader(command_from_json(v6, "old plan").params["params"], "test"), six);
+  EXPECT_EQ(six.max_support_layers, 0.0) << "before version 7: no limit";
 }
 
 TEST(Commands, UnknownTypeVersionAndMissingParameterAreNamed) {

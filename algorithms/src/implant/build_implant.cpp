@@ -453,9 +453,14 @@ class ShellBuilder {
   }
   // How far the inner surface lies at least below the fitted outer one: 0.3 mm, or a material's
   // minimum thickness below the outer surface it is given (set below the fitted one by the
-  // under-contour, unless the inner surface follows it down).
+  // under-contour, unless the inner surface follows it down). Fitted to the bone, at least half
+  // a millimetre more than the fit's smallest feature: thinner shell (a mirrored temporal
+  // squama of 1.5 mm) would be opened away by the fit and leave a hole by the rim.
   double min_depth() const {
-    if (!params_.material) return 0.3;
+    const double fit = params_.fit_to_bone_mm > 0.0 && params_.fit_keeps_shell_thick
+                           ? params_.trim.min_feature_mm + 0.5
+                           : 0.0;
+    if (!params_.material) return std::max(0.3, fit);
     const bool plate = !std::isnan(params_.material->thickness_mm);
     return params_.material->min_thickness_mm + (plate ? 0.0 : under_contour());
   }
@@ -865,7 +870,8 @@ void search_fit_margin(const std::vector<Marker>& markers, const SkullMesh& skul
   // The gap as the quality report judges it: with a clearance asked, its excess over it.
   const double clearance = params.material ? params.material->edge_clearance_mm : 0.0;
   const bool asked = clearance > 0.0 || !params.clearance_zones.empty();
-  const RimGap first = rim_gap(fitted, bone, asked, clearance, params.clearance_zones);
+  const RimGap first =
+      rim_gap(fitted, bone, asked, clearance, params.clearance_zones, params.scan_ends);
   if (first.mm <= kRimGapTargetMm) return;
   const double asked_margin = params.fit_to_bone_mm;
   for (const double step : kFitMarginSteps) {
@@ -878,7 +884,8 @@ void search_fit_margin(const std::vector<Marker>& markers, const SkullMesh& skul
     if (!s.usable()) continue;
     const TrimToBoneResult t = trim_to_bone(shell, skull, other.trim, trimmed, &bone);
     if (!t.usable()) continue;
-    const RimGap gap = rim_gap(trimmed, bone, asked, clearance, params.clearance_zones);
+    const RimGap gap =
+        rim_gap(trimmed, bone, asked, clearance, params.clearance_zones, params.scan_ends);
     if (gap.mm > kRimGapTargetMm) continue;
     fitted = trimmed;
     r.thickness_used_mm = s.thickness_used_mm;
@@ -914,6 +921,7 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
   }
   // The fit to the bone leaves nothing thinner than the material's minimum (and keeps a plate
   // of the material's thickness, which the default feature size would take away).
+  params.trim.scan_ends = given.scan_ends;
   if (given.material) params.trim.min_feature_mm = given.material->min_thickness_mm;
   if (given.material && given.material->edge_clearance_mm > 0.0)
     params.trim.clearance_mm =

@@ -81,7 +81,7 @@ bool across_plate(const Eigen::Vector3d& n, const Eigen::Vector3d& axis) {
 
 RimSamples rim_samples(const SkullMesh& implant, const SurfaceLocator& bone,
                        const Eigen::Vector3d& c, const Eigen::Vector3d& axis,
-                       std::vector<int> wall_vertices) {
+                       std::vector<int> wall_vertices, const std::vector<Plane>& scan_ends) {
   std::sort(wall_vertices.begin(), wall_vertices.end());
   wall_vertices.erase(std::unique(wall_vertices.begin(), wall_vertices.end()), wall_vertices.end());
   const Eigen::Vector3d e1 = axis.unitOrthogonal(), e2 = axis.cross(e1);
@@ -100,6 +100,11 @@ RimSamples rim_samples(const SkullMesh& implant, const SurfaceLocator& bone,
           const auto near = bone.closest(p);
           s.distance[i] = near.distance;
           s.nearest[i] = near.point;
+          for (const Plane& end : scan_ends)
+            if (std::abs(end.signed_distance(p)) <= kAtScanEndMm) {
+              s.distance[i] = 0.0;  // the edge ends at the scan's end, not at bone
+              s.nearest[i] = p;
+            }
         }
       },
       256);
@@ -119,7 +124,8 @@ std::vector<double> clearance_excess(const RimSamples& s, double clearance_mm,
 }
 
 RimGap rim_gap(const SkullMesh& implant, const SurfaceLocator& bone, bool clearance_asked,
-               double clearance_mm, const std::vector<ClearanceZone>& zones) {
+               double clearance_mm, const std::vector<ClearanceZone>& zones,
+               const std::vector<Plane>& scan_ends) {
   RimGap g;
   if (implant.n_faces() == 0) return g;
   const Eigen::Vector3d c = vertex_centroid(implant);
@@ -131,7 +137,7 @@ RimGap rim_gap(const SkullMesh& implant, const SurfaceLocator& bone, bool cleara
     if (n.norm() == 0 || across_plate(n.normalized(), axis)) continue;
     wall.insert(wall.end(), f.ids.begin(), f.ids.end());
   }
-  const RimSamples s = rim_samples(implant, bone, c, axis, std::move(wall));
+  const RimSamples s = rim_samples(implant, bone, c, axis, std::move(wall), scan_ends);
   if (s.vertices.empty()) return g;
   size_t at = 0;
   g.mm = clearance_asked

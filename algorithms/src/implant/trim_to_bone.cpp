@@ -394,6 +394,16 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull,
     before += mask[c];
     mask[c] = mask[c] && !bone[c];
   }
+  // Beyond the scan's end the bone is unknown: the implant ends there.
+  if (!params.scan_ends.empty())
+    for (int k = 0; k < grid.dims[2]; ++k)
+      for (int j = 0; j < grid.dims[1]; ++j)
+        for (int i = 0; i < grid.dims[0]; ++i) {
+          const size_t c = grid.index(i, j, k);
+          if (!mask[c]) continue;
+          for (const Plane& end : params.scan_ends)
+            if (end.signed_distance(grid.center(i, j, k)) > 0.0) mask[c] = 0;
+        }
   clock.mark("voxels");
   // The skull's triangles near the grid suffice for distances up to a few voxels beyond the
   // widest clearance.
@@ -505,6 +515,13 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull,
     clock.mark("blur");
   }
   Mask().swap(bone);
+  // The bridge and the blur may carry the implant back over the scan's end: nothing beyond it
+  // (the surface then ends within a voxel of it).
+  for (const Plane& end : params.scan_ends)
+    for (int k = 0; k < grid.dims[2]; ++k)
+      for (int j = 0; j < grid.dims[1]; ++j)
+        for (int i = 0; i < grid.dims[0]; ++i)
+          if (end.signed_distance(grid.center(i, j, k)) > 0.0) smooth[grid.index(i, j, k)] = 0.0f;
   if (params.iso_gap) keep_off_iso_level(smooth);
   // The implant as the meshing gives it: plans saved before meshes were made canonical replay
   // to their bytes.

@@ -14,6 +14,7 @@
 #include "cranioplan/algorithms/geometry/point_index.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/surface_samples.h"
+#include "cranioplan/algorithms/planning/trace_rim.h"
 #include "cranioplan/model/parallel.h"
 #include "cranioplan/model/plane.h"
 
@@ -496,6 +497,169 @@ void trace_rim(const RayFan& fan, const Openings& o, const Candidate& c, const R
   region.inner_rim = std::move(sorted_inner);
 }
 
+// Runs of consecutive points flagged in `flags` (a closed loop), each as a stretch from its first
+// to its last point.
+std::vector<RimStretch> flagged_stretches(const std::vector<Eigen::Vector3d>& loop,
+                                          const std::vector<char>& flags) {
+  std::vector<RimStretch> out;
+  const size_t n = loop.size();
+  if (n == 0) return out;
+  size_t start = 0;
+  while (start < n && flags[start]) ++start;
+  if (start == n) return {{loop.front(), loop.back()}};  // all of it
+  for (size_t k = 1; k <= n; ++k) {
+    const size_t i = (start + k) % n;
+    if (!flags[i] || flags[(i + n - 1) % n]) continue;
+    size_t j = i;
+    while (flags[(j + 1) % n] && (j + 1) % n != i) j = (j + 1) % n;
+    out.push_back({loop[i], loop[j]});
+  }
+  return out;
+}
+
+// The rim traced on the bone from the faces next to the opening the rays saw (its rim rays and
+// their bone neighbours); when it is found, the region's rim, opening and axis are the traced
+// ones, and stretches along the scan's end are named.
+// A stretch of the traced rim along the scan's end shorter than this is not the opening running
+// into the scan's end, mm.
+constexpr double kMinAtBorderMm = 5.0;
+// Bone a ray inside the traced rim meets more than this nearer the centre than the rim is seen
+// through the opening, mm.
+constexpr double kInsideRimMm = 10.0;
+// How far the outer table a seed of the traced rim lies on may be from the rays' median, mm.
+constexpr double kSeedRadiusMm = 15.0;
+
+// How many steps over the rays' neighbours (about 1.6° each) the band reaches into rays closed
+// by the scan's end next to the opening.
+constexpr int kBandRings = 8;
+
+void trace_on_bone(const SkullMesh& skull, const SurfaceLocator& locator, const RayFan& fan,
+                   const std::vector<int>& comp, const Candidate& c, const RayCaster& cast,
+                   const std::vector<ScanBorder>& borders, DefectRegion& region) {
+  std::vector<int> near = c.rim;
+  for (int j : c.rim)
+    for (int w : fan.nbrs[j])
+      if (fan.paired[w]) near.push_back(w);
+  std::sort(near.begin(), near.end());
+  near.erase(std::unique(near.begin(), near.end()), near.end());
+  // The tables are grown from the vault's regular shell only: both tables facing the ray
+  // within 45°, and the outer table within kSeedRadiusMm of the rays' median distance to it. A
+  // ray next to the opening that met other bone seen through it (a ridge of the skull base, deep
+  // in the head) would seed that bone's face as the outer table.
+  std::vector<RayThroughBone> hits;
+  std::vector<double> radii;
+  for (int j : near) {
+    hits.push_back(cast(fan.dirs[j]));
+    if (hits.back().paired) radii.push_back((*hits.back().outer - region.center).norm());
+  }
+  if (radii.empty()) return;
+  std::nth_element(radii.begin(), radii.begin() + radii.size() / 2, radii.end());
+  const double typical = radii[radii.size() / 2];
+  std::vector<Eigen::Vector3d> outer_seeds, inner_seeds;
+  for (size_t k = 0; k < near.size(); ++k) {
+    const RayThroughBone& h = hits[k];
+    const Eigen::Vector3d& d = fan.dirs[near[k]];
+    if (!h.paired || h.outer_normal.dot(d) < M_SQRT1_2 || -h.inner_normal.dot(d) < M_SQRT1_2 ||
+        std::abs((*h.outer - region.center).norm() - typical) > kSeedRadiusMm)
+      continue;
+    outer_seeds.push_back(*h.outer);
+    inner_seeds.push_back(*h.inner);
+  }
+  const Eigen::Vector3d e1 = across_axis(region.axis, region.frame);
+  // The band the tables are traced over: around the opening's rays and the rays next to them
+  // that meet no bone, closed by the scan's end (where the opening runs into it, its edge goes
+  // on along the scan's border).
+  std::vector<Eigen::Vector3d> band = region.hole_directions;
+  std::vector<int> ring(fan.size(), -1);  // steps from the opening's rays
+  std::vector<int> front = comp;
+  for (int i : comp) ring[i] = 0;
+  for (size_t q = 0; q < front.size(); ++q) {
+    if (ring[front[q]] >= kBandRings) continue;
+    for (int w : fan.nbrs[front[q]])
+      if (ring[w] < 0 && !fan.inner[w]) {
+        ring[w] = ring[front[q]] + 1;
+        band.push_back(fan.dirs[w]);
+        front.push_back(w);
+      }
+  }
+  const TracedRim traced =
+      trace_rim_on_bone(skull, locator, region.center, region.axis, e1, band,
+                        region.outer_rim, region.inner_rim, outer_seeds, inner_seeds, borders);
+  if (!traced.traced()) return;
+  const std::vector<char> inside = inside_loop(fan.dirs, traced.outer, region.center,
+                                               region.axis, e1);
+  // The opening: the rays inside the traced rim, but for those that meet bone about as far out
+  // as the rim (the wedge of an oblique cut face, inside its outer corner). Bone met well
+  // inside the rim is seen through the opening (the floor of a fossa below a flap's lower
+  // edge).
+  const Eigen::Vector3d e2 = region.axis.cross(e1);
+  std::vector<std::pair<double, double>> rim_by_bearing;  // (bearing, distance from the centre)
+  for (const Eigen::Vector3d& p : traced.outer) {
+    const Eigen::Vector3d d = p - region.center;
+    rim_by_bearing.emplace_back(std::atan2(d.dot(e2), d.dot(e1)), d.norm());
+  }
+  std::sort(rim_by_bearing.begin(), rim_by_bearing.end());
+  auto rim_radius = [&](const Eigen::Vector3d& dir) {
+    const double b = std::atan2(dir.dot(e2), dir.dot(e1));
+    auto it = std::lower_bound(rim_by_bearing.begin(), rim_by_bearing.end(),
+                               std::make_pair(b, -1.0));
+    if (it == rim_by_bearing.end()) it = rim_by_bearing.begin();
+    return it->second;
+  };
+  std::vector<Eigen::Vector3d> holes;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  size_t count = 0;
+  for (int i = 0; i < fan.size(); ++i) {
+    if (!inside[i]) continue;
+    if (fan.outer[i] &&
+        (*fan.outer[i] - region.center).norm() >= rim_radius(fan.dirs[i]) - kInsideRimMm)
+      continue;
+    holes.push_back(fan.dirs[i]);
+    sum += fan.dirs[i];
+    ++count;
+  }
+  if (holes.empty() || sum.norm() < 1e-9) return;
+  double radius = 0.0;
+  for (const Eigen::Vector3d& p : traced.outer) radius += (p - region.center).norm();
+  radius /= static_cast<double>(traced.outer.size());
+  region.hole_directions = std::move(holes);
+  region.axis = sum.normalized();
+  region.area_mm2 = static_cast<double>(count) * 4.0 * M_PI / fan.size() * radius * radius;
+  region.outer_rim = traced.outer;
+  if (traced.inner.size() == traced.outer.size()) {
+    region.inner_rim = traced.inner;
+  } else {  // the inner table not traced: the rays' inner rim nearest each point
+    const std::vector<Eigen::Vector3d> seen = region.inner_rim, seen_outer = region.outer_rim;
+    region.inner_rim.clear();
+    for (const Eigen::Vector3d& p : traced.outer) {
+      size_t best = 0;
+      for (size_t k = 1; k < seen_outer.size(); ++k)
+        if ((seen_outer[k] - p).squaredNorm() < (seen_outer[best] - p).squaredNorm()) best = k;
+      region.inner_rim.push_back(seen[best]);
+    }
+  }
+  region.rim_traced = true;
+  // Stretches along the scan's end, of kMinAtBorderMm or more (a point of the rim that touches a
+  // cap where the bone's edge meets the scan's is not the opening running into it).
+  for (const RimStretch& st : flagged_stretches(traced.outer, traced.at_scan_border))
+    if (st.length_mm() >= kMinAtBorderMm) region.at_scan_border.push_back(st);
+  for (const ScanBorder& b : borders)
+    for (const RimStretch& st : region.at_scan_border)
+      if (std::abs(b.normal.dot(st.from) - b.offset) < 2.0 &&
+          std::abs(b.normal.dot(st.to) - b.offset) < 2.0) {
+        region.scan_ends.push_back(Plane{b.normal, b.offset});
+        break;
+      }
+}
+
+// Whether the opening's rim is traced on the bone (DetectDefectParams::trace_from_area_mm2):
+// large, or seen by the rays with a long stretch of its rim unseen.
+bool wants_trace(const DefectRegion& region, const DetectDefectParams& params) {
+  if (region.area_mm2 >= params.trace_from_area_mm2) return true;
+  const std::vector<RimStretch> unseen = unseen_rim_stretches(region.outer_rim);
+  return !unseen.empty() && unseen.front().length_mm() >= params.trace_from_unseen_mm;
+}
+
 }  // namespace
 
 DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator,
@@ -531,6 +695,8 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
     for (int i : comp) region.hole_directions.push_back(fan.dirs[i]);
     region.axis = openings.mean_dir[openings.order[chosen.r]];
     trace_rim(fan, openings, chosen, cast, region);
+    if (params.trace_rim_on_bone && wants_trace(region, params))
+      trace_on_bone(skull, locator, fan, comp, chosen, cast, borders, region);
     // Asked for the opening towards a point, and none lies that way: the nearest was planned,
     // and the message says so (a point on intact bone, or at a cut that did not go through,
     // would otherwise plan another opening without a word).
@@ -540,7 +706,7 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
       for (int i : comp) closest = std::max(closest, fan.dirs[i].dot(want));
       region.near_miss_deg = std::acos(std::clamp(closest, -1.0, 1.0)) * 180.0 / M_PI;
     }
-    region.unseen_rim = unseen_rim_stretches(region.outer_rim);
+    if (!region.rim_traced) region.unseen_rim = unseen_rim_stretches(region.outer_rim);
   }
   region.message = region.describe();
   region.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -568,6 +734,13 @@ std::string DefectRegion::describe(bool others_planned) const {
                  std::to_string(static_cast<long long>(std::lround(unseen_rim[k].length_mm())));
     text += "; rim not seen along " + lengths +
             " mm (rays graze the bone there): check the edge markers";
+  }
+  if (!at_scan_border.empty()) {
+    double along = 0.0;
+    for (const RimStretch& s : at_scan_border) along += s.length_mm();
+    text += "; the opening reaches the scan's border (along " +
+            std::to_string(std::lround(along)) +
+            " mm): the bone beyond the scan is unknown, and the implant ends there";
   }
   return text;
 }

@@ -1,8 +1,10 @@
 #include "cranioplan/algorithms/planning/propose_markers.h"
 
+#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
+#include <limits>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -67,6 +69,38 @@ std::vector<size_t> along(const std::vector<Eigen::Vector3d>& loop, double spaci
   return out;
 }
 
+// A traced rim (about a millimetre between points, in order of bearing around the axis): the
+// point nearest each of evenly spaced bearings, their count the rim's length over `spacing` in
+// steps of kBearingSteps. Sampled by arc length, a local change of the rim (a point moved where
+// it crosses bone fragments) would move every marker after it along the rim.
+constexpr int kBearingSteps = 8;
+
+std::vector<size_t> by_bearing(const DefectRegion& defect, double spacing) {
+  const std::vector<Eigen::Vector3d>& rim = defect.outer_rim;
+  if (rim.size() < 3) return along(rim, spacing);
+  double length = 0.0;
+  for (size_t i = 0; i < rim.size(); ++i) length += (rim[(i + 1) % rim.size()] - rim[i]).norm();
+  const int count = std::max(
+      kBearingSteps, kBearingSteps * static_cast<int>(std::lround(length / spacing / kBearingSteps)));
+  const Eigen::Vector3d e1 = across_axis(defect.axis, defect.frame), e2 = defect.axis.cross(e1);
+  std::vector<double> bearing(rim.size());
+  for (size_t i = 0; i < rim.size(); ++i) {
+    const Eigen::Vector3d d = rim[i] - defect.center;
+    bearing[i] = std::atan2(d.dot(e2), d.dot(e1));
+  }
+  std::vector<size_t> picks;
+  for (int k = 0; k < count; ++k) {
+    const double want = -M_PI + (k + 0.5) * 2.0 * M_PI / count;
+    size_t best = 0;
+    for (size_t i = 1; i < rim.size(); ++i)
+      if (std::abs(std::remainder(bearing[i] - want, 2.0 * M_PI)) <
+          std::abs(std::remainder(bearing[best] - want, 2.0 * M_PI)))
+        best = i;
+    if (picks.empty() || picks.back() != best) picks.push_back(best);
+  }
+  return picks;
+}
+
 // Where the rays start. The vault's centre (vault_center, found from the skull's vertex
 // centroid on the plane: any start in the cavity converges to it within 0.05 mm) is a property
 // of the bone: no meshing moves it by more than 0.3 mm and a crop of the face by a few
@@ -74,13 +108,15 @@ std::vector<size_t> along(const std::vector<Eigen::Vector3d>& loop, double spaci
 // grazing angle, so the start moves from there towards the opening until the opening is seen
 // 50° wide (at most half the vault's radius). An opening seen that wide from the vault's
 // centre already (SkullFix's large defects) keeps the surface centroid, where those plans were
-// measured best. The surface centroid too when there is no vault to fit or no opening seen
-// from it. Not the vertex centroid: decimation moved it 7-12 mm, on a SkullFix skull into the
+// measured best, unless it sees the opening less than half as large as the vault's centre does
+// (the vault's centre then). The surface centroid too when there is no vault to fit or no
+// opening seen from it. Not the vertex centroid: decimation moved it 7-12 mm, on a SkullFix skull into the
 // bone of its base, where no ray from it crosses one table.
 Eigen::Vector3d rays_start(const SkullMesh& skull, const SurfaceLocator& bone, const Plane& plane,
                            const DetectDefectParams& params) {
   constexpr double kSeenWide = 25.0 * M_PI / 180.0;
   constexpr double kFarthest = 0.5;
+  constexpr double kSeenSmaller = 2.0;
   const Eigen::Vector3d centroid = plane.project(surface_centroid(skull));
   double radius = 0.0;
   std::optional<Eigen::Vector3d> vault =
@@ -91,6 +127,7 @@ Eigen::Vector3d rays_start(const SkullMesh& skull, const SurfaceLocator& bone, c
   if (!vault) return centroid;
   DetectDefectParams from_vault = params;
   from_vault.frame = skull_frame(skull, *vault, plane.normal);
+  from_vault.trace_rim_on_bone = false;  // a first look: how wide the opening is seen
   const DefectRegion seen = detect_defect(skull, bone, *vault, from_vault);
   if (seen.status != DefectRegion::Status::Found || seen.outer_rim.empty()) return centroid;
   double rim = 0.0;
@@ -98,8 +135,84 @@ Eigen::Vector3d rays_start(const SkullMesh& skull, const SurfaceLocator& bone, c
   rim /= static_cast<double>(seen.outer_rim.size());
   const double half_width = std::sqrt(seen.area_mm2 / M_PI);
   const double shift = rim - half_width / std::tan(kSeenWide);
-  if (shift <= 0.0) return centroid;  // seen wide enough from the vault's centre already
+  if (shift <= 0.0) {
+    // Seen wide enough from the vault's centre already: the surface centroid, unless the
+    // opening is much smaller seen from there. A face, a jaw and a neck in the scan pull the
+    // surface centroid down to the skull base, from where most rays through a large opening on
+    // the side of the head meet the temporal bone first.
+    DetectDefectParams from_centroid = from_vault;
+    from_centroid.frame = skull_frame(skull, centroid, plane.normal);
+    const DefectRegion low = detect_defect(skull, bone, centroid, from_centroid);
+    if (low.found() && low.area_mm2 * kSeenSmaller >= seen.area_mm2) return centroid;
+    return *vault;
+  }
   return plane.project(*vault + std::min(shift, kFarthest * radius) * seen.axis);
+}
+
+// The widest angle between the opening's axis and its rim, seen from where the rays started, deg.
+double widest_rim_deg(const DefectRegion& region) {
+  double widest = 0.0;
+  for (const Eigen::Vector3d& p : region.outer_rim)
+    widest = std::max(widest, std::acos(std::clamp((p - region.center).normalized().dot(region.axis),
+                                                   -1.0, 1.0)));
+  return widest * 180.0 / M_PI;
+}
+
+constexpr double kWidestRimDeg = 60.0;
+constexpr double kSeenWithinDeg = 50.0;
+constexpr double kMinDepthMm = 10.0;
+
+// `region` seen from `from` instead of its own start: each ray through the opening re-aimed at
+// where it crosses the rim's mean distance from the start, the ray through each other opening
+// at its point 100 mm out, the rim's points as they are.
+DefectRegion seen_from(const DefectRegion& region, const Eigen::Vector3d& from) {
+  DefectRegion r = region;
+  double radius = 0.0;
+  for (const Eigen::Vector3d& p : region.outer_rim) radius += (p - region.center).norm();
+  radius /= static_cast<double>(std::max<size_t>(1, region.outer_rim.size()));
+  r.center = from;
+  Eigen::Vector3d sum = Eigen::Vector3d::Zero();
+  for (Eigen::Vector3d& d : r.hole_directions) {
+    d = (region.center + radius * d - from).normalized();
+    sum += d;
+  }
+  if (sum.norm() > 1e-9) r.axis = sum.normalized();
+  for (Eigen::Vector3d& a : r.other_axes) a = (region.center + 100.0 * a - from).normalized();
+  return r;
+}
+
+// A start from which the opening's rim is seen narrowest: along the normal of the plane that
+// best fits the rim, behind its centroid, as deep as the rim is seen within kSeenWithinDeg of
+// that normal, but kMinDepthMm or more from the bone and in sight of the first start (in the
+// cavity); none when no such point sees it narrower than from the first start.
+std::optional<Eigen::Vector3d> step_back(const SurfaceLocator& bone, const DefectRegion& region) {
+  Eigen::Vector3d g = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& p : region.outer_rim) g += p;
+  g /= static_cast<double>(region.outer_rim.size());
+  Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
+  for (const Eigen::Vector3d& p : region.outer_rim) cov += (p - g) * (p - g).transpose();
+  Eigen::Vector3d n = Eigen::SelfAdjointEigenSolver<Eigen::Matrix3d>(cov).eigenvectors().col(0);
+  if (n.dot(region.axis) < 0.0) n = -n;
+  auto widest_from = [&](const Eigen::Vector3d& start) {
+    double widest = 0.0;
+    for (const Eigen::Vector3d& p : region.outer_rim)
+      widest = std::max(widest, std::acos(std::clamp((p - start).normalized().dot(n), -1.0, 1.0)));
+    return widest * 180.0 / M_PI;
+  };
+  std::optional<Eigen::Vector3d> best;
+  double best_widest = widest_rim_deg(region) - 5.0;
+  for (double depth = 10.0; depth <= 150.0; depth += 5.0) {
+    const Eigen::Vector3d start = g - depth * n;
+    if (bone.first_hit(region.center, start) || bone.closest(start).distance < kMinDepthMm)
+      continue;
+    const double widest = widest_from(start);
+    if (widest < best_widest) {
+      best = start;
+      best_widest = widest;
+    }
+    if (widest <= kSeenWithinDeg) break;
+  }
+  return best;
 }
 
 }  // namespace
@@ -119,7 +232,19 @@ DefectRegion detect_defect_near_plane(const SkullMesh& skull, const SurfaceLocat
   const Eigen::Vector3d center =
       params.center ? *params.center : rays_start(skull, bone, plane, framed);
   if (!params.frame) framed.frame = skull_frame(skull, center, plane.normal);
-  return detect_defect(skull, bone, center, framed);
+  DefectRegion region = detect_defect(skull, bone, center, framed);
+  if (params.center || !region.found()) return region;
+  // A large opening on the side of the head (a decompressive craniectomy) is seen from the
+  // midline up to 80° wide: its surfaces and its shell are parametrised along rays that would
+  // meet its edge nearly side-on (the shell's rays stop at 75°). The opening found is then seen
+  // from further back, away from it, until its rim lies within kSeenWithinDeg of its axis (at
+  // most until the start is kMinDepthMm from the bone): its rays re-aimed from there, its rim as
+  // it is.
+  const double widest = widest_rim_deg(region);
+  if (widest <= kWidestRimDeg) return region;
+  const std::optional<Eigen::Vector3d> back = step_back(bone, region);
+  if (!back) return region;
+  return seen_from(region, *back);
 }
 
 RegionOfInterest local_registration_region(const DefectRegion& defect, double margin_mm) {
@@ -227,7 +352,10 @@ void add_edge_markers(const DefectRegion& defect, const DefectSurfaces& surfaces
     std::nth_element(r.begin(), r.begin() + r.size() / 2, r.end());
     return r.empty() ? 0.0 : r[r.size() / 2];
   };
-  for (size_t i : along(defect.outer_rim, params.edge_spacing_mm)) {
+  const std::vector<size_t> picks = defect.rim_traced
+                                        ? by_bearing(defect, params.edge_spacing_mm)
+                                        : along(defect.outer_rim, params.edge_spacing_mm);
+  for (size_t i : picks) {
     const Eigen::Vector3d& rim = defect.outer_rim[i];
     const auto fitted = surfaces.at(rim - c);
     if (fitted && (surfaces.mirror_guided || bone_beyond(rim))) {
@@ -259,6 +387,7 @@ void add_edge_markers(const DefectRegion& defect, const DefectSurfaces& surfaces
 // Not where the first bone is a cut face met side-on: it lies above where the inner table
 // goes on, and the implant's inner surface would rise to it and leave the wedge of bone under
 // the cut empty (SkullFix: median Dice 0.904 -> 0.910, boundary Dice 0.901 -> 0.924).
+
 void add_support_markers(const DefectSurfaces& surfaces, const std::vector<FittedPoints>& ring_fit,
                          const ProposeParams& params, int& id, std::vector<Marker>& out) {
   std::vector<Eigen::Vector3d> support_outer, support_inner;
@@ -266,6 +395,16 @@ void add_support_markers(const DefectSurfaces& surfaces, const std::vector<Fitte
   const double min_facing =
       std::cos(std::clamp(params.max_support_inner_tilt_deg, 0.0, 90.0) * M_PI / 180.0) - 1e-12;
   const double max_off = params.max_support_off_fit_mm;
+  // The ring's bone is one layer (ProposeParams::max_support_layers).
+  std::vector<double> thickness;
+  for (size_t i = 0; i < surfaces.ring_outer.size(); ++i)
+    if (surfaces.ring_distance_mm[i] <= band)
+      thickness.push_back((surfaces.ring_outer[i] - surfaces.ring_inner[i]).norm());
+  double max_layer = std::numeric_limits<double>::infinity();
+  if (!thickness.empty() && params.max_support_layers > 0.0) {
+    std::nth_element(thickness.begin(), thickness.begin() + thickness.size() / 2, thickness.end());
+    max_layer = params.max_support_layers * thickness[thickness.size() / 2] + 1.0;
+  }
   for (size_t i = 0; i < surfaces.ring_outer.size(); ++i)
     if (surfaces.ring_distance_mm[i] <= band) {
       // A ring point the fitted surfaces do not reach (outside their cap) is kept: nothing
@@ -277,7 +416,8 @@ void add_support_markers(const DefectSurfaces& surfaces, const std::vector<Fitte
       const bool inner_on_fit =
           !judged || (fitted->second - surfaces.ring_inner[i]).norm() <= max_off;
       if (outer_on_fit) support_outer.push_back(surfaces.ring_outer[i]);
-      if (inner_on_fit && surfaces.ring_inner_facing[i] >= min_facing)
+      if (inner_on_fit && surfaces.ring_inner_facing[i] >= min_facing &&
+          (surfaces.ring_outer[i] - surfaces.ring_inner[i]).norm() <= max_layer)
         support_inner.push_back(surfaces.ring_inner[i]);
     }
   for (size_t i : thin_points(support_outer, params.surface_spacing_mm))

@@ -191,7 +191,8 @@ std::vector<float> measure_against_bone(const SkullMesh& implant, const SkullMes
                                         const Eigen::Vector3d& axis, std::vector<int> wall_vertices,
                                         const std::vector<uint8_t>& solid, const VoxelGrid& grid,
                                         const QualityParams& params, QualityReport& q) {
-  const RimSamples s = rim_samples(implant, bone, c, axis, std::move(wall_vertices));
+  const RimSamples s =
+      rim_samples(implant, bone, c, axis, std::move(wall_vertices), params.scan_ends);
   size_t gap_at = 0;
   q.rim_gap_mm = worst_arc_gap(s.angle, s.distance, kRimArcRad, &gap_at);
   if (!s.vertices.empty()) {
@@ -300,6 +301,7 @@ QualityParams quality_params_for(const ImplantParams& params, const ImplantResul
   QualityParams q = quality_params_for(params.material, params.clearance_zones);
   q.holes = result.holes;
   q.tabs = result.tabs;
+  q.scan_ends = params.scan_ends;
   if (!result.tabs.empty()) {
     q.tab_min_bone_mm = params.tabs.min_bone_mm;
     q.tab_midline_mm = params.tabs.midline ? params.tabs.midline_distance_mm : 0.0;

@@ -147,6 +147,39 @@ Material peek_with(double clearance, double under_contour) {
   return m;
 }
 
+// Where the scan ended across the opening (ImplantParams::scan_ends, a plane whose normal
+// points out of the scan): the implant fitted to the bone is not built beyond it, and the
+// quality report counts no gap between the rim and the bone where the rim runs along it (no
+// bone is known there).
+TEST(BuildImplant, FittedToTheBoneItEndsWhereTheScanEnded) {
+  const DefectCase& c = right_parietal_case();
+  ImplantParams p;
+  p.fit_to_bone_mm = 4.0;
+  const ImplantResult whole = build_implant(c.markers, &c.defective, p);
+  ASSERT_TRUE(whole.usable()) << whole.message;
+  double lo = 1e9, hi = -1e9;
+  for (auto vh : whole.mesh.vertices()) {
+    lo = std::min<double>(lo, whole.mesh.point(vh)[1]);
+    hi = std::max<double>(hi, whole.mesh.point(vh)[1]);
+  }
+  const double end = 0.5 * (lo + hi);  // the scan ends across the implant's middle
+  p.scan_ends = {Plane{Eigen::Vector3d::UnitY(), end}};
+  const ImplantResult cut = build_implant(c.markers, &c.defective, p);
+  ASSERT_TRUE(cut.usable()) << cut.message;
+  double widest = -1e9;
+  for (auto vh : cut.mesh.vertices()) widest = std::max<double>(widest, cut.mesh.point(vh)[1]);
+  // Voxels beyond the plane are cleared; the surface meshed from the blurred mask (σ 0.3 mm) on
+  // its grid (0.25–0.45 mm) may reach a little past it.
+  EXPECT_LT(widest, end + 1.0) << "built beyond the scan";
+  EXPECT_GT(widest, end - 1.0) << "ends at the scan's end, not short of it";
+  QualityParams q;
+  const QualityReport without = check_implant(cut.mesh, &c.defective, q);
+  q.scan_ends = p.scan_ends;
+  const QualityReport with = check_implant(cut.mesh, &c.defective, q);
+  EXPECT_GT(without.rim_gap_mm, 1.0) << "the cut side stands off the bone it never meets";
+  EXPECT_LE(with.rim_gap_mm, kRimGapTargetMm) << "no gap counted along the scan's end";
+}
+
 // A material's edge clearance: over every 5° arc of the rim, the gap to the bone is the
 // clearance to 0.2 mm (the measure), and the quality report says so; mass is volume
 // times density.

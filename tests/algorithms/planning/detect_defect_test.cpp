@@ -178,14 +178,24 @@ TEST(DetectDefect, TheRimRunsAlongAFrontalSinusTheDefectOpensInto) {
   for (double off : along) EXPECT_LT(off, 23.0) << "at the defect's edge (20°), not beyond";
   EXPECT_LT(unseen_mm(found), 10.0);
   // The sinus spans about 55 mm of the rim: with 15 mm no ray there crosses bone, and all but
-  // a stray ray at the edge of its walls leave it unseen.
+  // a stray ray at the edge of its walls leave it unseen by the rays.
   params.max_thickness_mm = 15.0;
+  params.trace_rim_on_bone = false;
   const DefectRegion thin = detect_defect(skull, locator, Eigen::Vector3d::Zero(), params);
   ASSERT_TRUE(thin.found()) << thin.message;
   EXPECT_LE(over_the_sinus(thin).size(), 1u);
   EXPECT_GT(unseen_mm(thin), 30.0);
   RecordProperty("unseen_rim_mm_at_15", std::to_string(unseen_mm(thin)));
   RecordProperty("unseen_rim_mm_at_20", std::to_string(unseen_mm(found)));
+  // Traced on the bone, the rim runs along the sinus's front wall all the same.
+  params.trace_rim_on_bone = true;
+  const DefectRegion traced = detect_defect(skull, locator, Eigen::Vector3d::Zero(), params);
+  ASSERT_TRUE(traced.found()) << traced.message;
+  EXPECT_TRUE(traced.rim_traced);
+  const std::vector<double> traced_along = over_the_sinus(traced);
+  EXPECT_GE(traced_along.size(), 4u);
+  for (double off : traced_along) EXPECT_LT(off, 23.0);
+  EXPECT_EQ(unseen_mm(traced), 0.0);
 }
 
 // A skull mesh's load report gives its borders to a detection that has none; borders already

@@ -425,8 +425,9 @@ TEST(SampleCase, RimOnlyPlanMeetsTheRealBone) {
 
 // The sample's PEEK plan, its rays crossing up to 20 mm of bone (the default, set here so that
 // the case stays the same: the rim then follows the frontal sinus's front wall;
-// docs/AUTOPLAN.md) and every fitting site weighed alike (as propose_markers 5 fitted them; the
-// plan weighed by its sites' rays has neither the tab nor the hole these tests need), made with
+// docs/AUTOPLAN.md), every fitting site weighed alike (as propose_markers 5 fitted them; the
+// plan weighed by its sites' rays has neither the tab nor the hole these tests need) and inner
+// support markers however thick the ring (as propose_markers 6 placed them), made with
 // today's rules and as build_implant 11 made it: `set(params, today)` adds the tabs or holes
 // and chooses the rule. Empty when the sample is not installed.
 std::vector<AutoplanResult> peek_plans_over_the_sinus(
@@ -439,6 +440,7 @@ std::vector<AutoplanResult> peek_plans_over_the_sinus(
     AutoplanParams params;
     params.propose.detect.max_thickness_mm = 20.0;
     params.propose.surfaces.weigh_sites_by_rays = false;
+    params.propose.max_support_layers = 0.0;  // as propose_markers 6 placed them
     params.implant.material = material_preset("peek");
     set(params.implant, today);
     plans.push_back(autoplan(skull.mesh, Landmarks{}, params));

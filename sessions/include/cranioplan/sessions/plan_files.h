@@ -22,6 +22,7 @@ using Json = nlohmann::ordered_json;
 
 Json to_json(const Eigen::Vector3d& v);
 Json to_json(const Plane& plane);       ///< {"normal":[..],"offset_mm":d}
+Json to_json(const std::vector<Plane>& planes);  ///< a list of planes
 Json to_json(const RigidTransform& t);  ///< {"rotation":[[..],[..],[..]],"translation":[..]}
 Json to_json(const Landmarks& lm);
 Json to_json(const MeshReport& r);
@@ -34,6 +35,7 @@ Json to_json(const SoftTissueCheck& c);  ///< without the intruding voxels' posi
 /// Readers of the same forms; `source` names the file in error messages. Throw InputError.
 Eigen::Vector3d vector_from_json(const Json& j, const std::string& source, const std::string& what);
 Plane plane_from_json(const Json& j, const std::string& source);
+std::vector<Plane> planes_from_json(const Json& j, const std::string& source);
 RigidTransform transform_from_json(const Json& j, const std::string& source);
 Landmarks landmarks_from_json(const Json& j, const std::string& source);
 /// The form to_json(RegisterResult) writes, read back; errors name `source`.

@@ -148,6 +148,9 @@ struct PlanState {
   /// From the last proposal: stretches of the rim no ray saw, where the outline between the
   /// edge markers is interpolated (the view draws them for the surgeon to check).
   std::vector<RimStretch> unseen_rim;
+  /// From the last proposal: where the scan ended across the opening (DefectRegion::scan_ends);
+  /// the implant ends there unless its parameters say where.
+  std::vector<Plane> scan_ends;
   // Step 7
   std::optional<ImplantParams> implant_params;  ///< rebuilt after every marker change
   std::shared_ptr<const ImplantData> implant;

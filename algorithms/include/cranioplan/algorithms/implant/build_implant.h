@@ -11,6 +11,7 @@
 #include "cranioplan/model/marker.h"
 #include "cranioplan/model/material.h"
 #include "cranioplan/model/mesh.h"
+#include "cranioplan/model/plane.h"
 
 namespace cranioplan {
 
@@ -55,6 +56,15 @@ struct ImplantParams {
   /// millimetre short of it turns on the margin. false: the margin asked only (build_implant
   /// commands before version 13).
   bool fit_margin_search = true;
+  /// Fitted to the bone, the shell is kept at least half a millimetre thicker than the fit's
+  /// smallest feature (`trim.min_feature_mm`), so that the fit does not open away a thin part
+  /// (a mirrored temporal squama of 1.5 mm) and leave a hole by the rim. false: the surfaces'
+  /// own thickness, down to 0.3 mm (build_implant commands before version 14).
+  bool fit_keeps_shell_thick = true;
+  /// Where the scan ended across the opening (DefectRegion::scan_ends): the implant ends at
+  /// these planes (their normals point out of the scanned volume), and its edge along them is
+  /// not judged against bone, which beyond the scan is unknown. With the fit to the bone only.
+  std::vector<Plane> scan_ends;
   TrimToBoneParams trim;  ///< how the shell is fitted to the bone (when fit_to_bone_mm > 0)
   /// What the implant is made of (none: the plan's surfaces as they are). A thickness of the
   /// material's replaces the inner surface (inner markers are not used); its under-contour sets

@@ -10,6 +10,7 @@
 
 #include "cranioplan/model/material.h"
 #include "cranioplan/model/mesh.h"
+#include "cranioplan/model/plane.h"
 
 namespace cranioplan {
 
@@ -52,10 +53,15 @@ struct RimSamples {
   std::vector<double> angle, distance;
   std::vector<Eigen::Vector3d> nearest;
 };
-/// `wall_vertices`: the side wall's vertices (repeats allowed).
+/// A wall vertex this near a plane where the scan ended lies at the scan's end, mm.
+inline constexpr double kAtScanEndMm = 1.0;
+
+/// `wall_vertices`: the side wall's vertices (repeats allowed). A vertex within kAtScanEndMm
+/// of a plane of `scan_ends` (where the scan ended: the implant ends there, and no bone is
+/// known beyond) counts as meeting the bone (distance 0, facing itself).
 RimSamples rim_samples(const SkullMesh& implant, const SurfaceLocator& bone,
                        const Eigen::Vector3d& c, const Eigen::Vector3d& axis,
-                       std::vector<int> wall_vertices);
+                       std::vector<int> wall_vertices, const std::vector<Plane>& scan_ends = {});
 
 /// Each sample's gap over the clearance asked at the bone it faces (`clearance_mm`, or a
 /// zone's); samples with `skip[i]` set count as exactly as asked (0). `skip` may be empty.
@@ -71,6 +77,7 @@ struct RimGap {
   std::optional<Eigen::Vector3d> at;
 };
 RimGap rim_gap(const SkullMesh& implant, const SurfaceLocator& bone, bool clearance_asked,
-               double clearance_mm, const std::vector<ClearanceZone>& zones);
+               double clearance_mm, const std::vector<ClearanceZone>& zones,
+               const std::vector<Plane>& scan_ends = {});
 
 }  // namespace cranioplan

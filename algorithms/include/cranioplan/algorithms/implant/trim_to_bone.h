@@ -10,6 +10,7 @@
 
 #include "cranioplan/model/material.h"
 #include "cranioplan/model/mesh.h"
+#include "cranioplan/model/plane.h"
 
 namespace cranioplan {
 
@@ -53,6 +54,9 @@ struct TrimToBoneParams {
   /// triangles without area, whose neighbours seem to cross. false: meshed as it comes
   /// (build_implant commands before version 11).
   bool iso_gap = true;
+  /// Where the scan ended (ImplantParams::scan_ends): what lies beyond these planes (on their
+  /// normals' side) is cut away.
+  std::vector<Plane> scan_ends;
 };
 
 struct TrimToBoneResult {

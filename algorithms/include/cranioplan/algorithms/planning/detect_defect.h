@@ -69,6 +69,18 @@ struct DetectDefectParams {
   /// report already (a skull mesh read by load_skull) gives them from it, and an empty list
   /// says the scan ended nowhere. detect_defect takes unset as none.
   std::optional<std::vector<ScanBorder>> scan_borders;
+  /// The rim traced on the bone itself (trace_rim.h) from where the rays saw it, so that the
+  /// stretches of the edge the rays graze or cannot reach are found too; the opening is then
+  /// every ray inside the traced rim. false: the rim the rays saw (the quick look a ray start
+  /// is chosen from, detect_defect_near_plane).
+  bool trace_rim_on_bone = true;
+  /// The rim is traced on the bone for an opening at least this large (mm², at the rays' rim
+  /// radius) and for one whose rays' rim leaves a stretch of `trace_from_unseen_mm` or more
+  /// unseen. A smaller opening the rays saw all round keeps
+  /// their rim: there the rays see the edge nearly square, and their rim moves less with the
+  /// rays' start than the traced one (docs/AUTOPLAN.md, "The rim traced on the bone").
+  double trace_from_area_mm2 = 3000.0;
+  double trace_from_unseen_mm = 25.0;
 };
 
 /// Gives `params` the scan's borders from the report a skull mesh was read with
@@ -110,6 +122,16 @@ struct DefectRegion {
   /// graze the bone or meet other bone first (along an orbit), so the outline there is
   /// interpolated between rim points far apart. The message names them; the wizard draws them.
   std::vector<RimStretch> unseen_rim;
+  /// The rim was traced on the bone (DetectDefectParams::trace_rim_on_bone): `outer_rim` is the
+  /// outer table's edge about 1 mm apart all round, and `unseen_rim` is empty.
+  bool rim_traced = false;
+  /// Stretches where the traced rim runs along the scan's end (the mesh's open border or a flat
+  /// cap) rather than a cut face: the opening reaches the scan's border there, and the bone
+  /// beyond it is unknown.
+  std::vector<RimStretch> at_scan_border;
+  /// The planes of the borders the traced rim runs along (ScanBorder's normal and offset: the
+  /// normal points out of the scanned volume): the implant ends there (ImplantParams::scan_ends).
+  std::vector<Plane> scan_ends;
   /// With DetectDefectParams::near: the angle, seen from `center`, between the point and the
   /// opening's nearest ray, degrees (0 when the point lies in the opening's direction). Over
   /// kNearMissDeg the message says that no opening lies towards the point.

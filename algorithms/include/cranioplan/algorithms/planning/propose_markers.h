@@ -40,6 +40,11 @@ struct ProposeParams {
   /// further than this from the fitted table along its ray is not where the table goes on (a
   /// fragment below a sinus, an orbital roof, bone across the opening), mm (0: off).
   double max_support_off_fit_mm = 1.5;
+  /// Inner support markers only where the ring's bone is at most this many times its median
+  /// thickness (plus 1 mm): a ray through much more bone met the inner table where it turns
+  /// into other bone (the floor of a fossa below a flap's lower edge, a sinus's walls), and a
+  /// marker there pulls the implant's inner surface down to it (0: no limit).
+  double max_support_layers = 2.0;
   SmoothParams smooth{10.0, 2.0, 1};  ///< applied to surface markers (put back after)
   DefectSurfaceParams surfaces;       ///< fitting the surfaces to the intact ring
 };

@@ -9,6 +9,7 @@
 #include "cranioplan/algorithms/implant/rim_gap.h"
 #include "cranioplan/model/material.h"
 #include "cranioplan/model/mesh.h"
+#include "cranioplan/model/plane.h"
 
 namespace cranioplan {
 
@@ -46,6 +47,9 @@ struct QualityParams {
   double max_tab_gap_mm = 0.2;   ///< mm
   double tab_min_bone_mm = 0.0;  ///< mm
   double tab_midline_mm = 0.0;   ///< mm (judged when the tabs were placed with the plane)
+  /// Where the scan ended across the opening (ImplantParams::scan_ends): the edge along these
+  /// planes is not judged against bone.
+  std::vector<Plane> scan_ends;
 };
 
 /// The quality check a build with a material asks for: its minimum thickness, clearance,
