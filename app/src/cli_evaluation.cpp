@@ -151,12 +151,9 @@ Json study_summary(const Json& rows) {
     }
     if (row.contains("seconds")) secs.push_back(row.at("seconds"));
   }
-  return Json{{"defects", rows.size()},
-              {"printable", printable},
-              {"median_dice", median(dsc)},
-              {"median_boundary_dice", median(bdsc)},
-              {"median_hd95_mm", median(hd95)},
-              {"median_seconds", median_or_null(secs)}};
+  return Json{{"defects", rows.size()},         {"printable", printable},
+              {"median_dice", median(dsc)},     {"median_boundary_dice", median(bdsc)},
+              {"median_hd95_mm", median(hd95)}, {"median_seconds", median_or_null(secs)}};
 }
 
 // Every case is in the table; the exit code says whether all of them were planned.
@@ -431,8 +428,8 @@ Subcommand add_study(CLI::App& app, const bool& json) {
           std::vector<Eigen::Vector3d> points;
           InjectDefectParams ip;
           if (spheres) {
-            const auto sphere =
-                sphere_defect(skull, bone, k, o->min_size.value_or(30.0), o->max_size.value_or(50.0));
+            const auto sphere = sphere_defect(skull, bone, k, o->min_size.value_or(30.0),
+                                              o->max_size.value_or(50.0));
             if (!sphere) continue;
             ip = *sphere;
             points = {ip.center};
@@ -496,8 +493,9 @@ Subcommand add_study(CLI::App& app, const bool& json) {
             write_mesh(d.implant, case_file(o->cases_out, k, "truth"), loaded.file_space);
           }
           if (!json)
-            std::cout << k << "  " << (spheres ? "size " + std::to_string(ip.size_mm) + " mm"
-                                              : row["flap"].get<std::string>())
+            std::cout << k << "  "
+                      << (spheres ? "size " + std::to_string(ip.size_mm) + " mm"
+                                  : row["flap"].get<std::string>())
                       << "  " << row.value("method", "-") << "  DSC " << row.value("dice", 0.0)
                       << "  bDSC " << row.value("boundary_dice", 0.0) << "  HD95 "
                       << row.value("hd95_mm", 0.0) << " mm  " << row["seconds"].get<double>()

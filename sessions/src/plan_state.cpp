@@ -900,12 +900,9 @@ void apply_step(PlanState& s, CommandType type, const ParamReader& r) {
 
 Json proposal_result(const MarkerProposal& p) {
   if (!p.proposed())
-    return Json{{"proposed", false},
-                {"markers", Json::array()},
-                {"defect_center", nullptr},
-                {"unseen_rim", Json::array()},
-                {"scan_ends", Json::array()},
-                {"message", "no markers proposed: " + p.message}};
+    return Json{{"proposed", false},          {"markers", Json::array()},
+                {"defect_center", nullptr},   {"unseen_rim", Json::array()},
+                {"scan_ends", Json::array()}, {"message", "no markers proposed: " + p.message}};
   const std::string proposed = std::to_string(p.markers.size()) + " markers proposed, " +
                                describe_method(p.method_used, p.mirror_coverage) + "; ";
   Json unseen = Json::array();

@@ -549,10 +549,10 @@ TEST(Cli, StudyOfFlapsNeedsTheFloorOfTheSkull) {
   test::TempDir dir;
   write_mesh(test::make_thick_head(), dir.path("thick.stl"));
   std::string out;
-  EXPECT_EQ(test::run_command("(" + kCli + " study --shape flap --count 1 " +
-                                  dir.path("thick.stl") + " 2>&1)",
-                              &out),
-            3)
+  EXPECT_EQ(
+      test::run_command(
+          "(" + kCli + " study --shape flap --count 1 " + dir.path("thick.stl") + " 2>&1)", &out),
+      3)
       << out;
   EXPECT_NE(out.find("thick.stl"), std::string::npos) << out;
   EXPECT_NE(out.find("floor of the cranial fossae"), std::string::npos) << out;

@@ -65,6 +65,21 @@ Mask dilate(const Mask& in, const VoxelGrid& g) {
   return out;
 }
 
+// Calls `f` with the index of every voxel whose centre lies beyond one of `ends` (planes whose
+// normals point out of the scan).
+template <class F>
+void for_each_beyond(const VoxelGrid& grid, const std::vector<Plane>& ends, F&& f) {
+  if (ends.empty()) return;
+  for (int k = 0; k < grid.dims[2]; ++k)
+    for (int j = 0; j < grid.dims[1]; ++j)
+      for (int i = 0; i < grid.dims[0]; ++i) {
+        const Eigen::Vector3d x = grid.center(i, j, k);
+        if (std::any_of(ends.begin(), ends.end(),
+                        [&](const Plane& end) { return end.signed_distance(x) > 0.0; }))
+          f(grid.index(i, j, k));
+      }
+}
+
 // Keeps the largest 6-connected piece (the first found, by its lowest voxel index, among
 // pieces as large). Each piece is gathered as a list of its voxels; only the largest list is
 // kept, so the work follows the mask's voxels rather than the grid's.
@@ -395,15 +410,7 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull,
     mask[c] = mask[c] && !bone[c];
   }
   // Beyond the scan's end the bone is unknown: the implant ends there.
-  if (!params.scan_ends.empty())
-    for (int k = 0; k < grid.dims[2]; ++k)
-      for (int j = 0; j < grid.dims[1]; ++j)
-        for (int i = 0; i < grid.dims[0]; ++i) {
-          const size_t c = grid.index(i, j, k);
-          if (!mask[c]) continue;
-          for (const Plane& end : params.scan_ends)
-            if (end.signed_distance(grid.center(i, j, k)) > 0.0) mask[c] = 0;
-        }
+  for_each_beyond(grid, params.scan_ends, [&](size_t c) { mask[c] = 0; });
   clock.mark("voxels");
   // The skull's triangles near the grid suffice for distances up to a few voxels beyond the
   // widest clearance.
@@ -517,11 +524,7 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull,
   Mask().swap(bone);
   // The bridge and the blur may carry the implant back over the scan's end: nothing beyond it
   // (the surface then ends within a voxel of it).
-  for (const Plane& end : params.scan_ends)
-    for (int k = 0; k < grid.dims[2]; ++k)
-      for (int j = 0; j < grid.dims[1]; ++j)
-        for (int i = 0; i < grid.dims[0]; ++i)
-          if (end.signed_distance(grid.center(i, j, k)) > 0.0) smooth[grid.index(i, j, k)] = 0.0f;
+  for_each_beyond(grid, params.scan_ends, [&](size_t c) { smooth[c] = 0.0f; });
   if (params.iso_gap) keep_off_iso_level(smooth);
   // The implant as the meshing gives it: plans saved before meshes were made canonical replay
   // to their bytes.

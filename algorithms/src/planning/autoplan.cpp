@@ -154,7 +154,7 @@ ImplantParams implant_params(const DefectRegion& defect, const Plane& plane,
                              const AutoplanParams& params) {
   ImplantParams implant = params.implant;
   implant.radial_center = defect.center;  // the rays that found the opening
-  implant.scan_ends = defect.scan_ends;    // where the opening runs into the scan's end
+  implant.scan_ends = defect.scan_ends;   // where the opening runs into the scan's end
   if (implant.tabs.any() && !implant.tabs.midline) implant.tabs.midline = plane;
   return implant;
 }

@@ -583,11 +583,11 @@ void trace_on_bone(const SkullMesh& skull, const SurfaceLocator& locator, const 
       }
   }
   const TracedRim traced =
-      trace_rim_on_bone(skull, locator, region.center, region.axis, e1, band,
-                        region.outer_rim, region.inner_rim, outer_seeds, inner_seeds, borders);
+      trace_rim_on_bone(skull, locator, region.center, region.axis, e1, band, region.outer_rim,
+                        region.inner_rim, outer_seeds, inner_seeds, borders);
   if (!traced.traced()) return;
-  const std::vector<char> inside = inside_loop(fan.dirs, traced.outer, region.center,
-                                               region.axis, e1);
+  const std::vector<char> inside =
+      inside_loop(fan.dirs, traced.outer, region.center, region.axis, e1);
   // The opening: the rays inside the traced rim, but for those that meet bone about as far out
   // as the rim (the wedge of an oblique cut face, inside its outer corner). Bone met well
   // inside the rim is seen through the opening (the floor of a fossa below a flap's lower
@@ -601,8 +601,8 @@ void trace_on_bone(const SkullMesh& skull, const SurfaceLocator& locator, const 
   std::sort(rim_by_bearing.begin(), rim_by_bearing.end());
   auto rim_radius = [&](const Eigen::Vector3d& dir) {
     const double b = std::atan2(dir.dot(e2), dir.dot(e1));
-    auto it = std::lower_bound(rim_by_bearing.begin(), rim_by_bearing.end(),
-                               std::make_pair(b, -1.0));
+    auto it =
+        std::lower_bound(rim_by_bearing.begin(), rim_by_bearing.end(), std::make_pair(b, -1.0));
     if (it == rim_by_bearing.end()) it = rim_by_bearing.begin();
     return it->second;
   };
@@ -738,8 +738,7 @@ std::string DefectRegion::describe(bool others_planned) const {
   if (!at_scan_border.empty()) {
     double along = 0.0;
     for (const RimStretch& s : at_scan_border) along += s.length_mm();
-    text += "; the opening reaches the scan's border (along " +
-            std::to_string(std::lround(along)) +
+    text += "; the opening reaches the scan's border (along " + std::to_string(std::lround(along)) +
             " mm): the bone beyond the scan is unknown, and the implant ends there";
   }
   return text;

@@ -80,8 +80,9 @@ std::vector<size_t> by_bearing(const DefectRegion& defect, double spacing) {
   if (rim.size() < 3) return along(rim, spacing);
   double length = 0.0;
   for (size_t i = 0; i < rim.size(); ++i) length += (rim[(i + 1) % rim.size()] - rim[i]).norm();
-  const int count = std::max(
-      kBearingSteps, kBearingSteps * static_cast<int>(std::lround(length / spacing / kBearingSteps)));
+  const int count =
+      std::max(kBearingSteps,
+               kBearingSteps * static_cast<int>(std::lround(length / spacing / kBearingSteps)));
   const Eigen::Vector3d e1 = across_axis(defect.axis, defect.frame), e2 = defect.axis.cross(e1);
   std::vector<double> bearing(rim.size());
   for (size_t i = 0; i < rim.size(); ++i) {
@@ -110,8 +111,8 @@ std::vector<size_t> by_bearing(const DefectRegion& defect, double spacing) {
 // centre already (SkullFix's large defects) keeps the surface centroid, where those plans were
 // measured best, unless it sees the opening less than half as large as the vault's centre does
 // (the vault's centre then). The surface centroid too when there is no vault to fit or no
-// opening seen from it. Not the vertex centroid: decimation moved it 7-12 mm, on a SkullFix skull into the
-// bone of its base, where no ray from it crosses one table.
+// opening seen from it. Not the vertex centroid: decimation moved it 7-12 mm, on a SkullFix skull
+// into the bone of its base, where no ray from it crosses one table.
 Eigen::Vector3d rays_start(const SkullMesh& skull, const SurfaceLocator& bone, const Plane& plane,
                            const DetectDefectParams& params) {
   constexpr double kSeenWide = 25.0 * M_PI / 180.0;
@@ -153,8 +154,8 @@ Eigen::Vector3d rays_start(const SkullMesh& skull, const SurfaceLocator& bone, c
 double widest_rim_deg(const DefectRegion& region) {
   double widest = 0.0;
   for (const Eigen::Vector3d& p : region.outer_rim)
-    widest = std::max(widest, std::acos(std::clamp((p - region.center).normalized().dot(region.axis),
-                                                   -1.0, 1.0)));
+    widest = std::max(widest, std::acos(std::clamp(
+                                  (p - region.center).normalized().dot(region.axis), -1.0, 1.0)));
   return widest * 180.0 / M_PI;
 }
 

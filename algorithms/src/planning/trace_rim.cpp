@@ -75,7 +75,8 @@ std::vector<Eigen::Vector3d> smooth_vertex_normals(const SkullMesh& mesh) {
     parallel_for(n.size(), [&](size_t first, size_t last) {
       for (size_t i = first; i < last; ++i) {
         Eigen::Vector3d sum = n[i];
-        for (auto w : mesh.vv_range(mesh.vertex_handle(static_cast<unsigned>(i)))) sum += n[w.idx()];
+        for (auto w : mesh.vv_range(mesh.vertex_handle(static_cast<unsigned>(i))))
+          sum += n[w.idx()];
         next[i] = sum.norm() > 0.0 ? Eigen::Vector3d(sum.normalized()) : Eigen::Vector3d::Zero();
       }
     });
@@ -164,7 +165,8 @@ class Table {
     for (size_t k = 0; k < pieces.size(); ++k) {
       if (keep[k]) continue;
       double area = 0.0;
-      for (int f : pieces[k]) area += 0.5 * face_corners(mesh_, mesh_.face_handle(f)).cross().norm();
+      for (int f : pieces[k])
+        area += 0.5 * face_corners(mesh_, mesh_.face_handle(f)).cross().norm();
       if (area < kMinPieceMm2) continue;
       for (int f : pieces[k]) {
         const Eigen::Vector3d d = centroid(f) - center_;
@@ -214,9 +216,9 @@ class Table {
 // A place the edge may run through in a sector: a point of the table's boundary.
 struct Candidate {
   Eigen::Vector3d point;
-  double theta;      // angle from the axis, rad
-  double radius;     // distance from the centre, mm
-  bool at_border;    // the face beyond is the scan's end
+  double theta;    // angle from the axis, rad
+  double radius;   // distance from the centre, mm
+  bool at_border;  // the face beyond is the scan's end
 };
 
 // In each sector of bearing around the axis, the table's boundary as up to kCandidates
@@ -299,8 +301,9 @@ std::vector<std::vector<Candidate>> edge_candidates(const SkullMesh& mesh, const
 // on without jumps, near the axis, and through the rim the rays saw where they saw it: the least
 // cost closed path through the sectors (dynamic programming, each candidate of a sector the rays
 // saw tried as the start). Costs in millimetres at the rim's radius `scale`: the angle from the
-// axis beyond the sector's nearest candidate (a little), the step from sector to sector in angle and in distance from the centre, the
-// distance from the rim point the rays saw in the sector, and a sector passed without a point.
+// axis beyond the sector's nearest candidate (a little), the step from sector to sector in angle
+// and in distance from the centre, the distance from the rim point the rays saw in the sector, and
+// a sector passed without a point.
 std::vector<int> choose_edge(const std::vector<std::vector<Candidate>>& candidates,
                              const std::vector<std::optional<Eigen::Vector3d>>& seen,
                              double scale) {
@@ -384,7 +387,7 @@ std::vector<int> choose_edge(const std::vector<std::vector<Candidate>>& candidat
 // reaches into the opening or along crushed fragments, as along the orbit's rim below the
 // sample's defect, not the vault's edge. Its sectors are left out, and the rim runs straight
 // across them (a grey-scale opening of the edge's angle from the axis over the sectors).
-constexpr int kBaySectors = 16;        // half the window: 8° of bearing
+constexpr int kBaySectors = 16;  // half the window: 8° of bearing
 constexpr double kBayDepthDeg = 4.0;
 
 std::vector<char> narrow_bays(const std::vector<std::vector<Candidate>>& candidates,
@@ -393,10 +396,13 @@ std::vector<char> narrow_bays(const std::vector<std::vector<Candidate>>& candida
   std::vector<double> theta(kSectors, none);
   for (int k = 0; k < kSectors; ++k)
     if (chosen[k] >= 0) theta[k] = candidates[k][chosen[k]].theta;
-  auto at = [&](const std::vector<double>& v, int k) { return v[((k % kSectors) + kSectors) % kSectors]; };
+  auto at = [&](const std::vector<double>& v, int k) {
+    return v[((k % kSectors) + kSectors) % kSectors];
+  };
   std::vector<double> eroded(kSectors, none), opened(kSectors, -none);
   for (int k = 0; k < kSectors; ++k)
-    for (int j = -kBaySectors; j <= kBaySectors; ++j) eroded[k] = std::min(eroded[k], at(theta, k + j));
+    for (int j = -kBaySectors; j <= kBaySectors; ++j)
+      eroded[k] = std::min(eroded[k], at(theta, k + j));
   for (int k = 0; k < kSectors; ++k)
     for (int j = -kBaySectors; j <= kBaySectors; ++j)
       if (at(eroded, k + j) < none) opened[k] = std::max(opened[k], at(eroded, k + j));
@@ -594,16 +600,14 @@ TracedRim trace_rim_on_bone(const SkullMesh& skull, const SurfaceLocator& bone,
                             const std::vector<Eigen::Vector3d>& seen_inner_rim,
                             const std::vector<Eigen::Vector3d>& outer_seeds,
                             const std::vector<Eigen::Vector3d>& inner_seeds,
-                            const std::vector<ScanBorder>& borders,
-                            const TraceRimParams& params) {
+                            const std::vector<ScanBorder>& borders, const TraceRimParams& params) {
   const auto t0 = std::chrono::steady_clock::now();
   TracedRim r;
   auto done = [&] {
     r.seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     return r;
   };
-  if (hole_directions.empty() || outer_seeds.empty() || seen_rim.empty() ||
-      skull.n_faces() == 0) {
+  if (hole_directions.empty() || outer_seeds.empty() || seen_rim.empty() || skull.n_faces() == 0) {
     r.message = "no opening to trace";
     return done();
   }
@@ -612,8 +616,8 @@ TracedRim trace_rim_on_bone(const SkullMesh& skull, const SurfaceLocator& bone,
       band_faces(skull, center, hole_directions, std::clamp(params.band_deg, 5.0, 90.0) * kDeg);
   r.faces_examined = band.size();
   const std::vector<Eigen::Vector3d> vn = smooth_vertex_normals(skull);
-  const TableEdge outer = trace_table(skull, bone, vn, project, center, band, outer_seeds,
-                                      seen_rim, borders, true, params);
+  const TableEdge outer = trace_table(skull, bone, vn, project, center, band, outer_seeds, seen_rim,
+                                      borders, true, params);
   if (!covers_enough(outer.sector)) {
     r.message = "the outer table's edge was not found all around the opening";
     return done();

@@ -26,8 +26,7 @@ Eigen::Vector3d at_elevation(const Eigen::Vector3d& out, const Eigen::Vector3d& 
 // the wall above (the floor, met obliquely) or that meets no bone; its first bone. Nothing when
 // no wall is seen above or no floor below.
 std::optional<Eigen::Vector3d> floor_point(const SurfaceLocator& bone, const Eigen::Vector3d& apex,
-                                           const Eigen::Vector3d& out,
-                                           const Eigen::Vector3d& up) {
+                                           const Eigen::Vector3d& out, const Eigen::Vector3d& up) {
   std::vector<double> wall;
   for (int deg = 40; deg >= 0; deg -= 2) {
     const RayThroughBone h =
@@ -97,7 +96,8 @@ FlapPlacement place_flap(const SkullMesh& skull, const SurfaceLocator& bone, con
   }
   const double front_end = std::min(fwd + 0.5 * length / side_radius, 80.0 * kDeg);
   const Eigen::Vector3d front_out =
-      bifrontal ? front : (std::cos(front_end) * lateral + std::sin(front_end) * front).normalized();
+      bifrontal ? front
+                : (std::cos(front_end) * lateral + std::sin(front_end) * front).normalized();
   const std::optional<Eigen::Vector3d> front_floor = floor_point(bone, *apex, front_out, up);
   const std::optional<Eigen::Vector3d> side_floor =
       bifrontal ? front_floor : floor_point(bone, *apex, out, up);
@@ -144,8 +144,10 @@ FlapPlacement place_flap(const SkullMesh& skull, const SurfaceLocator& bone, con
   r.outer_radius_mm = radius;
   char buf[200];
   std::snprintf(buf, sizeof(buf), "%s flap %.0f × %.0f mm, %.0f mm off the midline",
-                bifrontal ? "bifrontal" : side > 0 ? "left" : "right", length, width,
-                cut.midline_margin_mm);
+                bifrontal  ? "bifrontal"
+                : side > 0 ? "left"
+                           : "right",
+                length, width, cut.midline_margin_mm);
   r.message = buf;
   return r;
 }

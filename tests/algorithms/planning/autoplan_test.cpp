@@ -261,7 +261,7 @@ TEST(Autoplan, SkullFixCaseAcrossTheMidlineMatchesTheGroundTruth) {
 // The worst of the library's flaps in docs/AUTOPLAN.md's table, and the Dice it planned at
 // (measured less 0.03: the plan moves with the rays' start by about that much).
 constexpr const char* kWorstFlapSkull = "034_complete_skull.nrrd";
-constexpr int kWorstFlap = 1;  // a right flap 145 × 105 mm, 16 mm off the midline
+constexpr int kWorstFlap = 1;            // a right flap 145 × 105 mm, 16 mm off the midline
 constexpr double kWorstFlapDice = 0.66;  // measured 0.696 (the registered mirror alone: 0.753)
 
 // Real bone when present (../shared/data/skull-library, beside the SkullFix cases; skipped

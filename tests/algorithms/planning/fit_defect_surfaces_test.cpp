@@ -109,7 +109,8 @@ const PlateCase& plate_case() {
     PlateCase k;
     k.skull = with_plate_in_the_opening();
     k.bone = std::make_unique<SurfaceLocator>(k.skull);
-    // Its rim traced on the bone whatever the opening's size (DetectDefectParams::trace_from_area_mm2).
+    // Its rim traced on the bone whatever the opening's size
+    // (DetectDefectParams::trace_from_area_mm2).
     DetectDefectParams traced;
     traced.trace_from_area_mm2 = 0.0;
     k.defect = detect_defect(k.skull, *k.bone, the_case().defect.center, traced);

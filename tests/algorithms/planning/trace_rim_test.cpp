@@ -36,7 +36,8 @@ const ShelfedFlap& shelfed_flap() {
     for (auto vh : inner.vertices()) inner.set_point(vh, inner.point(vh) * 0.93);
     const auto [lo, hi] = mesh_bounds(outer);
     const VoxelGrid grid = VoxelGrid::covering(lo, hi, 0.5);
-    const std::vector<uint8_t> head = voxelize_mesh(outer, grid), cavity = voxelize_mesh(inner, grid);
+    const std::vector<uint8_t> head = voxelize_mesh(outer, grid),
+                               cavity = voxelize_mesh(inner, grid);
     k.flap.apex = Eigen::Vector3d::Zero();
     k.flap.axis = Eigen::Vector3d(1.0, 0.0, 0.45).normalized();
     k.flap.along = unit_across(Eigen::Vector3d::UnitY(), k.flap.axis);
@@ -91,7 +92,8 @@ double distance_to_polyline(const Eigen::Vector3d& p, const std::vector<Eigen::V
   for (size_t i = 0; i < loop.size(); ++i) {
     const Eigen::Vector3d& a = loop[i];
     const Eigen::Vector3d& b = loop[(i + 1) % loop.size()];
-    const double t = std::clamp((p - a).dot(b - a) / std::max(1e-12, (b - a).squaredNorm()), 0.0, 1.0);
+    const double t =
+        std::clamp((p - a).dot(b - a) / std::max(1e-12, (b - a).squaredNorm()), 0.0, 1.0);
     best = std::min(best, (a + t * (b - a) - p).norm());
   }
   return best;

@@ -62,9 +62,9 @@ TEST(InjectDefect, AFlapIsAnEllipticalConeOffTheMidlineAboveTheFloor) {
   cut.midline = Plane{Eigen::Vector3d::UnitX(), 20.0};
   cut.midline_margin_mm = 15.0;
   cut.one_side = 1;
-  EXPECT_TRUE(cut.contains(at(0, 0)));                             // 70 mm off the plane
-  EXPECT_FALSE(cut.contains(Eigen::Vector3d(30.0, 0.0, 0.0)));     // 10 mm off it
-  EXPECT_TRUE(cut.contains(Eigen::Vector3d(36.0, 0.0, 0.0)));      // 16 mm off it
+  EXPECT_TRUE(cut.contains(at(0, 0)));                          // 70 mm off the plane
+  EXPECT_FALSE(cut.contains(Eigen::Vector3d(30.0, 0.0, 0.0)));  // 10 mm off it
+  EXPECT_TRUE(cut.contains(Eigen::Vector3d(36.0, 0.0, 0.0)));   // 16 mm off it
   cut.one_side = -1;
   EXPECT_FALSE(cut.contains(at(0, 0))) << "the other side only";
   cut.one_side = 1;

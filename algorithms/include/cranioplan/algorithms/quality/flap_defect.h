@@ -38,9 +38,9 @@ struct FlapPlacementParams {
 };
 
 struct FlapPlacement {
-  std::optional<FlapCut> cut;   ///< none when the skull's vault or floor was not found
-  std::string message;          ///< what was placed, or why nothing was
-  double outer_radius_mm = 0.0; ///< the outer table's distance from the apex along the axis
+  std::optional<FlapCut> cut;    ///< none when the skull's vault or floor was not found
+  std::string message;           ///< what was placed, or why nothing was
+  double outer_radius_mm = 0.0;  ///< the outer table's distance from the apex along the axis
 };
 
 /// Places a flap on a complete skull whose midsagittal plane is `plane`, in the patient's frame

@@ -18,7 +18,7 @@ namespace cranioplan {
 /// with `one_side` only bone on that side of the plane is cut. Bone below `floor` (its negative
 /// side: the floor of the cranial fossae, which a craniectomy reaches but does not cross) is kept.
 struct FlapCut {
-  Eigen::Vector3d apex = Eigen::Vector3d::Zero();  ///< inside the cavity, mm
+  Eigen::Vector3d apex = Eigen::Vector3d::Zero();    ///< inside the cavity, mm
   Eigen::Vector3d axis = Eigen::Vector3d::UnitX();   ///< unit, towards the flap's centre
   Eigen::Vector3d along = Eigen::Vector3d::UnitY();  ///< unit, across the axis: the long direction
   double half_length_rad = 0.8;                      ///< angular half-length along `along`
