@@ -370,6 +370,43 @@ SkullMesh joined(const std::vector<const SkullMesh*>& meshes) {
   return build_mesh(all);
 }
 
+// The k-th defect of `study`: its cut, the points a user would click to choose its openings,
+// and what its row says of it.
+struct StudyDefect {
+  InjectDefectParams cut;
+  std::vector<Eigen::Vector3d> points;
+};
+
+// A sphere of the series (sphere_defect); none when it does not fit the skull.
+std::optional<StudyDefect> sphere_study_defect(const SkullMesh& skull, const SurfaceLocator& bone,
+                                               int k, double min_size, double max_size, Json& row) {
+  const auto sphere = sphere_defect(skull, bone, k, min_size, max_size);
+  if (!sphere) return std::nullopt;
+  row["center"] = to_json(sphere->center);
+  row["size_mm"] = sphere->size_mm;
+  return StudyDefect{*sphere, {sphere->center}};
+}
+
+// A flap of the series (flap_series), placed on the skull whose midsagittal plane is `plane`;
+// a skull it cannot be placed on is bad input (`file` named).
+std::optional<StudyDefect> flap_study_defect(const std::string& file, const SkullMesh& skull,
+                                             const SurfaceLocator& bone, const Plane& plane,
+                                             bool bifrontal, int k, Json& row) {
+  const FlapPlacementParams fp = flap_series(bifrontal, k);
+  const FlapPlacement placed = place_flap(skull, bone, plane, fp);
+  if (!placed.cut) throw InputError(file, placed.message);
+  StudyDefect d;
+  d.cut.shape = InjectDefectParams::Shape::Flap;
+  d.cut.flap = *placed.cut;
+  d.cut.voxel_mm = 0.5;
+  d.points = flap_points(placed);
+  row["flap"] = placed.message;
+  row["length_mm"] = fp.length_mm;
+  row["width_mm"] = fp.width_mm;
+  row["midline_margin_mm"] = placed.cut->midline_margin_mm;
+  return d;
+}
+
 Subcommand add_study(CLI::App& app, const bool& json) {
   struct Opts {
     std::string skull, shape = "sphere", cases_out, method = "auto";
@@ -425,29 +462,14 @@ Subcommand add_study(CLI::App& app, const bool& json) {
         for (int k = 0; k < o->count; ++k) {
           if (!o->shard.takes(static_cast<size_t>(k))) continue;
           Json row{{"defect", k}};
-          std::vector<Eigen::Vector3d> points;
-          InjectDefectParams ip;
-          if (spheres) {
-            const auto sphere = sphere_defect(skull, bone, k, o->min_size.value_or(30.0),
-                                              o->max_size.value_or(50.0));
-            if (!sphere) continue;
-            ip = *sphere;
-            points = {ip.center};
-            row["center"] = to_json(ip.center);
-            row["size_mm"] = ip.size_mm;
-          } else {
-            const FlapPlacementParams fp = flap_series(o->shape == "bifrontal", k);
-            const FlapPlacement placed = place_flap(skull, bone, *plane, fp);
-            if (!placed.cut) throw InputError(o->skull, placed.message);
-            ip.shape = InjectDefectParams::Shape::Flap;
-            ip.flap = *placed.cut;
-            ip.voxel_mm = 0.5;
-            points = flap_points(placed);
-            row["flap"] = placed.message;
-            row["length_mm"] = fp.length_mm;
-            row["width_mm"] = fp.width_mm;
-            row["midline_margin_mm"] = placed.cut->midline_margin_mm;
-          }
+          const std::optional<StudyDefect> defect =
+              spheres ? sphere_study_defect(skull, bone, k, o->min_size.value_or(30.0),
+                                            o->max_size.value_or(50.0), row)
+                      : flap_study_defect(o->skull, skull, bone, *plane, o->shape == "bifrontal", k,
+                                          row);
+          if (!defect) continue;
+          const InjectDefectParams& ip = defect->cut;
+          const std::vector<Eigen::Vector3d>& points = defect->points;
           const InjectDefectResult d = inject_defect(skull, ip);
           if (!d.usable()) continue;
           // The skull may have a defect of its own (the sample has): the planner is told
