@@ -8,7 +8,10 @@
 #include <QPdfWriter>
 #include <QTextDocument>
 #include <QUrl>
+#include <algorithm>
+#include <tuple>
 
+#include "cranioplan/algorithms/geometry/slices.h"
 #include "cranioplan/sessions/audit.h"
 #include "main_window.h"
 
@@ -21,46 +24,105 @@ bool MainWindow::write_design_report(const QString& html_path) {
   }
   const QFileInfo info(html_path);
   const QString dir = info.absolutePath(), stem = info.completeBaseName();
+  // The report's findings, the soft tissue's among them: the plan's CT read first (its arrival
+  // checks the implant again with it).
+  slices_->show_state(controller_->state());
+  slices_->wait_loaded();
+  wait_quality();
+  // The pictures show the implant on the patient's skull and nothing over it: no mirror, no
+  // plane, no markers; each framed on the implant and the bone around it.
   const bool thickness_was_shown = show_thickness_->isChecked();
   const bool mirror_was_shown = show_mirror_->isChecked();
-  show_mirror_->setChecked(false);  // the implant on the patient's skull, nothing over it
+  const Layout layout_was = layout_;
+  show_mirror_->setChecked(false);
+  view_->set_plane_visible(false);
+  view_->set_markers_visible(false);
+  const auto restore = [&] {
+    set_thickness_map_shown(thickness_was_shown);
+    show_mirror_->setChecked(mirror_was_shown);
+    view_->set_plane_visible(findChild<QAction*>("showPlane")->isChecked());
+    view_->set_markers_visible(true);
+    set_layout(layout_was);
+    view_->look_at_markers();
+  };
   struct Shot {
     const char* caption;
     const char* suffix;
-    std::optional<SkullView::StandardView> view;  // none: along the defect (the markers)
+    std::optional<SkullView::StandardView> view;  // none: along the defect
     bool thickness;
   };
   using V = SkullView::StandardView;
-  const Shot shots[] = {{"Along the defect", "defect", std::nullopt, false},
-                        {"Front", "front", V::Front, false},
-                        {"Right side", "right", V::Right, false},
-                        {"Top", "top", V::Top, false},
-                        {"Thickness map", "thickness", std::nullopt, true}};
+  const Shot shots[] = {
+      {"Along the defect", "defect", std::nullopt, false},
+      {"From the front", "front", V::Front, false},
+      {"From the right", "right", V::Right, false},
+      {"From above", "top", V::Top, false},
+      {"Thickness of the implant and its gap to the bone (mm)", "thickness", std::nullopt, true}};
   std::vector<ReportImage> images;
+  const auto save = [&](const QImage& grabbed, const QString& suffix, const char* caption,
+                        ReportImage::Kind kind) {
+    // Square pictures around the middle (where the implant is framed): two to a row on A4.
+    const int side = std::min(grabbed.width(), grabbed.height());
+    const QImage picture =
+        grabbed.copy((grabbed.width() - side) / 2, (grabbed.height() - side) / 2, side, side);
+    const QString file = stem + "_" + suffix + ".png";
+    if (!picture.save(dir + "/" + file)) {
+      show_message(tr("Cannot write %1.").arg(dir + "/" + file), true);
+      return false;
+    }
+    images.push_back({caption, file.toStdString(), kind});
+    return true;
+  };
+  set_layout(Layout::ThreeD);
   for (const Shot& shot : shots) {
     set_thickness_map_shown(shot.thickness);
     wait_quality();  // the thickness map is computed with the quality report
-    if (shot.view)
-      view_->set_standard_view(*shot.view);
-    else
-      view_->look_at_markers();
+    view_->look_at_implant(shot.view);
     view_->update();
     QApplication::processEvents();
-    const QString file = stem + "_" + shot.suffix + ".png";
-    if (!view_->grabFramebuffer().save(dir + "/" + file)) {
-      show_message(tr("Cannot write %1.").arg(dir + "/" + file), true);
-      set_thickness_map_shown(thickness_was_shown);
-      show_mirror_->setChecked(mirror_was_shown);
+    if (!save(view_->grabFramebuffer(), shot.suffix, shot.caption,
+              shot.thickness ? ReportImage::Kind::Thickness : ReportImage::Kind::View)) {
+      restore();
       return false;
     }
-    images.push_back({shot.caption, file.toStdString()});
   }
-  set_thickness_map_shown(thickness_was_shown);
-  show_mirror_->setChecked(mirror_was_shown);
-  view_->look_at_markers();
+  // The CT through the implant's middle, each slice alone in the centre, zoomed on the implant
+  // with its outline (a plan without a CT has none to show).
+  slices_->show_state(controller_->state());
+  slices_->wait_loaded();
+  if (slices_->has_ct()) {
+    const Eigen::Vector3d was = slices_->cursor();
+    const Eigen::Vector3d middle = vertex_centroid(controller_->state().implant->result().mesh);
+    slices_->set_cursor(middle);
+    const std::tuple<SliceOrientation, Layout, const char*, const char*> cuts[] = {
+        {SliceOrientation::Axial, Layout::Axial, "axial", "CT, axial, through the implant"},
+        {SliceOrientation::Coronal, Layout::Coronal, "coronal", "CT, coronal, through the implant"},
+        {SliceOrientation::Sagittal, Layout::Sagittal, "sagittal",
+         "CT, sagittal, through the implant"}};
+    for (const auto& [orientation, alone, suffix, caption] : cuts) {
+      set_layout(alone);
+      QApplication::processEvents();
+      SliceView& v = slices_->view(orientation);
+      // Twice the fitted size, the implant's middle in the middle of the picture.
+      v.fit();
+      v.zoom_by(2.0, v.to_widget(middle));
+      v.pan_by(QPointF(v.width() / 2.0, v.height() / 2.0) - v.to_widget(middle));
+      const QImage picture = v.grab().toImage();
+      v.fit();
+      if (!save(picture, suffix, caption, ReportImage::Kind::Slice)) {
+        slices_->set_cursor(was);
+        restore();
+        return false;
+      }
+    }
+    slices_->set_cursor(was);
+  }
+  restore();
 
-  const QString html = QString::fromStdString(
-      design_report_html(controller_->session(), images, CRANIOPLAN_VERSION));
+  const QString html = QString::fromStdString(design_report_html(
+      controller_->session(), images, CRANIOPLAN_VERSION,
+      judged_tissue_ && judged_implant_ == controller_->state().implant ? &*judged_tissue_
+                                                                        : nullptr));
   QFile out(html_path);
   if (!out.open(QIODevice::WriteOnly | QIODevice::Truncate) || out.write(html.toUtf8()) < 0) {
     show_message(tr("Cannot write %1.").arg(html_path), true);

@@ -8,6 +8,7 @@
 #include <QTimer>
 #include <algorithm>
 #include <cstdio>
+#include <cstring>
 #include <memory>
 #include <vector>
 
@@ -19,10 +20,19 @@ int main(int argc, char** argv) {
   cranioplan::start_with_huge_pages(argv);
   cranioplan::gui::SkullView::set_default_surface_format();
 
-  QApplication app(argc, argv);
-  QApplication::setOrganizationName("Cranioplan");
-  QApplication::setApplicationName("Cranioplan");
-  QApplication::setApplicationVersion(CRANIOPLAN_VERSION);
+  // --help and --version print and quit: no window, so no display is needed for them.
+  const bool text_only = std::any_of(argv + 1, argv + argc, [](const char* a) {
+    for (const char* o : {"--help", "-h", "-?", "--help-all", "--version", "-v"})
+      if (std::strcmp(a, o) == 0) return true;
+    return false;
+  });
+  std::unique_ptr<QCoreApplication> application =
+      text_only ? std::make_unique<QCoreApplication>(argc, argv)
+                : std::make_unique<QApplication>(argc, argv);
+  QCoreApplication& app = *application;
+  QCoreApplication::setOrganizationName("Cranioplan");
+  QCoreApplication::setApplicationName("Cranioplan");
+  QCoreApplication::setApplicationVersion(CRANIOPLAN_VERSION);
 
   QCommandLineParser parser;
   parser.setApplicationDescription(
@@ -37,7 +47,11 @@ int main(int argc, char** argv) {
   const QCommandLineOption quit("quit", "quit when done (no dialogs)");
   const QCommandLineOption view("view", "front, back, left, right, top or markers", "VIEW");
   const QCommandLineOption units("units", "a mesh file's length unit: mm, cm, m, in or um", "U");
-  const QCommandLineOption layout("layout", "3d, both (3D and CT slices) or slices", "LAYOUT");
+  const QCommandLineOption layout(
+      "layout",
+      "3d, four (3D and the three CT slices in equal panes), or axial, coronal or sagittal (that "
+      "slice alone)",
+      "LAYOUT");
   const QCommandLineOption window_preset("window", "CT window: bone, soft or brain", "W");
   const QCommandLineOption thickness("thickness-map",
                                      "colour the implant by its thickness (View → Thickness map)");
@@ -124,7 +138,11 @@ int main(int argc, char** argv) {
   if (parser.isSet(layout)) {
     using L = cranioplan::gui::MainWindow::Layout;
     const QString l = parser.value(layout).toLower();
-    window.set_layout(l == "slices" ? L::Slices : l == "both" ? L::ThreeDAndSlices : L::ThreeD);
+    window.set_layout(l == "four" || l == "both" ? L::FourUp
+                      : l == "axial"             ? L::Axial
+                      : l == "coronal"           ? L::Coronal
+                      : l == "sagittal"          ? L::Sagittal
+                                                 : L::ThreeD);
     window.slices().wait_loaded();
   }
   if (parser.isSet(thickness)) window.set_thickness_map_shown(true);

@@ -27,7 +27,6 @@
 #include <QSettings>
 #include <QShortcut>
 #include <QSlider>
-#include <QSplitter>
 #include <QStackedWidget>
 #include <QStandardPaths>
 #include <QStatusBar>
@@ -35,8 +34,10 @@
 #include <QTableWidget>
 #include <QTextBrowser>
 #include <QTimer>
+#include <QToolBar>
 #include <QVBoxLayout>
 #include <QtConcurrent/QtConcurrent>
+#include <atomic>
 #include <cmath>
 
 #include "cranioplan/algorithms/io/load_skull.h"
@@ -81,15 +82,9 @@ MainWindow::MainWindow(QWidget* parent)
     : QMainWindow(parent), controller_(new PlanController(this)), view_(new SkullView(this)) {
   setWindowTitle(tr("Cranioplan"));
   resize(1500, 950);
-  center_ = new QSplitter(Qt::Horizontal, this);
-  center_->setObjectName("center");
-  center_->addWidget(view_);
-  slices_ = new SlicePanel(center_);
-  center_->addWidget(slices_);
-  center_->setStretchFactor(0, 3);
-  center_->setStretchFactor(1, 1);
-  setCentralWidget(center_);
-  slices_->setVisible(false);
+  slices_ = new SlicePanel(view_, this);
+  setCentralWidget(slices_);
+  connect(slices_, &SlicePanel::arranged, this, [this](Layout a) { set_layout(a); });
   build_steps_dock();
   build_plan_dock();
   build_menus();
@@ -125,6 +120,7 @@ MainWindow::MainWindow(QWidget* parent)
   step_timer_.start();
 
   connect(controller_, &PlanController::stateChanged, this, &MainWindow::refresh);
+  connect(controller_, &PlanController::trialSettled, this, &MainWindow::trial_settled);
   connect(controller_, &PlanController::refused, this,
           [this](const QString& m) { show_message(m, true); });
   connect(controller_, &PlanController::failed, this, [this](const QString& m) {
@@ -395,10 +391,19 @@ bool MainWindow::export_landmarks(const QString& path) {
 
 void MainWindow::build_edit_view_menus() {
   QMenu* edit = menuBar()->addMenu(tr("&Edit"));
-  undo_ = edit->addAction(tr("Undo"), controller_, &PlanController::undo);
+  // Undo and redo say what they did (the state's own message is the old command's).
+  undo_ = edit->addAction(tr("Undo"), this, [this] {
+    const std::string what = controller_->session().undo_text();
+    controller_->undo();
+    if (!what.empty()) note_shown(tr("Undone: %1").arg(q(what.substr(what.find(' ') + 1))));
+  });
   undo_->setShortcut(QKeySequence(Qt::CTRL | Qt::Key_Z));
   undo_->setObjectName("undo");
-  redo_ = edit->addAction(tr("Redo"), controller_, &PlanController::redo);
+  redo_ = edit->addAction(tr("Redo"), this, [this] {
+    const std::string what = controller_->session().redo_text();
+    controller_->redo();
+    if (!what.empty()) note_shown(tr("Redone: %1").arg(q(what.substr(what.find(' ') + 1))));
+  });
   redo_->setShortcut(QKeySequence(Qt::CTRL | Qt::SHIFT | Qt::Key_Z));
   redo_->setObjectName("redo");
   edit->addSeparator();
@@ -445,11 +450,40 @@ void MainWindow::build_edit_view_menus() {
          "its gap to the implant"));
   connect(show_thickness_, &QAction::toggled, view_, &SkullView::set_thickness_visible);
   QAction* show_plane = view->addAction(tr("Show midsagittal plane"));
+  show_plane->setObjectName("showPlane");
   show_plane->setCheckable(true);
   show_plane->setChecked(true);
   connect(show_plane, &QAction::toggled, view_, &SkullView::set_plane_visible);
+  // Step 4's clip plane cuts the skulls in step 4, and elsewhere only when asked here.
+  clip_ = view->addAction(tr("Clip the skulls"));
+  clip_->setObjectName("viewClip");
+  clip_->setCheckable(true);
+  clip_->setShortcut(QKeySequence(Qt::Key_C));
+  clip_->setToolTip(tr("Cut the skulls at step 4's clip plane (on in step 4; C toggles it)"));
+  connect(clip_, &QAction::toggled, view_, &SkullView::set_clip_enabled);
   view->addSeparator();
   add_slice_actions(view);
+
+  // The same in sight above the view: the standard views and what is shown.
+  QToolBar* bar = addToolBar(tr("View"));
+  bar->setObjectName("viewBar");
+  bar->setMovable(false);
+  bar->setToolButtonStyle(Qt::ToolButtonTextOnly);
+  for (QAction* a : view->actions()) {
+    if (a->isSeparator() || a->menu()) continue;
+    if (a == show_thickness_ || a == show_mirror_ || a == show_plane || a == clip_) continue;
+    if (a->shortcut().isEmpty() || a->shortcut()[0].key() < Qt::Key_F5 ||
+        a->shortcut()[0].key() > Qt::Key_F9)
+      continue;
+    bar->addAction(a);  // Front, Back, Left, Right, Top
+  }
+  bar->addSeparator();
+  show_mirror_->setText(tr("Mirror"));
+  show_plane->setText(tr("Plane"));
+  for (QAction* a : {clip_, show_mirror_, show_plane, show_thickness_}) bar->addAction(a);
+  bar->addSeparator();
+  if (QAction* four = findChild<QAction*>("layoutFourUp")) bar->addAction(four);
+  if (QAction* only = findChild<QAction*>("layout3d")) bar->addAction(only);
 }
 
 // The CT slices: the centre's layout, and window/level presets.
@@ -458,8 +492,10 @@ void MainWindow::add_slice_actions(QMenu* view) {
   auto* layouts = new QActionGroup(this);
   const std::tuple<QString, Layout, const char*> modes[] = {
       {tr("3D only"), Layout::ThreeD, "layout3d"},
-      {tr("3D and CT slices"), Layout::ThreeDAndSlices, "layoutBoth"},
-      {tr("CT slices only"), Layout::Slices, "layoutSlices"}};
+      {tr("Four-up: 3D and CT slices"), Layout::FourUp, "layoutFourUp"},
+      {tr("Axial slice alone"), Layout::Axial, "layoutAxial"},
+      {tr("Coronal slice alone"), Layout::Coronal, "layoutCoronal"},
+      {tr("Sagittal slice alone"), Layout::Sagittal, "layoutSagittal"}};
   for (const auto& [name, mode, object] : modes) {
     QAction* a = layout->addAction(name, this, [this, mode = mode] { set_layout(mode); });
     a->setObjectName(object);
@@ -470,7 +506,7 @@ void MainWindow::add_slice_actions(QMenu* view) {
   QAction* markers = view->addAction(tr("Markers on the CT slices"));
   markers->setObjectName("slicesMarkers");
   markers->setCheckable(true);
-  markers->setChecked(true);
+  markers->setChecked(false);  // the implant's outline is what the slices are looked at for
   connect(markers, &QAction::toggled, slices_, &SlicePanel::set_markers_shown);
   QMenu* wl = view->addMenu(tr("CT window"));
   const std::tuple<QString, SlicePanel::Preset, const char*> presets[] = {
@@ -485,20 +521,9 @@ void MainWindow::add_slice_actions(QMenu* view) {
 
 void MainWindow::set_layout(Layout layout) {
   layout_ = layout;
-  view_->setVisible(layout != Layout::Slices);
-  slices_->setVisible(layout != Layout::ThreeD);
-  slices_->set_column(layout == Layout::ThreeDAndSlices);
-  if (layout == Layout::ThreeDAndSlices) {
-    // The slices take three eighths of the width; set once the shown widgets are laid out
-    // (a splitter keeps a hidden widget's old size otherwise).
-    const auto widths = [this] {
-      const int w = std::max(600, center_->width());
-      center_->setSizes({w * 5 / 8, w * 3 / 8});
-    };
-    widths();
-    QTimer::singleShot(0, this, widths);
-  }
-  const char* names[] = {"layout3d", "layoutBoth", "layoutSlices"};
+  slices_->arrange(layout);
+  const char* names[] = {"layout3d",      "layoutFourUp",   "layoutAxial",
+                         "layoutCoronal", "layoutSagittal", "layout3d"};
   if (auto* a = findChild<QAction*>(names[static_cast<int>(layout)])) a->setChecked(true);
   if (layout == Layout::ThreeD) {
     view_->set_cursor(std::nullopt);
@@ -605,9 +630,26 @@ void MainWindow::build_steps_dock() {
   scroll->setMinimumWidth(pages_->minimumSizeHint().width() +
                           scroll->verticalScrollBar()->sizeHint().width());
   layout->addWidget(scroll, 1);
+  page_scroll_ = scroll;
   done_button_ = button(tr("Done — next step"), "done", panel);
-  connect(done_button_, &QPushButton::clicked, this,
-          [this] { push(commands::complete_step(controller_->state().current_step)); });
+  connect(done_button_, &QPushButton::clicked, this, [this] {
+    const PlanState& s = controller_->state();
+    // Step 7 with an implant the quality check refuses: said, and asked, not passed silently.
+    if (s.current_step == 7 && s.implant && s.implant->result().usable() &&
+        !s.implant->quality().printable) {
+      const QString what =
+          tr("The quality check refuses this implant: %1. Step 7's page says what to try.")
+              .arg(q(s.implant->quality().reasons.empty() ? std::string("see the Quality panel")
+                                                          : s.implant->quality().reasons.front()));
+      show_message(what, true);
+      if (!interactive_ || QMessageBox::question(this, tr("Go on with a refused implant?"),
+                                                 what + "\n\n" + tr("Go on to step 8 anyway?"),
+                                                 QMessageBox::Yes | QMessageBox::No,
+                                                 QMessageBox::No) != QMessageBox::Yes)
+        return;
+    }
+    push(commands::complete_step(s.current_step));
+  });
   layout->addWidget(done_button_);
   dock->setWidget(panel);
   dock->setMinimumWidth(360);
@@ -624,8 +666,10 @@ void MainWindow::build_plan_dock() {
   plan_tabs_->addTab(quality_, tr("Quality"));
   history_ = new QListWidget(plan_tabs_);
   history_->setObjectName("history");
-  connect(history_, &QListWidget::itemClicked, this,
-          [this](QListWidgetItem* item) { controller_->set_index(history_->row(item)); });
+  connect(history_, &QListWidget::itemClicked, this, [this](QListWidgetItem* item) {
+    controller_->set_index(history_->row(item));
+    note_shown(tr("The plan as it was after command %1.").arg(history_->row(item)));
+  });
   plan_tabs_->addTab(history_, tr("History"));
 
   audit_tab_ = new QWidget(plan_tabs_);
@@ -696,7 +740,9 @@ void MainWindow::refresh() {
                            .arg(session.header().info.case_id.empty()
                                     ? tr("none")
                                     : q(session.header().info.case_id)));
+  // What was just done: the window's own words (undo, redo, save), else the last command's.
   if (!s.message.empty()) show_message(q(s.message), false);
+  clip_->setEnabled(s.clip_plane.has_value());
   finish_training_if_done();
   update_timers();
 }
@@ -708,11 +754,19 @@ void MainWindow::refresh_steps() {
     std::string missing, why;
     const bool done = step_complete(s, step, &missing);
     const bool unlocked = step_unlocked(s, step, &why);
+    // An implant the quality check refuses is built, but the step is not done well: marked
+    // ✘, its page says what is wrong and what to try.
+    const bool refused = step == 7 && done && refused_implant();
     QString text = QStringLiteral("%1 %2  %3")
-                       .arg(done ? QStringLiteral("✔") : QStringLiteral("  "))
+                       .arg(refused ? QStringLiteral("✘")
+                            : done  ? QStringLiteral("✔")
+                                    : QStringLiteral("  "))
                        .arg(step)
                        .arg(tr(wizard_steps()[step - 1].title));
-    QString tip = done ? tr("Done") : q(missing);
+    QString tip = refused ? tr("Built, but the quality check refuses the implant: see the step's "
+                               "page for what to try")
+                  : done  ? tr("Done")
+                          : q(missing);
     if (s.stale.count(step)) {
       text += QStringLiteral("  ⚠");
       tip += "\n" + tr("Recomputed: ") + q(s.stale.at(step));
@@ -728,6 +782,11 @@ void MainWindow::refresh_steps() {
     item->setFont(f);
   }
   steps_->setCurrentRow(s.current_step - 1);
+  if (shown_step_ != s.current_step) {
+    // Another step: its page opens at its top, and the view is set as the step needs it.
+    page_scroll_->verticalScrollBar()->setValue(0);
+    clip_->setChecked(s.current_step == 4);
+  }
   shown_step_ = s.current_step;
   pages_->setCurrentIndex(s.current_step - 1);
   StepPage* page = step_pages_[static_cast<size_t>(s.current_step - 1)];
@@ -766,14 +825,14 @@ void MainWindow::refresh_quality() {
   if (!s.implant) {
     quality_->setHtml(tr("<p>No implant yet.</p>"));
     for (StepPage* page : step_pages_)
-      page->show_quality(tr("<p>Build the implant first (step 7).</p>"));
+      page->show_verdict(tr("<p>Build the implant first (step 7).</p>"));
     return;
   }
   // The report (overlap on a fine grid, thickness, self-intersections) takes a few tenths of a
   // second on a real skull: while markers are dragged it is computed once the implant has
   // stopped changing, not for every rebuild.
   quality_->setHtml(tr("<p>Checking the implant…</p>"));
-  for (StepPage* page : step_pages_) page->show_quality(tr("<p>Checking the implant…</p>"));
+  for (StepPage* page : step_pages_) page->show_verdict(tr("<p>Checking the implant…</p>"));
   quality_timer_->start();
 }
 
@@ -781,7 +840,9 @@ void MainWindow::refresh_quality() {
 struct MainWindow::QualityView {
   std::shared_ptr<const ImplantData> implant;  ///< the implant it is of
   QString html;
+  QString verdict;  ///< for the pages: printable, or what is wrong and what to try
   std::vector<Eigen::Vector3d> intrusion;  ///< the implant's voxels in soft tissue (CT plans)
+  std::optional<SoftTissueCheck> tissue;   ///< without the voxels (CT plans)
   std::shared_ptr<const ThicknessMap> thickness;  ///< the implant's, and the skull's gap to it
 };
 
@@ -805,10 +866,15 @@ void MainWindow::show_quality() {
     view_->set_thickness_map(&v->implant->result().mesh, v->thickness);
     view_->set_rim_gap(rim_gap_to_mark(v->implant->quality()));
     quality_->setHtml(v->html);
-    for (StepPage* page : step_pages_) page->show_quality(v->html);
+    judged_implant_ = v->implant;
+    judged_printable_ = v->implant->quality().printable;
+    judged_tissue_ = v->tissue;
+    for (StepPage* page : step_pages_) page->show_verdict(v->verdict);
+    refresh_steps();  // step 7's mark: printable or refused
   });
   const std::shared_ptr<const SkullInput> skull = s.skull;
-  quality_watcher_->setFuture(QtConcurrent::run([implant, ct, inside, skull] {
+  const ImplantParams params = s.implant_params ? *s.implant_params : ImplantParams{};
+  quality_watcher_->setFuture(QtConcurrent::run([implant, ct, inside, skull, params] {
     auto v = std::make_shared<QualityView>();
     v->implant = implant;
     v->thickness = std::make_shared<const ThicknessMap>(
@@ -816,12 +882,18 @@ void MainWindow::show_quality() {
     SoftTissueCheck tissue;
     if (ct) tissue = check_soft_tissue(implant->result().mesh, *ct, inside);
     v->intrusion = std::move(tissue.intrusion);
+    if (tissue.checked) v->tissue = tissue;
     v->html = quality_html(implant->quality(), tissue.checked ? &tissue : nullptr);
+    v->verdict = q(quality_verdict_html(implant->quality(), params));
     return v;
   }));
 }
 
 void MainWindow::set_thickness_map_shown(bool shown) { show_thickness_->setChecked(shown); }
+
+bool MainWindow::refused_implant() const {
+  return judged_implant_ && judged_implant_ == controller_->state().implant && !judged_printable_;
+}
 
 void MainWindow::show_mould(bool shown) {
   mould_wanted_ = shown;
@@ -891,6 +963,12 @@ void MainWindow::update_timers() {
                             .arg(training_reference_.isEmpty() ? QString() : tr("   (training)")));
 }
 
+void MainWindow::note_shown(const QString& text) {
+  show_message(text, false);
+  statusBar()->setStyleSheet("QStatusBar{background:#e3f2e1}");  // a sign that it happened
+  QTimer::singleShot(1500, this, [this] { statusBar()->setStyleSheet(QString()); });
+}
+
 void MainWindow::show_message(const QString& text, bool problem) {
   statusBar()->showMessage((problem ? QStringLiteral("⚠ ") : QString()) + text,
                            problem ? 15000 : 8000);
@@ -929,30 +1007,43 @@ void MainWindow::open_input(const QString& path, double threshold) {
   const bool volume = is_volume_path(path.toStdString());
   if (!volume) import.mesh_unit_mm = load_page_->mesh_unit_mm();
   if (volume && QFileInfo(path).isDir() && !choose_dicom_series(path, import)) return;
-  if (volume) {
-    import.threshold = std::isfinite(threshold) ? threshold : load_page_->threshold();
-    if (interactive_ && !std::isfinite(threshold)) {
-      bool ok = false;
-      const double v = QInputDialog::getDouble(
-          this, tr("Bone threshold"),
-          tr("Iso-value for the bone surface (CT: Hounsfield units, about 200–400; masks: 0.5):"),
-          load_page_->threshold(), -1000, 3000, 1, &ok);
-      if (!ok) return;
-      import.threshold = v;
-      load_page_->set_threshold(v);
-    }
-  }
+  // A CT's bone threshold: the one asked (command line, sample), else step 1's field
+  // (automatic by default: 300 HU for a CT, 0.5 for a mask).
+  if (volume) import.threshold = std::isfinite(threshold) ? threshold : load_page_->threshold();
   const QString case_id = QFileInfo(path).completeBaseName();
   QDir().mkpath(autosave_folder());
   const QString autosave = autosave_folder() + "/" + case_id + "-" +
                            QDateTime::currentDateTimeUtc().toString("yyyyMMdd-HHmmss") +
                            ".json.autosave";
-  controller_->new_session(SessionInfo{case_id.toStdString(), "", ""}, autosave);
+  // On trial: the plan open now stays until the file has loaded (a bad file closes nothing).
+  if (!controller_->on_trial()) trial_kept_path_ = session_path_;
+  trial_input_ = path;
+  controller_->try_new_session(SessionInfo{case_id.toStdString(), "", ""}, autosave);
   session_path_.clear();
   total_timer_.restart();
-  add_recent(path);
   push(commands::load_skull(path.toStdString(), import), tr("Loading %1").arg(case_id));
 }
+
+void MainWindow::trial_settled(bool loaded) {
+  if (loaded) {
+    forget_discarded();
+    add_recent(trial_input_);
+  } else {
+    keep_discarded();
+    session_path_ = trial_kept_path_;
+    show_message(tr("%1 was not opened; the plan that was open is kept as it was.")
+                     .arg(QFileInfo(trial_input_).fileName()),
+                 true);
+  }
+  trial_input_.clear();
+}
+
+void MainWindow::forget_discarded() {
+  if (!discarded_autosave_.isEmpty()) QFile::remove(discarded_autosave_);
+  discarded_autosave_.clear();
+}
+
+void MainWindow::keep_discarded() { discarded_autosave_.clear(); }
 
 bool MainWindow::choose_dicom_series(const QString& folder, ExtractBoneSurfaceParams& import) {
   std::vector<DicomSeries> series;
@@ -1017,14 +1108,25 @@ bool MainWindow::open_session(const QString& path) {
                                 tr("%1.\n\nRecover them?").arg(q(info.message))) ==
           QMessageBox::Yes;
     // Opening replays the plan's commands (seconds for a fitted implant): on a worker thread,
-    // the window greyed out but painting, as a computation's wait is.
+    // the steps, view and panels held while it runs, the status bar counting the commands.
     struct Opened {
       std::shared_ptr<Session> session;
       std::string error;
     };
+    auto done = std::make_shared<std::atomic<size_t>>(0);
+    auto total = std::make_shared<std::atomic<size_t>>(0);
+    options.progress = [done, total](size_t k, size_t n) {
+      total->store(n);
+      done->store(k);
+    };
     QApplication::setOverrideCursor(Qt::WaitCursor);
-    show_message(tr("Opening %1…").arg(QFileInfo(path).fileName()), false);
-    setEnabled(false);
+    const QString name = QFileInfo(path).fileName();
+    show_message(tr("Opening %1…").arg(name), false);
+    const std::vector<QWidget*> held = {centralWidget(), steps_->parentWidget(), plan_tabs_,
+                                        menuBar()};
+    for (QWidget* w : held) w->setEnabled(false);
+    progress_->setRange(0, 0);
+    progress_->setVisible(true);
     QFuture<Opened> opening = QtConcurrent::run([file = path.toStdString(), options] {
       Opened o;
       try {
@@ -1036,14 +1138,31 @@ bool MainWindow::open_session(const QString& path) {
       }
       return o;
     });
-    while (!opening.isFinished()) QApplication::processEvents(QEventLoop::AllEvents, 20);
-    setEnabled(true);
+    size_t shown = 0;
+    while (!opening.isFinished()) {
+      QApplication::processEvents(QEventLoop::AllEvents, 20);
+      if (total->load() > 0 && done->load() != shown) {
+        shown = done->load();
+        progress_->setRange(0, static_cast<int>(total->load()));
+        progress_->setValue(static_cast<int>(shown));
+        show_message(tr("Opening %1: replaying command %2 of %3…")
+                         .arg(name)
+                         .arg(shown + 1)
+                         .arg(total->load()),
+                     false);
+      }
+    }
+    for (QWidget* w : held) w->setEnabled(true);
+    progress_->setRange(0, 0);
+    progress_->setVisible(false);
     QApplication::restoreOverrideCursor();
     Opened opened = opening.result();
     if (!opened.session) {
+      keep_discarded();
       emit controller_->failed(QString::fromStdString(opened.error));
       return false;
     }
+    forget_discarded();
     controller_->set_read_only(false);
     controller_->set_session(std::move(*opened.session));
     session_path_ = path;
@@ -1052,6 +1171,7 @@ bool MainWindow::open_session(const QString& path) {
     return true;
   } catch (const Error& e) {
     QApplication::restoreOverrideCursor();
+    keep_discarded();
     emit controller_->failed(QString::fromUtf8(e.what()));
     return false;
   }
@@ -1075,8 +1195,10 @@ bool MainWindow::save_session_to(const QString& path) {
   if (!old_autosave.empty() && q(old_autosave).startsWith(autosave_folder()))
     QFile::remove(q(old_autosave));
   add_recent(path);
-  show_message(tr("Saved %1").arg(path), false);
   refresh();
+  note_shown(tr("Saved the plan to %1 (%2 commands).")
+                 .arg(path)
+                 .arg(controller_->session().stack().size()));
   return true;
 }
 
@@ -1115,6 +1237,7 @@ void MainWindow::open_audit(const QString& path) {
     const SessionDocument doc = read_session_document(path.toStdString());
     Session s = Session::open(path.toStdString());
     QApplication::restoreOverrideCursor();
+    forget_discarded();
     controller_->set_session(std::move(s));
     controller_->set_read_only(true);
     session_path_.clear();
@@ -1188,19 +1311,35 @@ QString MainWindow::autosave_folder() const {
   return QStandardPaths::writableLocation(QStandardPaths::AppDataLocation) + "/autosave";
 }
 
-void MainWindow::offer_recovery() {
+void MainWindow::offer_recovery(std::optional<RecoveryChoice> answer) {
   QDir dir(autosave_folder());
   const QFileInfoList found =
       dir.entryInfoList({"*.autosave"}, QDir::Files, QDir::Time);  // newest first
   if (found.isEmpty()) return;
   const QFileInfo& newest = found.front();
-  if (interactive_ && QMessageBox::question(
-                          this, tr("Recover a plan?"),
-                          tr("Cranioplan stopped before the plan \"%1\" was saved (last change "
-                             "%2).\n\nRecover it?")
-                              .arg(newest.completeBaseName(), newest.lastModified().toString())) !=
-                          QMessageBox::Yes)
+  // Without interaction and without an answer given, it is recovered.
+  RecoveryChoice choice = answer.value_or(RecoveryChoice::Recover);
+  if (interactive_ && !answer) {
+    // Recover it, discard it for good, or leave it for later (offered again at the next start).
+    QMessageBox box(QMessageBox::Question, tr("Recover a plan?"),
+                    tr("Cranioplan stopped before the plan \"%1\" was saved (last change %2).")
+                        .arg(newest.completeBaseName(), newest.lastModified().toString()),
+                    QMessageBox::NoButton, this);
+    QPushButton* recover = box.addButton(tr("Recover"), QMessageBox::AcceptRole);
+    QPushButton* discard = box.addButton(tr("Discard it"), QMessageBox::DestructiveRole);
+    box.addButton(tr("Later"), QMessageBox::RejectRole);
+    box.setDefaultButton(recover);
+    box.exec();
+    choice = box.clickedButton() == recover   ? RecoveryChoice::Recover
+             : box.clickedButton() == discard ? RecoveryChoice::Discard
+                                              : RecoveryChoice::Later;
+  }
+  if (choice == RecoveryChoice::Discard) {
+    QFile::remove(newest.filePath());
+    show_message(tr("Discarded the unsaved plan \"%1\".").arg(newest.completeBaseName()), false);
     return;
+  }
+  if (choice == RecoveryChoice::Later) return;
   try {
     controller_->set_session(Session::recover(newest.filePath().toStdString()));
     show_message(
@@ -1225,9 +1364,11 @@ bool MainWindow::confirm_discard() {
                                           tr("Cranioplan plan (*.cranioplan.json *.json)"));
     return !path.isEmpty() && save_session_to(path);
   }
-  // Discarded on purpose: the unsaved plan's autosave is not a crash to recover from.
+  // Discarded on purpose: the unsaved plan's autosave is not a crash to recover from. It is
+  // removed once the plan that replaces it is open (a bad file leaves the old plan, and its
+  // autosave, as they were).
   const QString autosave = q(s.autosave_path());
-  if (autosave.startsWith(autosave_folder())) QFile::remove(autosave);
+  if (autosave.startsWith(autosave_folder())) discarded_autosave_ = autosave;
   return true;
 }
 
@@ -1269,6 +1410,7 @@ void MainWindow::closeEvent(QCloseEvent* event) {
     return;
   }
   controller_->wait();
+  forget_discarded();
   event->accept();
 }
 

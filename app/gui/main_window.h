@@ -25,6 +25,7 @@ class QLabel;
 class QListWidget;
 class QProgressBar;
 class QPushButton;
+class QScrollArea;
 class QSlider;
 class QSpinBox;
 class QVBoxLayout;
@@ -53,9 +54,9 @@ class MainWindow : public QMainWindow, public PageHost {
   PlanController& controller() { return *controller_; }
   SkullView& view() override { return *view_; }
   SlicePanel& slices() { return *slices_; }
-  /// What the centre shows: the 3D view, the 3D view with the three CT slices beside it, or
-  /// the slices alone (View → Layout).
-  enum class Layout { ThreeD, ThreeDAndSlices, Slices };
+  /// What the centre shows: the 3D view alone, the 3D view and the three CT slices in four
+  /// equal panes, or one pane maximised (View → Layout, each pane's ⤢ button).
+  using Layout = SlicePanel::Arrangement;
   void set_layout(Layout layout);
   /// View → Thickness map on or off.
   void set_thickness_map_shown(bool shown);
@@ -64,7 +65,7 @@ class MainWindow : public QMainWindow, public PageHost {
   /// cannot be written.
   bool write_design_report(const QString& html_path);
   Layout layout() const { return layout_; }
-  void show_slices() override { set_layout(Layout::ThreeDAndSlices); }
+  void show_slices() override { set_layout(Layout::FourUp); }
   /// In step 9, the casting mould of the implant (made off the GUI thread) shown in the view.
   void show_mould(bool shown) override;
   /// Waits until the mould asked for is made and shown (tests).
@@ -74,6 +75,8 @@ class MainWindow : public QMainWindow, public PageHost {
   const PlanState& plan() const override { return controller_->state(); }
   void push(Command command, const QString& what = QString()) override;
   void show_message(const QString& text, bool problem) override;
+  /// What the window itself just did (undo, redo, save), in the status bar with a brief flash.
+  void note_shown(const QString& text);
   MarkerType marker_type() const override { return marker_type_; }
   /// The marker type that clicks place (keys 0–3).
   void set_marker_type(MarkerType type) override;
@@ -111,8 +114,11 @@ class MainWindow : public QMainWindow, public PageHost {
   bool export_landmarks(const QString& path);
   void open_audit(const QString& path);
   void start_training(const QString& reference_session);
-  /// Unsaved plans of earlier runs that crashed; offers to recover the newest.
-  void offer_recovery();
+  /// Unsaved plans of earlier runs that crashed; offers to recover the newest, discard it for
+  /// good, or leave it for later. `answer`: taken without asking (tests); none and not
+  /// interactive: recovered.
+  enum class RecoveryChoice { Recover, Discard, Later };
+  void offer_recovery(std::optional<RecoveryChoice> answer = std::nullopt);
   /// The training report as HTML (empty when not training or not finished).
   QString training_report_html() const { return training_html_; }
   /// Waits (processing events) until the quality panel shows the current implant's report.
@@ -135,11 +141,18 @@ class MainWindow : public QMainWindow, public PageHost {
   void refresh_steps();
   void refresh_history();
   void refresh_quality();
+  /// Whether the quality check has refused the implant shown (false while it is computed).
+  bool refused_implant() const;
   void show_quality();
   void update_timers();
   void on_surface_clicked(const Eigen::Vector3d& point);
   void on_marker_dragged(int id, const Eigen::Vector3d& point);
+  /// Asks to save unsaved changes; false: cancelled. A plan discarded keeps its autosave until
+  /// the plan replacing it is open (forget_discarded), so a bad file loses nothing.
   bool confirm_discard();
+  void forget_discarded();
+  void keep_discarded();
+  void trial_settled(bool loaded);
   void add_recent(const QString& path);
   void refresh_recent_menu();
   void finish_training_if_done();
@@ -149,7 +162,6 @@ class MainWindow : public QMainWindow, public PageHost {
 
   PlanController* controller_;
   SkullView* view_;
-  QSplitter* center_;
   SlicePanel* slices_;
   Layout layout_ = Layout::ThreeD;
   bool interactive_ = true;
@@ -159,7 +171,8 @@ class MainWindow : public QMainWindow, public PageHost {
   QLabel* instructions_ = nullptr;
   QStackedWidget* pages_ = nullptr;
   QPushButton* done_button_ = nullptr;
-  int shown_step_ = 1;
+  QScrollArea* page_scroll_ = nullptr;
+  int shown_step_ = 0;
 
   std::vector<StepPage*> step_pages_;  ///< steps 1–9, owned by pages_
   LoadPage* load_page_ = nullptr;
@@ -198,9 +211,17 @@ class MainWindow : public QMainWindow, public PageHost {
   QAction* redo_ = nullptr;
   QAction* show_mirror_ = nullptr;
   QAction* show_thickness_ = nullptr;
+  QAction* clip_ = nullptr;  ///< the clip plane applied to the view (on in step 4)
+  /// The implant the quality check last judged, and whether it was printable.
+  std::shared_ptr<const ImplantData> judged_implant_;
+  bool judged_printable_ = true;
+  std::optional<SoftTissueCheck> judged_tissue_;  ///< of that implant, with the plan's CT
   class QMenu* recent_menu_ = nullptr;
 
   QString session_path_;
+  QString discarded_autosave_;  ///< of the plan discarded, removed once it is replaced
+  QString trial_input_;         ///< the file being opened on trial
+  QString trial_kept_path_;     ///< the kept plan's file, back if the trial fails
   std::string last_proposal_;
   QString training_reference_;
   QString training_html_;

@@ -3,6 +3,7 @@
 #include <QCoreApplication>
 #include <QFutureWatcher>
 #include <QtConcurrent/QtConcurrentRun>
+#include <cstdio>
 
 #include "cranioplan/model/error.h"
 #include "cranioplan/sessions/previews.h"
@@ -24,14 +25,40 @@ void PlanController::drop_work() {
 
 void PlanController::new_session(const SessionInfo& info, const QString& autosave_path) {
   drop_work();
+  previous_.reset();
   session_ = std::make_unique<Session>(info);
   if (!autosave_path.isEmpty()) session_->set_autosave_path(autosave_path.toStdString());
   read_only_ = false;
   emit stateChanged();
 }
 
+void PlanController::try_new_session(const SessionInfo& info, const QString& autosave_path) {
+  drop_work();
+  // A second trial before the first settled keeps the first's old plan; its own session goes.
+  const std::string abandoned = previous_ ? session_->autosave_path() : std::string();
+  std::unique_ptr<Session> kept = previous_ ? std::move(previous_) : std::move(session_);
+  new_session(info, autosave_path);
+  previous_ = std::move(kept);
+  if (!abandoned.empty()) std::remove(abandoned.c_str());
+}
+
+void PlanController::settle_trial() {
+  if (!previous_ || busy()) return;
+  const bool loaded = session_->state().skull != nullptr;
+  if (loaded) {
+    previous_.reset();
+  } else {
+    const std::string autosave = session_->autosave_path();
+    session_ = std::move(previous_);  // the trial's session closes its autosave file
+    if (!autosave.empty()) std::remove(autosave.c_str());
+    emit stateChanged();
+  }
+  emit trialSettled(loaded);
+}
+
 void PlanController::set_session(Session session) {
   drop_work();
+  previous_.reset();
   session_ = std::make_unique<Session>(std::move(session));
   emit stateChanged();
 }
@@ -156,6 +183,7 @@ void PlanController::start(Command command, const QString& what) {
                what.isEmpty() ? QString::fromStdString(describe(command)) : what);
   else
     push(std::move(command));
+  if (!busy()) settle_trial();  // refused before it started
 }
 
 void PlanController::start_queued() {
@@ -210,6 +238,7 @@ void PlanController::finish() {
     emit busyChanged(false, QString());
   }
   emit stateChanged();
+  settle_trial();
 }
 
 void PlanController::cancel() {

@@ -31,6 +31,11 @@ class PlanController : public QObject {
   const PlanState& state() const { return session_->state(); }
   /// Starts a new plan. Its journal is autosaved to `autosave_path` (empty: none).
   void new_session(const SessionInfo& info, const QString& autosave_path);
+  /// Starts a new plan on trial: the plan open now is kept until the first long command (the
+  /// skull's load) settles. Loaded, the old plan goes; failed, refused or cancelled, the old
+  /// plan comes back as it was and the trial's autosave is removed (`trialSettled`).
+  void try_new_session(const SessionInfo& info, const QString& autosave_path);
+  bool on_trial() const { return previous_ != nullptr; }
   /// Replaces the plan (opened or recovered).
   void set_session(Session session);
   bool read_only() const { return read_only_; }
@@ -82,6 +87,8 @@ class PlanController : public QObject {
   void refused(const QString& message);
   void failed(const QString& message);
   void busyChanged(bool busy, const QString& what);
+  /// A plan on trial settled: `loaded`, the new plan stays; otherwise the old one is back.
+  void trialSettled(bool loaded);
 
  private:
   void finish();
@@ -91,12 +98,15 @@ class PlanController : public QObject {
   void start_queued();
   /// The previews of the running and queued edits, from the plan as it stands.
   void update_intent();
+  /// Ends a trial (try_new_session) as the new plan's state says.
+  void settle_trial();
 
   struct Queued {
     Command command;
     QString what;
   };
   std::unique_ptr<Session> session_;
+  std::unique_ptr<Session> previous_;  ///< the plan kept while a new one is on trial
   QFutureWatcher<Computed>* watcher_ = nullptr;
   PreparedCommand running_;
   bool running_edit_ = false;

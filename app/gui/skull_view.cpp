@@ -30,11 +30,13 @@
 #include <vtkPolyDataMapper.h>
 #include <vtkPolyDataNormals.h>
 #include <vtkProperty.h>
+#include <vtkProperty2D.h>
 #include <vtkQuadricClustering.h>
 #include <vtkRenderer.h>
 #include <vtkScalarBarActor.h>
 #include <vtkSmartPointer.h>
 #include <vtkSphereSource.h>
+#include <vtkTextActor.h>
 #include <vtkTextProperty.h>
 
 #include <Eigen/Geometry>
@@ -278,6 +280,7 @@ struct GlyphLayer {
     points_data->Modified();
     actor->SetVisibility(!pts.empty());
   }
+  vtkIdType count() const { return points_data->GetNumberOfPoints(); }
 };
 
 vtkSmartPointer<vtkAlgorithm> sphere(double radius) {
@@ -380,9 +383,16 @@ struct SkullView::Impl {
   vtkNew<vtkScalarBarActor> thickness_bar, gap_bar;
   vtkNew<vtkRenderer> orientation;
   vtkNew<vtkAnnotatedCubeActor> orientation_cube;
+  // The patient's directions at the middle of the view's left, right, top and bottom edges, as
+  // radiology viewers show them, following the camera.
+  std::array<vtkNew<vtkTextActor>, 4> edge_text;
+  std::array<std::string, 4> edge_letters;
+  bool clip_wanted = false;         // the plan's clip plane applied to the view
+  std::optional<Plane> clip_plane;  // the plan's, applied or not
 
   std::vector<Marker> markers;
   bool mirror_wanted = true, plane_wanted = true, markers_editable = false, camera_set = false;
+  bool markers_wanted = true;  // markers, landmarks, handles and zones drawn
   PickTarget target = PickTarget::None;
   int selected_id = 0, drag_id = 0;
   std::optional<Eigen::Vector3d> drag_to;  // where the dragged marker is, while dragged
@@ -545,8 +555,32 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
     bar->SetVisibility(false);
     d.overlay->AddActor2D(bar);
   };
-  legend(d.thickness_bar, d.thickness_colors, "Thickness", 0.88);
-  legend(d.gap_bar, d.gap_colors, "Bone gap", 0.75);
+  legend(d.thickness_bar, d.thickness_colors, "Thickness (mm)", 0.88);
+  legend(d.gap_bar, d.gap_colors, "Bone gap (mm)", 0.75);
+  for (vtkScalarBarActor* bar : {d.thickness_bar.Get(), d.gap_bar.Get()}) {
+    // Dark text on a light card: readable over bone and over the background.
+    bar->GetTitleTextProperty()->SetColor(0.1, 0.1, 0.1);
+    bar->GetLabelTextProperty()->SetColor(0.1, 0.1, 0.1);
+    bar->DrawBackgroundOn();
+    bar->GetBackgroundProperty()->SetColor(1.0, 1.0, 1.0);
+    bar->GetBackgroundProperty()->SetOpacity(0.85);
+  }
+  const double edge_at[4][2] = {{0.012, 0.5}, {0.988, 0.5}, {0.5, 0.985}, {0.5, 0.015}};
+  for (int k = 0; k < 4; ++k) {
+    vtkTextActor* t = d.edge_text[k];
+    t->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
+    t->SetPosition(edge_at[k][0], edge_at[k][1]);
+    vtkTextProperty* tp = t->GetTextProperty();
+    tp->SetFontSize(18);
+    tp->BoldOn();
+    tp->SetColor(1.0, 0.85, 0.25);
+    tp->SetJustification(k == 0 ? VTK_TEXT_LEFT : k == 1 ? VTK_TEXT_RIGHT : VTK_TEXT_CENTERED);
+    tp->SetVerticalJustification(k == 2   ? VTK_TEXT_TOP
+                                 : k == 3 ? VTK_TEXT_BOTTOM
+                                          : VTK_TEXT_CENTERED);
+    tp->ShadowOn();
+    d.overlay->AddActor2D(t);
+  }
   d.zones.mapper->ScalingOn();
   d.zones.mapper->SetScaleArray("radius");
   d.zones.mapper->SetScaleModeToScaleByMagnitude();
@@ -588,6 +622,7 @@ void SkullView::paintGL() {
   d.window->SetReadyForRendering(true);
   d.window->SetSize(static_cast<int>(width() * d.dpr), static_cast<int>(height() * d.dpr));
   follow_camera(d.renderer->GetActiveCamera(), d.orientation->GetActiveCamera());
+  update_edge_letters();
   // With a mould shown, it and the implant alone: the rest of the scene is hidden while drawn.
   std::vector<vtkActor*> hidden;
   if (d.mould_outer.visible()) {
@@ -647,7 +682,8 @@ void SkullView::show_state(const PlanState& s) {
   // Clip plane: keep the side the normal points away from.
   d.skull.mapper->RemoveAllClippingPlanes();
   d.mirror.mapper->RemoveAllClippingPlanes();
-  if (s.clip_plane) {
+  d.clip_plane = s.clip_plane;
+  if (s.clip_plane && d.clip_wanted) {
     const Eigen::Vector3d keep = -s.clip_plane->normal;
     d.clip->SetNormal(keep.x(), keep.y(), keep.z());
     const Eigen::Vector3d origin = s.clip_plane->normal * s.clip_plane->offset;
@@ -722,6 +758,7 @@ void SkullView::show_state(const PlanState& s) {
     d.camera_set = true;
   }
   if (!s.skull) d.camera_set = false;
+  if (!d.markers_wanted) set_markers_visible(false);
   update();
 }
 
@@ -814,13 +851,81 @@ void SkullView::set_standard_view(StandardView view) {
   cam->SetFocalPoint(d.center.data());
   cam->SetPosition(pos.x(), pos.y(), pos.z());
   cam->SetViewUp(up.x(), up.y(), up.z());
-  d.renderer->ResetCamera();
-  cam->Zoom(1.5);  // ResetCamera fits the bounding sphere; the skull fills more of the view
+  // The skull framed (not the plane's square, nor the markers): ResetCamera fits the bounding
+  // sphere of the bounds, and the skull fills more of the view zoomed by 1.5.
+  double b[6];
+  if (d.skull.shown) {
+    d.skull.mapper->GetInput()->GetBounds(b);
+    d.renderer->ResetCamera(b);
+  } else {
+    d.renderer->ResetCamera();
+  }
+  cam->Zoom(1.5);
   d.renderer->ResetCameraClippingRange();
   update();
 }
 
 void SkullView::reset_camera() { set_standard_view(StandardView::Front); }
+
+std::string patient_direction_letters(const Eigen::Vector3d& direction) {
+  // LPS: +x the patient's left, +y posterior, +z superior. The largest component's letter,
+  // then the next one's when it is more than 22.5° worth (as "LA", "SR"...).
+  static const char* const kPlus[] = {"L", "P", "S"};
+  static const char* const kMinus[] = {"R", "A", "I"};
+  const Eigen::Vector3d d = direction.normalized();
+  std::array<int, 3> order{0, 1, 2};
+  std::stable_sort(order.begin(), order.end(),
+                   [&](int a, int b) { return std::abs(d[a]) > std::abs(d[b]); });
+  std::string out = d[order[0]] >= 0 ? kPlus[order[0]] : kMinus[order[0]];
+  if (std::abs(d[order[1]]) > std::sin(22.5 * M_PI / 180.0))
+    out += d[order[1]] >= 0 ? kPlus[order[1]] : kMinus[order[1]];
+  return out;
+}
+
+void SkullView::update_edge_letters() {
+  Impl& d = *d_;
+  vtkCamera* cam = d.renderer->GetActiveCamera();
+  double dop[3], up[3];
+  cam->GetDirectionOfProjection(dop);
+  cam->GetViewUp(up);
+  const Eigen::Vector3d forward(dop[0], dop[1], dop[2]);
+  Eigen::Vector3d upward(up[0], up[1], up[2]);
+  upward = (upward - upward.dot(forward) * forward).normalized();
+  const Eigen::Vector3d right = forward.cross(upward).normalized();
+  d.edge_letters = {patient_direction_letters(-right), patient_direction_letters(right),
+                    patient_direction_letters(upward), patient_direction_letters(-upward)};
+  const bool any = d.skull.shown != nullptr;
+  for (int k = 0; k < 4; ++k) {
+    d.edge_text[k]->SetInput(d.edge_letters[k].c_str());
+    d.edge_text[k]->SetVisibility(any);
+  }
+}
+
+std::array<std::string, 4> SkullView::edge_letters() {
+  update_edge_letters();
+  return d_->edge_letters;
+}
+
+void SkullView::set_clip_enabled(bool enabled) {
+  Impl& d = *d_;
+  d.clip_wanted = enabled;
+  d.skull.mapper->RemoveAllClippingPlanes();
+  d.mirror.mapper->RemoveAllClippingPlanes();
+  if (enabled && d.clip_plane) {
+    const Eigen::Vector3d keep = -d.clip_plane->normal;
+    d.clip->SetNormal(keep.x(), keep.y(), keep.z());
+    const Eigen::Vector3d origin = d.clip_plane->normal * d.clip_plane->offset;
+    d.clip->SetOrigin(origin.x(), origin.y(), origin.z());
+    d.skull.mapper->AddClippingPlane(d.clip);
+    d.mirror.mapper->AddClippingPlane(d.clip);
+  }
+  update();
+}
+
+bool SkullView::clip_shown() const {
+  return d_->skull.mapper->GetClippingPlanes() &&
+         d_->skull.mapper->GetClippingPlanes()->GetNumberOfItems() > 0;
+}
 
 void SkullView::look_at_markers() {
   Impl& d = *d_;
@@ -839,6 +944,49 @@ void SkullView::look_at_markers() {
   cam->SetPosition(pos.x(), pos.y(), pos.z());
   cam->SetViewUp(up.x(), up.y(), up.z());
   d.renderer->ResetCameraClippingRange();
+  update();
+}
+
+void SkullView::look_at_implant(std::optional<StandardView> from) {
+  Impl& d = *d_;
+  if (!d.implant.shown) return;
+  double b[6];
+  d.implant.mapper->GetInput()->GetBounds(b);
+  const Eigen::Vector3d c((b[0] + b[1]) / 2, (b[2] + b[3]) / 2, (b[4] + b[5]) / 2);
+  if (from) {
+    set_standard_view(*from);
+  } else {
+    // Along the defect: from outside the skull through the implant's middle.
+    Eigen::Vector3d dir = c - d.center;
+    if (dir.norm() < 1e-6) dir = -Eigen::Vector3d::UnitY();
+    dir.normalize();
+    const Eigen::Vector3d up = std::abs(dir.z()) > 0.9 ? Eigen::Vector3d(-Eigen::Vector3d::UnitY())
+                                                       : Eigen::Vector3d::UnitZ();
+    vtkCamera* cam = d.renderer->GetActiveCamera();
+    const Eigen::Vector3d pos = c + 4.0 * d.radius * dir;
+    cam->SetFocalPoint(c.x(), c.y(), c.z());
+    cam->SetPosition(pos.x(), pos.y(), pos.z());
+    cam->SetViewUp(up.x(), up.y(), up.z());
+  }
+  // The implant and the bone around it fill the view: its bounds grown by half on each side.
+  double around[6];
+  for (int k = 0; k < 3; ++k) {
+    const double half = 0.5 * (b[2 * k + 1] - b[2 * k]);
+    around[2 * k] = b[2 * k] - 0.5 * half - 10.0;
+    around[2 * k + 1] = b[2 * k + 1] + 0.5 * half + 10.0;
+  }
+  d.renderer->ResetCamera(around);
+  d.renderer->ResetCameraClippingRange();
+  update();
+}
+
+void SkullView::set_markers_visible(bool visible) {
+  Impl& d = *d_;
+  d.markers_wanted = visible;
+  for (GlyphLayer* g : {&d.outer_edge, &d.inner_edge, &d.outer_surface, &d.inner_surface,
+                        &d.landmarks, &d.selected, &d.handle_balls, &d.zones})
+    g->actor->SetVisibility(visible && g->count() > 0);
+  d.unseen_actor->SetVisibility(visible && d.unseen_data->GetNumberOfCells() > 0);
   update();
 }
 

@@ -4,8 +4,10 @@
 // midsagittal plane, implant, clip plane — and turns clicks and drags into surface points. It
 // computes no geometry of the plan: the window turns its signals into session commands.
 #include <QOpenGLWidget>
+#include <array>
 #include <memory>
 #include <optional>
+#include <string>
 #include <vector>
 
 #include "cranioplan/algorithms/quality/thickness_map.h"
@@ -17,6 +19,10 @@ struct MouldResult;
 }
 
 namespace cranioplan::gui {
+
+/// The patient's direction `direction` points to (LPS frame) as radiology viewers letter it:
+/// "L", "R", "A", "P", "S" or "I", two letters when it is oblique by more than 22.5°.
+std::string patient_direction_letters(const Eigen::Vector3d& direction);
 
 class SkullView : public QOpenGLWidget {
   Q_OBJECT
@@ -36,10 +42,23 @@ class SkullView : public QOpenGLWidget {
   void set_plane_visible(bool visible);
 
   enum class StandardView { Front, Back, Left, Right, Top };
+  /// The camera along a patient axis, framing the skull (not the plane or the markers).
   void set_standard_view(StandardView view);
+  /// The letters at the view's left, right, top and bottom edges for the camera now.
+  std::array<std::string, 4> edge_letters();
+  /// Whether the plan's clip plane (step 4) cuts the skulls in the view; off: the whole skulls
+  /// (the plane stays in the plan).
+  void set_clip_enabled(bool enabled);
+  bool clip_shown() const;
   void reset_camera();
   /// Looks at the markers (the defect) from outside the skull.
   void look_at_markers();
+  /// The implant and the bone around it filling the view, from a standard direction or (none)
+  /// along the defect, from outside the skull.
+  void look_at_implant(std::optional<StandardView> from = std::nullopt);
+  /// Whether markers, landmarks, handles, zones and the rim's unseen stretches are drawn (the
+  /// design report's pictures: off).
+  void set_markers_visible(bool visible);
 
   /// Which surface a click places on (None: clicks only select markers).
   enum class PickTarget { None, Original, Mirrored, Implant };
@@ -130,6 +149,7 @@ class SkullView : public QOpenGLWidget {
   void forward_button(QMouseEvent* event, bool press);
   /// Takes the worker's coarse copy of the skull, if it is done and of the skull shown.
   void take_coarse_copy();
+  void update_edge_letters();
 
   struct Impl;
   std::unique_ptr<Impl> d_;

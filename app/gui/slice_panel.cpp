@@ -3,6 +3,11 @@
 #include <QCoreApplication>
 #include <QFutureWatcher>
 #include <QGridLayout>
+#include <QHBoxLayout>
+#include <QLabel>
+#include <QSlider>
+#include <QToolButton>
+#include <QVBoxLayout>
 #include <QtConcurrent/QtConcurrent>
 
 #include "cranioplan/algorithms/io/read_volume.h"
@@ -15,30 +20,124 @@ struct SlicePanel::Read {
   QString error;
 };
 
-SlicePanel::SlicePanel(QWidget* parent) : QWidget(parent), grid_(new QGridLayout(this)) {
+SlicePanel::SlicePanel(QWidget* three_d, QWidget* parent)
+    : QWidget(parent), grid_(new QGridLayout(this)) {
   setObjectName("slicePanel");
   grid_->setContentsMargins(0, 0, 0, 0);
-  grid_->setSpacing(2);
+  grid_->setSpacing(3);
+  panes_[0] = make_pane(three_d, tr("3D"), 0);
+  const QString titles[] = {tr("Axial"), tr("Coronal"), tr("Sagittal")};
   for (SliceOrientation o :
        {SliceOrientation::Axial, SliceOrientation::Coronal, SliceOrientation::Sagittal}) {
+    const int i = static_cast<int>(o);
     auto* v = new SliceView(o, this);
-    views_[static_cast<int>(o)] = v;
+    views_[i] = v;
     connect(v, &SliceView::cursorMoved, this, [this](const Eigen::Vector3d& p) {
       set_cursor(p);
       emit cursorMoved(p);
     });
     connect(v, &SliceView::windowLevelChanged, this, &SlicePanel::set_window_level);
+    connect(v, &SliceView::sliceChanged, this, [this, i] { sync_slider(i); });
+    connect(v, &SliceView::maximiseToggled, this, [this, i] { maximise_[i + 1]->click(); });
+    panes_[i + 1] = make_pane(v, titles[i], i + 1);
   }
-  set_column(true);
+  // Four equal panes: 3D top left, axial top right, coronal and sagittal below.
+  for (int k = 0; k < 4; ++k) grid_->addWidget(panes_[k], k / 2, k % 2);
+  for (int k = 0; k < 2; ++k) {
+    grid_->setRowStretch(k, 1);
+    grid_->setColumnStretch(k, 1);
+  }
+  arrange(Arrangement::ThreeD);
 }
 
 SlicePanel::~SlicePanel() {
   if (watcher_) watcher_->waitForFinished();
 }
 
-void SlicePanel::set_column(bool column) {
-  for (SliceView* v : views_) grid_->removeWidget(v);
-  for (int i = 0; i < 3; ++i) grid_->addWidget(views_[i], column ? i : i / 2, column ? 0 : i % 2);
+QWidget* SlicePanel::make_pane(QWidget* content, const QString& title, int index) {
+  auto* pane = new QWidget(this);
+  auto* column = new QVBoxLayout(pane);
+  column->setContentsMargins(0, 0, 0, 0);
+  column->setSpacing(1);
+  auto* header = new QWidget(pane);
+  header->setStyleSheet("background:#2b2f36;color:#e8e8e8");
+  auto* row = new QHBoxLayout(header);
+  row->setContentsMargins(6, 1, 2, 1);
+  auto* name = new QLabel(title, header);
+  name->setMinimumWidth(name->fontMetrics().horizontalAdvance(QStringLiteral("Sagittal  ")));
+  row->addWidget(name);
+  if (index > 0) {
+    auto* slider = new QSlider(Qt::Horizontal, header);
+    static const char* const kNames[] = {"sliceSliderAxial", "sliceSliderCoronal",
+                                         "sliceSliderSagittal"};
+    slider->setObjectName(kNames[index - 1]);
+    slider->setToolTip(tr("The slice (the wheel steps it too)"));
+    connect(slider, &QSlider::valueChanged, this, [this, index](int value) {
+      SliceView& v = *views_[index - 1];
+      const SliceView::Range r = v.range();
+      v.set_slice_position(r.from + value * r.step);
+    });
+    sliders_[index - 1] = slider;
+    row->addWidget(slider, 1);
+    auto* fit = new QToolButton(header);
+    fit->setText(tr("Fit"));
+    fit->setToolTip(tr("The whole slice in the pane (Ctrl+wheel zooms, middle drag pans)"));
+    connect(fit, &QToolButton::clicked, this, [this, index] { views_[index - 1]->fit(); });
+    row->addWidget(fit);
+  } else {
+    row->addStretch(1);
+  }
+  auto* max = new QToolButton(header);
+  static const char* const kMax[] = {"maximise3d", "maximiseAxial", "maximiseCoronal",
+                                     "maximiseSagittal"};
+  max->setObjectName(kMax[index]);
+  max->setText(QStringLiteral("⤢"));
+  max->setToolTip(tr("This pane alone, or back to the four (a double click on a slice too)"));
+  max->setCheckable(true);
+  connect(max, &QToolButton::clicked, this, [this, index](bool on) {
+    static const Arrangement kOne[] = {Arrangement::ThreeDMaximised, Arrangement::Axial,
+                                       Arrangement::Coronal, Arrangement::Sagittal};
+    arrange(on ? kOne[index] : Arrangement::FourUp);
+    emit arranged(arrangement_);
+  });
+  maximise_[index] = max;
+  row->addWidget(max);
+  headers_[index] = header;
+  column->addWidget(header);
+  column->addWidget(content, 1);
+  return pane;
+}
+
+void SlicePanel::arrange(Arrangement a) {
+  arrangement_ = a;
+  const std::array<bool, 4> shown = {
+      a == Arrangement::ThreeD || a == Arrangement::FourUp || a == Arrangement::ThreeDMaximised,
+      a == Arrangement::FourUp || a == Arrangement::Axial,
+      a == Arrangement::FourUp || a == Arrangement::Coronal,
+      a == Arrangement::FourUp || a == Arrangement::Sagittal};
+  for (int k = 0; k < 4; ++k) {
+    panes_[k]->setVisible(shown[k]);
+    // The 3D view alone is the plain wizard: no header.
+    headers_[k]->setVisible(a != Arrangement::ThreeD);
+    const QSignalBlocker block(maximise_[k]);
+    maximise_[k]->setChecked(a != Arrangement::FourUp && a != Arrangement::ThreeD && shown[k]);
+  }
+  // A hidden pane's row or column takes no room.
+  grid_->setRowStretch(0, shown[0] || shown[1] ? 1 : 0);
+  grid_->setRowStretch(1, shown[2] || shown[3] ? 1 : 0);
+  grid_->setColumnStretch(0, shown[0] || shown[2] ? 1 : 0);
+  grid_->setColumnStretch(1, shown[1] || shown[3] ? 1 : 0);
+}
+
+void SlicePanel::sync_slider(int i) {
+  QSlider* slider = sliders_[i];
+  if (!slider) return;
+  const SliceView::Range r = views_[i]->range();
+  const QSignalBlocker block(slider);
+  slider->setEnabled(views_[i]->has_volume());
+  slider->setRange(0, std::max(0, r.count() - 1));
+  slider->setValue(
+      static_cast<int>(std::lround((views_[i]->geometry().position_mm - r.from) / r.step)));
 }
 
 void SlicePanel::show_state(const PlanState& s) {
@@ -73,6 +172,7 @@ void SlicePanel::show_state(const PlanState& s) {
   key_ = key;
   volume_.reset();
   for (SliceView* v : views_) v->set_volume(nullptr, key.empty() ? missing : tr("Reading the CT…"));
+  for (int i = 0; i < 3; ++i) sync_slider(i);
   set_highlight({});
   emit ctChanged();
   if (key.empty()) return;
@@ -114,6 +214,7 @@ void SlicePanel::loaded() {
     v->set_cursor(cursor_);
     v->set_volume(volume_);
   }
+  for (int i = 0; i < 3; ++i) sync_slider(i);
   emit ctChanged();
 }
 

@@ -1,7 +1,9 @@
 #pragma once
-// The wizard's three CT slice views (axial, coronal, sagittal) with one shared cursor and one
-// window/level. The plan's CT is the volume its skull was imported from; it is read again off
-// the GUI thread when the plan's skull changes (a plan made from a mesh has none).
+// The wizard's centre: the 3D view and the three CT slice views (axial, coronal, sagittal) in
+// equal panes (four-up, as 3D Slicer and InVesalius lay them out), or one of them maximised;
+// each slice with a slider, one shared cursor and one window/level. The plan's CT is the volume
+// its skull was imported from; it is read again off the GUI thread when the plan's skull
+// changes (a plan made from a mesh has none).
 #include <QWidget>
 #include <array>
 #include <memory>
@@ -12,6 +14,9 @@
 template <typename T>
 class QFutureWatcher;
 class QGridLayout;
+class QLabel;
+class QSlider;
+class QToolButton;
 
 namespace cranioplan::gui {
 
@@ -19,8 +24,16 @@ class SlicePanel : public QWidget {
   Q_OBJECT
 
  public:
-  explicit SlicePanel(QWidget* parent = nullptr);
+  /// `three_d`: the 3D view, laid out as the first pane.
+  explicit SlicePanel(QWidget* three_d, QWidget* parent = nullptr);
   ~SlicePanel() override;
+
+  /// What the centre shows: the 3D view alone, the four panes, or one pane maximised.
+  enum class Arrangement { ThreeD, FourUp, Axial, Coronal, Sagittal, ThreeDMaximised };
+  void arrange(Arrangement arrangement);
+  Arrangement arrangement() const { return arrangement_; }
+  /// The slider of a slice view.
+  QSlider& slider(SliceOrientation orientation) { return *sliders_[static_cast<int>(orientation)]; }
 
   /// Shows the plan; reads its CT when the skull changed.
   void show_state(const PlanState& state);
@@ -31,8 +44,6 @@ class SlicePanel : public QWidget {
   /// Window and level of a preset (a mask's 0/1 whatever the preset).
   void apply_preset(Preset preset);
   void set_markers_shown(bool shown);
-  /// The three views one above the other (beside the 3D view), or in a grid.
-  void set_column(bool column);
   SliceView& view(SliceOrientation orientation) { return *views_[static_cast<int>(orientation)]; }
   /// Waits (processing events) until the CT is read; for tests and the command line.
   void wait_loaded();
@@ -46,12 +57,23 @@ class SlicePanel : public QWidget {
   void cursorMoved(const Eigen::Vector3d& point);
   /// The plan's CT has been read (or is gone).
   void ctChanged();
+  /// The arrangement changed from within (a pane's maximise button, a double click).
+  void arranged(Arrangement arrangement);
 
  private:
   void loaded();
+  /// A pane: a header (its name, the slice slider, maximise) over `content`.
+  QWidget* make_pane(QWidget* content, const QString& title, int index);
+  /// The sliders' ranges and positions as the views' slices are.
+  void sync_slider(int orientation);
 
   std::array<SliceView*, 3> views_{};
+  std::array<QSlider*, 3> sliders_{};
+  std::array<QWidget*, 4> panes_{};  ///< 3D, axial, coronal, sagittal
+  std::array<QToolButton*, 4> maximise_{};
+  std::array<QWidget*, 4> headers_{};
   QGridLayout* grid_;
+  Arrangement arrangement_ = Arrangement::ThreeD;
   std::string key_;  ///< the file (and series) whose CT is shown or being read
   std::shared_ptr<const Volume> volume_;
   struct Read;

@@ -3,7 +3,9 @@
 #include <QMouseEvent>
 #include <QPainter>
 #include <QWheelEvent>
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace cranioplan::gui {
 
@@ -90,10 +92,58 @@ void SliceView::reslice() {
     update();
     return;
   }
+  const double before = slice_.position_mm;
   slice_ = slice_through(*volume_, orientation_, cursor_);
   values_ = sample_slice(*volume_, slice_);
   recut();
   set_window_level(window_, level_);
+  if (slice_.position_mm != before) emit sliceChanged(slice_.position_mm);
+}
+
+SliceView::Range SliceView::range() const {
+  Range r;
+  if (!volume_) return r;
+  r.from = std::numeric_limits<double>::infinity();
+  r.to = -r.from;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d ijk((corner & 1) ? volume_->dims[0] - 1 : 0,
+                              (corner & 2) ? volume_->dims[1] - 1 : 0,
+                              (corner & 4) ? volume_->dims[2] - 1 : 0);
+    const double along = slice_.normal.dot(volume_->world(ijk));
+    r.from = std::min(r.from, along);
+    r.to = std::max(r.to, along);
+  }
+  r.step = std::max(1e-3, slice_.right.norm());
+  return r;
+}
+
+void SliceView::set_slice_position(double position_mm) {
+  if (!volume_) return;
+  emit cursorMoved(cursor_ + (position_mm - slice_.normal.dot(cursor_)) * slice_.normal);
+}
+
+void SliceView::zoom_by(double factor, const QPointF& about) {
+  const double next = std::clamp(zoom_ * factor, 1.0, 20.0);
+  // The point under `about` stays there: the offset scales about it.
+  const QPointF o = offset();
+  const double k = next / zoom_;
+  zoom_ = next;
+  const QPointF centred =
+      QPointF((width() - scale() * slice_.width) / 2.0, (height() - scale() * slice_.height) / 2.0);
+  pan_ = about - (about - o) * k - centred;
+  if (zoom_ == 1.0) pan_ = QPointF();
+  update();
+}
+
+void SliceView::pan_by(const QPointF& pixels) {
+  pan_ += pixels;
+  update();
+}
+
+void SliceView::fit() {
+  zoom_ = 1.0;
+  pan_ = QPointF();
+  update();
 }
 
 void SliceView::recut() {
@@ -106,13 +156,13 @@ void SliceView::recut() {
 
 double SliceView::scale() const {
   if (slice_.width == 0 || slice_.height == 0) return 1.0;
-  return std::min(width() / static_cast<double>(slice_.width),
-                  height() / static_cast<double>(slice_.height));
+  return zoom_ * std::min(width() / static_cast<double>(slice_.width),
+                          height() / static_cast<double>(slice_.height));
 }
 
 QPointF SliceView::offset() const {
   const double s = scale();
-  return {(width() - s * slice_.width) / 2.0, (height() - s * slice_.height) / 2.0};
+  return QPointF((width() - s * slice_.width) / 2.0, (height() - s * slice_.height) / 2.0) + pan_;
 }
 
 QPointF SliceView::to_widget(const Eigen::Vector3d& point) const {
@@ -154,7 +204,6 @@ void SliceView::paintEvent(QPaintEvent*) {
   p.drawLine(QPointF(o.x(), c.y()), QPointF(o.x() + s * slice_.width, c.y()));
   p.drawLine(QPointF(c.x(), o.y()), QPointF(c.x(), o.y() + s * slice_.height));
   draw_outline(p, skull_cut_, QColor(240, 220, 90), 1.0);
-  draw_outline(p, implant_cut_, QColor(255, 130, 0), 2.0);
   // Where the implant lies in soft tissue: its voxels in this slice, red.
   p.setPen(Qt::NoPen);
   p.setBrush(QColor(255, 30, 30, 190));
@@ -170,6 +219,9 @@ void SliceView::paintEvent(QPaintEvent*) {
     p.setBrush(marker_color(m.type));
     p.drawEllipse(to_widget(m.position), 3.5, 3.5);
   }
+  // The implant's outline over everything else: what the slice is looked at for.
+  p.setBrush(Qt::NoBrush);
+  draw_outline(p, implant_cut_, QColor(255, 130, 0), 2.0);
   // Orientation letters at the middle of the image's edges; the slice's position and the
   // window and level in the widget's corners.
   const QRectF image(o, QSizeF(s * slice_.width, s * slice_.height));
@@ -195,12 +247,22 @@ void SliceView::paintEvent(QPaintEvent*) {
                  .arg(slice_.position_mm, 0, 'f', 1));
   p.drawText(corners, Qt::AlignRight | Qt::AlignBottom,
              tr("W %1\nL %2").arg(window_, 0, 'g', 4).arg(level_, 0, 'g', 4));
+  // A scale bar (10 mm) in the lower left: the slice's millimetres at a glance, at any zoom.
+  const double ten = 10.0 * s / std::max(1e-9, slice_.right.norm());
+  const QPointF bar(corners.left() + 4, corners.bottom() - 6);
+  p.setPen(QPen(QColor(220, 220, 220), 2));
+  p.drawLine(bar, bar + QPointF(ten, 0));
+  p.drawText(QRectF(bar.x(), bar.y() - 20, std::max(40.0, ten + 30), 16), Qt::AlignLeft,
+             zoom_ > 1.0 ? tr("10 mm  ×%1").arg(zoom_, 0, 'f', 1) : tr("10 mm"));
 }
 
 void SliceView::mousePressEvent(QMouseEvent* e) {
   if (!volume_) return;
   drag_start_ = e->position();
-  if (e->button() == Qt::LeftButton) {
+  if (e->button() == Qt::MiddleButton ||
+      (e->button() == Qt::LeftButton && (e->modifiers() & Qt::ShiftModifier))) {
+    drag_ = Drag::Pan;
+  } else if (e->button() == Qt::LeftButton) {
     drag_ = Drag::Cursor;
     emit cursorMoved(to_patient(e->position()));
   } else if (e->button() == Qt::RightButton) {
@@ -211,7 +273,10 @@ void SliceView::mousePressEvent(QMouseEvent* e) {
 }
 
 void SliceView::mouseMoveEvent(QMouseEvent* e) {
-  if (drag_ == Drag::Cursor) {
+  if (drag_ == Drag::Pan) {
+    pan_by(e->position() - drag_start_);
+    drag_start_ = e->position();
+  } else if (drag_ == Drag::Cursor) {
     emit cursorMoved(to_patient(e->position()));
   } else if (drag_ == Drag::WindowLevel) {
     // One widget width of drag doubles (or halves) the window; one height moves the level by
@@ -226,8 +291,16 @@ void SliceView::mouseMoveEvent(QMouseEvent* e) {
 
 void SliceView::mouseReleaseEvent(QMouseEvent*) { drag_ = Drag::None; }
 
+void SliceView::mouseDoubleClickEvent(QMouseEvent* e) {
+  if (e->button() == Qt::LeftButton) emit maximiseToggled();
+}
+
 void SliceView::wheelEvent(QWheelEvent* e) {
   if (!volume_ || e->angleDelta().y() == 0) return;
+  if (e->modifiers() & Qt::ControlModifier) {  // zoom about the pointer, 1.25× a notch
+    zoom_by(std::pow(1.25, e->angleDelta().y() / 120.0), e->position());
+    return;
+  }
   // One step: the slice's pixel size (the CT's finest spacing) along its normal.
   const double step = slice_.right.norm() * (e->angleDelta().y() > 0 ? 1.0 : -1.0);
   emit cursorMoved(cursor_ + step * slice_.normal);

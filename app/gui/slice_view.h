@@ -2,11 +2,13 @@
 // A CT slice view of the wizard: an axial, coronal or sagittal slice of the plan's CT in the
 // patient frame, with window/level, the skull's and the implant's cut outlines, the markers near
 // the slice, a crosshair at the shared cursor and the orientation letters at its edges. Wheel:
-// the next or previous slice; left click or drag: moves the cursor (all views follow); right
-// drag: window (left–right) and level (up–down). The slicing and cutting are algorithms
-// (cranioplan/algorithms/geometry/slices.h); the view only draws them.
+// the next or previous slice; Ctrl+wheel: zoom about the pointer; middle drag (or Shift+left
+// drag): pan; left click or drag: moves the cursor (all views follow); right drag: window
+// (left–right) and level (up–down); double click: the view maximised or back. The slicing and
+// cutting are algorithms (cranioplan/algorithms/geometry/slices.h); the view only draws them.
 #include <QImage>
 #include <QWidget>
+#include <cmath>
 #include <memory>
 #include <optional>
 
@@ -42,6 +44,22 @@ class SliceView : public QWidget {
   QPointF to_widget(const Eigen::Vector3d& point) const;
   /// The patient point on the slice under a widget position.
   Eigen::Vector3d to_patient(const QPointF& position) const;
+  /// Where slices of this orientation can lie (mm along the normal: the volume's extent) and the
+  /// step between them (the wheel's); {0, 0, 1} without a volume.
+  struct Range {
+    double from = 0.0, to = 0.0, step = 1.0;
+    int count() const { return 1 + static_cast<int>(std::lround((to - from) / step)); }
+  };
+  Range range() const;
+  /// Moves the slice to `position_mm` along the normal (the cursor moves with it).
+  void set_slice_position(double position_mm);
+  /// Magnification over the whole slice fitted to the view (1: fitted), about the widget point
+  /// `about` (kept where it is).
+  void zoom_by(double factor, const QPointF& about);
+  void pan_by(const QPointF& pixels);
+  /// The whole slice fitted to the view again.
+  void fit();
+  double zoom() const { return zoom_; }
   /// How many outline segments of the skull and of the implant the slice shows.
   int skull_segments() const { return static_cast<int>(skull_cut_.size()); }
   int implant_segments() const { return static_cast<int>(implant_cut_.size()); }
@@ -49,6 +67,10 @@ class SliceView : public QWidget {
  signals:
   void cursorMoved(const Eigen::Vector3d& point);
   void windowLevelChanged(double window, double level);
+  /// The slice moved (its position along the normal, mm).
+  void sliceChanged(double position_mm);
+  /// A double click: the view maximised, or back among the others.
+  void maximiseToggled();
 
  protected:
   void paintEvent(QPaintEvent* event) override;
@@ -56,6 +78,7 @@ class SliceView : public QWidget {
   void mouseMoveEvent(QMouseEvent* event) override;
   void mouseReleaseEvent(QMouseEvent* event) override;
   void wheelEvent(QWheelEvent* event) override;
+  void mouseDoubleClickEvent(QMouseEvent* event) override;
 
  private:
   void reslice();  ///< the image and the outlines for the current slice
@@ -77,11 +100,13 @@ class SliceView : public QWidget {
   std::shared_ptr<const SharedSurface> skull_;
   std::shared_ptr<const ImplantData> implant_;
   std::vector<Marker> markers_;
-  bool markers_shown_ = true;
+  bool markers_shown_ = false;
   std::vector<Eigen::Vector3d> highlight_;
   double highlight_half_mm_ = 0.5;
   std::vector<CutSegment> skull_cut_, implant_cut_;
-  enum class Drag { None, Cursor, WindowLevel } drag_ = Drag::None;
+  double zoom_ = 1.0;
+  QPointF pan_;  ///< widget pixels
+  enum class Drag { None, Cursor, WindowLevel, Pan } drag_ = Drag::None;
   QPointF drag_start_;
   double window_start_ = 0.0, level_start_ = 0.0;
 };

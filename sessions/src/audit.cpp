@@ -422,6 +422,66 @@ std::string training_report_html(const TrainingReport& r) {
   return out.str();
 }
 
+std::vector<std::string> quality_advice(const QualityReport& r, const ImplantParams& params) {
+  std::vector<std::string> out;
+  if (r.printable) return out;
+  const QualityParams limits;
+  const bool fitted = params.fit_to_bone_mm > 0;
+  const bool gap = r.rim_gap_mm > limits.max_rim_gap_mm ||
+                   (r.clearance_asked && r.clearance_high_mm > limits.max_rim_gap_mm);
+  const bool overlap = r.penetration_mm3 > limits.max_penetration_mm3;
+  const bool crossing = r.self_intersections > 0 || !r.watertight || !r.manifold || !r.outward;
+  if (!fitted && (gap || overlap || crossing)) {
+    out.push_back(
+        "Set \"Fit to the bone\" to 4 mm (step 7) and build again: the implant is then made to "
+        "meet the cut face all around, without entering the bone or folding over itself.");
+  } else {
+    if (gap)
+      out.push_back(
+          "The edge stands off the bone where the red ball shows: move the edge markers there "
+          "onto the bone's edge (step 5), or widen \"Fit to the bone\", and build again.");
+    if (overlap)
+      out.push_back(
+          "The implant enters the bone: check the outer surface markers near the rim (step 6), "
+          "or raise the material's edge clearance.");
+    if (crossing)
+      out.push_back(
+          "The surfaces fold over themselves: smooth the markers (step 8) or delete markers "
+          "that lie out of line, and build again.");
+  }
+  if (r.taper_reach_mm < 0 || r.corner_reach_mm > limits.max_corner_mm ||
+      r.taper_reach_mm > limits.max_taper_mm)
+    out.push_back(
+        "Parts are thinner than the minimum: set a thickness (\"Thickness without inner "
+        "markers\" or the material's plate thickness), or check the inner surface markers.");
+  if (r.holes_blocked > 0)
+    out.push_back("Move or remove the holes that do not go through (step 7, Remove a hole).");
+  if (r.screws_blocked > 0 || r.tab_gap_mm > limits.max_tab_gap_mm ||
+      r.tab_gap_mm < -limits.max_tab_gap_mm ||
+      (r.tab_bone_mm >= 0 && r.tab_bone_mm < limits.tab_min_bone_mm) ||
+      (r.tab_midline_mm >= 0 && r.tab_midline_mm < limits.tab_midline_mm))
+    out.push_back(
+        "Drag the tabs named above along the rim to thicker bone, away from the midline.");
+  if (r.clearance_asked && -r.clearance_low_mm > limits.clearance_tolerance_mm)
+    out.push_back("Lower the clearance asked, or widen \"Fit to the bone\".");
+  if (out.empty())
+    out.push_back("Read the problems listed in the Quality panel (right) and build again.");
+  return out;
+}
+
+std::string quality_verdict_html(const QualityReport& r, const ImplantParams& params) {
+  if (r.printable)
+    return "<p style='color:#070'><b>Printable:</b> the quality check passes (the full report "
+           "is in the Quality panel on the right).</p>";
+  std::string h =
+      "<p style='color:#a00'><b>Not printable: the quality check refuses this "
+      "implant.</b></p><ul>";
+  for (const std::string& reason : r.reasons) h += "<li>" + html_escape(reason) + "</li>";
+  h += "</ul><p><b>What to try:</b></p><ul>";
+  for (const std::string& a : quality_advice(r, params)) h += "<li>" + html_escape(a) + "</li>";
+  return h + "</ul>";
+}
+
 std::string quality_report_html(const QualityReport& r, const SoftTissueCheck* tissue) {
   auto fixed = [](double v, int decimals) {
     char buf[64];
@@ -443,9 +503,11 @@ std::string quality_report_html(const QualityReport& r, const SoftTissueCheck* t
   row("Volume", fixed(r.volume_mm3, 0) + " mm³");
   row("Area", fixed(r.area_mm2, 0) + " mm²");
   if (r.mass_g > 0) row("Mass", fixed(r.mass_g, 1) + " g");
-  row("Thickness min / median / max", fixed(r.thickness_min_mm, 1) + " / " +
-                                          fixed(r.thickness_median_mm, 1) + " / " +
-                                          fixed(r.thickness_max_mm, 1) + " mm");
+  // The least thickness along the faces' normals is that of the tapered edge (0 where it
+  // meets the bone): shown as such, not as a verdict.
+  row("Thickness median / max", fixed(r.thickness_median_mm, 1) + " / " +
+                                    fixed(r.thickness_max_mm, 1) + " mm (" +
+                                    fixed(r.thickness_min_mm, 1) + " at the tapered edge)");
   row("Thinner than the minimum", r.taper_reach_mm < 0
                                       ? std::string("everywhere")
                                       : fixed(r.thin_volume_mm3, 1) + " mm³: edge on the bone " +
@@ -480,14 +542,24 @@ std::string quality_report_html(const QualityReport& r, const SoftTissueCheck* t
       row("Tabs from the midsagittal plane (nearest)", fixed(r.tab_midline_mm, 1) + " mm");
   }
   if (tissue && tissue->checked) {
-    row("In soft tissue (CT)", fixed(tissue->intrusion_mm3, 0) + " mm³");
-    row("Soft tissue under it",
-        std::isfinite(tissue->closest_mm) ? fixed(tissue->closest_mm, 1) + " mm" : "none near");
+    row("Brain or dura in the implant's place (CT)",
+        fixed(tissue->intrusion_mm3, 0) + " mm³" +
+            (tissue->intrusion_mm3 > 0
+                 ? ", up to " + fixed(tissue->intrusion_reach_mm, 1) + " mm above its inner surface"
+                 : std::string()));
+    if (tissue->sunken_scalp_mm3 > 0)
+      row("Sunken scalp in its place (lifted by it)", fixed(tissue->sunken_scalp_mm3, 0) + " mm³");
+    row("Free space under the inner surface",
+        tissue->intrusion_mm3 > 0           ? std::string("none (tissue reaches into it)")
+        : std::isfinite(tissue->closest_mm) ? fixed(tissue->closest_mm, 1) + " mm to soft tissue"
+                                            : std::string("no soft tissue near"));
   }
   h += "</table>";
-  if (tissue && tissue->checked && tissue->intrusion_mm3 > 0)
+  if (tissue && tissue->checked && tissue->finding)
     h += "<p style='color:#a00'><b>Check on the CT slices:</b> " + html_escape(tissue->message) +
          " (red on the slices).</p>";
+  else if (tissue && tissue->checked && (tissue->intrusion_mm3 > 0 || tissue->sunken_scalp_mm3 > 0))
+    h += "<p>" + html_escape(tissue->message) + ".</p>";
   if (!r.reasons.empty()) {
     h += "<p><b>Problems:</b></p><ul>";
     for (const auto& reason : r.reasons) h += "<li>" + html_escape(reason) + "</li>";
@@ -497,7 +569,7 @@ std::string quality_report_html(const QualityReport& r, const SoftTissueCheck* t
 }
 
 std::string design_report_html(const Session& session, const std::vector<ReportImage>& images,
-                               const std::string& program_version) {
+                               const std::string& program_version, const SoftTissueCheck* tissue) {
   const PlanState& st = session.state();
   const ImplantData& implant = *st.implant;
   const QualityReport& q = implant.quality();
@@ -508,26 +580,52 @@ std::string design_report_html(const Session& session, const std::vector<ReportI
   auto point = [&](const Eigen::Vector3d& x) {
     return fixed(x.x(), 1) + ", " + fixed(x.y(), 1) + ", " + fixed(x.z(), 1);
   };
-  std::string h = html_head("Cranioplan design report") + "<h1>Implant design report</h1>";
-  // Sign-off first: what is being signed.
-  if (st.approval)
-    h += "<p class=ok><b>Approved</b> by " + html_escape(st.approval->by) + " (" +
-         html_escape(st.approval->role) + ") for the implant with STL SHA-256 <code>" +
-         st.approval->implant_sha256 + "</code>.</p>";
-  else if (!st.approval_withdrawn.empty())
-    h += "<p class=bad>Not approved: " + html_escape(st.approval_withdrawn) + ".</p>";
-  else
-    h += "<p><b>Not approved yet.</b> Approved by: ____________________ &nbsp; Date: ____________ "
-         "&nbsp; Signature: ____________________</p>";
-  if (!images.empty()) {  // two to a row, to fit an A4 page
-    h += "<table>";
-    for (size_t k = 0; k < images.size(); ++k) {
-      if (k % 2 == 0) h += "<tr>";
-      h += "<td><img src=\"" + html_escape(images[k].file) + "\" width=240><br>" +
-           html_escape(images[k].caption) + "</td>";
-      if (k % 2 == 1 || k + 1 == images.size()) h += "</tr>";
+  const SessionHeader& header = session.header();
+  const std::string case_id = header.info.case_id.empty() ? "(no case ID)" : header.info.case_id;
+  std::string h = html_head("Cranioplan design report — " + case_id) +
+                  "<h1>Implant design report — " + html_escape(case_id) + "</h1>";
+  auto row = [&](const std::string& k, const std::string& v) {
+    h += "<tr><th>" + k + "</th><td>" + v + "</td></tr>";
+  };
+  // Identity: whose plan this is, who made it, when, with what.
+  std::string skull_file;
+  for (const Command& cmd : session.effective_commands())
+    if (cmd.type == CommandType::LoadSkull) skull_file = cmd.params.value("path", std::string());
+  h += "<table width=100%>";
+  row("Case (patient) ID", "<b>" + html_escape(case_id) + "</b>");
+  row("Planned by", html_escape(header.info.user.empty() ? "—" : header.info.user));
+  row("Plan started", html_escape(header.info.created));
+  row("Last change",
+      html_escape(session.journal().empty() ? std::string("—") : session.journal().back().time));
+  row("Skull from", html_escape(std::filesystem::path(skull_file).filename().string()));
+  row("Program", "Cranioplan " + html_escape(program_version));
+  h += "</table>";
+  // The verdict, then the implant and the checks it passed or failed.
+  h += q.printable ? "<p class=ok><b>Printable:</b> the quality check passes.</p>"
+                   : "<p class=bad>NOT printable: the quality check refuses this implant.</p>";
+  std::string pictures;
+  if (!images.empty()) {
+    // The views of the skull on one page, the CT slices and the thickness map on the next, two
+    // pictures to a row.
+    const std::pair<std::vector<ReportImage::Kind>, const char*> pages[] = {
+        {{ReportImage::Kind::View}, "The implant on the skull"},
+        {{ReportImage::Kind::Slice, ReportImage::Kind::Thickness},
+         "CT slices through the implant (its outline orange), and its thickness"}};
+    for (const auto& [kinds, title] : pages) {
+      std::vector<const ReportImage*> of;
+      for (ReportImage::Kind kind : kinds)
+        for (const ReportImage& image : images)
+          if (image.kind == kind) of.push_back(&image);
+      if (of.empty()) continue;
+      pictures += std::string("<h2 style=\"page-break-before: always\">") + title + "</h2><table>";
+      for (size_t k = 0; k < of.size(); ++k) {
+        if (k % 2 == 0) pictures += "<tr>";
+        pictures += "<td><img src=\"" + html_escape(of[k]->file) + "\" width=300><br>" +
+                    html_escape(of[k]->caption) + "</td>";
+        if (k % 2 == 1 || k + 1 == of.size()) pictures += "</tr>";
+      }
+      pictures += "</table>";
     }
-    h += "</table>";
   }
   // Dimensions along the implant's principal axes.
   const Eigen::Vector3d c = vertex_centroid(mesh);
@@ -544,18 +642,17 @@ std::string design_report_html(const Session& session, const std::vector<ReportI
     hi = hi.cwiseMax(d);
   }
   const Eigen::Vector3d extent = hi - lo;
-  h += "<h2>Dimensions</h2><table>";
-  auto row = [&](const std::string& k, const std::string& v) {
-    h += "<tr><th>" + k + "</th><td>" + v + "</td></tr>";
-  };
+  h += "<h2>Implant</h2><table width=100%>";
+  if (st.implant_params && st.implant_params->material)
+    row("Material", html_escape(describe(*st.implant_params->material)));
+  else
+    row("Material", "none chosen (the plan's surfaces as they are)");
   row("Extent (principal axes)",
       fixed(extent.z(), 1) + " × " + fixed(extent.y(), 1) + " × " + fixed(extent.x(), 1) + " mm");
   row("Surface area", fixed(q.area_mm2, 0) + " mm²");
   row("Volume", fixed(q.volume_mm3, 0) + " mm³");
-  if (st.implant_params && st.implant_params->material) {
-    row("Material", html_escape(describe(*st.implant_params->material)));
+  if (st.implant_params && st.implant_params->material)
     row("Mass", fixed(q.volume_mm3 * 1e-3 * st.implant_params->material->density_g_cm3, 1) + " g");
-  }
   row("Triangles", std::to_string(mesh.n_faces()));
   const ImplantResult& built = implant.result();
   if (built.fit_to_bone_used_mm > 0.0)
@@ -563,7 +660,8 @@ std::string design_report_html(const Session& session, const std::vector<ReportI
         fixed(built.fit_to_bone_used_mm, 1) + " mm over it" +
             (built.fit_margin_note.empty() ? std::string()
                                            : " (" + html_escape(built.fit_margin_note) + ")"));
-  h += "</table><h2>Quality</h2>" + quality_report_html(q);
+  h += "</table><h2>Quality</h2>" + quality_report_html(q, tissue);
+  h += pictures;
   if (!built.holes.empty()) {
     h += "<h2>Perforations</h2><table><tr><th>#</th><th>Centre (mm)</th><th>Axis</th>"
          "<th>Placed</th></tr>";
@@ -589,6 +687,29 @@ std::string design_report_html(const Session& session, const std::vector<ReportI
            (std::isnan(t.midline_mm) ? std::string("—") : fixed(t.midline_mm, 1) + " mm") +
            "</td></tr>";
     }
+    h += "</table>";
+  }
+  // What is approved, and by whom: each line on its own, nothing to wrap.
+  h += "<h2 style=\"page-break-before: always\">Approval</h2><p>The approver confirms having "
+       "checked the implant above — its "
+       "shape on the skull, its fit to the bone on the CT slices, its thickness and every "
+       "finding of the quality table — and approves it for manufacture";
+  if (st.implant_params && st.implant_params->material)
+    h += " in " + html_escape(st.implant_params->material->name);
+  h += " as the binary STL with SHA-256 <code>" + implant.stl_sha256() + "</code>, for case " +
+       html_escape(case_id) + ".</p>";
+  if (st.approval) {
+    h += "<p class=ok><b>Approved</b> by " + html_escape(st.approval->by) + " (" +
+         html_escape(st.approval->role) + ") for the implant with STL SHA-256 <code>" +
+         st.approval->implant_sha256 + "</code>.</p>";
+  } else {
+    if (!st.approval_withdrawn.empty())
+      h += "<p class=bad>Not approved: " + html_escape(st.approval_withdrawn) + ".</p>";
+    else
+      h += "<p><b>Not approved yet.</b></p>";
+    h += "<table width=100%>";
+    for (const char* line : {"Name", "Role", "Date", "Signature"})
+      h += std::string("<tr><th width=25%>") + line + "</th><td height=34>&nbsp;</td></tr>";
     h += "</table>";
   }
   h += "<h2>Provenance</h2><table>";

@@ -153,6 +153,10 @@ Json to_json(const QualityReport& q) {
 Json to_json(const SoftTissueCheck& c) {
   return Json{{"checked", c.checked},
               {"intrusion_mm3", c.intrusion_mm3},
+              {"sunken_scalp_mm3", c.sunken_scalp_mm3},
+              {"intrusion_reach_mm", c.intrusion_reach_mm},
+              {"scalp_mm", c.scalp_mm},
+              {"finding", c.finding},
               {"closest_mm", std::isfinite(c.closest_mm) ? Json(c.closest_mm) : Json(nullptr)},
               {"message", c.message}};
 }

@@ -130,6 +130,26 @@ bool fail(std::string* out, const std::string& why) {
 
 }  // namespace
 
+std::string describe_plane_fit(const PlaneFit& fit) {
+  const double rms = fit.symmetry_rms_mm, inliers = fit.inlier_fraction;
+  const char* verdict =
+      rms <= 1.5 && inliers >= 0.6 ? "good: the two sides agree as a normal skull's do"
+      : rms <= 3.0 && inliers >= 0.4
+          ? "fair: check the plane on the face (nose and between the eyes) before going on"
+          : "poor: place the landmarks again, or adjust the plane by hand";
+  char buf[320];
+  std::snprintf(buf, sizeof(buf), "symmetry RMS %.2f mm, %.0f%% inliers (%s start) — %s", rms,
+                100.0 * inliers, fit.initial_method.c_str(), verdict);
+  return buf;
+}
+
+std::string landmark_words(const std::string& name) {
+  if (name == "orbit_left") return "left orbit";
+  if (name == "orbit_right") return "right orbit";
+  if (name == "midline") return "midline";
+  return name;  // nasion
+}
+
 bool step_complete(const PlanState& s, int step, std::string* missing) {
   switch (step) {
     case 1:
@@ -514,7 +534,9 @@ void apply_landmark(PlanState& s, const ParamReader& r, bool set) {
   } else {
     throw Refusal{"unknown landmark \"" + name + "\" (nasion, orbit_left, orbit_right or midline)"};
   }
-  s.message = (set ? "set " : "cleared ") + name;
+  s.message =
+      set ? "placed the " + landmark_words(name) + " landmark"
+          : "cleared the " + landmark_words(name) + " landmark" + (name == "midline" ? "s" : "");
 }
 
 // Fits the plane, or applies the fit the command recorded when it was first done (version 2),
@@ -541,10 +563,7 @@ void apply_fit_plane(PlanState& s, const ParamReader& r, int version, Json& reco
     return;
   }
   s.plane = fit.plane;
-  char buf[200];
-  std::snprintf(buf, sizeof(buf), "plane fitted (%s start): symmetry RMS %.2f mm, %.0f%% inliers",
-                fit.initial_method.c_str(), fit.symmetry_rms_mm, 100.0 * fit.inlier_fraction);
-  s.message = buf;
+  s.message = "plane fitted: " + describe_plane_fit(fit);
   plane_changed(s, version >= 2 ? &r : nullptr, version >= 2 ? &record : nullptr);
 }
 

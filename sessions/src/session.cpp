@@ -359,12 +359,14 @@ std::vector<Command> Session::effective_commands() const {
   return {stack_.begin(), stack_.begin() + static_cast<std::ptrdiff_t>(index_)};
 }
 
-const PlanState& Session::ensure_state(size_t index) {
+const PlanState& Session::ensure_state(size_t index,
+                                       const std::function<void(size_t, size_t)>& progress) {
   assert(index <= stack_.size());
   if (states_[index]) return *states_[index];
   size_t from = index;
   while (!states_[from]) --from;  // states_[0] is always there
   for (size_t i = from; i < index; ++i) {
+    if (progress) progress(i, index);
     ApplyOutcome out = apply_command(*states_[i], stack_[i], context_);
     if (!out.accepted)
       throw SessionError(path_.empty() ? "session" : path_,
@@ -372,6 +374,7 @@ const PlanState& Session::ensure_state(size_t index) {
                              ") is refused on replay: " + out.message);
     states_[i + 1] = std::make_shared<const PlanState>(std::move(out.state));
   }
+  if (progress) progress(index, index);
   return *states_[index];
 }
 
@@ -637,7 +640,8 @@ void Session::save(const std::string& path) {
 }
 
 Session Session::from_journal(const SessionHeader& header, const std::vector<JournalEntry>& journal,
-                              const std::string& source, const ApplyContext& context) {
+                              const std::string& source, const ApplyContext& context,
+                              const std::function<void(size_t, size_t)>& progress) {
   Session s;
   s.header_ = header;
   s.header_.app_version = CRANIOPLAN_VERSION;
@@ -649,7 +653,7 @@ Session Session::from_journal(const SessionHeader& header, const std::vector<Jou
   s.journal_ = journal;
   s.path_ = source;
   s.index_ = rec.index;
-  s.ensure_state(s.index_);
+  s.ensure_state(s.index_, progress);
   s.trim_cache();
   return s;
 }
@@ -672,7 +676,7 @@ Session Session::open(const std::string& path, const OpenOptions& options) {
       fs::rename(info.autosave_path, info.autosave_path + ".declined", ec);
     }
   }
-  Session s = from_journal(doc.header, journal, path, context);
+  Session s = from_journal(doc.header, journal, path, context, options.progress);
   s.header_.app_version = doc.header.app_version;
   if (!recovered) s.clean_index_ = s.index_;
   if (options.attach_autosave) {

@@ -12,6 +12,10 @@
 #include <QSlider>
 #include <QTest>
 #include <QTextBrowser>
+#include <cmath>
+#include <limits>
+
+#include "cranioplan/algorithms/planning/autoplan.h"
 
 namespace cranioplan::gui {
 namespace {
@@ -281,6 +285,45 @@ TEST(StepPages, TheMaterialAndClearanceZonesAreBuilt) {
   EXPECT_TRUE(host.pushed.back().params.at("params").at("clearance_zones").empty());
 }
 
+// Step 7's defaults are the automatic plan's (fitted to the bone), its Build button comes
+// first on the page, a control changed after a build says Build applies it, and the quality
+// check's verdict shows on the page.
+TEST(StepPages, BuildDefaultsToTheAutomaticPlansFitAndSaysWhatChanged) {
+  RecordingHost host;
+  BuildPage page(host);
+  page.resize(360, 900);
+  page.show();
+  ASSERT_TRUE(QTest::qWaitForWindowExposed(&page));
+  EXPECT_DOUBLE_EQ(child<QDoubleSpinBox>(page, "implantFit")->value(),
+                   AutoplanParams{}.implant.fit_to_bone_mm);
+  QPushButton* build = child<QPushButton>(page, "build");
+  ASSERT_TRUE(build);
+  for (QWidget* w : page.findChildren<QDoubleSpinBox*>())
+    EXPECT_LT(build->mapTo(&page, QPoint()).y(), w->mapTo(&page, QPoint()).y())
+        << "Build comes before " << w->objectName().toStdString();
+  click(page, "build");
+  ASSERT_EQ(host.pushed.size(), 1u);
+  EXPECT_DOUBLE_EQ(host.pushed[0].params.at("params").at("fit_to_bone_mm").get<double>(), 4.0);
+
+  // An implant built: a change says it is not applied yet; the next implant clears it.
+  QLabel* changed = child<QLabel>(page, "buildChanged");
+  host.state.implant_params = ImplantParams{};
+  host.state.implant_params->fit_to_bone_mm = 4.0;
+  ImplantResult built;
+  built.status = ImplantResult::Status::Built;
+  host.state.implant = std::make_shared<const ImplantData>(built, nullptr);
+  page.show_state(host.state);
+  EXPECT_TRUE(changed->isHidden()) << "showing the plan is not a change";
+  page.show_verdict("<p>Not printable: the quality check refuses this implant.</p>");
+  EXPECT_FALSE(child<QLabel>(page, "buildVerdict")->isHidden());
+  child<QComboBox>(page, "implantMaterial")->setCurrentIndex(1);
+  EXPECT_FALSE(changed->isHidden());
+  EXPECT_FALSE(child<QLabel>(page, "buildVerdict")->isEnabled()) << "the old verdict greyed";
+  host.state.implant = std::make_shared<const ImplantData>(built, nullptr);
+  page.show_state(host.state);
+  EXPECT_TRUE(changed->isHidden());
+}
+
 TEST(StepPages, SmoothingIsPreviewedThenApplied) {
   RecordingHost host;
   SmoothPage page(host);
@@ -292,16 +335,25 @@ TEST(StepPages, SmoothingIsPreviewedThenApplied) {
   ASSERT_EQ(host.previewed.size(), 1u);
   EXPECT_EQ(host.previewed[0].type, CommandType::SmoothMarkers);
   EXPECT_TRUE(host.pushed.empty()) << "a preview records nothing";
+  EXPECT_EQ(child<QLabel>(page, "smoothRadiusValue")->text(), "20 mm") << "value beside it";
+  child<QSlider>(page, "smoothWeight")->setValue(5);
+  EXPECT_EQ(child<QLabel>(page, "smoothWeightValue")->text(), "5");
   click(page, "applySmoothing");
   ASSERT_EQ(host.pushed.size(), 1u);
-  EXPECT_EQ(host.pushed[0].params, host.previewed[0].params);
+  EXPECT_EQ(host.pushed[0].params, host.previewed[1].params);
+  bool applied = false;
+  for (QLabel* l : page.findChildren<QLabel*>()) applied |= l->text().startsWith("Applied");
+  EXPECT_TRUE(applied) << "after Apply the page says it was applied, not 'preview'";
 }
 
-TEST(StepPages, TheExportPageShowsTheQualityReport) {
+// The export page shows the quality check's verdict; the table itself is the window's
+// Quality panel, shown once.
+TEST(StepPages, TheExportPageShowsTheQualityVerdict) {
   RecordingHost host;
   ExportPage page(host);
-  page.show_quality("<p>Printable: yes</p>");
-  EXPECT_TRUE(child<QTextBrowser>(page, "exportReport")->toPlainText().contains("Printable"));
+  page.show_verdict("<p>Printable: the quality check passes</p>");
+  EXPECT_TRUE(child<QLabel>(page, "exportVerdict")->text().contains("Printable"));
+  EXPECT_EQ(page.findChild<QTextBrowser*>(), nullptr) << "no second quality table";
 }
 
 TEST(StepPages, TheLoadPageKnowsTheMeshUnits) {
@@ -312,6 +364,13 @@ TEST(StepPages, TheLoadPageKnowsTheMeshUnits) {
   EXPECT_DOUBLE_EQ(page.mesh_unit_mm(), 10.0);
   EXPECT_FALSE(page.set_mesh_unit("furlong"));
   EXPECT_DOUBLE_EQ(page.mesh_unit_mm(), 10.0);
+  // The bone threshold is automatic by default (a CT at 300 HU, a mask at 0.5): a mask opens
+  // with the default as a CT does.
+  EXPECT_TRUE(std::isnan(page.threshold()));
+  page.set_threshold(250.0);
+  EXPECT_DOUBLE_EQ(page.threshold(), 250.0);
+  page.set_threshold(std::numeric_limits<double>::quiet_NaN());
+  EXPECT_TRUE(std::isnan(page.threshold()));
   click(page, "pageSample");
   ASSERT_EQ(host.opened.size(), 1u);
   EXPECT_EQ(host.opened[0], "sample");

@@ -15,9 +15,14 @@
 #include <QMessageBox>
 #include <QMouseEvent>
 #include <QPushButton>
+#include <QScrollArea>
+#include <QScrollBar>
 #include <QSlider>
+#include <QStandardPaths>
+#include <QStatusBar>
 #include <QTest>
 #include <QTimer>
+#include <QToolButton>
 #include <QWheelEvent>
 #include <chrono>
 #include <cmath>
@@ -182,6 +187,14 @@ TEST_F(Wizard, AllNineStepsOnTheSampleReplayToTheSameImplant) {
   EXPECT_EQ(plan.state().current_step, 2);
   view.set_standard_view(SkullView::StandardView::Front);
   expect_like_baseline(view, "sample_front");
+  // The patient's directions at the view's edges, as radiology viewers letter them.
+  using Letters = std::array<std::string, 4>;  // left, right, top, bottom
+  EXPECT_EQ(view.edge_letters(), (Letters{"R", "L", "S", "I"}));
+  view.set_standard_view(SkullView::StandardView::Left);
+  EXPECT_EQ(view.edge_letters(), (Letters{"A", "P", "S", "I"}));
+  view.set_standard_view(SkullView::StandardView::Top);
+  EXPECT_EQ(view.edge_letters(), (Letters{"L", "R", "A", "P"}));
+  view.set_standard_view(SkullView::StandardView::Front);
 
   // 2. A landmark by a click at a known surface point, then Fit. A cancelled fit changes nothing.
   const Eigen::Vector3d target = anterior_midline_point(plan.state());
@@ -200,6 +213,27 @@ TEST_F(Wizard, AllNineStepsOnTheSampleReplayToTheSameImplant) {
   click(w, "fitPlane");
   plan.wait();
   ASSERT_TRUE(plan.state().plane);
+  EXPECT_NE(plan.state().message.find(" — "), std::string::npos)
+      << "the fit says whether it is good: " << plan.state().message;
+  // A standard view frames the skull, not the plane's square around it: shown or hidden, the
+  // plane leaves the skull's picture as it is.
+  const auto skull_height = [&] {
+    view.set_standard_view(SkullView::StandardView::Front);
+    const SkullMesh& mesh = plan.state().skull->surface->mesh;
+    int top = view.height(), bottom = 0;
+    for (auto vh : mesh.vertices()) {
+      if (vh.idx() % 97 != 0) continue;
+      if (const auto at = view.project(to_eigen(mesh.point(vh))))
+        top = std::min(top, at->y()), bottom = std::max(bottom, at->y());
+    }
+    return bottom - top;
+  };
+  const int with_plane = skull_height();
+  view.set_plane_visible(false);
+  const int without_plane = skull_height();
+  view.set_plane_visible(true);
+  EXPECT_NEAR(with_plane, without_plane, 2) << "the plane changes the framing";
+  EXPECT_GT(with_plane, view.height() / 2);
   click(w, "done");
   EXPECT_EQ(plan.state().current_step, 3);
 
@@ -247,8 +281,16 @@ TEST_F(Wizard, AllNineStepsOnTheSampleReplayToTheSameImplant) {
     EXPECT_GT(kept_aimed, 0);
     EXPECT_GE(kept_hits, kept_aimed * 9 / 10) << "kept bone is picked";
   }
+  EXPECT_TRUE(view.clip_shown());
   click(w, "done");
   ASSERT_EQ(plan.state().current_step, 5);
+  // Step 4's clip cuts the skulls in step 4 only: from step 5 the whole skull, until the
+  // view's toggle asks for the cut again.
+  EXPECT_FALSE(view.clip_shown()) << "the clip left on after step 4";
+  trigger(w, "viewClip");
+  EXPECT_TRUE(view.clip_shown());
+  trigger(w, "viewClip");
+  EXPECT_FALSE(view.clip_shown());
 
   // 5. Propose, drag a marker along the surface (one merged command), place and delete one.
   click(w, "propose");
@@ -324,10 +366,50 @@ TEST_F(Wizard, AllNineStepsOnTheSampleReplayToTheSameImplant) {
   click(w, "done");  // 6: the proposal's surface markers complete it
   ASSERT_EQ(plan.state().current_step, 7);
 
-  // 7. Build.
+  // 7. The page opens at its top with Build in sight. Built without the fit to the bone, the
+  // implant is refused: the step is marked ✘, the page says what is wrong and what to try,
+  // and Done does not pass it silently. The defaults (the automatic plan's fit) build a
+  // printable one.
+  auto* scroll = child<QScrollArea>(w, "pageScroll");
+  auto* build = child<QPushButton>(w, "build");
+  ASSERT_TRUE(scroll && build);
+  EXPECT_EQ(scroll->verticalScrollBar()->value(), 0) << "step 7 opens at its top";
+  EXPECT_LE(build->mapTo(scroll->viewport(), QPoint(0, build->height())).y(),
+            scroll->viewport()->height())
+      << "Build is in sight";
+  auto* fit = child<QDoubleSpinBox>(w, "implantFit");
+  EXPECT_DOUBLE_EQ(fit->value(), 4.0) << "the automatic plan's fit is the default";
+  fit->setValue(0.0);
   click(w, "build");
   plan.wait();
+  w.wait_quality();
   ASSERT_TRUE(plan.state().implant);
+  auto* verdict = child<QLabel>(w, "buildVerdict");
+  if (!plan.state().implant->quality().printable) {
+    EXPECT_TRUE(steps->item(6)->text().startsWith(QStringLiteral("✘"))) << "step 7 marked";
+    EXPECT_FALSE(verdict->isHidden());
+    EXPECT_TRUE(verdict->text().contains("What to try")) << verdict->text().toStdString();
+    click(w, "done");
+    EXPECT_EQ(plan.state().current_step, 7) << "a refused implant is not passed silently";
+    EXPECT_TRUE(w.statusBar()->currentMessage().contains("quality check refuses"))
+        << w.statusBar()->currentMessage().toStdString();
+  } else {
+    ADD_FAILURE() << "the sample's implant without the fit to the bone was expected refused";
+  }
+  fit->setValue(4.0);
+  EXPECT_FALSE(child<QLabel>(w, "buildChanged")->isHidden()) << "a change not yet built";
+  click(w, "build");
+  plan.wait();
+  w.wait_quality();
+  ASSERT_TRUE(plan.state().implant);
+  EXPECT_TRUE(plan.state().implant->quality().printable)
+      << "the defaults build a printable implant: "
+      << (plan.state().implant->quality().reasons.empty()
+              ? std::string()
+              : plan.state().implant->quality().reasons.front());
+  EXPECT_TRUE(steps->item(6)->text().startsWith(QStringLiteral("✔")));
+  EXPECT_TRUE(child<QLabel>(w, "buildChanged")->isHidden());
+  EXPECT_TRUE(verdict->text().contains("Printable")) << verdict->text().toStdString();
   click(w, "done");
 
   // 8. The slider previews without recording; Apply records.
@@ -348,14 +430,20 @@ TEST_F(Wizard, AllNineStepsOnTheSampleReplayToTheSameImplant) {
   trigger(w, "undo");
   EXPECT_EQ(plan.session().index(), end - 1);
   EXPECT_FALSE(step_complete(plan.state(), 9));
+  EXPECT_TRUE(w.statusBar()->currentMessage().startsWith("Undone: "))
+      << "undo says what it undid: " << w.statusBar()->currentMessage().toStdString();
   trigger(w, "redo");
   EXPECT_EQ(plan.session().index(), end);
+  EXPECT_TRUE(w.statusBar()->currentMessage().startsWith("Redone: "))
+      << w.statusBar()->currentMessage().toStdString();
   view.look_at_markers();
   expect_like_baseline(view, "sample_plan_markers");
 
   // The saved session replays to the same implant, byte for byte.
   const std::string session = tmp.path("plan.json");
   ASSERT_TRUE(w.save_session_to(QString::fromStdString(session)));
+  EXPECT_TRUE(w.statusBar()->currentMessage().startsWith("Saved the plan to "))
+      << w.statusBar()->currentMessage().toStdString();
   const Session replayed = Session::open(session);
   ASSERT_TRUE(replayed.state().implant);
   EXPECT_EQ(replayed.state().implant->stl_sha256(), sha256_file(implant));
@@ -443,10 +531,18 @@ TEST_F(Wizard, CtSlicesShowTheImplantWhereTheGeometrySays) {
   MainWindow w;
   ASSERT_TRUE(shown(w, QSize(1500, 950)));
   ASSERT_TRUE(w.open_session(QString::fromStdString(session)));
-  w.set_layout(MainWindow::Layout::Slices);
+  w.set_layout(MainWindow::Layout::FourUp);
   w.slices().wait_loaded();
   ASSERT_TRUE(w.slices().has_ct());
   QTest::qWait(50);
+  // Four equal panes: the 3D view and the three slices.
+  for (SliceOrientation o :
+       {SliceOrientation::Axial, SliceOrientation::Coronal, SliceOrientation::Sagittal}) {
+    EXPECT_TRUE(w.slices().view(o).isVisible());
+    EXPECT_NEAR(w.slices().view(o).width(), w.view().width(), 4) << to_string(o);
+    EXPECT_NEAR(w.slices().view(o).height(), w.view().height(), 4) << to_string(o);
+  }
+  EXPECT_FALSE(child<QAction>(w, "slicesMarkers")->isChecked()) << "markers off by default";
 
   // Until pointed elsewhere, the slices go through the implant: each shows its outline, drawn
   // in orange at the points where the implant's cut lies.
@@ -458,7 +554,8 @@ TEST_F(Wizard, CtSlicesShowTheImplantWhereTheGeometrySays) {
   const SliceGeometry& g = axial.geometry();
   const std::vector<CutSegment> cut = cut_mesh(implant, g.normal, g.position_mm);
   ASSERT_FALSE(cut.empty());
-  w.slices().set_markers_shown(false);  // markers near the slice would hide parts of it
+  // With the markers shown the outline is drawn over them: it stays orange where it lies.
+  w.slices().set_markers_shown(true);
   const QImage picture = axial.grab().toImage();
   int orange = 0, checked = 0;
   for (size_t i = 0; i < cut.size(); i += std::max<size_t>(1, cut.size() / 40)) {
@@ -474,10 +571,10 @@ TEST_F(Wizard, CtSlicesShowTheImplantWhereTheGeometrySays) {
   }
   EXPECT_GE(checked, 5);
   EXPECT_GE(orange, checked * 9 / 10) << "implant outline drawn where it is cut";
-  w.slices().set_markers_shown(true);
+  w.slices().set_markers_shown(false);
 
   // The soft tissue under the implant, from the CT: the voxels of the implant in it are red on
-  // the slices (the sample's scalp lies in the defect).
+  // the slices (brain or dura deeper than the scalp in the sample's defect).
   w.wait_quality();
   EXPECT_GT(axial.highlighted(), 0);
 
@@ -507,11 +604,87 @@ TEST_F(Wizard, CtSlicesShowTheImplantWhereTheGeometrySays) {
   emit w.view().pointed(bone);
   EXPECT_LT((w.slices().cursor() - bone).norm(), 1e-9);
   EXPECT_NEAR(axial.geometry().position_mm, bone.z(), 1.0);
+  // The slider over the axial pane moves its slice, and follows the wheel.
+  QSlider& slider = w.slices().slider(SliceOrientation::Axial);
+  const SliceView::Range range = axial.range();
+  EXPECT_EQ(slider.maximum(), range.count() - 1);
+  EXPECT_NEAR(range.from + slider.value() * range.step, axial.geometry().position_mm, range.step);
+  slider.setValue(slider.maximum() / 3);
+  EXPECT_NEAR(axial.geometry().position_mm, range.from + slider.value() * range.step,
+              0.5 * range.step);
+  QApplication::sendEvent(&axial, &wheel);
+  EXPECT_NEAR(range.from + slider.value() * range.step, axial.geometry().position_mm,
+              0.51 * range.step);
+  // Ctrl+wheel zooms about the pointer (the point under it stays), a middle drag pans.
+  const Eigen::Vector3d under = axial.to_patient(QPointF(at));
+  QWheelEvent zoom(QPointF(at), axial.mapToGlobal(QPointF(at)), QPoint(), QPoint(0, 240),
+                   Qt::NoButton, Qt::ControlModifier, Qt::NoScrollPhase, false);
+  QApplication::sendEvent(&axial, &zoom);
+  EXPECT_NEAR(axial.zoom(), 1.5625, 1e-9);
+  EXPECT_LT((axial.to_patient(QPointF(at)) - under).norm(), 1e-6);
+  const QPoint pan(30, -20);
+  QTest::mousePress(&axial, Qt::MiddleButton, Qt::NoModifier, at);
+  QMouseEvent drag(QEvent::MouseMove, QPointF(at + pan), axial.mapToGlobal(QPointF(at + pan)),
+                   Qt::NoButton, Qt::MiddleButton, Qt::NoModifier);
+  QApplication::sendEvent(&axial, &drag);
+  QTest::mouseRelease(&axial, Qt::MiddleButton, Qt::NoModifier, at + pan);
+  EXPECT_LT((axial.to_patient(QPointF(at + pan)) - under).norm(), 1e-6) << "panned with the hand";
+  axial.fit();
+  EXPECT_EQ(axial.zoom(), 1.0);
+  // A pane maximised by its button, and back to the four.
+  const int four_up_width = axial.width();
+  QTest::mouseClick(child<QToolButton>(w, "maximiseAxial"), Qt::LeftButton);
+  QTest::qWait(20);
+  EXPECT_TRUE(axial.isVisible());
+  EXPECT_FALSE(w.view().isVisible());
+  EXPECT_FALSE(w.slices().view(SliceOrientation::Coronal).isVisible());
+  EXPECT_GT(axial.width(), four_up_width * 3 / 2);
+  QTest::mouseClick(child<QToolButton>(w, "maximiseAxial"), Qt::LeftButton);
+  QTest::qWait(20);
+  EXPECT_TRUE(w.view().isVisible());
+  EXPECT_TRUE(w.slices().view(SliceOrientation::Sagittal).isVisible());
 
-  w.set_layout(MainWindow::Layout::ThreeDAndSlices);
+  w.set_layout(MainWindow::Layout::FourUp);
   w.slices().set_cursor(expected);
   QTest::qWait(50);
   expect_image_like_baseline(w.slices().grab().toImage(), "sample_slices", 0.02);
+
+  // The design report a surgeon signs: who, what and when; pictures without markers; the CT
+  // through the implant with its outline; what is approved, with lines to sign; A4 pages.
+  const std::string html = tmp.path("report.html");
+  ASSERT_TRUE(w.write_design_report(QString::fromStdString(html)));
+  const std::string text = test::read_bytes(html);
+  for (const char* part :
+       {"Implant design report — sample", "<th>Case (patient) ID</th><td><b>sample</b>",
+        "<th>Planned by</th>", "<th>Plan started</th>", "<th>Program</th>",
+        "CT slices through the implant", "report_axial.png", "report_coronal.png",
+        "report_sagittal.png", "approves it for manufacture", "<th width=25%>Signature</th>",
+        "Brain or dura in the implant's place (CT)"})
+    EXPECT_NE(text.find(part), std::string::npos) << part;
+  QImage along, axial_shot;
+  ASSERT_TRUE(along.load(QString::fromStdString(tmp.path("report_defect.png"))));
+  ASSERT_TRUE(axial_shot.load(QString::fromStdString(tmp.path("report_axial.png"))));
+  long long magenta = 0, orange_px = 0;
+  for (int y = 0; y < along.height(); ++y)
+    for (int x = 0; x < along.width(); ++x) {
+      const QColor c = along.pixelColor(x, y);
+      magenta += c.red() > 180 && c.green() < 90 && c.blue() > 160;  // surface markers
+    }
+  for (int y = 0; y < axial_shot.height(); ++y)
+    for (int x = 0; x < axial_shot.width(); ++x) {
+      const QColor c = axial_shot.pixelColor(x, y);
+      orange_px += c.red() > 200 && c.green() > 80 && c.green() < 190 && c.blue() < 90;
+    }
+  EXPECT_LT(magenta, 20) << "no markers over the implant in the report's pictures";
+  EXPECT_GT(orange_px, 100) << "the implant's outline on the report's axial slice";
+  EXPECT_EQ(along.width(), along.height()) << "square pictures, two to a row on A4";
+  const std::string pdf = test::read_bytes(tmp.path("report.pdf"));
+  int pages = 0;
+  for (size_t at = pdf.find("/Type /Page\n"); at != std::string::npos;
+       at = pdf.find("/Type /Page\n", at + 1))
+    ++pages;
+  EXPECT_GE(pages, 4) << "identity, views, CT slices, approval";
+  EXPECT_TRUE(w.view().isVisible()) << "the layout is given back";
 }
 
 // A plan made from a mesh has no CT: the slices say so, until File → Attach CT gives it one
@@ -521,7 +694,7 @@ TEST(WizardSlices, APlanFromAMeshShowsTheCtAttachedToIt) {
   MainWindow w;
   w.set_interactive(false);
   ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
-  w.set_layout(MainWindow::Layout::Slices);
+  w.set_layout(MainWindow::Layout::Axial);
   w.slices().wait_loaded();
   EXPECT_FALSE(w.slices().has_ct());
   EXPECT_FALSE(w.view().isVisible());
@@ -544,6 +717,53 @@ TEST(WizardSlices, APlanFromAMeshShowsTheCtAttachedToIt) {
   EXPECT_GT(std::count(labels.data.begin(), labels.data.end(), 1.0f), 1000);
   w.set_layout(MainWindow::Layout::ThreeD);
   EXPECT_FALSE(w.slices().isVisible());
+}
+
+// Work is never put at risk by a file: opening one that turns out bad keeps the plan that was
+// open, as it was, and leaves no autosave behind; a crash's autosave discarded in recovery is
+// gone for good, and one left for later is offered again.
+TEST(WizardSafety, ABadFileClosesNothingAndDiscardedRecoveryIsGone) {
+  test::TempDir tmp;
+  const QString autosaves =
+      QStandardPaths::writableLocation(QStandardPaths::AppDataLocation) + "/autosave";
+  QDir(autosaves).removeRecursively();
+  QDir().mkpath(autosaves);
+  MainWindow w;
+  w.set_interactive(false);
+  ASSERT_TRUE(w.open_session(QString::fromStdString(test::planned_defect_case().session_path)));
+  const size_t commands = w.controller().session().stack().size();
+  const std::string implant = w.plan().implant->stl_sha256();
+  const std::string bad = tmp.path("notes.stl");
+  test::write_bytes(bad,
+                    "Patient notes, not a mesh: frontal defect, PEEK implant planned.\n"
+                    "A second line so that the file is longer than a header.\n");
+  QString failure;
+  QObject::connect(&w.controller(), &PlanController::failed,
+                   [&](const QString& m) { failure = m; });
+  w.open_input(QString::fromStdString(bad));
+  w.controller().wait();
+  EXPECT_TRUE(failure.contains("not an STL file: it is text")) << failure.toStdString();
+  ASSERT_TRUE(w.plan().skull) << "the plan open before is kept";
+  EXPECT_EQ(w.controller().session().stack().size(), commands);
+  ASSERT_TRUE(w.plan().implant);
+  EXPECT_EQ(w.plan().implant->stl_sha256(), implant);
+  EXPECT_TRUE(w.statusBar()->currentMessage().contains("the plan that was open is kept"))
+      << w.statusBar()->currentMessage().toStdString();
+  EXPECT_TRUE(QDir(autosaves).entryList({"*.autosave"}, QDir::Files).isEmpty())
+      << "a failed load leaves no autosave";
+
+  // A crash's autosave: left for later it stays, discarded it is gone.
+  const QString crashed = autosaves + "/crashed-20261207-050000.json.autosave";
+  {
+    Session s(SessionInfo{"crashed", "", ""});
+    s.set_autosave_path(crashed.toStdString());
+  }
+  ASSERT_TRUE(QFileInfo::exists(crashed));
+  w.offer_recovery(MainWindow::RecoveryChoice::Later);
+  EXPECT_TRUE(QFileInfo::exists(crashed));
+  w.offer_recovery(MainWindow::RecoveryChoice::Discard);
+  EXPECT_FALSE(QFileInfo::exists(crashed)) << "discarded, not offered again";
+  EXPECT_EQ(w.controller().session().stack().size(), commands) << "the plan open is untouched";
 }
 
 // A mesh in metres (STL carries no unit): refused with the unit named, then loaded once the
@@ -647,6 +867,9 @@ TEST(WizardMoving, ADraggedViewDrawsLargeMeshesCoarseUntilItStops) {
   w.controller().wait();
   ASSERT_TRUE(w.controller().state().mirrored);
   SkullView& view = w.view();
+  // The plane hidden: seen face on from the side, it would stand behind the head across the
+  // view (the skull, not the plane, is framed), where the background is compared.
+  view.set_plane_visible(false);
   view.set_standard_view(SkullView::StandardView::Left);
   view.update();
   QTest::qWait(100);
@@ -1254,6 +1477,7 @@ TEST_F(Wizard, CommandLineScreenshotOfASessionAtAStep) {
 
 int main(int argc, char** argv) {
   cranioplan::gui::SkullView::set_default_surface_format();
+  QStandardPaths::setTestModeEnabled(true);  // settings and autosaves apart from the user's
   QApplication app(argc, argv);
   QApplication::setOrganizationName("CranioplanTests");
   QApplication::setApplicationName("CranioplanTests");

@@ -295,7 +295,7 @@ TEST(QualityHtml, ShowsEveryFigureAndEscapesTheReasons) {
   for (const char* part :
        {"<td>Printable</td><td><b>NO</b>", "<td>Manifold</td><td><b><b>no</b></b>",
         "<td>Self-intersections</td><td><b>3</b>", "<td>Volume</td><td><b>5867 mm³</b>",
-        "<td>Area</td><td><b>3487 mm²</b>", "<b>0.0 / 4.0 / 10.1 mm</b>",
+        "<td>Area</td><td><b>3487 mm²</b>", "<b>4.0 / 10.1 mm (0.0 at the tapered edge)</b>",
         "104.3 mm³: edge on the bone 1.5 mm wide, elsewhere 0.3 mm", "<b>0.09 mm</b>",
         "<td>Overlap with skull</td><td><b>0.0 mm³</b>",
         "<li>gap of 1.2 mm &lt; the rim &amp; &quot;more&quot;</li>"})
@@ -309,6 +309,77 @@ TEST(QualityHtml, ShowsEveryFigureAndEscapesTheReasons) {
             std::string::npos);
   EXPECT_EQ(without.find("Gap to bone"), std::string::npos) << "not measured, not shown";
   EXPECT_EQ(without.find("Problems"), std::string::npos);
+}
+
+// The soft tissue in the implant's place: brain or dura reaching into the defect is the finding
+// (red); a scalp sunk into an old defect is said apart, without alarm; the rows say what each
+// figure is of, so that none reads as contradicting another.
+TEST(QualityHtml, TellsTheBrainsSideFromASunkenScalp) {
+  QualityReport r;
+  r.printable = true;
+  SoftTissueCheck sunken;
+  sunken.checked = true;
+  sunken.sunken_scalp_mm3 = 1882;
+  sunken.closest_mm = 3.4;
+  sunken.message =
+      "soft tissue lies 3.4 mm under the implant's inner surface; 1882 mm³ of it are "
+      "scalp sunk into the defect, which the implant lifts";
+  const std::string calm = quality_report_html(r, &sunken);
+  EXPECT_EQ(calm.find("color:#a00"), std::string::npos) << "no alarm for a sunken scalp\n" << calm;
+  EXPECT_NE(calm.find("Sunken scalp in its place (lifted by it)</td><td><b>1882 mm³"),
+            std::string::npos)
+      << calm;
+  EXPECT_NE(calm.find("Free space under the inner surface</td><td><b>3.4 mm to soft tissue"),
+            std::string::npos)
+      << calm;
+  SoftTissueCheck bulging;
+  bulging.checked = true;
+  bulging.intrusion_mm3 = 640;
+  bulging.intrusion_reach_mm = 3.5;
+  bulging.finding = true;
+  bulging.closest_mm = 0.0;
+  bulging.message = "640 mm³ of the implant's inner half lie where the CT shows soft tissue";
+  const std::string alarm = quality_report_html(r, &bulging);
+  EXPECT_NE(alarm.find("color:#a00"), std::string::npos);
+  EXPECT_NE(alarm.find("640 mm³, up to 3.5 mm above its inner surface"), std::string::npos);
+  // Within the tolerance (the dura, the CT's partial volume): said, without alarm.
+  bulging.intrusion_reach_mm = 1.2;
+  bulging.finding = false;
+  EXPECT_EQ(quality_report_html(r, &bulging).find("color:#a00"), std::string::npos);
+  EXPECT_NE(alarm.find("Free space under the inner surface</td><td><b>none (tissue reaches"),
+            std::string::npos)
+      << alarm;
+}
+
+// A refused implant's verdict names what is wrong and what to try, in the wizard's words: the
+// fit to the bone when it is off, the markers when it is on already; none for a printable one.
+TEST(QualityAdvice, SaysWhatToTryForWhatIsWrong) {
+  QualityReport r;
+  r.printable = false;
+  r.watertight = r.manifold = r.outward = true;
+  r.self_intersections = 9;
+  r.rim_gap_mm = 2.73;
+  r.penetration_mm3 = 177;
+  r.taper_reach_mm = 0.5;
+  r.reasons = {"9 pairs of triangles cross each other",
+               "gap of 2.73 mm between the rim and the bone (limit 1.00 mm)"};
+  ImplantParams unfitted;
+  const std::vector<std::string> fit = quality_advice(r, unfitted);
+  ASSERT_EQ(fit.size(), 1u);
+  EXPECT_NE(fit[0].find("\"Fit to the bone\" to 4 mm"), std::string::npos) << fit[0];
+  ImplantParams fitted;
+  fitted.fit_to_bone_mm = 4.0;
+  const std::vector<std::string> markers = quality_advice(r, fitted);
+  ASSERT_EQ(markers.size(), 3u);
+  EXPECT_NE(markers[0].find("edge markers"), std::string::npos) << markers[0];
+  EXPECT_NE(markers[2].find("smooth the markers (step 8)"), std::string::npos) << markers[2];
+  const std::string verdict = quality_verdict_html(r, unfitted);
+  EXPECT_NE(verdict.find("Not printable"), std::string::npos);
+  EXPECT_NE(verdict.find("<li>9 pairs of triangles cross each other</li>"), std::string::npos);
+  EXPECT_NE(verdict.find("What to try"), std::string::npos);
+  r.printable = true;
+  EXPECT_TRUE(quality_advice(r, unfitted).empty());
+  EXPECT_NE(quality_verdict_html(r, unfitted).find("Printable"), std::string::npos);
 }
 
 }  // namespace

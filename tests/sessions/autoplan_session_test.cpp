@@ -2,6 +2,9 @@
 
 #include <gtest/gtest.h>
 
+#include <cstdio>
+#include <filesystem>
+
 #include "cranioplan/algorithms/io/load_skull.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/algorithms/planning/autoplan.h"
@@ -108,6 +111,40 @@ TEST(AutoplanSession, UndoOfTheLastCommandUsesTheCache) {
   ASSERT_TRUE(s.redo());
   ASSERT_TRUE(s.redo());
   EXPECT_EQ(s.state().implant->stl_sha256(), planned().implant_sha);
+}
+
+}  // namespace
+}  // namespace cranioplan
+
+namespace cranioplan {
+namespace {
+
+// The wizard's manual path with every page's defaults — the commands its buttons push: Fit
+// plane, Done, Mirror, Register, Done, Done (step 4), Propose markers, Done, Done, Build implant
+// with step 7's defaults (the automatic plan's fit to the bone) — ends printable on SkullFix's
+// five cases (../shared/data/skullfix; skipped without it).
+TEST(ManualPath, TheWizardsDefaultsEndPrintableOnSkullFix) {
+  const std::string dir = CRANIOPLAN_SKULLFIX_DIR;
+  if (!std::filesystem::exists(dir + "/000_defective_skull.nrrd"))
+    GTEST_SKIP() << "SkullFix data not present";
+  for (int k = 0; k < 5; ++k) {
+    char name[64];
+    std::snprintf(name, sizeof(name), "%03d_defective_skull.nrrd", k);
+    Session s(SessionInfo{name, "", ""});
+    // Step 1's threshold field is automatic by default (a mask: 0.5).
+    test::push_ok(s, commands::load_skull(dir + "/" + name, ExtractBoneSurfaceParams{}));
+    for (Command c : {commands::fit_plane(), commands::complete_step(2), commands::mirror(),
+                      commands::register_mirror(RegisterParams{}), commands::complete_step(3),
+                      commands::complete_step(4), commands::propose_markers(ProposeParams{}),
+                      commands::complete_step(5), commands::complete_step(6),
+                      commands::build_implant(AutoplanParams{}.implant)})
+      test::push_ok(s, std::move(c));
+    ASSERT_TRUE(s.state().implant) << name << ": " << s.state().message;
+    const QualityReport& q = s.state().implant->quality();
+    RecordProperty(std::string(name, 3) + "_rim_gap_mm", std::to_string(q.rim_gap_mm));
+    EXPECT_TRUE(q.printable) << name << ": "
+                             << (q.reasons.empty() ? std::string() : q.reasons.front());
+  }
 }
 
 }  // namespace

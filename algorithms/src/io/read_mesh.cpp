@@ -267,7 +267,27 @@ TriangleSoup read_stl(const std::string& path, std::string& format, MeshSpace& s
     space = space_in_text(std::string_view(bytes).substr(0, bytes.find('\n')));
     return parse_ascii_stl(path, bytes);
   }
+  // Text that is not ASCII STL (a note, a CSV, an HTML error page saved as .stl): said as such,
+  // not read as a binary STL's count of triangles.
+  {
+    const size_t shown = std::min<size_t>(bytes.size(), 1024);
+    bool text = shown > 0;
+    for (size_t i = 0; i < shown && text; ++i) {
+      const unsigned char c = static_cast<unsigned char>(bytes[i]);
+      text = c >= 32 || c == '\n' || c == '\r' || c == '\t';
+    }
+    if (text) {
+      std::string start = bytes.substr(0, std::min<size_t>(bytes.find('\n'), 40));
+      fail(path, "not an STL file: it is text (beginning \"" + start +
+                     "\"), not a mesh; an ASCII STL begins with \"solid\"");
+    }
+  }
   if (size < 84) fail(path, "too short for an STL file (" + format_count(size) + " bytes)");
+  // A count beyond any scan's mesh (5 GB of triangles) that the file is far from holding is
+  // not a truncated STL but another file.
+  if (size < expected && n > 100'000'000u && size < expected / 2)
+    fail(path, "not an STL file: its header would declare " + format_count(n) +
+                   " triangles, and the file holds " + format_count(size) + " bytes");
   if (size < expected)
     fail(path, "file ends after " + format_count((size - 84) / 50) + " of " + format_count(n) +
                    " triangles");

@@ -9,11 +9,43 @@
 #include <algorithm>
 #include <cmath>
 
+#include "cranioplan/algorithms/planning/autoplan.h"
 #include "step_pages.h"
 
 namespace cranioplan::gui {
 
+namespace {
+// The manual path's defaults are the automatic plan's: fitted to the bone, so that the implant
+// meets the cut face all around and the quality check passes.
+const ImplantParams& automatic_implant() {
+  static const ImplantParams p = AutoplanParams{}.implant;
+  return p;
+}
+}  // namespace
+
 BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
+  // The step's action first, with what became of it, so it is in sight whatever the options.
+  build_ = add_button(tr("Build implant"), "build");
+  connect(build_, &QPushButton::clicked, this,
+          [this] { host_.push(commands::build_implant(params()), tr("Building the implant")); });
+  info_ = new QLabel(this);
+  info_->setObjectName("buildInfo");
+  info_->setWordWrap(true);
+  form_->addRow(info_);
+  changed_ =
+      new QLabel(tr("<b>Changed since the last build:</b> press Build implant to apply."), this);
+  changed_->setObjectName("buildChanged");
+  changed_->setWordWrap(true);
+  changed_->setStyleSheet("QLabel{color:#8a5a00}");
+  changed_->hide();
+  form_->addRow(changed_);
+  verdict_ = new QLabel(this);
+  verdict_->setObjectName("buildVerdict");
+  verdict_->setWordWrap(true);
+  verdict_->setTextFormat(Qt::RichText);
+  verdict_->hide();
+  form_->addRow(verdict_);
+
   method_ = new QComboBox(this);
   method_->setObjectName("implantMethod");
   method_->addItems({tr("Shell (fitted surfaces)"), tr("Delaunay 3D (the paper's)")});
@@ -31,6 +63,7 @@ BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
   fit_->setObjectName("implantFit");
   fit_->setRange(0, 8);
   fit_->setSingleStep(0.5);
+  fit_->setValue(automatic_implant().fit_to_bone_mm);
   fit_->setSpecialValueText(tr("off"));
   fit_->setSuffix(" mm");
   fit_->setToolTip(
@@ -165,12 +198,29 @@ BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
   drag_hint->setWordWrap(true);
   form_->addRow(drag_hint);
 
-  QPushButton* build = add_button(tr("Build implant"), "build");
-  connect(build, &QPushButton::clicked, this,
-          [this] { host_.push(commands::build_implant(params()), tr("Building the implant")); });
-  info_ = new QLabel(this);
-  info_->setWordWrap(true);
-  form_->addRow(info_);
+  // Any control changed after a build: the implant shown is not what the controls say.
+  for (auto* b : findChildren<QDoubleSpinBox*>())
+    connect(b, &QDoubleSpinBox::valueChanged, this, &BuildPage::mark_changed);
+  for (auto* b : findChildren<QSpinBox*>())
+    connect(b, &QSpinBox::valueChanged, this, &BuildPage::mark_changed);
+  for (auto* b : findChildren<QComboBox*>())
+    connect(b, &QComboBox::currentIndexChanged, this, &BuildPage::mark_changed);
+  for (auto* b : findChildren<QCheckBox*>())
+    connect(b, &QCheckBox::toggled, this, &BuildPage::mark_changed);
+}
+
+void BuildPage::mark_changed() {
+  if (showing_ || !host_.plan().implant) return;
+  changed_->show();
+  verdict_->setEnabled(false);  // greyed: of the implant before the change
+  QFont f = build_->font();
+  f.setBold(true);
+  build_->setFont(f);
+}
+
+void BuildPage::show_verdict(const QString& html) {
+  verdict_->setText(html);
+  verdict_->setVisible(!html.isEmpty() && host_.plan().implant);
 }
 
 void BuildPage::show_material(int index) {
@@ -348,7 +398,7 @@ ImplantParams BuildPage::params() const {
   p.method = method_->currentIndex() == 0 ? ImplantMethod::Shell : ImplantMethod::Delaunay3D;
   p.resolution_mm = resolution_->value();
   if (thickness_->value() > 0) p.thickness_mm = thickness_->value();
-  p.surface_smoothing = 0.003;
+  p.surface_smoothing = automatic_implant().surface_smoothing;
   p.fit_to_bone_mm = fit_->value();
   const int index = material_->currentIndex();
   if (index > 0) {
@@ -381,6 +431,16 @@ ImplantParams BuildPage::params() const {
 }
 
 void BuildPage::show_state(const PlanState& s) {
+  showing_ = true;
+  if (s.implant.get() != shown_implant_) {  // a new implant (or none): what it was built with
+    shown_implant_ = s.implant.get();
+    changed_->hide();
+    verdict_->setEnabled(true);
+    QFont f = build_->font();
+    f.setBold(false);
+    build_->setFont(f);
+    if (!s.implant) verdict_->hide();
+  }
   // The controls show the parameters the plan's implant was built with (an automatic plan is
   // fitted to the bone), so pressing Build again keeps them unless changed.
   if (s.implant_params) {
@@ -452,6 +512,7 @@ void BuildPage::show_state(const PlanState& s) {
                           ? tr("1 clearance zone on the rim (orange).")
                           : tr("%1 clearance zones on the rim (orange).").arg(zones_.size()));
   info_->setText(text);
+  showing_ = false;
 }
 
 }  // namespace cranioplan::gui

@@ -4,7 +4,6 @@
 #include <QLabel>
 #include <QLineEdit>
 #include <QPushButton>
-#include <QTextBrowser>
 #include <QVBoxLayout>
 #include <utility>
 
@@ -13,9 +12,11 @@
 namespace cranioplan::gui {
 
 ExportPage::ExportPage(PageHost& host) : StepPage(9, host) {
-  report_ = new QTextBrowser(this);
-  report_->setObjectName("exportReport");
-  layout_->addWidget(report_, 1);
+  verdict_ = new QLabel(this);
+  verdict_->setObjectName("exportVerdict");
+  verdict_->setWordWrap(true);
+  verdict_->setTextFormat(Qt::RichText);
+  layout_->addWidget(verdict_);
   // STL and PLY for any printer's software; 3MF (millimetres, the plan's hash inside) for
   // those that take it.
   const std::pair<const char*, const char*> formats[] = {
@@ -64,7 +65,7 @@ ExportPage::ExportPage(PageHost& host) : StepPage(9, host) {
   layout_->addWidget(approval_);
 }
 
-void ExportPage::show_quality(const QString& html) { report_->setHtml(html); }
+void ExportPage::show_verdict(const QString& html) { verdict_->setText(html); }
 
 void ExportPage::show_mould_message(const QString& text) {
   mould_info_->setText(text);

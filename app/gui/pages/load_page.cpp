@@ -4,11 +4,17 @@
 #include <QFormLayout>
 #include <QLabel>
 #include <QPushButton>
+#include <cmath>
+#include <limits>
 
 #include "cranioplan/algorithms/io/load_skull.h"
 #include "step_pages.h"
 
 namespace cranioplan::gui {
+
+namespace {
+constexpr double kAutomatic = -1001.0;  // the threshold field's "automatic"
+}  // namespace
 
 LoadPage::LoadPage(PageHost& host) : StepPage(1, host) {
   QPushButton* open = add_button(tr("Open mesh or CT…"), "pageOpen");
@@ -30,10 +36,14 @@ LoadPage::LoadPage(PageHost& host) : StepPage(1, host) {
          "skull of the wrong size is refused, naming the unit it looks to be in."));
   threshold_ = new QDoubleSpinBox(this);
   threshold_->setObjectName("threshold");
-  threshold_->setRange(-1000, 3000);
-  threshold_->setValue(300);
+  // Automatic by default: 300 HU for a CT, 0.5 for a mask (a segmentation), so that either
+  // opens with the default; a value typed here is used as it is.
+  threshold_->setRange(kAutomatic, 3000);
+  threshold_->setValue(kAutomatic);
+  threshold_->setSpecialValueText(tr("automatic (CT 300 HU, mask 0.5)"));
   threshold_->setSuffix(" HU");
-  threshold_->setToolTip(tr("Bone threshold for CTs (masks use 0.5)"));
+  threshold_->setToolTip(
+      tr("The iso-value of the bone surface: automatic is 300 HU for a CT and 0.5 for a mask"));
   form_->addRow(tr("Mesh units"), units_);
   form_->addRow(tr("CT bone threshold"), threshold_);
   skull_info_ = new QLabel(this);
@@ -50,9 +60,12 @@ bool LoadPage::set_mesh_unit(const std::string& name) {
   return true;
 }
 
-double LoadPage::threshold() const { return threshold_->value(); }
+double LoadPage::threshold() const {
+  return threshold_->value() <= kAutomatic ? std::numeric_limits<double>::quiet_NaN()
+                                           : threshold_->value();
+}
 
-void LoadPage::set_threshold(double hu) { threshold_->setValue(hu); }
+void LoadPage::set_threshold(double hu) { threshold_->setValue(std::isnan(hu) ? kAutomatic : hu); }
 
 void LoadPage::show_state(const PlanState& s) {
   QString info = tr("No skull loaded.");

@@ -85,10 +85,7 @@ QWidget* PlanePage::make_adjust_box() {
 void PlanePage::show_state(const PlanState& s) {
   QString fit;
   if (s.plane_fit)
-    fit = tr("Fit: symmetry RMS %1 mm, %2% inliers (%3 start)")
-              .arg(s.plane_fit->symmetry_rms_mm, 0, 'f', 2)
-              .arg(100.0 * s.plane_fit->inlier_fraction, 0, 'f', 0)
-              .arg(QString::fromStdString(s.plane_fit->initial_method));
+    fit = tr("Fit: %1").arg(QString::fromStdString(describe_plane_fit(*s.plane_fit)));
   const int n = (s.landmarks.nasion ? 1 : 0) + (s.landmarks.orbit_left ? 1 : 0) +
                 (s.landmarks.orbit_right ? 1 : 0);
   plane_info_->setText(

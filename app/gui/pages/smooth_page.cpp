@@ -1,5 +1,6 @@
 #include <QCheckBox>
 #include <QFormLayout>
+#include <QHBoxLayout>
 #include <QLabel>
 #include <QPushButton>
 #include <QSlider>
@@ -27,13 +28,35 @@ SmoothPage::SmoothPage(PageHost& host) : StepPage(8, host) {
   for (QSlider* s : {radius_, weight_})
     connect(s, &QSlider::valueChanged, this, &SmoothPage::preview);
   connect(iterations_, &QSpinBox::valueChanged, this, &SmoothPage::preview);
-  form_->addRow(tr("Radius"), radius_);
-  form_->addRow(tr("Edge-marker weight"), weight_);
+  // Each slider with its value beside it.
+  const auto with_value = [this](QSlider* slider, QLabel*& value, const char* name) {
+    value = new QLabel(this);
+    value->setObjectName(name);
+    value->setMinimumWidth(value->fontMetrics().horizontalAdvance(QStringLiteral("40 mm")));
+    auto* row = new QHBoxLayout;
+    row->addWidget(slider, 1);
+    row->addWidget(value);
+    return row;
+  };
+  form_->addRow(tr("Radius"), with_value(radius_, radius_value_, "smoothRadiusValue"));
+  form_->addRow(tr("Edge-marker weight"), with_value(weight_, weight_value_, "smoothWeightValue"));
+  const auto show_values = [this] {
+    radius_value_->setText(tr("%1 mm").arg(radius_->value()));
+    weight_value_->setText(QString::number(weight_->value()));
+  };
+  for (QSlider* s : {radius_, weight_}) connect(s, &QSlider::valueChanged, this, show_values);
+  show_values();
   form_->addRow(tr("Iterations"), iterations_);
   form_->addRow(project_);
   QPushButton* apply = add_button(tr("Apply smoothing"), "applySmoothing");
-  connect(apply, &QPushButton::clicked, this,
-          [this] { host_.push(smooth_command(), tr("Smoothing")); });
+  connect(apply, &QPushButton::clicked, this, [this] {
+    host_.push(smooth_command(), tr("Smoothing"));
+    info_->setText(tr("Applied: radius %1 mm, edge weight %2, %3 iterations (Edit → Undo takes "
+                      "it back).")
+                       .arg(radius_->value())
+                       .arg(weight_->value())
+                       .arg(iterations_->value()));
+  });
   form_->addRow(info_);
 }
 
@@ -45,7 +68,7 @@ Command SmoothPage::smooth_command() const {
 
 void SmoothPage::preview() {
   if (!host_.plan().implant) return;
-  info_->setText(tr("Radius %1 mm, edge weight %2 — preview (Apply to keep it)")
+  info_->setText(tr("Preview of radius %1 mm, edge weight %2: Apply smoothing keeps it.")
                      .arg(radius_->value())
                      .arg(weight_->value()));
   if (auto state = host_.preview(smooth_command())) host_.view().show_state(*state);

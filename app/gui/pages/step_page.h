@@ -53,8 +53,9 @@ class StepPage : public QWidget {
   QString instructions_html(const PlanState& state) const;
   /// Shows the plan's state in the page's controls.
   virtual void show_state(const PlanState& state) { (void)state; }
-  /// The implant's quality report, when it changes (empty while it is being computed).
-  virtual void show_quality(const QString& html) { (void)html; }
+  /// The quality check's verdict on the implant in a few lines (printable, or what is wrong and
+  /// what to try), when it changes; the full table is the window's Quality panel.
+  virtual void show_verdict(const QString& html) { (void)html; }
   /// What became of the casting mould asked for (its cavity's figures, or why there is none);
   /// empty: none shown.
   virtual void show_mould_message(const QString& text) { (void)text; }

@@ -24,6 +24,8 @@ class LoadPage : public StepPage {
   double mesh_unit_mm() const;
   /// Chooses the unit by name (mm, cm, m, in, um); false for another name.
   bool set_mesh_unit(const std::string& name);
+  /// The CT bone threshold of step 1's field; NaN: automatic (300 HU for a CT, 0.5 for a
+  /// mask), the default.
   double threshold() const;
   void set_threshold(double hu);
 
@@ -124,6 +126,7 @@ class BuildPage : public StepPage {
  public:
   explicit BuildPage(PageHost& host);
   void show_state(const PlanState& state) override;
+  void show_verdict(const QString& html) override;
   /// With "Mark a wider clearance" on, a click on the rim adds a clearance zone there.
   void surface_clicked(const Eigen::Vector3d& point) override;
   SkullView::PickTarget pick_target() const override;
@@ -164,7 +167,14 @@ class BuildPage : public StepPage {
   void take_tabs_over();
   /// Turns the other click modes off when one is turned on.
   void click_mode(QPushButton* on);
+  /// A control changed since the implant shown was built: the page says Build applies it.
+  void mark_changed();
   QLabel* info_;
+  QLabel* changed_;  ///< "changed since the last build"
+  QLabel* verdict_;  ///< the quality check's verdict on the implant shown
+  QPushButton* build_;
+  bool showing_ = false;  ///< show_state is setting the controls (not the user)
+  const void* shown_implant_ = nullptr;
 };
 
 /// Step 8: Laplacian smoothing of the markers, previewed live, and marker edits.
@@ -187,19 +197,21 @@ class SmoothPage : public StepPage {
   QSpinBox* iterations_;
   QCheckBox* project_;
   QLabel* info_;
+  QLabel* radius_value_;
+  QLabel* weight_value_;
 };
 
 /// Step 9: the quality report and export.
 class ExportPage : public StepPage {
  public:
   explicit ExportPage(PageHost& host);
-  void show_quality(const QString& html) override;
+  void show_verdict(const QString& html) override;
   /// Whether (and by whom) the implant is approved, or why an approval was withdrawn.
   void show_state(const PlanState& state) override;
   void show_mould_message(const QString& text) override;
 
  private:
-  QTextBrowser* report_;
+  QLabel* verdict_;
   QCheckBox* mould_;  ///< the 3MF export with a casting mould
   QLabel* mould_info_;
   QLabel* approval_;

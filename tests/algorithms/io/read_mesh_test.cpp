@@ -265,6 +265,19 @@ TEST(ReadMesh, BadInputsGiveOneClearMessage) {
   std::string truncated = binary_stl({tri, tri, tri}, 40000);
   test::write_bytes(dir.path("truncated.stl"), truncated);
   expect_bad(dir.path("truncated.stl"), "file ends after 3 of 40,000 triangles");
+  // A text file saved as .stl (a note, an error page): said to be text, not a count of
+  // triangles read from its letters.
+  test::write_bytes(dir.path("note.stl"),
+                    "Patient notes: skull CT 2026-03-01, frontal defect after decompression.\n"
+                    "Second line of the note, long enough to pass 84 bytes.\n");
+  expect_bad(dir.path("note.stl"), "not an STL file: it is text (beginning \"Patient notes");
+  // A binary header whose count no file could hold: not taken for a truncated STL.
+  std::string other = binary_stl({tri}, 1);
+  const uint32_t huge = 1'851'878'512u;
+  std::memcpy(other.data() + 80, &huge, 4);
+  other[0] = '\x01';  // not text
+  test::write_bytes(dir.path("other.stl"), other);
+  expect_bad(dir.path("other.stl"), "not an STL file: its header would declare 1,851,878,512");
 
   const float nan = std::numeric_limits<float>::quiet_NaN();
   test::write_bytes(dir.path("nan.stl"), binary_stl({tri, {0, 0, 0, nan, 0, 0, 0, 1, 0}}, 2));

@@ -76,16 +76,33 @@ std::string training_report_html(const TrainingReport& report);
 std::string quality_report_html(const QualityReport& report,
                                 const SoftTissueCheck* tissue = nullptr);
 
-/// A picture in the design report: its caption and its file (beside the report).
+/// What a person can try when the quality check refuses an implant built with `params`, one
+/// sentence each in the wizard's words (empty when it is printable): the fit to the bone for
+/// gaps, overlap and crossing triangles; the markers and smoothing when the fit is on already;
+/// the thickness for thin material; the tabs and holes for theirs.
+std::vector<std::string> quality_advice(const QualityReport& report, const ImplantParams& params);
+
+/// The quality check's verdict in a few lines for a wizard page: printable, or what is wrong
+/// (the report's reasons) and what to try (quality_advice).
+std::string quality_verdict_html(const QualityReport& report, const ImplantParams& params);
+
+/// A picture in the design report: its caption, its file (beside the report) and what it
+/// shows (the implant on the skull, its thickness map, or a CT slice through it).
 struct ReportImage {
+  enum class Kind { View, Thickness, Slice };
   std::string caption, file;
+  Kind kind = Kind::View;
 };
-/// The design report for the surgeon's sign-off (HTML): the plan's pictures, the implant's
-/// dimensions (extent along its principal axes, area, volume, mass for its material), the
-/// quality table, the perforations and the fixation tabs, the inputs' SHA-256, the plan's hash
-/// (the journal's last), the implant's STL hash, the approval (or that there is none, or why it
-/// was withdrawn) and the program's version. The plan must have an implant.
+/// The design report for the surgeon's sign-off (HTML laid out for A4: identity, verdict,
+/// implant, quality and approval on the first page; the pictures on the next ones). Identity:
+/// the case, who planned it and when, the last change, the program's version. The implant's
+/// material and dimensions (extent along its principal axes, area, volume, mass), the quality
+/// table with every finding (with `tissue`, the soft tissue in its place on the CT), the
+/// perforations and the fixation tabs, the inputs' SHA-256, the plan's hash (the journal's last)
+/// and the implant's STL hash; the approval (or that there is none, or why it was withdrawn)
+/// with what is approved. The plan must have an implant.
 std::string design_report_html(const Session& session, const std::vector<ReportImage>& images,
-                               const std::string& program_version);
+                               const std::string& program_version,
+                               const SoftTissueCheck* tissue = nullptr);
 
 }  // namespace cranioplan

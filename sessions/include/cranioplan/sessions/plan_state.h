@@ -184,6 +184,14 @@ struct WizardStep {
 /// mesh plan without one.
 std::optional<AttachedCt> plan_ct(const PlanState& state);
 
+/// A plane fit in a person's words: its symmetry RMS and inliers, and whether that is good
+/// (RMS ≤ 1.5 mm with ≥ 60 % inliers: the two sides agree as a normal skull's do), fair (RMS
+/// ≤ 3 mm with ≥ 40 %: check the plane on the face) or poor (place the landmarks again or
+/// adjust the plane by hand).
+std::string describe_plane_fit(const PlaneFit& fit);
+/// A landmark's name as a person says it ("orbit_left": "left orbit").
+std::string landmark_words(const std::string& name);
+
 /// The nine steps of the wizard, 1..9.
 const std::array<WizardStep, 9>& wizard_steps();
 /// Whether step `step` (1..9) is done; when not, `missing` says what is missing.

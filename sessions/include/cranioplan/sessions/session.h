@@ -5,6 +5,7 @@
 // each command is cached, so undo and redo are instant; the journal is appended to an autosave
 // file after every command, so a crash loses no completed command.
 #include <cstdio>
+#include <functional>
 #include <memory>
 #include <optional>
 #include <string>
@@ -104,6 +105,9 @@ struct OpenOptions {
   /// Append this session's new events to PATH.autosave (the wizard). Without it, opening
   /// writes nothing: replay, verify and audit leave the files as they are.
   bool attach_autosave = false;
+  /// Called before each command is replayed with (commands replayed, commands in all), and
+  /// once at the end; from the thread that opens.
+  std::function<void(size_t done, size_t total)> progress;
 };
 
 class Session {
@@ -178,10 +182,12 @@ class Session {
   void append_event(const std::string& event, const std::optional<Command>& command);
   void write_autosave_all();
   void append_autosave(const JournalEntry& entry);
-  const PlanState& ensure_state(size_t index);
+  const PlanState& ensure_state(size_t index,
+                                const std::function<void(size_t, size_t)>& progress = nullptr);
   void trim_cache();
   static Session from_journal(const SessionHeader& header, const std::vector<JournalEntry>& journal,
-                              const std::string& source, const ApplyContext& context);
+                              const std::string& source, const ApplyContext& context,
+                              const std::function<void(size_t, size_t)>& progress = nullptr);
 
   SessionHeader header_;
   std::vector<Command> stack_;
