@@ -3,12 +3,14 @@
 #include <QApplication>
 #include <QFile>
 #include <QFileInfo>
+#include <QFont>
 #include <QImage>
 #include <QPageSize>
 #include <QPdfWriter>
 #include <QTextDocument>
 #include <QUrl>
 #include <algorithm>
+#include <array>
 #include <tuple>
 
 #include "cranioplan/algorithms/geometry/slices.h"
@@ -34,6 +36,7 @@ bool MainWindow::write_design_report(const QString& html_path) {
   const bool thickness_was_shown = show_thickness_->isChecked();
   const bool mirror_was_shown = show_mirror_->isChecked();
   const Layout layout_was = layout_;
+  const std::array<double, 10> camera_was = view_->camera();
   show_mirror_->setChecked(false);
   view_->set_plane_visible(false);
   view_->set_markers_visible(false);
@@ -43,7 +46,7 @@ bool MainWindow::write_design_report(const QString& html_path) {
     view_->set_plane_visible(findChild<QAction*>("showPlane")->isChecked());
     view_->set_markers_visible(true);
     set_layout(layout_was);
-    view_->look_at_markers();
+    view_->set_camera(camera_was);  // the view as the user left it
   };
   struct Shot {
     const char* caption;
@@ -103,7 +106,10 @@ bool MainWindow::write_design_report(const QString& html_path) {
       set_layout(alone);
       QApplication::processEvents();
       SliceView& v = slices_->view(orientation);
-      // Twice the fitted size, the implant's middle in the middle of the picture.
+      // A square picture (the layout gives the view back its size afterwards), twice the
+      // fitted size, the implant's middle in its middle; letters, position and scale within.
+      const int side = std::min(v.width(), v.height());
+      v.resize(side, side);
       v.fit();
       v.zoom_by(2.0, v.to_widget(middle));
       v.pan_by(QPointF(v.width() / 2.0, v.height() / 2.0) - v.to_widget(middle));
@@ -136,6 +142,10 @@ bool MainWindow::write_design_report(const QString& html_path) {
     const QString file = QString::fromStdString(image.file);
     document.addResource(QTextDocument::ImageResource, QUrl(file), QImage(dir + "/" + file));
   }
+  // 8 pt on A4: the first page holds the identity, the implant and the whole quality table.
+  QFont font = document.defaultFont();
+  font.setPointSizeF(8.0);
+  document.setDefaultFont(font);
   document.setHtml(html);
   QPdfWriter pdf(pdf_path);
   pdf.setPageSize(QPageSize(QPageSize::A4));

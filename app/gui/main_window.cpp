@@ -245,16 +245,16 @@ void MainWindow::add_points_actions(QMenu* file) {
     if (!dir.isEmpty()) attach_ct(dir);
   });
   file->addAction(tr("Design report…"), this, [this] {
-    const QString path =
-        QFileDialog::getSaveFileName(this, tr("Design report for sign-off (HTML; a PDF beside it)"),
-                                     QStringLiteral("design-report.html"), tr("HTML (*.html)"));
+    const QString path = QFileDialog::getSaveFileName(
+        this, tr("Design report for sign-off (HTML; a PDF beside it)"),
+        suggested_path(QStringLiteral("design-report.html")), tr("HTML (*.html)"));
     if (!path.isEmpty()) write_design_report(path);
   });
   file->addAction(tr("Export implant over the CT…"), this,
                   [this] {
                     const QString path = QFileDialog::getSaveFileName(
                         this, tr("The implant as a labelmap on the CT's grid"),
-                        QStringLiteral("implant.seg.nrrd"),
+                        suggested_path(QStringLiteral("implant.seg.nrrd")),
                         tr("3D Slicer segmentation (*.seg.nrrd);;Labelmap (*.nrrd)"));
                     if (!path.isEmpty()) export_labelmap(path);
                   })
@@ -271,7 +271,8 @@ void MainWindow::add_points_actions(QMenu* file) {
   file->addAction(tr("Export markers…"), this,
                   [this, markers] {
                     const QString path = QFileDialog::getSaveFileName(
-                        this, tr("Export markers"), QStringLiteral("markers.mrk.json"), markers);
+                        this, tr("Export markers"),
+                        suggested_path(QStringLiteral("markers.mrk.json")), markers);
                     if (!path.isEmpty()) export_markers(path);
                   })
       ->setObjectName("exportMarkers");
@@ -285,8 +286,8 @@ void MainWindow::add_points_actions(QMenu* file) {
   file->addAction(tr("Export landmarks…"), this,
                   [this, landmarks] {
                     const QString path = QFileDialog::getSaveFileName(
-                        this, tr("Export landmarks"), QStringLiteral("landmarks.mrk.json"),
-                        landmarks);
+                        this, tr("Export landmarks"),
+                        suggested_path(QStringLiteral("landmarks.mrk.json")), landmarks);
                     if (!path.isEmpty()) export_landmarks(path);
                   })
       ->setObjectName("exportLandmarks");
@@ -520,6 +521,14 @@ void MainWindow::add_slice_actions(QMenu* view) {
 }
 
 void MainWindow::set_layout(Layout layout) {
+  // Laying out the slices (their outlines of the skull) and drawing the 3D view again take a
+  // second or two on a large skull: said, and the pointer waits.
+  const bool slow = layout != layout_ && layout != Layout::ThreeD;
+  if (slow) {
+    QApplication::setOverrideCursor(Qt::WaitCursor);
+    show_message(tr("Laying out the views…"), false);
+    statusBar()->repaint();
+  }
   layout_ = layout;
   slices_->arrange(layout);
   const char* names[] = {"layout3d",      "layoutFourUp",   "layoutAxial",
@@ -531,6 +540,10 @@ void MainWindow::set_layout(Layout layout) {
   }
   slices_->show_state(controller_->state());
   view_->set_cursor(slices_->cursor());
+  if (slow) {
+    // Until the views have been drawn; clicks given meanwhile wait for them.
+    QTimer::singleShot(0, this, [] { QApplication::restoreOverrideCursor(); });
+  }
 }
 
 // Training (a reference plan and the report) and Help (About).
@@ -713,6 +726,9 @@ void MainWindow::build_plan_dock() {
 // Showing the plan
 
 void MainWindow::refresh() {
+  // While a file is loading on trial, the plan open before stays on screen (it stays open if
+  // the file turns out bad); the status bar shows the load's progress.
+  if (controller_->on_trial()) return;
   const PlanState& s = controller_->state();
   if (!controller_->read_only()) view_->show_state(controller_->shown_state());
   if (layout_ != Layout::ThreeD) slices_->show_state(controller_->shown_state());
@@ -884,7 +900,8 @@ void MainWindow::show_quality() {
     v->intrusion = std::move(tissue.intrusion);
     if (tissue.checked) v->tissue = tissue;
     v->html = quality_html(implant->quality(), tissue.checked ? &tissue : nullptr);
-    v->verdict = q(quality_verdict_html(implant->quality(), params));
+    v->verdict =
+        q(quality_verdict_html(implant->quality(), params, tissue.checked ? &tissue : nullptr));
     return v;
   }));
 }
@@ -1016,11 +1033,8 @@ void MainWindow::open_input(const QString& path, double threshold) {
                            QDateTime::currentDateTimeUtc().toString("yyyyMMdd-HHmmss") +
                            ".json.autosave";
   // On trial: the plan open now stays until the file has loaded (a bad file closes nothing).
-  if (!controller_->on_trial()) trial_kept_path_ = session_path_;
   trial_input_ = path;
   controller_->try_new_session(SessionInfo{case_id.toStdString(), "", ""}, autosave);
-  session_path_.clear();
-  total_timer_.restart();
   push(commands::load_skull(path.toStdString(), import), tr("Loading %1").arg(case_id));
 }
 
@@ -1028,9 +1042,11 @@ void MainWindow::trial_settled(bool loaded) {
   if (loaded) {
     forget_discarded();
     add_recent(trial_input_);
+    session_path_.clear();
+    total_timer_.restart();
+    step_timer_.restart();
   } else {
     keep_discarded();
-    session_path_ = trial_kept_path_;
     show_message(tr("%1 was not opened; the plan that was open is kept as it was.")
                      .arg(QFileInfo(trial_input_).fileName()),
                  true);
@@ -1210,14 +1226,24 @@ bool MainWindow::export_to(const QString& path, bool with_mould) {
   }
   const QualityReport& r = s.implant->quality();
   if (interactive_) {
+    // What is exported, and what the check and the CT say of it, before it is written.
+    const SoftTissueCheck* tissue =
+        judged_tissue_ && judged_implant_ == s.implant ? &*judged_tissue_ : nullptr;
     QMessageBox box(this);
-    box.setWindowTitle(tr("Quality report before export"));
+    box.setWindowTitle(tr("Export the implant"));
     box.setTextFormat(Qt::RichText);
-    box.setText(quality_html(r));
-    box.setIcon(r.printable ? QMessageBox::Information : QMessageBox::Warning);
-    if (!r.printable)
-      box.setInformativeText(tr("The implant fails a check (listed above). Export anyway?"));
+    box.setText(
+        tr("<p><b>Export the implant to %1?</b></p>")
+            .arg(QFileInfo(path).fileName().toHtmlEscaped()) +
+        q(quality_verdict_html(r, s.implant_params ? *s.implant_params : ImplantParams{}, tissue)));
+    box.setIcon(r.printable && !(tissue && tissue->finding) ? QMessageBox::Question
+                                                            : QMessageBox::Warning);
+    QString more;
+    if (!r.printable) more += tr("The implant fails a check (above). ");
+    if (!s.approval) more += tr("It is not approved yet (step 9: Approve the implant…).");
+    box.setInformativeText(more);
     box.setStandardButtons(QMessageBox::Ok | QMessageBox::Cancel);
+    box.button(QMessageBox::Ok)->setText(tr("Export"));
     if (box.exec() != QMessageBox::Ok) return false;
   } else if (!r.printable) {
     show_message(tr("Exported although a check fails: %1")
@@ -1302,9 +1328,27 @@ void MainWindow::finish_training_if_done() {
 }
 
 QString MainWindow::default_plan_name() const {
-  // The name the desktop knows as a plan (docs/INSTALL.md): CASE.cranioplan.json.
+  // The name the desktop knows as a plan (docs/INSTALL.md): CASE.cranioplan.json, in the
+  // plan's folder.
   const std::string& id = controller_->session().header().info.case_id;
-  return (id.empty() ? tr("plan") : q(id)) + QStringLiteral(".cranioplan.json");
+  return suggested_path((id.empty() ? tr("plan") : q(id)) + QStringLiteral(".cranioplan.json"));
+}
+
+QString MainWindow::suggested_path(const QString& file_name) const {
+  // Beside the plan's file; a plan not saved yet: beside its skull's file (a sample installed
+  // read-only: the home folder).
+  QString dir;
+  if (!session_path_.isEmpty()) {
+    dir = QFileInfo(session_path_).absolutePath();
+  } else {
+    for (const Command& c : controller_->session().effective_commands())
+      if (c.type == CommandType::LoadSkull) {
+        const QFileInfo input(q(c.params.value("path", std::string())));
+        dir = input.isDir() ? input.absoluteFilePath() : input.absolutePath();
+      }
+    if (dir.isEmpty() || !QFileInfo(dir).isWritable()) dir = QDir::homePath();
+  }
+  return dir + "/" + file_name;
 }
 
 QString MainWindow::autosave_folder() const {

@@ -160,6 +160,11 @@ class MainWindow : public QMainWindow, public PageHost {
   QString autosave_folder() const;
   QString default_plan_name() const;
 
+ public:
+  /// `file_name` in the folder a save dialog should open in: the plan's, else its skull's.
+  QString suggested_path(const QString& file_name) const override;
+
+ private:
   PlanController* controller_;
   SkullView* view_;
   SlicePanel* slices_;
@@ -221,7 +226,6 @@ class MainWindow : public QMainWindow, public PageHost {
   QString session_path_;
   QString discarded_autosave_;  ///< of the plan discarded, removed once it is replaced
   QString trial_input_;         ///< the file being opened on trial
-  QString trial_kept_path_;     ///< the kept plan's file, back if the trial fails
   std::string last_proposal_;
   QString training_reference_;
   QString training_html_;

@@ -51,8 +51,8 @@ void PlanController::settle_trial() {
     const std::string autosave = session_->autosave_path();
     session_ = std::move(previous_);  // the trial's session closes its autosave file
     if (!autosave.empty()) std::remove(autosave.c_str());
-    emit stateChanged();
   }
+  emit stateChanged();  // the window shows the plan that stays
   emit trialSettled(loaded);
 }
 

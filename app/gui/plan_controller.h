@@ -35,6 +35,7 @@ class PlanController : public QObject {
   /// skull's load) settles. Loaded, the old plan goes; failed, refused or cancelled, the old
   /// plan comes back as it was and the trial's autosave is removed (`trialSettled`).
   void try_new_session(const SessionInfo& info, const QString& autosave_path);
+  /// A new plan is on trial; the window goes on showing the one open before until it settles.
   bool on_trial() const { return previous_ != nullptr; }
   /// Replaces the plan (opened or recovered).
   void set_session(Session session);

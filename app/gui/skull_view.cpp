@@ -555,16 +555,15 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
     bar->SetVisibility(false);
     d.overlay->AddActor2D(bar);
   };
-  legend(d.thickness_bar, d.thickness_colors, "Thickness (mm)", 0.88);
-  legend(d.gap_bar, d.gap_colors, "Bone gap (mm)", 0.75);
-  for (vtkScalarBarActor* bar : {d.thickness_bar.Get(), d.gap_bar.Get()}) {
-    // Dark text on a light card: readable over bone and over the background.
-    bar->GetTitleTextProperty()->SetColor(0.1, 0.1, 0.1);
-    bar->GetLabelTextProperty()->SetColor(0.1, 0.1, 0.1);
-    bar->DrawBackgroundOn();
-    bar->GetBackgroundProperty()->SetColor(1.0, 1.0, 1.0);
-    bar->GetBackgroundProperty()->SetOpacity(0.85);
-  }
+  legend(d.thickness_bar, d.thickness_colors, "Thickness\n(mm)", 0.87);
+  legend(d.gap_bar, d.gap_colors, "Bone gap\n(mm)", 0.70);
+  for (vtkScalarBarActor* bar : {d.thickness_bar.Get(), d.gap_bar.Get()})
+    for (vtkTextProperty* t : {bar->GetTitleTextProperty(), bar->GetLabelTextProperty()}) {
+      // Light text on a dark card of its own: readable over bone and over the background.
+      t->SetColor(1.0, 1.0, 1.0);
+      t->SetBackgroundColor(0.0, 0.0, 0.0);
+      t->SetBackgroundOpacity(0.75);
+    }
   const double edge_at[4][2] = {{0.012, 0.5}, {0.988, 0.5}, {0.5, 0.985}, {0.5, 0.015}};
   for (int k = 0; k < 4; ++k) {
     vtkTextActor* t = d.edge_text[k];
@@ -847,6 +846,7 @@ void SkullView::set_standard_view(StandardView view) {
       break;
   }
   vtkCamera* cam = d.renderer->GetActiveCamera();
+  cam->SetViewAngle(30.0);  // the zoom is set anew below
   const Eigen::Vector3d pos = d.center + 4.0 * d.radius * dir;
   cam->SetFocalPoint(d.center.data());
   cam->SetPosition(pos.x(), pos.y(), pos.z());
@@ -854,13 +854,30 @@ void SkullView::set_standard_view(StandardView view) {
   // The skull framed (not the plane's square, nor the markers): ResetCamera fits the bounding
   // sphere of the bounds, and the skull fills more of the view zoomed by 1.5.
   double b[6];
-  if (d.skull.shown) {
-    d.skull.mapper->GetInput()->GetBounds(b);
-    d.renderer->ResetCamera(b);
-  } else {
+  if (!d.skull.shown) {
     d.renderer->ResetCamera();
+    cam->Zoom(1.5);
+    d.renderer->ResetCameraClippingRange();
+    update();
+    return;
   }
-  cam->Zoom(1.5);
+  d.skull.mapper->GetInput()->GetBounds(b);
+  d.renderer->ResetCamera(b);
+  // The skull's box as the camera sees it, fitted in both the view's width and its height with
+  // a margin (ResetCamera fits the box's bounding sphere, which leaves the skull small).
+  const Eigen::Vector3d right = dir.cross(up).normalized();
+  double half_w = 0.0, half_h = 0.0;
+  for (int corner = 0; corner < 8; ++corner) {
+    const Eigen::Vector3d p(b[corner & 1], b[2 + ((corner >> 1) & 1)], b[4 + ((corner >> 2) & 1)]);
+    half_w = std::max(half_w, std::abs((p - d.center).dot(right)));
+    half_h = std::max(half_h, std::abs((p - d.center).dot(up)));
+  }
+  const double distance = cam->GetDistance();
+  const double visible_h = distance * std::tan(0.5 * cam->GetViewAngle() * M_PI / 180.0);
+  const double aspect = height() > 0 ? static_cast<double>(width()) / height() : 1.0;
+  const double fit = 0.92 * std::min(visible_h / std::max(half_h, 1e-6),
+                                     visible_h * aspect / std::max(half_w, 1e-6));
+  cam->Zoom(std::clamp(fit, 0.2, 5.0));
   d.renderer->ResetCameraClippingRange();
   update();
 }
@@ -901,6 +918,26 @@ void SkullView::update_edge_letters() {
   }
 }
 
+std::array<double, 10> SkullView::camera() const {
+  vtkCamera* cam = d_->renderer->GetActiveCamera();
+  std::array<double, 10> c{};
+  cam->GetPosition(c.data());
+  cam->GetFocalPoint(c.data() + 3);
+  cam->GetViewUp(c.data() + 6);
+  c[9] = cam->GetViewAngle();
+  return c;
+}
+
+void SkullView::set_camera(const std::array<double, 10>& c) {
+  vtkCamera* cam = d_->renderer->GetActiveCamera();
+  cam->SetPosition(c.data());
+  cam->SetFocalPoint(c.data() + 3);
+  cam->SetViewUp(c.data() + 6);
+  cam->SetViewAngle(c[9]);
+  d_->renderer->ResetCameraClippingRange();
+  update();
+}
+
 std::array<std::string, 4> SkullView::edge_letters() {
   update_edge_letters();
   return d_->edge_letters;
@@ -939,6 +976,7 @@ void SkullView::look_at_markers() {
   const Eigen::Vector3d up = std::abs(dir.z()) > 0.9 ? Eigen::Vector3d(-Eigen::Vector3d::UnitY())
                                                      : Eigen::Vector3d::UnitZ();
   vtkCamera* cam = d.renderer->GetActiveCamera();
+  cam->SetViewAngle(20.0);  // as after a standard view's 1.5× zoom, whatever the view had before
   const Eigen::Vector3d pos = c + 2.6 * d.radius * dir;
   cam->SetFocalPoint(c.x(), c.y(), c.z());
   cam->SetPosition(pos.x(), pos.y(), pos.z());
@@ -968,6 +1006,7 @@ void SkullView::look_at_implant(std::optional<StandardView> from) {
     cam->SetPosition(pos.x(), pos.y(), pos.z());
     cam->SetViewUp(up.x(), up.y(), up.z());
   }
+  d.renderer->GetActiveCamera()->SetViewAngle(30.0);
   // The implant and the bone around it fill the view: its bounds grown by half on each side.
   double around[6];
   for (int k = 0; k < 3; ++k) {

@@ -44,6 +44,9 @@ class SkullView : public QOpenGLWidget {
   enum class StandardView { Front, Back, Left, Right, Top };
   /// The camera along a patient axis, framing the skull (not the plane or the markers).
   void set_standard_view(StandardView view);
+  /// Where the camera is (position, focal point, up, view angle), to be put back.
+  std::array<double, 10> camera() const;
+  void set_camera(const std::array<double, 10>& camera);
   /// The letters at the view's left, right, top and bottom edges for the camera now.
   std::array<std::string, 4> edge_letters();
   /// Whether the plan's clip plane (step 4) cuts the skulls in the view; off: the whole skulls

@@ -109,6 +109,10 @@ QWidget* SlicePanel::make_pane(QWidget* content, const QString& title, int index
 }
 
 void SlicePanel::arrange(Arrangement a) {
+  // Back to the four from one slice alone: that slice fitted again (zoomed and panned alone,
+  // it would show a corner of the head among the four).
+  const int alone = static_cast<int>(arrangement_) - static_cast<int>(Arrangement::Axial);
+  if (a == Arrangement::FourUp && alone >= 0 && alone < 3) views_[alone]->fit();
   arrangement_ = a;
   const std::array<bool, 4> shown = {
       a == Arrangement::ThreeD || a == Arrangement::FourUp || a == Arrangement::ThreeDMaximised,

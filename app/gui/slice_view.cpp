@@ -222,14 +222,15 @@ void SliceView::paintEvent(QPaintEvent*) {
   // The implant's outline over everything else: what the slice is looked at for.
   p.setBrush(Qt::NoBrush);
   draw_outline(p, implant_cut_, QColor(255, 130, 0), 2.0);
-  // Orientation letters at the middle of the image's edges; the slice's position and the
-  // window and level in the widget's corners.
+  // Orientation letters at the middle of the image's edges (within the widget, whatever the
+  // zoom); the slice's position and the window and level in the widget's corners, each on a
+  // dark card so that they read over bone.
   const QRectF image(o, QSizeF(s * slice_.width, s * slice_.height));
   QFont f = font();
   f.setBold(true);
   p.setFont(f);
   p.setPen(QColor(255, 230, 120));
-  const QRectF letters = image.adjusted(3, 1, -3, -1);
+  const QRectF letters = image.intersected(QRectF(rect())).adjusted(3, 1, -3, -1);
   p.drawText(letters, Qt::AlignLeft | Qt::AlignVCenter, slice_.edge_labels[0]);
   p.drawText(letters, Qt::AlignRight | Qt::AlignVCenter, slice_.edge_labels[1]);
   p.drawText(letters, Qt::AlignHCenter | Qt::AlignTop, slice_.edge_labels[2]);
@@ -237,23 +238,33 @@ void SliceView::paintEvent(QPaintEvent*) {
   f.setBold(false);
   f.setPointSizeF(f.pointSizeF() * 0.85);
   p.setFont(f);
-  p.setPen(QColor(220, 220, 220));
+  const auto card = [&p](const QRectF& within, int align, const QString& text) {
+    const QRectF box = p.boundingRect(within, align, text).adjusted(-3, -1, 3, 1);
+    p.fillRect(box, QColor(0, 0, 0, 170));
+    p.setPen(QColor(225, 225, 225));
+    p.drawText(within, align, text);
+  };
   static const char* const kAxis[] = {"z", "y", "x"};
-  const QRect corners = rect().adjusted(4, 2, -4, -2);
-  p.drawText(corners, Qt::AlignLeft | Qt::AlignTop,
-             tr("%1\n%2 = %3 mm")
-                 .arg(QString::fromLatin1(to_string(orientation_)))
-                 .arg(QString::fromLatin1(kAxis[static_cast<int>(orientation_)]))
-                 .arg(slice_.position_mm, 0, 'f', 1));
-  p.drawText(corners, Qt::AlignRight | Qt::AlignBottom,
-             tr("W %1\nL %2").arg(window_, 0, 'g', 4).arg(level_, 0, 'g', 4));
+  const QRectF corners = QRectF(rect()).adjusted(5, 3, -5, -3);
+  card(corners, Qt::AlignLeft | Qt::AlignTop,
+       tr("%1\n%2 = %3 mm")
+           .arg(QString::fromLatin1(to_string(orientation_)))
+           .arg(QString::fromLatin1(kAxis[static_cast<int>(orientation_)]))
+           .arg(slice_.position_mm, 0, 'f', 1));
+  card(corners, Qt::AlignRight | Qt::AlignBottom,
+       tr("W %1\nL %2").arg(window_, 0, 'g', 4).arg(level_, 0, 'g', 4));
   // A scale bar (10 mm) in the lower left: the slice's millimetres at a glance, at any zoom.
   const double ten = 10.0 * s / std::max(1e-9, slice_.right.norm());
+  const QString scale_text = zoom_ > 1.0 ? tr("10 mm  ×%1").arg(zoom_, 0, 'f', 1) : tr("10 mm");
   const QPointF bar(corners.left() + 4, corners.bottom() - 6);
+  const QRectF label(bar.x(), bar.y() - 20, std::max(40.0, ten + 30), 16);
+  p.fillRect(QRectF(bar.x() - 4, label.top() - 1,
+                    std::max(ten, p.fontMetrics().horizontalAdvance(scale_text) * 1.0) + 8,
+                    bar.y() - label.top() + 6),
+             QColor(0, 0, 0, 170));
   p.setPen(QPen(QColor(220, 220, 220), 2));
   p.drawLine(bar, bar + QPointF(ten, 0));
-  p.drawText(QRectF(bar.x(), bar.y() - 20, std::max(40.0, ten + 30), 16), Qt::AlignLeft,
-             zoom_ > 1.0 ? tr("10 mm  ×%1").arg(zoom_, 0, 'f', 1) : tr("10 mm"));
+  p.drawText(label, Qt::AlignLeft, scale_text);
 }
 
 void SliceView::mousePressEvent(QMouseEvent* e) {

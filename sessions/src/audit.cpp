@@ -469,7 +469,15 @@ std::vector<std::string> quality_advice(const QualityReport& r, const ImplantPar
   return out;
 }
 
-std::string quality_verdict_html(const QualityReport& r, const ImplantParams& params) {
+std::string quality_verdict_html(const QualityReport& r, const ImplantParams& params,
+                                 const SoftTissueCheck* tissue) {
+  const bool finding = tissue && tissue->checked && tissue->finding;
+  if (r.printable && finding)
+    return "<p style='color:#8a5a00'><b>Printable, with a finding to check before approval:</b> "
+           "brain or dura reaches " +
+           fmt("%.1f", tissue->intrusion_reach_mm) +
+           " mm above the implant's inner surface (red on the CT slices; the Quality panel on "
+           "the right has the figures).</p>";
   if (r.printable)
     return "<p style='color:#070'><b>Printable:</b> the quality check passes (the full report "
            "is in the Quality panel on the right).</p>";
@@ -594,15 +602,27 @@ std::string design_report_html(const Session& session, const std::vector<ReportI
   h += "<table width=100%>";
   row("Case (patient) ID", "<b>" + html_escape(case_id) + "</b>");
   row("Planned by", html_escape(header.info.user.empty() ? "—" : header.info.user));
-  row("Plan started", html_escape(header.info.created));
+  // "2026-12-07T06:09:07.055Z" as "2026-12-07 06:09 UTC".
+  const auto when = [](const std::string& iso) {
+    if (iso.size() < 16 || iso[10] != 'T') return iso.empty() ? std::string("—") : iso;
+    return iso.substr(0, 10) + " " + iso.substr(11, 5) + " UTC";
+  };
+  row("Plan started", html_escape(when(header.info.created)));
   row("Last change",
-      html_escape(session.journal().empty() ? std::string("—") : session.journal().back().time));
+      html_escape(when(session.journal().empty() ? std::string() : session.journal().back().time)));
   row("Skull from", html_escape(std::filesystem::path(skull_file).filename().string()));
   row("Program", "Cranioplan " + html_escape(program_version));
   h += "</table>";
   // The verdict, then the implant and the checks it passed or failed.
-  h += q.printable ? "<p class=ok><b>Printable:</b> the quality check passes.</p>"
-                   : "<p class=bad>NOT printable: the quality check refuses this implant.</p>";
+  if (!q.printable)
+    h += "<p class=bad>NOT printable: the quality check refuses this implant.</p>";
+  else if (tissue && tissue->checked && tissue->finding)
+    h += "<p style='color:#8a5a00'><b>Printable, with a finding to check before approval:</b> "
+         "brain or dura reaches " +
+         fixed(tissue->intrusion_reach_mm, 1) +
+         " mm above the implant's inner surface (Quality, and the CT slices on page 3).</p>";
+  else
+    h += "<p class=ok><b>Printable:</b> the quality check passes.</p>";
   std::string pictures;
   if (!images.empty()) {
     // The views of the skull on one page, the CT slices and the thickness map on the next, two
@@ -662,8 +682,17 @@ std::string design_report_html(const Session& session, const std::vector<ReportI
                                            : " (" + html_escape(built.fit_margin_note) + ")"));
   h += "</table><h2>Quality</h2>" + quality_report_html(q, tissue);
   h += pictures;
+  // After the pictures, on a page of their own: the perforations and tabs, the approval and the
+  // provenance.
+  const char* const kNewPage = "<h2 style=\"page-break-before: always\">";
+  bool paged = false;
+  const auto heading = [&](const char* title) {
+    h += std::string(paged ? "<h2>" : kNewPage) + title + "</h2>";
+    paged = true;
+  };
   if (!built.holes.empty()) {
-    h += "<h2>Perforations</h2><table><tr><th>#</th><th>Centre (mm)</th><th>Axis</th>"
+    heading("Perforations");
+    h += "<table><tr><th>#</th><th>Centre (mm)</th><th>Axis</th>"
          "<th>Placed</th></tr>";
     for (size_t k = 0; k < built.holes.size(); ++k) {
       const Hole& hole = built.holes[k];
@@ -675,7 +704,8 @@ std::string design_report_html(const Session& session, const std::vector<ReportI
     h += "</table>";
   }
   if (!built.tabs.empty()) {
-    h += "<h2>Fixation tabs</h2><table><tr><th>#</th><th>At the rim (mm)</th><th>Length × "
+    heading("Fixation tabs");
+    h += "<table><tr><th>#</th><th>At the rim (mm)</th><th>Length × "
          "width × thickness</th><th>Screws</th><th>Bone under the screws</th><th>From the "
          "midline</th></tr>";
     for (size_t k = 0; k < built.tabs.size(); ++k) {
@@ -690,7 +720,8 @@ std::string design_report_html(const Session& session, const std::vector<ReportI
     h += "</table>";
   }
   // What is approved, and by whom: each line on its own, nothing to wrap.
-  h += "<h2 style=\"page-break-before: always\">Approval</h2><p>The approver confirms having "
+  heading("Approval");
+  h += "<p>The approver confirms having "
        "checked the implant above — its "
        "shape on the skull, its fit to the bone on the CT slices, its thickness and every "
        "finding of the quality table — and approves it for manufacture";

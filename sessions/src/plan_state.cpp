@@ -87,7 +87,7 @@ const std::array<WizardStep, 9>& wizard_steps() {
        "midline), then press Fit: the plane is refined from the landmarks and the skull's "
        "symmetry. Adjust it by hand if needed. Done when a plane is set."},
       {3, "Mirror and register",
-       "Mirror the skull across the plane (green), then Register: the mirror is fitted onto the "
+       "Mirror the skull across the plane, then Register: the mirror (green) is fitted onto the "
        "healthy bone (whole skull or a region). Nudge it by hand if needed. Done when the mirror "
        "is registered (or accepted as it is)."},
       {4, "Clip and inspect",
@@ -96,14 +96,19 @@ const std::array<WizardStep, 9>& wizard_steps() {
       {5, "Edge markers",
        "Place outer edge markers (key 0) along the outer rim of the defect on the skull, and "
        "optionally inner edge markers (key 1) along its inner rim — or press Propose to place "
-       "them automatically and edit them. Done with at least 3 outer edge markers (and either "
-       "no inner edge markers or at least 3)."},
+       "them automatically and edit them. Green: edge markers; magenta: surface markers "
+       "(spheres outer, cubes inner); an orange line: a stretch of the rim no ray saw. Done "
+       "with at least 3 outer edge markers (and either no inner edge markers or at least 3)."},
       {6, "Surface markers",
        "Place outer surface markers (key 2) and inner surface markers (key 3) on the mirrored "
-       "skull inside the defect. Done with at least 3 outer surface markers."},
+       "skull inside the defect (a proposal also places some on the intact bone around it, "
+       "where the implant must meet the skull's curve). Done with at least 3 outer surface "
+       "markers."},
       {7, "Build implant",
-       "Choose the method (shell: smooth fitted surfaces, or the paper's Delaunay 3D) and the "
-       "resolution, then Build. Done when an implant is built."},
+       "Build the implant (the defaults are the automatic plan's: a shell fitted to the bone); "
+       "or choose the method (shell: smooth fitted surfaces, or Delaunay 3D as in Egger et al. "
+       "2017), the material, holes and tabs first. Done when an implant is built that the "
+       "quality check passes."},
       {8, "Smooth and refine",
        "Smooth the surface markers (radius, edge-marker weight; edge markers stay fixed) and "
        "move markers where needed: the implant follows. Press Done when satisfied."},
@@ -141,6 +146,15 @@ std::string describe_plane_fit(const PlaneFit& fit) {
   std::snprintf(buf, sizeof(buf), "symmetry RMS %.2f mm, %.0f%% inliers (%s start) — %s", rms,
                 100.0 * inliers, fit.initial_method.c_str(), verdict);
   return buf;
+}
+
+const char* registration_verdict(const RegisterResult& r) {
+  if (r.rms_mm <= 1.5 && r.inlier_fraction >= 0.6)
+    return "good: the mirror lies on the healthy bone";
+  if (r.rms_mm <= 3.0 && r.inlier_fraction >= 0.4)
+    return "fair: look at the mirror on the healthy side, or register on a region near the "
+           "defect";
+  return "poor: check the plane (step 2), or nudge the mirror by hand and register again";
 }
 
 std::string landmark_words(const std::string& name) {
@@ -302,12 +316,12 @@ bool run_registration(PlanState& s, const Json* recorded = nullptr, Json* record
   }
   s.registration = std::move(result);
   s.manual = RigidTransform{};
-  char buf[200];
+  char buf[320];
   if (s.registration->usable())
     std::snprintf(buf, sizeof(buf),
-                  "registered: RMS %.2f mm, %.0f%% of samples paired, %d iterations",
+                  "registered: RMS %.2f mm, %.0f%% of samples paired, %d iterations — %s",
                   s.registration->rms_mm, 100.0 * s.registration->inlier_fraction,
-                  s.registration->iterations);
+                  s.registration->iterations, registration_verdict(*s.registration));
   else
     std::snprintf(buf, sizeof(buf), "registration failed: %s", s.registration->message.c_str());
   s.message = buf;

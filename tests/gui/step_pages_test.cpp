@@ -40,6 +40,7 @@ class RecordingHost : public PageHost {
   void import_markers(const QString& path) override { opened.push_back(path); }
   void show_slices() override { opened.push_back("slices"); }
   void show_mould(bool shown) override { opened.push_back(shown ? "mould" : "no mould"); }
+  QString suggested_path(const QString& file_name) const override { return file_name; }
   std::shared_ptr<const PlanState> preview(const Command& command) override {
     previewed.push_back(command);
     return nullptr;

@@ -105,6 +105,18 @@ TEST(StepLock, LaterStepsAreRefusedWithWhatIsMissing) {
   EXPECT_NE(missing.find("inner edge markers: 1 placed"), std::string::npos) << missing;
 }
 
+// Opening a plan says how far its replay is: each command before it is replayed, then the end.
+TEST(Session, OpeningReportsTheCommandsReplayed) {
+  std::vector<std::pair<size_t, size_t>> calls;
+  OpenOptions options;
+  options.progress = [&calls](size_t done, size_t total) { calls.emplace_back(done, total); };
+  const Session s = Session::open(test::planned_defect_case().session_path, options);
+  const size_t n = s.index();
+  ASSERT_GT(n, 3u);
+  ASSERT_EQ(calls.size(), n + 1);
+  for (size_t k = 0; k <= n; ++k) EXPECT_EQ(calls[k], std::make_pair(k, n));
+}
+
 TEST(Session, AVersionOneBuildIsAppliedWithoutFitting) {
   Session s = session_at_markers();
   add_rim(s);
@@ -625,7 +637,10 @@ TEST(SessionFile, AutosaveOffersRecoveryOfUnsavedCommands) {
   const RecoveryInfo info = Session::recovery_info(path);
   ASSERT_TRUE(info.available) << info.message;
   EXPECT_EQ(info.extra_events, 3);
-  const Session recovered = Session::open(path, OpenOptions{true, true});
+  OpenOptions recover;
+  recover.recover_autosave = true;
+  recover.attach_autosave = true;
+  const Session recovered = Session::open(path, recover);
   EXPECT_EQ(fingerprint(recovered.state()), fingerprint(s.state()));
   EXPECT_FALSE(recovered.is_clean());
   EXPECT_TRUE(recovered.can_redo());

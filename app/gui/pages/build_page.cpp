@@ -48,7 +48,7 @@ BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
 
   method_ = new QComboBox(this);
   method_->setObjectName("implantMethod");
-  method_->addItems({tr("Shell (fitted surfaces)"), tr("Delaunay 3D (the paper's)")});
+  method_->addItems({tr("Shell (fitted surfaces)"), tr("Delaunay 3D (Egger et al. 2017)")});
   resolution_ = new QDoubleSpinBox(this);
   resolution_->setRange(0.3, 5);
   resolution_->setValue(1.0);
@@ -219,7 +219,7 @@ void BuildPage::mark_changed() {
 }
 
 void BuildPage::show_verdict(const QString& html) {
-  verdict_->setText(html);
+  set_wrapped_text(verdict_, html);
   verdict_->setVisible(!html.isEmpty() && host_.plan().implant);
 }
 

@@ -25,7 +25,8 @@ ExportPage::ExportPage(PageHost& host) : StepPage(9, host) {
     QPushButton* b = make_button(tr("Export %1…").arg(QString(ext).toUpper()), name);
     connect(b, &QPushButton::clicked, this, [this, ext = ext] {
       const QString path = QFileDialog::getSaveFileName(
-          this, tr("Export the implant"), QStringLiteral("implant.%1").arg(ext),
+          this, tr("Export the implant"),
+          host_.suggested_path(QStringLiteral("implant.%1").arg(ext)),
           QStringLiteral("%1 (*.%2)").arg(QString(ext).toUpper(), ext));
       if (!path.isEmpty()) host_.export_to(path, QString(ext) == "3mf" && mould_->isChecked());
     });
@@ -65,7 +66,7 @@ ExportPage::ExportPage(PageHost& host) : StepPage(9, host) {
   layout_->addWidget(approval_);
 }
 
-void ExportPage::show_verdict(const QString& html) { verdict_->setText(html); }
+void ExportPage::show_verdict(const QString& html) { set_wrapped_text(verdict_, html); }
 
 void ExportPage::show_mould_message(const QString& text) {
   mould_info_->setText(text);

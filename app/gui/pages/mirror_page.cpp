@@ -71,9 +71,10 @@ void MirrorPage::show_state(const PlanState& s) {
   if (!s.registration)
     text = s.mirrored ? tr("Mirrored, not registered.") : tr("Not mirrored yet.");
   else if (s.registration->usable())
-    text = tr("Registered: RMS %1 mm, %2 iterations")
+    text = tr("Registered: RMS %1 mm, %2 iterations — %3")
                .arg(s.registration->rms_mm, 0, 'f', 2)
-               .arg(s.registration->iterations);
+               .arg(s.registration->iterations)
+               .arg(QString::fromUtf8(registration_verdict(*s.registration)));
   else
     text = tr("Registration failed: %1").arg(QString::fromStdString(s.registration->message));
   register_info_->setText(text);

@@ -50,6 +50,7 @@ SmoothPage::SmoothPage(PageHost& host) : StepPage(8, host) {
   form_->addRow(project_);
   QPushButton* apply = add_button(tr("Apply smoothing"), "applySmoothing");
   connect(apply, &QPushButton::clicked, this, [this] {
+    applying_ = true;
     host_.push(smooth_command(), tr("Smoothing"));
     info_->setText(tr("Applied: radius %1 mm, edge weight %2, %3 iterations (Edit → Undo takes "
                       "it back).")
@@ -64,6 +65,15 @@ Command SmoothPage::smooth_command() const {
   return commands::smooth_markers({static_cast<double>(radius_->value()),
                                    static_cast<double>(weight_->value()), iterations_->value()},
                                   project_->isChecked());
+}
+
+void SmoothPage::show_state(const PlanState& s) {
+  if (applying_) {
+    applying_ = false;
+    applied_ = s.implant.get();
+    return;
+  }
+  if (s.implant.get() != applied_ && info_->text().startsWith(tr("Applied"))) info_->clear();
 }
 
 void SmoothPage::preview() {

@@ -1,8 +1,12 @@
 #include "step_page.h"
 
 #include <QFormLayout>
+#include <QLabel>
 #include <QPushButton>
+#include <QTextDocument>
 #include <QVBoxLayout>
+#include <algorithm>
+#include <cmath>
 
 #include "step_pages.h"
 
@@ -55,6 +59,36 @@ QPushButton* StepPage::add_button(const QString& text, const char* name) {
   QPushButton* b = make_button(text, name);
   form_->addRow(b);
   return b;
+}
+
+void StepPage::set_wrapped_text(QLabel* label, const QString& text) {
+  label->setText(text);
+  if (std::find(wrapped_.begin(), wrapped_.end(), label) == wrapped_.end())
+    wrapped_.push_back(label);
+  fit_wrapped();
+}
+
+void StepPage::fit_wrapped() {
+  // A page lies in a stacked widget, which does not pass the height a wrapped label needs for
+  // its width on to the layout: each such label (a full row of the form) asks for it itself,
+  // at the width the page gives a row.
+  const QMargins outer = layout_->contentsMargins(), inner = form_->contentsMargins();
+  const int row = width() - outer.left() - outer.right() - inner.left() - inner.right();
+  for (QLabel* label : wrapped_) {
+    // The rich text laid out as the label lays it out (QLabel's own heightForWidth leaves out
+    // the lists' margins).
+    QTextDocument text;
+    text.setDefaultFont(label->font());
+    text.setHtml(label->text());
+    text.setTextWidth(std::max(row, 150));
+    label->setMinimumHeight(
+        label->text().isEmpty() ? 0 : static_cast<int>(std::ceil(text.size().height())) + 4);
+  }
+}
+
+void StepPage::resizeEvent(QResizeEvent* event) {
+  QWidget::resizeEvent(event);
+  fit_wrapped();
 }
 
 std::unique_ptr<StepPage> make_step_page(int step, PageHost& host) {

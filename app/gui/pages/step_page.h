@@ -6,12 +6,14 @@
 #include <QString>
 #include <QWidget>
 #include <memory>
+#include <vector>
 
 #include "cranioplan/sessions/command.h"
 #include "cranioplan/sessions/plan_state.h"
 #include "skull_view.h"
 
 class QFormLayout;
+class QLabel;
 class QPushButton;
 class QVBoxLayout;
 
@@ -40,6 +42,8 @@ class PageHost {
   virtual void show_mould(bool shown) = 0;
   /// Markers from a file (.mrk.json, .json, .csv), as one command.
   virtual void import_markers(const QString& path) = 0;
+  /// `file_name` in the folder a save dialog should open in (beside the plan).
+  virtual QString suggested_path(const QString& file_name) const = 0;
   /// The state a command would give, without recording it.
   virtual std::shared_ptr<const PlanState> preview(const Command& command) = 0;
 };
@@ -87,13 +91,19 @@ class StepPage : public QWidget {
   QPushButton* make_button(const QString& text, const char* name);
   /// A button added as a row of the page's form.
   QPushButton* add_button(const QString& text, const char* name);
+  /// A word-wrapped label's text, its height made room for at the page's width (again when the
+  /// page is resized).
+  void set_wrapped_text(QLabel* label, const QString& text);
+  void resizeEvent(QResizeEvent* event) override;
 
   PageHost& host_;
   QVBoxLayout* layout_;  ///< the page, top to bottom
   QFormLayout* form_;    ///< the form at its top
 
  private:
+  void fit_wrapped();
   int step_;
+  std::vector<QLabel*> wrapped_;
 };
 
 /// The page of each wizard step (1–9).

@@ -181,6 +181,8 @@ class BuildPage : public StepPage {
 class SmoothPage : public StepPage {
  public:
   explicit SmoothPage(PageHost& host);
+  /// "Applied" stays for the state the smoothing made; another (an undo, an edit) clears it.
+  void show_state(const PlanState& state) override;
   void surface_clicked(const Eigen::Vector3d& point) override;
   SkullView::PickTarget pick_target() const override;
   bool markers_editable() const override { return true; }
@@ -199,6 +201,8 @@ class SmoothPage : public StepPage {
   QLabel* info_;
   QLabel* radius_value_;
   QLabel* weight_value_;
+  bool applying_ = false;          ///< Apply pressed: the next state is the smoothing's
+  const void* applied_ = nullptr;  ///< the state the smoothing made
 };
 
 /// Step 9: the quality report and export.

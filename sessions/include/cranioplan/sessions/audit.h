@@ -83,8 +83,11 @@ std::string quality_report_html(const QualityReport& report,
 std::vector<std::string> quality_advice(const QualityReport& report, const ImplantParams& params);
 
 /// The quality check's verdict in a few lines for a wizard page: printable, or what is wrong
-/// (the report's reasons) and what to try (quality_advice).
-std::string quality_verdict_html(const QualityReport& report, const ImplantParams& params);
+/// (the report's reasons) and what to try (quality_advice); with `tissue`, a finding on the CT
+/// (brain or dura in the implant's place) said beside "printable" as one to check before
+/// approval.
+std::string quality_verdict_html(const QualityReport& report, const ImplantParams& params,
+                                 const SoftTissueCheck* tissue = nullptr);
 
 /// A picture in the design report: its caption, its file (beside the report) and what it
 /// shows (the implant on the skull, its thickness map, or a CT slice through it).

@@ -189,6 +189,9 @@ std::optional<AttachedCt> plan_ct(const PlanState& state);
 /// ≤ 3 mm with ≥ 40 %: check the plane on the face) or poor (place the landmarks again or
 /// adjust the plane by hand).
 std::string describe_plane_fit(const PlaneFit& fit);
+/// A registration's verdict: good (RMS ≤ 1.5 mm with ≥ 60 % paired), fair (≤ 3 mm with
+/// ≥ 40 %) or poor, with what to do.
+const char* registration_verdict(const RegisterResult& result);
 /// A landmark's name as a person says it ("orbit_left": "left orbit").
 std::string landmark_words(const std::string& name);
 
