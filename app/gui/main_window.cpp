@@ -442,6 +442,7 @@ void MainWindow::build_edit_view_menus() {
   show_mirror_->setChecked(true);
   show_mirror_->setShortcut(QKeySequence(Qt::Key_M));
   connect(show_mirror_, &QAction::toggled, view_, &SkullView::set_mirror_visible);
+  connect(show_mirror_, &QAction::toggled, slices_, &SlicePanel::set_mirror_shown);
   show_thickness_ = view->addAction(tr("Thickness map"));
   show_thickness_->setObjectName("thicknessMap");
   show_thickness_->setCheckable(true);

@@ -7,6 +7,7 @@
 #include <vtkActor.h>
 #include <vtkActorCollection.h>
 #include <vtkAnnotatedCubeActor.h>
+#include <vtkBillboardTextActor3D.h>
 #include <vtkCallbackCommand.h>
 #include <vtkCamera.h>
 #include <vtkCellArray.h>
@@ -386,6 +387,9 @@ struct SkullView::Impl {
   // The patient's directions at the middle of the view's left, right, top and bottom edges, as
   // radiology viewers show them, following the camera.
   std::array<vtkNew<vtkTextActor>, 4> edge_text;
+  // The named landmarks' names beside their balls (nasion, left orbit, right orbit).
+  std::array<vtkNew<vtkBillboardTextActor3D>, 3> landmark_names;
+  std::array<bool, 3> landmark_named{};  // which of them the plan has
   std::array<std::string, 4> edge_letters;
   bool clip_wanted = false;         // the plan's clip plane applied to the view
   std::optional<Plane> clip_plane;  // the plan's, applied or not
@@ -564,6 +568,19 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
       t->SetBackgroundColor(0.0, 0.0, 0.0);
       t->SetBackgroundOpacity(0.75);
     }
+  for (vtkBillboardTextActor3D* t : d.landmark_names) {
+    vtkTextProperty* tp = t->GetTextProperty();
+    tp->SetFontSize(15);
+    tp->BoldOn();
+    tp->SetColor(1.0, 1.0, 1.0);
+    tp->SetBackgroundColor(0.55, 0.08, 0.05);
+    tp->SetBackgroundOpacity(0.8);
+    tp->SetJustificationToLeft();
+    tp->SetVerticalJustificationToBottom();
+    t->SetDisplayOffset(10, 6);
+    t->SetVisibility(false);
+    d.overlay->AddActor(t);
+  }
   const double edge_at[4][2] = {{0.012, 0.5}, {0.988, 0.5}, {0.5, 0.985}, {0.5, 0.015}};
   for (int k = 0; k < 4; ++k) {
     vtkTextActor* t = d.edge_text[k];
@@ -678,18 +695,9 @@ void SkullView::show_state(const PlanState& s) {
     d.implant_locator_of = nullptr;
   }
 
-  // Clip plane: keep the side the normal points away from.
-  d.skull.mapper->RemoveAllClippingPlanes();
-  d.mirror.mapper->RemoveAllClippingPlanes();
+  // The plan's clip plane, applied when the view is asked to (step 4, or the toggle).
   d.clip_plane = s.clip_plane;
-  if (s.clip_plane && d.clip_wanted) {
-    const Eigen::Vector3d keep = -s.clip_plane->normal;
-    d.clip->SetNormal(keep.x(), keep.y(), keep.z());
-    const Eigen::Vector3d origin = s.clip_plane->normal * s.clip_plane->offset;
-    d.clip->SetOrigin(origin.x(), origin.y(), origin.z());
-    d.skull.mapper->AddClippingPlane(d.clip);
-    d.mirror.mapper->AddClippingPlane(d.clip);
-  }
+  set_clip_enabled(d.clip_wanted);
 
   d.markers = s.markers;
   std::array<std::vector<Eigen::Vector3d>, 4> by_type;
@@ -703,6 +711,21 @@ void SkullView::show_state(const PlanState& s) {
     if (*p) lm.push_back(**p);
   lm.insert(lm.end(), s.landmarks.midline.begin(), s.landmarks.midline.end());
   d.landmarks.set(lm);
+  {
+    const std::pair<const std::optional<Eigen::Vector3d>*, const char*> named[] = {
+        {&s.landmarks.nasion, "nasion"},
+        {&s.landmarks.orbit_left, "left orbit"},
+        {&s.landmarks.orbit_right, "right orbit"}};
+    for (int k = 0; k < 3; ++k) {
+      vtkBillboardTextActor3D* t = d.landmark_names[k];
+      const auto& at = *named[k].first;
+      d.landmark_named[k] = at.has_value();
+      t->SetVisibility(at.has_value() && d.markers_wanted);
+      if (!at) continue;
+      t->SetInput(named[k].second);
+      t->SetPosition(at->x(), at->y(), at->z());
+    }
+  }
   // The implant's clearance zones: translucent balls of their radius on the rim.
   std::vector<Eigen::Vector3d> zone_centres;
   vtkNew<vtkDoubleArray> zone_radii;
@@ -948,7 +971,7 @@ void SkullView::set_clip_enabled(bool enabled) {
   d.clip_wanted = enabled;
   d.skull.mapper->RemoveAllClippingPlanes();
   d.mirror.mapper->RemoveAllClippingPlanes();
-  if (enabled && d.clip_plane) {
+  if (enabled && d.clip_plane) {  // keep the side the normal points away from
     const Eigen::Vector3d keep = -d.clip_plane->normal;
     d.clip->SetNormal(keep.x(), keep.y(), keep.z());
     const Eigen::Vector3d origin = d.clip_plane->normal * d.clip_plane->offset;
@@ -1026,7 +1049,15 @@ void SkullView::set_markers_visible(bool visible) {
                         &d.landmarks, &d.selected, &d.handle_balls, &d.zones})
     g->actor->SetVisibility(visible && g->count() > 0);
   d.unseen_actor->SetVisibility(visible && d.unseen_data->GetNumberOfCells() > 0);
+  for (int k = 0; k < 3; ++k) d.landmark_names[k]->SetVisibility(visible && d.landmark_named[k]);
   update();
+}
+
+int SkullView::landmark_names_shown() const {
+  int n = 0;
+  for (const vtkBillboardTextActor3D* t : d_->landmark_names)
+    n += const_cast<vtkBillboardTextActor3D*>(t)->GetVisibility() != 0;
+  return n;
 }
 
 void SkullView::set_pick_target(PickTarget target) { d_->target = target; }

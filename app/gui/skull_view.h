@@ -99,6 +99,8 @@ class SkullView : public QOpenGLWidget {
   /// Whether the thickness map is drawn now.
   bool thickness_shown() const;
   int selected_marker() const;
+  /// How many named landmarks carry their name in the view.
+  int landmark_names_shown() const;
   /// How many stretches of the rim no ray saw are drawn (the last proposal's).
   int unseen_rim_shown() const;
   /// A ball where the implant's edge stands furthest off the bone (the quality report's worst

@@ -245,6 +245,10 @@ void SlicePanel::set_highlight(const std::vector<Eigen::Vector3d>& points) {
   for (SliceView* v : views_) v->set_highlight(points, half);
 }
 
+void SlicePanel::set_mirror_shown(bool shown) {
+  for (SliceView* v : views_) v->set_mirror_shown(shown);
+}
+
 void SlicePanel::set_markers_shown(bool shown) {
   for (SliceView* v : views_) v->set_markers_shown(shown);
 }

@@ -44,6 +44,7 @@ class SlicePanel : public QWidget {
   /// Window and level of a preset (a mask's 0/1 whatever the preset).
   void apply_preset(Preset preset);
   void set_markers_shown(bool shown);
+  void set_mirror_shown(bool shown);
   SliceView& view(SliceOrientation orientation) { return *views_[static_cast<int>(orientation)]; }
   /// Waits (processing events) until the CT is read; for tests and the command line.
   void wait_loaded();

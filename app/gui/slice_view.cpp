@@ -37,8 +37,9 @@ void SliceView::set_volume(std::shared_ptr<const Volume> volume, const QString& 
 
 void SliceView::show_state(const PlanState& s) {
   const std::shared_ptr<const SharedSurface> skull = s.skull ? s.skull->surface : nullptr;
-  const bool changed = skull != skull_ || s.implant != implant_;
+  const bool changed = skull != skull_ || s.implant != implant_ || s.mirrored != mirror_;
   skull_ = skull;
+  mirror_ = s.mirrored;
   implant_ = s.implant;
   markers_ = s.markers;
   if (changed) recut();
@@ -79,6 +80,11 @@ int SliceView::highlighted() const {
   for (const Eigen::Vector3d& p : highlight_)
     n += std::abs(slice_.distance(p)) <= highlight_half_mm_;
   return n;
+}
+
+void SliceView::set_mirror_shown(bool shown) {
+  mirror_shown_ = shown;
+  update();
 }
 
 void SliceView::set_markers_shown(bool shown) {
@@ -148,9 +154,20 @@ void SliceView::fit() {
 
 void SliceView::recut() {
   skull_cut_.clear();
+  mirror_cut_.clear();
   implant_cut_.clear();
   if (!volume_) return;
   if (skull_) skull_cut_ = cut_mesh(skull_->mesh, slice_.normal, slice_.position_mm);
+  if (mirror_) {
+    // The mirror is the skull moved by its placement x = A y + t: the slice n·x = d is, in the
+    // skull's own frame, (Aᵀn)·y = d − n·t; its cut is moved back into place.
+    const RigidTransform& m = mirror_->placement;
+    const Eigen::Vector3d n = m.rotation.transpose() * slice_.normal;
+    const double d = slice_.position_mm - slice_.normal.dot(m.translation);
+    mirror_cut_ = cut_mesh(mirror_->skull->mesh, n.normalized(), d / n.norm());
+    for (CutSegment& c : mirror_cut_)
+      for (Eigen::Vector3d& p : c) p = m.apply(p);
+  }
   if (implant_) implant_cut_ = cut_mesh(implant_->result().mesh, slice_.normal, slice_.position_mm);
 }
 
@@ -204,6 +221,7 @@ void SliceView::paintEvent(QPaintEvent*) {
   p.drawLine(QPointF(o.x(), c.y()), QPointF(o.x() + s * slice_.width, c.y()));
   p.drawLine(QPointF(c.x(), o.y()), QPointF(c.x(), o.y() + s * slice_.height));
   draw_outline(p, skull_cut_, QColor(240, 220, 90), 1.0);
+  if (mirror_shown_) draw_outline(p, mirror_cut_, QColor(90, 210, 110, 200), 1.0);  // as in 3D
   // Where the implant lies in soft tissue: its voxels in this slice, red.
   p.setPen(Qt::NoPen);
   p.setBrush(QColor(255, 30, 30, 190));

@@ -1,6 +1,7 @@
 #pragma once
 // A CT slice view of the wizard: an axial, coronal or sagittal slice of the plan's CT in the
-// patient frame, with window/level, the skull's and the implant's cut outlines, the markers near
+// patient frame, with window/level, the skull's, the mirrored skull's and the implant's cut
+// outlines, the markers near
 // the slice, a crosshair at the shared cursor and the orientation letters at its edges. Wheel:
 // the next or previous slice; Ctrl+wheel: zoom about the pointer; middle drag (or Shift+left
 // drag): pan; left click or drag: moves the cursor (all views follow); right drag: window
@@ -36,6 +37,8 @@ class SliceView : public QWidget {
   int highlighted() const;  ///< how many of them the current slice shows
   /// Whether the markers near the slice are drawn over it.
   void set_markers_shown(bool shown);
+  /// Whether the mirrored skull's outline is drawn (View → Show mirrored skull, M).
+  void set_mirror_shown(bool shown);
   double window() const { return window_; }
   double level() const { return level_; }
   const SliceGeometry& geometry() const { return slice_; }
@@ -63,6 +66,7 @@ class SliceView : public QWidget {
   /// How many outline segments of the skull and of the implant the slice shows.
   int skull_segments() const { return static_cast<int>(skull_cut_.size()); }
   int implant_segments() const { return static_cast<int>(implant_cut_.size()); }
+  int mirror_segments() const { return static_cast<int>(mirror_cut_.size()); }
 
  signals:
   void cursorMoved(const Eigen::Vector3d& point);
@@ -98,12 +102,14 @@ class SliceView : public QWidget {
   double window_ = 1000.0, level_ = 400.0;
   Eigen::Vector3d cursor_ = Eigen::Vector3d::Zero();
   std::shared_ptr<const SharedSurface> skull_;
+  std::shared_ptr<const MovedSurface> mirror_;  ///< the mirrored skull where the plan put it
   std::shared_ptr<const ImplantData> implant_;
   std::vector<Marker> markers_;
   bool markers_shown_ = false;
+  bool mirror_shown_ = true;
   std::vector<Eigen::Vector3d> highlight_;
   double highlight_half_mm_ = 0.5;
-  std::vector<CutSegment> skull_cut_, implant_cut_;
+  std::vector<CutSegment> skull_cut_, mirror_cut_, implant_cut_;
   double zoom_ = 1.0;
   QPointF pan_;  ///< widget pixels
   enum class Drag { None, Cursor, WindowLevel, Pan } drag_ = Drag::None;

@@ -81,7 +81,8 @@ const std::array<WizardStep, 9>& wizard_steps() {
       {1, "Load skull",
        "Open the patient's skull: a surface mesh (STL, PLY, OBJ, OFF, VTK, VTP) or a CT "
        "(InVesalius .inv3, NRRD, NIfTI, DICOM folder), which is turned into a bone surface at "
-       "the threshold you choose. Done when a skull is loaded."},
+       "step 1's threshold (automatic: 300 HU for a CT, 0.5 for a mask). Done when a skull is "
+       "loaded."},
       {2, "Landmarks and midsagittal plane",
        "Click the nasion and the centres of the left and right orbits (optional: points on the "
        "midline), then press Fit: the plane is refined from the landmarks and the skull's "

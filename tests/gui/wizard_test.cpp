@@ -202,6 +202,7 @@ TEST_F(Wizard, AllNineStepsOnTheSampleReplayToTheSameImplant) {
   ASSERT_TRUE(at);
   click_view(view, *at);
   ASSERT_TRUE(plan.state().landmarks.nasion) << "the click placed no landmark";
+  EXPECT_EQ(view.landmark_names_shown(), 1) << "the landmark carries its name";
   EXPECT_LT((*plan.state().landmarks.nasion - target).norm(), 3.0);
   const size_t before_cancel = plan.session().index();
   click(w, "fitPlane");
@@ -549,8 +550,10 @@ TEST_F(Wizard, CtSlicesShowTheImplantWhereTheGeometrySays) {
   SliceView& axial = w.slices().view(SliceOrientation::Axial);
   const SkullMesh& implant = w.plan().implant->result().mesh;
   for (SliceOrientation o :
-       {SliceOrientation::Axial, SliceOrientation::Coronal, SliceOrientation::Sagittal})
+       {SliceOrientation::Axial, SliceOrientation::Coronal, SliceOrientation::Sagittal}) {
     EXPECT_GT(w.slices().view(o).implant_segments(), 10) << to_string(o);
+    EXPECT_GT(w.slices().view(o).mirror_segments(), 10) << "the mirror's outline too";
+  }
   const SliceGeometry& g = axial.geometry();
   const std::vector<CutSegment> cut = cut_mesh(implant, g.normal, g.position_mm);
   ASSERT_FALSE(cut.empty());
