@@ -77,12 +77,17 @@ bool MainWindow::write_design_report(const QString& html_path) {
     return true;
   };
   set_layout(Layout::ThreeD);
+  QApplication::processEvents();
+  // Square pictures drawn square (the layout gives the view its size back afterwards), so that
+  // the legends and letters at the view's edges are in them.
+  const int side_3d = std::min(view_->width(), view_->height());
   for (const Shot& shot : shots) {
     set_thickness_map_shown(shot.thickness);
     wait_quality();  // the thickness map is computed with the quality report
+    view_->resize(side_3d, side_3d);
     view_->look_at_implant(shot.view);
     view_->update();
-    QApplication::processEvents();
+    QApplication::processEvents(QEventLoop::ExcludeUserInputEvents);
     if (!save(view_->grabFramebuffer(), shot.suffix, shot.caption,
               shot.thickness ? ReportImage::Kind::Thickness : ReportImage::Kind::View)) {
       restore();
@@ -156,7 +161,8 @@ bool MainWindow::write_design_report(const QString& html_path) {
     show_message(tr("Cannot write %1.").arg(pdf_path), true);
     return false;
   }
-  show_message(tr("Design report written: %1 and %2.").arg(html_path, pdf_path), false);
+  remember_dir(html_path);
+  note_shown(tr("Design report written: %1 and %2.").arg(html_path, pdf_path));
   return true;
 }
 

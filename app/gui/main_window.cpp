@@ -732,7 +732,10 @@ void MainWindow::refresh() {
   if (controller_->on_trial()) return;
   const PlanState& s = controller_->state();
   if (!controller_->read_only()) view_->show_state(controller_->shown_state());
-  if (layout_ != Layout::ThreeD) slices_->show_state(controller_->shown_state());
+  if (layout_ != Layout::ThreeD)
+    slices_->show_state(controller_->shown_state());
+  else
+    slices_->load_ct(s);  // the soft tissue is checked on it whether the slices show or not
   // A new proposal: turn to the defect it found.
   if (s.proposal_message != last_proposal_) {
     last_proposal_ = s.proposal_message;
@@ -1212,6 +1215,7 @@ bool MainWindow::save_session_to(const QString& path) {
   if (!old_autosave.empty() && q(old_autosave).startsWith(autosave_folder()))
     QFile::remove(q(old_autosave));
   add_recent(path);
+  remember_dir(path);
   refresh();
   note_shown(tr("Saved the plan to %1 (%2 commands).")
                  .arg(path)
@@ -1251,6 +1255,7 @@ bool MainWindow::export_to(const QString& path, bool with_mould) {
                      .arg(q(r.reasons.empty() ? std::string() : r.reasons.front())),
                  true);
   }
+  remember_dir(path);
   return controller_->push(commands::export_implant(
       path.toStdString(), "",
       with_mould ? std::optional<MouldParams>(MouldParams{}) : std::nullopt));
@@ -1336,20 +1341,16 @@ QString MainWindow::default_plan_name() const {
 }
 
 QString MainWindow::suggested_path(const QString& file_name) const {
-  // Beside the plan's file; a plan not saved yet: beside its skull's file (a sample installed
-  // read-only: the home folder).
-  QString dir;
-  if (!session_path_.isEmpty()) {
-    dir = QFileInfo(session_path_).absolutePath();
-  } else {
-    for (const Command& c : controller_->session().effective_commands())
-      if (c.type == CommandType::LoadSkull) {
-        const QFileInfo input(q(c.params.value("path", std::string())));
-        dir = input.isDir() ? input.absoluteFilePath() : input.absolutePath();
-      }
-    if (dir.isEmpty() || !QFileInfo(dir).isWritable()) dir = QDir::homePath();
-  }
+  // Beside the plan's file; else where the user last saved or exported; else the folder the
+  // program was started in (never the skull's folder: the sample's is a system folder).
+  QString dir = session_path_.isEmpty() ? QSettings().value("lastDir").toString()
+                                        : QFileInfo(session_path_).absolutePath();
+  if (dir.isEmpty() || !QFileInfo(dir).isDir()) dir = QDir::currentPath();
   return dir + "/" + file_name;
+}
+
+void MainWindow::remember_dir(const QString& written) {
+  QSettings().setValue("lastDir", QFileInfo(written).absolutePath());
 }
 
 QString MainWindow::autosave_folder() const {

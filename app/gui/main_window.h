@@ -163,6 +163,8 @@ class MainWindow : public QMainWindow, public PageHost {
  public:
   /// `file_name` in the folder a save dialog should open in: the plan's, else its skull's.
   QString suggested_path(const QString& file_name) const override;
+  /// The folder of a file just written, for the next save dialog.
+  void remember_dir(const QString& written);
 
  private:
   PlanController* controller_;

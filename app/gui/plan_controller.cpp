@@ -36,9 +36,12 @@ void PlanController::try_new_session(const SessionInfo& info, const QString& aut
   drop_work();
   // A second trial before the first settled keeps the first's old plan; its own session goes.
   const std::string abandoned = previous_ ? session_->autosave_path() : std::string();
-  std::unique_ptr<Session> kept = previous_ ? std::move(previous_) : std::move(session_);
-  new_session(info, autosave_path);
-  previous_ = std::move(kept);
+  if (!previous_) previous_ = std::move(session_);
+  // The new plan replaces the open one only once it has loaded: on trial meanwhile, so that
+  // the window goes on showing the plan open before (no state change is announced now).
+  session_ = std::make_unique<Session>(info);
+  if (!autosave_path.isEmpty()) session_->set_autosave_path(autosave_path.toStdString());
+  read_only_ = false;
   if (!abandoned.empty()) std::remove(abandoned.c_str());
 }
 

@@ -1106,6 +1106,11 @@ void SkullView::set_thickness_map(const SkullMesh* implant,
                                   std::shared_ptr<const ThicknessMap> map) {
   d_->thickness = std::move(map);
   d_->thickness_of = implant;
+  // The colours span 0 to 6 mm, or to the implant's thickest (rounded up) when it is thicker:
+  // the legend's top is then the thickest there is.
+  const double top = d_->thickness ? std::max(6.0, std::ceil(d_->thickness->max_mm)) : 6.0;
+  d_->thickness_colors->SetRange(0.0, top);
+  d_->thickness_colors->Build();
   set_thickness_visible(d_->thickness_wanted);
 }
 

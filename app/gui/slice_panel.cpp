@@ -159,6 +159,10 @@ void SlicePanel::show_state(const PlanState& s) {
     cursor_ = plan_centre_;
     for (SliceView* v : views_) v->set_cursor(cursor_);
   }
+  load_ct(s);
+}
+
+void SlicePanel::load_ct(const PlanState& s) {
   const SharedSurface* skull = s.skull ? s.skull->surface.get() : nullptr;
   // The CT: the one attached to a mesh plan, or the volume the skull was imported from.
   const std::optional<AttachedCt> ct = plan_ct(s);

@@ -37,6 +37,9 @@ class SlicePanel : public QWidget {
 
   /// Shows the plan; reads its CT when the skull changed.
   void show_state(const PlanState& state);
+  /// Reads the plan's CT (in the background) when it is another than the one read, whether or
+  /// not the slices are shown: the quality check's soft tissue needs it.
+  void load_ct(const PlanState& state);
   void set_cursor(const Eigen::Vector3d& point);
   const Eigen::Vector3d& cursor() const { return cursor_; }
   void set_window_level(double window, double level);

@@ -1,5 +1,6 @@
 #include "slice_view.h"
 
+#include <QFontMetrics>
 #include <QMouseEvent>
 #include <QPainter>
 #include <QWheelEvent>
@@ -271,6 +272,27 @@ void SliceView::paintEvent(QPaintEvent*) {
            .arg(slice_.position_mm, 0, 'f', 1));
   card(corners, Qt::AlignRight | Qt::AlignBottom,
        tr("W %1\nL %2").arg(window_, 0, 'g', 4).arg(level_, 0, 'g', 4));
+  // What the lines and colours are, in the upper right.
+  {
+    const std::pair<QColor, QString> keys[] = {{QColor(255, 130, 0), tr("implant")},
+                                               {QColor(240, 220, 90), tr("bone")},
+                                               {QColor(90, 210, 110), tr("mirror")},
+                                               {QColor(255, 30, 30), tr("brain/dura in it")}};
+    const QFontMetrics fm(p.font());
+    int wide = 0;
+    for (const auto& k : keys) wide = std::max(wide, fm.horizontalAdvance(k.second));
+    const double line = fm.height();
+    const QRectF box(corners.right() - wide - 26, corners.top(), wide + 26, 4 * line + 4);
+    p.fillRect(box, QColor(0, 0, 0, 170));
+    for (int k = 0; k < 4; ++k) {
+      const double y = box.top() + 2 + (k + 0.5) * line;
+      p.setPen(QPen(keys[k].first, 2));
+      p.drawLine(QPointF(box.left() + 4, y), QPointF(box.left() + 18, y));
+      p.setPen(QColor(225, 225, 225));
+      p.drawText(QRectF(box.left() + 22, y - line / 2, wide + 4, line), Qt::AlignVCenter,
+                 keys[k].second);
+    }
+  }
   // A scale bar (10 mm) in the lower left: the slice's millimetres at a glance, at any zoom.
   const double ten = 10.0 * s / std::max(1e-9, slice_.right.norm());
   const QString scale_text = zoom_ > 1.0 ? tr("10 mm  ×%1").arg(zoom_, 0, 'f', 1) : tr("10 mm");

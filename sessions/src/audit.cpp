@@ -469,6 +469,14 @@ std::vector<std::string> quality_advice(const QualityReport& r, const ImplantPar
   return out;
 }
 
+namespace {
+// "2026-12-07T06:09:07.055Z" as "2026-12-07 06:09 UTC"; "—" for none.
+std::string readable_time(const std::string& iso) {
+  if (iso.size() < 16 || iso[10] != 'T') return iso.empty() ? std::string("—") : iso;
+  return iso.substr(0, 10) + " " + iso.substr(11, 5) + " UTC";
+}
+}  // namespace
+
 std::string quality_verdict_html(const QualityReport& r, const ImplantParams& params,
                                  const SoftTissueCheck* tissue) {
   const bool finding = tissue && tissue->checked && tissue->finding;
@@ -476,8 +484,8 @@ std::string quality_verdict_html(const QualityReport& r, const ImplantParams& pa
     return "<p style='color:#8a5a00'><b>Printable, with a finding to check before approval:</b> "
            "brain or dura reaches " +
            fmt("%.1f", tissue->intrusion_reach_mm) +
-           " mm above the implant's inner surface (red on the CT slices; the Quality panel on "
-           "the right has the figures).</p>";
+           " mm above the implant's inner surface (red on the CT slices, seen in View → CT window "
+           "→ Soft tissue; the Quality panel on the right has the figures).</p>";
   if (r.printable)
     return "<p style='color:#070'><b>Printable:</b> the quality check passes (the full report "
            "is in the Quality panel on the right).</p>";
@@ -730,19 +738,25 @@ std::string design_report_html(const Session& session, const std::vector<ReportI
   h += " as the binary STL with SHA-256 <code>" + implant.stl_sha256() + "</code>, for case " +
        html_escape(case_id) + ".</p>";
   if (st.approval) {
+    // When: the approve command's time in the journal.
+    std::string when;
+    for (const Command& c : session.effective_commands())
+      if (c.type == CommandType::Approve) when = c.meta.ended;
     h += "<p class=ok><b>Approved</b> by " + html_escape(st.approval->by) + " (" +
-         html_escape(st.approval->role) + ") for the implant with STL SHA-256 <code>" +
-         st.approval->implant_sha256 + "</code>.</p>";
+         html_escape(st.approval->role) + ")" +
+         (when.empty() ? std::string() : " on " + html_escape(readable_time(when))) +
+         " for the implant with STL SHA-256 <code>" + st.approval->implant_sha256 +
+         "</code>, recorded in the plan.</p>";
+  } else if (!st.approval_withdrawn.empty()) {
+    h += "<p class=bad>Not approved: " + html_escape(st.approval_withdrawn) + ".</p>";
   } else {
-    if (!st.approval_withdrawn.empty())
-      h += "<p class=bad>Not approved: " + html_escape(st.approval_withdrawn) + ".</p>";
-    else
-      h += "<p><b>Not approved yet.</b></p>";
-    h += "<table width=100%>";
-    for (const char* line : {"Name", "Role", "Date", "Signature"})
-      h += std::string("<tr><th width=25%>") + line + "</th><td height=34>&nbsp;</td></tr>";
-    h += "</table>";
+    h += "<p><b>Not approved yet.</b></p>";
   }
+  // The lines to sign by hand, on paper, whatever the plan records.
+  h += "<table width=100%>";
+  for (const char* line : {"Name", "Role", "Date", "Signature"})
+    h += std::string("<tr><th width=25%>") + line + "</th><td height=34>&nbsp;</td></tr>";
+  h += "</table>";
   h += "<h2>Provenance</h2><table>";
   for (const Command& cmd : session.effective_commands())
     if (cmd.type == CommandType::LoadSkull || cmd.type == CommandType::AttachCt)

@@ -143,9 +143,12 @@ std::string describe_plane_fit(const PlaneFit& fit) {
       : rms <= 3.0 && inliers >= 0.4
           ? "fair: check the plane on the face (nose and between the eyes) before going on"
           : "poor: place the landmarks again, or adjust the plane by hand";
-  char buf[320];
-  std::snprintf(buf, sizeof(buf), "symmetry RMS %.2f mm, %.0f%% inliers (%s start) — %s", rms,
-                100.0 * inliers, fit.initial_method.c_str(), verdict);
+  const char* start = fit.initial_method == "landmarks"   ? "started from the landmarks"
+                      : fit.initial_method == "automatic" ? "started from the skull's symmetry"
+                                                          : fit.initial_method.c_str();
+  char buf[360];
+  std::snprintf(buf, sizeof(buf), "symmetry RMS %.2f mm, %.0f%% inliers (%s) — %s", rms,
+                100.0 * inliers, start, verdict);
   return buf;
 }
 

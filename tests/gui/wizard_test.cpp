@@ -21,6 +21,7 @@
 #include <QStandardPaths>
 #include <QStatusBar>
 #include <QTest>
+#include <QTextBrowser>
 #include <QTimer>
 #include <QToolButton>
 #include <QWheelEvent>
@@ -410,6 +411,14 @@ TEST_F(Wizard, AllNineStepsOnTheSampleReplayToTheSameImplant) {
               : plan.state().implant->quality().reasons.front());
   EXPECT_TRUE(steps->item(6)->text().startsWith(QStringLiteral("✔")));
   EXPECT_TRUE(child<QLabel>(w, "buildChanged")->isHidden());
+  // The CT is read whatever the layout (3D only here): the quality check has its soft tissue,
+  // and the verdict says the finding beside "printable" before anyone approves.
+  w.slices().wait_loaded();
+  w.wait_quality();
+  EXPECT_TRUE(child<QTextBrowser>(w, "quality")->toPlainText().contains("Brain or dura"))
+      << "the CT's soft tissue in the Quality panel without the slices shown";
+  EXPECT_TRUE(verdict->text().contains("finding to check before approval"))
+      << verdict->text().toStdString();
   EXPECT_TRUE(verdict->text().contains("Printable")) << verdict->text().toStdString();
   click(w, "done");
 
@@ -744,6 +753,11 @@ TEST(WizardSafety, ABadFileClosesNothingAndDiscardedRecoveryIsGone) {
   QObject::connect(&w.controller(), &PlanController::failed,
                    [&](const QString& m) { failure = m; });
   w.open_input(QString::fromStdString(bad));
+  // While it loads, the window goes on showing the plan open before.
+  auto* steps = child<QListWidget>(w, "steps");
+  ASSERT_TRUE(steps);
+  EXPECT_TRUE(steps->item(6)->text().startsWith(QStringLiteral("✔")))
+      << "the plan on screen while the file loads: " << steps->item(6)->text().toStdString();
   w.controller().wait();
   EXPECT_TRUE(failure.contains("not an STL file: it is text")) << failure.toStdString();
   ASSERT_TRUE(w.plan().skull) << "the plan open before is kept";

@@ -97,7 +97,9 @@ void PlanePage::surface_clicked(const Eigen::Vector3d& p) {
   // A click places the chosen landmark; the list moves on to the next of the three.
   const int index = landmark_->currentIndex();
   host_.push(commands::set_landmark(kLandmarkNames[index], p));
-  if (index < 2) landmark_->setCurrentIndex(index + 1);
+  // On to the next of the three; after the third, midline points (a further click adds one
+  // rather than moving the right orbit's).
+  if (index < 3) landmark_->setCurrentIndex(index + 1);
 }
 
 }  // namespace cranioplan::gui
