@@ -652,10 +652,36 @@ void trace_on_bone(const SkullMesh& skull, const SurfaceLocator& locator, const 
       }
 }
 
+// Rays of the opening next to this many rays closed by the scan's end (about 1.6° apart) make
+// it an opening that runs into the scan's end, not one that only touches it at a corner.
+constexpr int kScanEndRays = 8;
+
+// Whether the opening `comp` runs into the scan's end: rays next to it meet no bone and reach
+// a border within its outline.
+bool reaches_scan_end(const RayFan& fan, const std::vector<int>& comp,
+                      const Eigen::Vector3d& center, const std::vector<ScanBorder>& borders) {
+  if (borders.empty()) return false;
+  std::vector<char> counted(fan.size(), 0);
+  int closed = 0;
+  for (int i : comp)
+    for (int w : fan.nbrs[i]) {
+      if (counted[w] || fan.inner[w]) continue;
+      counted[w] = 1;
+      for (const ScanBorder& b : borders)
+        if (b.reached_by(center, fan.dirs[w])) {
+          if (++closed >= kScanEndRays) return true;
+          break;
+        }
+    }
+  return false;
+}
+
 // Whether the opening's rim is traced on the bone (DetectDefectParams::trace_from_area_mm2):
-// large, or seen by the rays with a long stretch of its rim unseen.
-bool wants_trace(const DefectRegion& region, const DetectDefectParams& params) {
-  if (region.area_mm2 >= params.trace_from_area_mm2) return true;
+// large, seen by the rays with a long stretch of its rim unseen, or running into the scan's end
+// (where no ray sees a rim, and the traced one follows the border's plane).
+bool wants_trace(const DefectRegion& region, const DetectDefectParams& params,
+                 bool runs_into_scan_end) {
+  if (region.area_mm2 >= params.trace_from_area_mm2 || runs_into_scan_end) return true;
   const std::vector<RimStretch> unseen = unseen_rim_stretches(region.outer_rim);
   return !unseen.empty() && unseen.front().length_mm() >= params.trace_from_unseen_mm;
 }
@@ -695,7 +721,8 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
     for (int i : comp) region.hole_directions.push_back(fan.dirs[i]);
     region.axis = openings.mean_dir[openings.order[chosen.r]];
     trace_rim(fan, openings, chosen, cast, region);
-    if (params.trace_rim_on_bone && wants_trace(region, params))
+    if (params.trace_rim_on_bone &&
+        wants_trace(region, params, reaches_scan_end(fan, comp, center, borders)))
       trace_on_bone(skull, locator, fan, comp, chosen, cast, borders, region);
     // Asked for the opening towards a point, and none lies that way: the nearest was planned,
     // and the message says so (a point on intact bone, or at a cut that did not go through,

@@ -313,6 +313,37 @@ std::vector<FittedPoints> fitted_along_ring(const DefectRegion& defect,
 // fitted outer surface counts: bone met far below it is not the outer table going on.
 constexpr double kEdgeRingReach = 12.0;  // beyond the rim clearance, mm
 
+// Along the scan's end the rim is where the table would cross the border's plane
+// (trace_rim.h), and the fitted outer surface may cross it a little further out or in. An
+// edge marker there stands on the fitted surface kBeyondScanEndMm past the plane, found by
+// turning the rim's direction away from the opening's axis in steps of kScanEndStepDeg (up to
+// kScanEndTurnDeg): the implant is built across the scan's end and cut flat at it
+// (ImplantParams::scan_ends), not ended short of it where the fit runs lower than the table's
+// distance the rim was put at. None when the rim point is not on a scan's end or the fitted
+// surface does not reach past it.
+constexpr double kBeyondScanEndMm = 1.5, kScanEndStepDeg = 0.5, kScanEndTurnDeg = 20.0;
+constexpr double kOnScanEndMm = 1.0;
+
+std::optional<Eigen::Vector3d> past_the_scans_end(const DefectRegion& defect,
+                                                  const DefectSurfaces& surfaces,
+                                                  const Eigen::Vector3d& rim) {
+  const Plane* end = nullptr;
+  for (const Plane& e : defect.scan_ends)
+    if (std::abs(e.signed_distance(rim)) < kOnScanEndMm) end = &e;
+  if (!end) return std::nullopt;
+  const Eigen::Vector3d dir = (rim - defect.center).normalized();
+  Eigen::Vector3d away = dir.dot(defect.axis) * dir - defect.axis;  // across dir, off the axis
+  if (away.norm() < 1e-9) return std::nullopt;
+  away.normalize();
+  for (double turn = 0.0; turn <= kScanEndTurnDeg + 1e-9; turn += kScanEndStepDeg) {
+    const double b = turn * M_PI / 180.0;
+    const auto fitted = surfaces.at(std::cos(b) * dir + std::sin(b) * away);
+    if (!fitted) return std::nullopt;
+    if (end->signed_distance(fitted->first) >= kBeyondScanEndMm) return fitted->first;
+  }
+  return std::nullopt;
+}
+
 void add_edge_markers(const DefectRegion& defect, const DefectSurfaces& surfaces,
                       const std::vector<FittedPoints>& ring_fit, const ProposeParams& params,
                       int& id, std::vector<Marker>& out) {
@@ -358,6 +389,10 @@ void add_edge_markers(const DefectRegion& defect, const DefectSurfaces& surfaces
                                         : along(defect.outer_rim, params.edge_spacing_mm);
   for (size_t i : picks) {
     const Eigen::Vector3d& rim = defect.outer_rim[i];
+    if (const auto beyond = past_the_scans_end(defect, surfaces, rim)) {
+      out.push_back({id++, MarkerType::OuterEdge, *beyond, MarkerSurface::Original});
+      continue;
+    }
     const auto fitted = surfaces.at(rim - c);
     if (fitted && (surfaces.mirror_guided || bone_beyond(rim))) {
       out.push_back({id++, MarkerType::OuterEdge, fitted->first, MarkerSurface::Original});

@@ -520,6 +520,102 @@ std::vector<int> band_faces(const SkullMesh& mesh, const Eigen::Vector3d& center
   return out;
 }
 
+// Where the opening runs into the scan's end, no bone edges it: beyond the border's plane
+// nothing was scanned, so the opening, seen from the centre, ends where the table would cross
+// that plane. In each sector, the point at the table's distance from the centre where the
+// sector's half-plane of directions meets the border's plane, on the side away from the axis:
+// nearer the axis a ray reaches the table inside the scan, beyond it the scan ends first. The
+// table's distance is that of the seeds (the bone the rays met next to the opening) at the
+// same bearing around the axis, interpolated across bearings without seeds: across the
+// opening's stretch along the scan's end, from the bone on either side of it. Kept where its
+// direction lies within `band` (rad) of the opening's rays, as the faces examined do; the path
+// chooses between these and the table's own edge (at the border's cap or cut the two coincide;
+// across the opening only these exist).
+constexpr int kBearingBins = 72;  // 5° of bearing each
+
+// The mean of `values` by bearing (rad) in kBearingBins bins, bins without a value
+// interpolated linearly (around the circle) from their nearest neighbours with one; empty when
+// no bin has a value.
+std::vector<double> by_bearing_bins(const std::vector<double>& bearings,
+                                    const std::vector<double>& values) {
+  std::vector<double> sum(kBearingBins, 0.0);
+  std::vector<int> count(kBearingBins, 0);
+  for (size_t i = 0; i < bearings.size(); ++i) {
+    const int k = std::clamp(static_cast<int>((bearings[i] + M_PI) / (2.0 * M_PI) * kBearingBins),
+                             0, kBearingBins - 1);
+    sum[k] += values[i];
+    ++count[k];
+  }
+  std::vector<int> filled;
+  for (int k = 0; k < kBearingBins; ++k)
+    if (count[k] > 0) {
+      sum[k] /= count[k];
+      filled.push_back(k);
+    }
+  if (filled.empty()) return {};
+  for (size_t j = 0; j < filled.size(); ++j) {
+    const int from = filled[j], to = filled[(j + 1) % filled.size()];
+    const int gap = (to - from + kBearingBins - 1) % kBearingBins + 1;  // a full turn alone
+    for (int step = 1; step < gap; ++step) {
+      const double t = static_cast<double>(step) / gap;
+      sum[(from + step) % kBearingBins] = (1.0 - t) * sum[from] + t * sum[to];
+    }
+  }
+  return sum;
+}
+
+void add_scan_end_candidates(std::vector<std::vector<Candidate>>& all, const Projection& project,
+                             const Eigen::Vector3d& center, const std::vector<ScanBorder>& borders,
+                             const std::vector<Eigen::Vector3d>& seeds,
+                             const std::vector<Eigen::Vector3d>& holes, double band) {
+  if (borders.empty() || seeds.empty() || holes.empty()) return;
+  std::vector<double> bearings, radii;
+  for (const Eigen::Vector3d& p : seeds) {
+    const Eigen::Vector2d q = project(p - center);
+    if (q.norm() < 1e-9) continue;
+    bearings.push_back(std::atan2(q.y(), q.x()));
+    radii.push_back((p - center).norm());
+  }
+  const std::vector<double> bins = by_bearing_bins(bearings, radii);
+  if (bins.empty()) return;
+  auto radius_at = [&](double phi) {  // linear between the bins' middles
+    const double x = (phi + M_PI) / (2.0 * M_PI) * kBearingBins - 0.5;
+    const int k = static_cast<int>(std::floor(x));
+    const double t = x - k;
+    return (1.0 - t) * bins[(k % kBearingBins + kBearingBins) % kBearingBins] +
+           t * bins[((k + 1) % kBearingBins + kBearingBins) % kBearingBins];
+  };
+  const PointIndex hole_index(holes);
+  const double band_chord2 = std::pow(2.0 * std::sin(0.5 * band), 2);
+  const double width = 2.0 * M_PI / kSectors;
+  for (const ScanBorder& b : borders) {
+    const double h = b.offset - b.normal.dot(center);  // the plane's distance from the centre
+    if (!(h > 0.0)) continue;                          // the centre must lie inside the scan
+    const double along = b.normal.dot(project.axis);
+    for (int k = 0; k < kSectors; ++k) {
+      const double phi = (k + 0.5) * width - M_PI;
+      const Eigen::Vector3d u = std::cos(phi) * project.e1 + std::sin(phi) * project.e2;
+      // n·d(θ) = A cos θ + B sin θ = ρ cos(θ − α) for d(θ) = cos θ axis + sin θ u.
+      const double across = b.normal.dot(u);
+      const double rho = std::hypot(along, across), alpha = std::atan2(across, along);
+      const double radius = radius_at(phi);
+      const double s = h / radius;
+      if (rho < 1e-9 || s > rho) continue;
+      const double theta = alpha - std::acos(std::clamp(s / rho, -1.0, 1.0));
+      if (theta <= 0.0 || theta >= M_PI) continue;
+      const Eigen::Vector3d d = std::cos(theta) * project.axis + std::sin(theta) * u;
+      const Eigen::Vector3d point = center + radius * d;
+      double d2 = 0.0;
+      hole_index.nearest(d, &d2);
+      if (d2 > band_chord2) continue;
+      auto& sector = all[k];
+      sector.push_back({point, theta, radius, true});
+      std::sort(sector.begin(), sector.end(),
+                [](const Candidate& x, const Candidate& y) { return x.theta < y.theta; });
+    }
+  }
+}
+
 // The edge of one table: its candidates per sector and the path chosen through them, as a
 // closed polyline in order of bearing (empty when too little of it was found).
 struct TableEdge {
@@ -528,19 +624,28 @@ struct TableEdge {
   std::vector<int> sector;  // each point's sector
 };
 
+// The opening the edge goes round: the faces examined, and the rays through it (and beside it,
+// closed by the scan's end) with the angle around them the faces were taken from.
+struct Band {
+  std::vector<int> faces;
+  const std::vector<Eigen::Vector3d>& rays;
+  double angle;  // rad
+};
+
 TableEdge trace_table(const SkullMesh& mesh, const SurfaceLocator& bone,
                       const std::vector<Eigen::Vector3d>& vn, const Projection& project,
-                      const Eigen::Vector3d& center, const std::vector<int>& band,
+                      const Eigen::Vector3d& center, const Band& band,
                       const std::vector<Eigen::Vector3d>& seeds,
                       const std::vector<Eigen::Vector3d>& seen_rim,
                       const std::vector<ScanBorder>& borders, bool outer,
                       const TraceRimParams& params) {
   TableEdge e;
   Table table(mesh, bone, vn, center, outer, params);
-  table.grow(band, seed_faces(bone, seeds));
+  table.grow(band.faces, seed_faces(bone, seeds));
   std::vector<uint8_t> examined(mesh.n_faces(), 0);
-  for (int f : band) examined[f] = 1;
-  const auto candidates = edge_candidates(mesh, table, examined, project, center, borders);
+  for (int f : band.faces) examined[f] = 1;
+  auto candidates = edge_candidates(mesh, table, examined, project, center, borders);
+  add_scan_end_candidates(candidates, project, center, borders, seeds, band.rays, band.angle);
   std::vector<std::optional<Eigen::Vector3d>> seen(kSectors);
   double scale = 0.0;
   for (const Eigen::Vector3d& p : seen_rim) {
@@ -612,9 +717,10 @@ TracedRim trace_rim_on_bone(const SkullMesh& skull, const SurfaceLocator& bone,
     return done();
   }
   const Projection project{axis, e1, axis.cross(e1)};
-  const std::vector<int> band =
-      band_faces(skull, center, hole_directions, std::clamp(params.band_deg, 5.0, 90.0) * kDeg);
-  r.faces_examined = band.size();
+  const double band_angle = std::clamp(params.band_deg, 5.0, 90.0) * kDeg;
+  const Band band{band_faces(skull, center, hole_directions, band_angle), hole_directions,
+                  band_angle};
+  r.faces_examined = band.faces.size();
   const std::vector<Eigen::Vector3d> vn = smooth_vertex_normals(skull);
   const TableEdge outer = trace_table(skull, bone, vn, project, center, band, outer_seeds, seen_rim,
                                       borders, true, params);

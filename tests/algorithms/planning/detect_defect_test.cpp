@@ -343,6 +343,57 @@ TEST(DetectDefect, ADefectThatReachesAPaddedScanEndIsStillADefect) {
       padded_head_with_defect(kDefectAtTheCut, cut_through_the_defect_x()));
 }
 
+// Where the opening runs into the scan's end no bone edges it, and no ray sees a rim there:
+// the rim is traced on the bone and, across the scan's end, along the border's plane where the
+// table would cross it. The opening is planned as itself, its rim seen all round, the plane goes
+// with it (the implant ends there) and the message says the bone beyond the scan is unknown.
+void expect_the_rim_along_the_scans_end(const OpenHead& h) {
+  const std::vector<ScanBorder> borders = scan_borders(report_mesh(h.skull));
+  ASSERT_EQ(borders.size(), 1u);
+  const DefectRegion with = detect(h.skull, true);
+  ASSERT_TRUE(with.found()) << with.message;
+  EXPECT_LT(angle_deg(with.axis, h.defect_direction), 20.0) << with.message;
+  ASSERT_TRUE(with.rim_traced) << with.message;
+  EXPECT_TRUE(with.unseen_rim.empty()) << with.message;
+  ASSERT_EQ(with.scan_ends.size(), 1u) << with.message;
+  EXPECT_LT(angle_deg(with.scan_ends[0].normal, borders[0].normal), 1.0);
+  double along = 0.0;
+  for (const RimStretch& st : with.at_scan_border) {
+    along += st.length_mm();
+    for (const Eigen::Vector3d& p : {st.from, st.to})
+      EXPECT_NEAR(borders[0].normal.dot(p), borders[0].offset, 2.0);
+  }
+  // The cut runs 12 mm inside the 55 mm defect's centre: a chord of about 2·√(27.5² − 12²).
+  EXPECT_GT(along, 30.0) << with.message;
+  EXPECT_NE(with.message.find("the bone beyond the scan is unknown"), std::string::npos)
+      << with.message;
+  // The rim's points along the scan's end lie on its plane, where the intact head's outer table
+  // crosses it (within the head's curvature between the seeds the table's distance is read
+  // from).
+  const SkullMesh intact = test::make_thick_head(0.93, 1.0);
+  const SurfaceLocator whole(intact);
+  int on_plane = 0;
+  double worst = 0.0;
+  for (const Eigen::Vector3d& p : with.outer_rim)
+    if (std::abs(borders[0].normal.dot(p) - borders[0].offset) < 0.5) {
+      ++on_plane;
+      worst = std::max(worst, whole.closest(p).distance);
+    }
+  ::testing::Test::RecordProperty("worst_off_the_table_mm", std::to_string(worst));
+  EXPECT_LT(worst, 2.0);
+  EXPECT_GT(on_plane, 20);
+}
+
+TEST(DetectDefect, AnOpeningIntoAnOpenScansEndIsTracedAlongItsPlane) {
+  expect_the_rim_along_the_scans_end(
+      open_head_with_defect(kDefectAtTheCut, cut_through_the_defect_x()));
+}
+
+TEST(DetectDefect, AnOpeningIntoAPaddedScansEndIsTracedAlongItsPlane) {
+  expect_the_rim_along_the_scans_end(
+      padded_head_with_defect(kDefectAtTheCut, cut_through_the_defect_x()));
+}
+
 // A point to choose the opening: one in its direction plans it without a note; one on intact
 // bone far from it still plans the only opening, and the message says no opening lies towards
 // the point (a cut that did not go through would otherwise plan another opening unsaid).

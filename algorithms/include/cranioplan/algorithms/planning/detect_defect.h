@@ -75,8 +75,9 @@ struct DetectDefectParams {
   /// is chosen from, detect_defect_near_plane).
   bool trace_rim_on_bone = true;
   /// The rim is traced on the bone for an opening at least this large (mm², at the rays' rim
-  /// radius) and for one whose rays' rim leaves a stretch of `trace_from_unseen_mm` or more
-  /// unseen. A smaller opening the rays saw all round keeps
+  /// radius), for one whose rays' rim leaves a stretch of `trace_from_unseen_mm` or more
+  /// unseen, and for one that runs into the scan's end (there no ray sees a rim; the traced one
+  /// follows the border's plane). A smaller opening the rays saw all round keeps
   /// their rim: there the rays see the edge nearly square, and their rim moves less with the
   /// rays' start than the traced one (docs/AUTOPLAN.md, "The rim traced on the bone").
   double trace_from_area_mm2 = 3000.0;

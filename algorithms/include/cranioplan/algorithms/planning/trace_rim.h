@@ -15,7 +15,9 @@
 // is a set of closed loops; the rim is the loop that winds once around the opening's axis
 // nearest to it. The inner rim likewise on the inner table (facing the centre). Where the loop
 // runs along the mesh's own open border or along a flat cap where the scan ended, the opening
-// reaches the scan's border: the bone beyond it is unknown.
+// reaches the scan's border: the bone beyond it is unknown. Across the stretch where the
+// opening itself runs into the scan's end no bone edges it: there the loop runs along the
+// border's plane, where the table (at the distance of the bone on either side) would cross it.
 #include <Eigen/Core>
 #include <string>
 #include <vector>
