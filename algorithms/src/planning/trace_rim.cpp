@@ -85,6 +85,43 @@ std::vector<Eigen::Vector3d> smooth_vertex_normals(const SkullMesh& mesh) {
   return n;
 }
 
+// For each face of `band`, the faces that share a corner with it (itself too), sorted: the
+// neighbourhood the tables' majority vote counts, found once for both tables and every round.
+// Flat: face i's are faces[start[i]] to faces[start[i + 1]].
+struct FacesAround {
+  std::vector<size_t> start;
+  std::vector<int> faces;
+};
+
+FacesAround faces_around(const SkullMesh& mesh, const std::vector<int>& band) {
+  auto gather = [&](int f, std::vector<int>& a) {
+    a.clear();
+    for (auto vh : mesh.fv_range(mesh.face_handle(f)))
+      for (auto g : mesh.vf_range(vh)) a.push_back(g.idx());
+    std::sort(a.begin(), a.end());
+    a.erase(std::unique(a.begin(), a.end()), a.end());
+  };
+  FacesAround out;
+  out.start.assign(band.size() + 1, 0);
+  parallel_for(band.size(), [&](size_t first, size_t last) {
+    std::vector<int> a;
+    for (size_t i = first; i < last; ++i) {
+      gather(band[i], a);
+      out.start[i + 1] = a.size();
+    }
+  });
+  for (size_t i = 0; i < band.size(); ++i) out.start[i + 1] += out.start[i];
+  out.faces.resize(out.start.back());
+  parallel_for(band.size(), [&](size_t first, size_t last) {
+    std::vector<int> a;
+    for (size_t i = first; i < last; ++i) {
+      gather(band[i], a);
+      std::copy(a.begin(), a.end(), out.faces.begin() + static_cast<long>(out.start[i]));
+    }
+  });
+  return out;
+}
+
 // One table of the skull near the opening (outer: facing away from the centre; inner: towards
 // it): the faces whose bone has two tables, evened out by a majority vote and kept where they
 // are connected to the seeds.
@@ -94,8 +131,10 @@ class Table {
         const Eigen::Vector3d& center, bool outer, const TraceRimParams& params)
       : mesh_(mesh), bone_(bone), vn_(vn), center_(center), outer_(outer), params_(params) {}
 
-  // `band`: the faces examined (near the opening, seen from the centre).
-  void grow(const std::vector<int>& band, const std::vector<int>& seeds) {
+  // `band`: the faces examined (near the opening, seen from the centre); `around`: for each,
+  // the faces that share a corner with it (itself too), sorted (faces_around).
+  void grow(const std::vector<int>& band, const FacesAround& around,
+            const std::vector<int>& seeds) {
     in_.assign(mesh_.n_faces(), 0);
     std::vector<uint8_t> label(mesh_.n_faces(), 0), decided(band.size(), 0);
     parallel_for(band.size(), [&](size_t first, size_t last) {
@@ -108,16 +147,11 @@ class Table {
     for (int round = 0; round < kMajorityRounds; ++round) {
       std::vector<uint8_t> next(band.size(), 0);
       parallel_for(band.size(), [&](size_t first, size_t last) {
-        std::vector<int> around;
         for (size_t i = first; i < last; ++i) {
-          around.clear();
-          for (auto vh : mesh_.fv_range(mesh_.face_handle(band[i])))
-            for (auto g : mesh_.vf_range(vh)) around.push_back(g.idx());
-          std::sort(around.begin(), around.end());
-          around.erase(std::unique(around.begin(), around.end()), around.end());
           int on = 0;
-          for (int g : around) on += label[g];
-          next[i] = 2 * on > static_cast<int>(around.size());
+          for (size_t k = around.start[i]; k < around.start[i + 1]; ++k)
+            on += label[around.faces[k]];
+          next[i] = 2 * on > static_cast<int>(around.start[i + 1] - around.start[i]);
         }
       });
       for (size_t i = 0; i < band.size(); ++i) label[band[i]] = next[i];
@@ -504,11 +538,25 @@ std::vector<int> band_faces(const SkullMesh& mesh, const Eigen::Vector3d& center
                             const std::vector<Eigen::Vector3d>& holes, double band) {
   const PointIndex index(holes);
   const double chord2 = std::pow(2.0 * std::sin(0.5 * band), 2);
+  // A face further from the rays' mean direction than the widest ray and the band together has
+  // no ray within the band (the triangle inequality on the sphere): no search for it.
+  Eigen::Vector3d mean = Eigen::Vector3d::Zero();
+  for (const Eigen::Vector3d& h : holes) mean += h;
+  double reach = M_PI;
+  if (mean.norm() > 1e-9) {
+    mean.normalize();
+    double widest = 0.0;
+    for (const Eigen::Vector3d& h : holes)
+      widest = std::max(widest, std::acos(std::clamp(h.dot(mean), -1.0, 1.0)));
+    reach = widest + band;
+  }
+  const double min_cos = reach >= M_PI ? -2.0 : std::cos(reach) - 1e-9;
   std::vector<uint8_t> near(mesh.n_faces(), 0);
   parallel_for(mesh.n_faces(), [&](size_t first, size_t last) {
     for (size_t f = first; f < last; ++f) {
       const FaceCorners c = face_corners(mesh, mesh.face_handle(static_cast<int>(f)));
       const Eigen::Vector3d d = ((c.p[0] + c.p[1] + c.p[2]) / 3.0 - center).normalized();
+      if (d.dot(mean) < min_cos) continue;
       double d2 = 0.0;
       index.nearest(d, &d2);
       near[f] = d2 <= chord2;
@@ -628,6 +676,7 @@ struct TableEdge {
 // closed by the scan's end) with the angle around them the faces were taken from.
 struct Band {
   std::vector<int> faces;
+  FacesAround around;  // faces_around(faces)
   const std::vector<Eigen::Vector3d>& rays;
   double angle;  // rad
 };
@@ -641,7 +690,7 @@ TableEdge trace_table(const SkullMesh& mesh, const SurfaceLocator& bone,
                       const TraceRimParams& params) {
   TableEdge e;
   Table table(mesh, bone, vn, center, outer, params);
-  table.grow(band.faces, seed_faces(bone, seeds));
+  table.grow(band.faces, band.around, seed_faces(bone, seeds));
   std::vector<uint8_t> examined(mesh.n_faces(), 0);
   for (int f : band.faces) examined[f] = 1;
   auto candidates = edge_candidates(mesh, table, examined, project, center, borders);
@@ -718,8 +767,9 @@ TracedRim trace_rim_on_bone(const SkullMesh& skull, const SurfaceLocator& bone,
   }
   const Projection project{axis, e1, axis.cross(e1)};
   const double band_angle = std::clamp(params.band_deg, 5.0, 90.0) * kDeg;
-  const Band band{band_faces(skull, center, hole_directions, band_angle), hole_directions,
-                  band_angle};
+  std::vector<int> faces = band_faces(skull, center, hole_directions, band_angle);
+  FacesAround around = faces_around(skull, faces);
+  const Band band{std::move(faces), std::move(around), hole_directions, band_angle};
   r.faces_examined = band.faces.size();
   const std::vector<Eigen::Vector3d> vn = smooth_vertex_normals(skull);
   const TableEdge outer = trace_table(skull, bone, vn, project, center, band, outer_seeds, seen_rim,
