@@ -18,7 +18,9 @@
 #include <chrono>
 #include <filesystem>
 #include <functional>
+#include <memory>
 
+#include "cli_output.h"
 #include "cranioplan/algorithms/alignment/fit_sagittal_plane.h"
 #include "cranioplan/algorithms/alignment/mirror_mesh.h"
 #include "cranioplan/algorithms/alignment/register_icp.h"
@@ -230,6 +232,19 @@ Json run_bench(const BenchOptions& options) {
   }
   out["peak_memory_mb"] = peak_rss_mb();
   return out;
+}
+
+// bench: the pipeline's steps timed on the sample case
+Subcommand add_bench(CLI::App& app, const bool& json) {
+  auto o = std::make_shared<BenchOptions>();
+  auto* cmd = app.add_subcommand("bench", "Time the pipeline's steps on the sample case");
+  cmd->add_option("--input", o->input, "volume or mesh instead of the sample case");
+  cmd->add_option("--runs", o->runs, "repetitions per step (median reported)")
+      ->check(CLI::Range(1, 100));
+  return {cmd, [o, &json] {
+            print_result(run_bench(*o), json);
+            return kOk;
+          }};
 }
 
 }  // namespace cranioplan::cli

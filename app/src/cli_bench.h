@@ -1,6 +1,7 @@
 #pragma once
 #include <string>
 
+#include "cli_run.h"
 #include "cranioplan/sessions/plan_files.h"
 
 namespace cranioplan::cli {
@@ -13,5 +14,8 @@ struct BenchOptions {
 /// Times each step of the foundation pipeline (import, STL load vs vtkSTLReader, plane, mirror,
 /// register) and returns per-step medians in seconds plus the peak memory.
 Json run_bench(const BenchOptions& options);
+
+/// bench [--input FILE] [--runs N]: run_bench, printed.
+Subcommand add_bench(CLI::App& app, const bool& json);
 
 }  // namespace cranioplan::cli

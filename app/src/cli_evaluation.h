@@ -1,9 +1,9 @@
 #pragma once
-// The evaluation subcommands of cranioplan-cli: evaluate (a folder of cases with their truth),
+// The evaluation subcommands of cranioplan-lab: evaluate (a folder of cases with their truth),
 // study (defects injected into a healthy skull) and merge (the shards of either, as one run).
 #include <vector>
 
-#include "cli_implant_commands.h"
+#include "cli_run.h"
 
 namespace cranioplan::cli {
 

@@ -4,7 +4,6 @@
 #include <limits>
 #include <memory>
 
-#include "cli_bench.h"
 #include "cli_output.h"
 #include "cranioplan/algorithms/alignment/fit_sagittal_plane.h"
 #include "cranioplan/algorithms/alignment/mirror_mesh.h"
@@ -343,25 +342,12 @@ Subcommand add_series(CLI::App& app, const bool& json) {
           }};
 }
 
-// bench: the pipeline's steps timed on the sample case
-Subcommand add_bench(CLI::App& app, const bool& json) {
-  auto o = std::make_shared<BenchOptions>();
-  auto* cmd = app.add_subcommand("bench", "Time the pipeline's steps on the sample case");
-  cmd->add_option("--input", o->input, "volume or mesh instead of the sample case");
-  cmd->add_option("--runs", o->runs, "repetitions per step (median reported)")
-      ->check(CLI::Range(1, 100));
-  return {cmd, [o, &json] {
-            print_result(run_bench(*o), json);
-            return kOk;
-          }};
-}
-
 }  // namespace
 
 std::vector<Subcommand> add_mesh_commands(CLI::App& app, const bool& json) {
   return {add_info(app, json),   add_import_ct(app, json), add_plane(app, json),
           add_mirror(app, json), add_register(app, json),  add_pipeline(app, json),
-          add_series(app, json), add_bench(app, json)};
+          add_series(app, json)};
 }
 
 }  // namespace cranioplan::cli

@@ -20,6 +20,7 @@ namespace cranioplan {
 namespace {
 
 const std::string kCli = CRANIOPLAN_CLI;
+const std::string kLab = CRANIOPLAN_LAB;  // the research tools
 
 TEST(Cli, InfoPlaneMirrorRegisterOnASyntheticHead) {
   test::TempDir dir;
@@ -253,6 +254,34 @@ TEST(Cli, LabelmapWritesTheImplantOnTheReferenceGrid) {
             3);
 }
 
+// The planner's command line is the product; the research tools are cranioplan-lab's. The
+// planner lists none of them, says where one moved when it is asked for, and does not link the
+// VTK filters of bench's reference pipeline.
+TEST(Cli, TheResearchToolsAreTheLabsNotThePlanners) {
+  std::string out;
+  ASSERT_EQ(test::run_command(kCli + " --help", &out), 0);
+  ASSERT_EQ(test::run_command(kLab + " --help", &out), 0);
+  for (const char* tool : {"bench", "study", "evaluate", "merge"}) {
+    SCOPED_TRACE(tool);
+    std::string planner, lab;
+    ASSERT_EQ(test::run_command(kCli + " --help", &planner), 0);
+    EXPECT_EQ(planner.find(std::string("\n  ") + tool + " "), std::string::npos) << planner;
+    ASSERT_EQ(test::run_command(kLab + " --help", &lab), 0);
+    EXPECT_NE(lab.find(std::string("\n  ") + tool + " "), std::string::npos) << lab;
+    std::string said;
+    EXPECT_EQ(test::run_command("(" + kCli + " " + tool + " --count 2 skull.stl 2>&1)", &said), 2);
+    EXPECT_NE(said.find(std::string(tool) + " is a research tool and moved to cranioplan-lab"),
+              std::string::npos)
+        << said;
+  }
+  // The planner links the VTK its readers use (VTP, legacy VTK), not the filters and the STL
+  // reader of bench's reference pipeline.
+  ASSERT_EQ(test::run_command("ldd " + std::string(CRANIOPLAN_CLI_PROGRAM), &out), 0);
+  EXPECT_NE(out.find("libc.so"), std::string::npos) << out;
+  for (const char* lib : {"libvtkFiltersGeneral", "libvtkFiltersHybrid", "libvtkIOGeometry"})
+    EXPECT_EQ(out.find(lib), std::string::npos) << lib << " in\n" << out;
+}
+
 TEST(Cli, ExitCodesForUsageAndBadInput) {
   test::TempDir dir;
   EXPECT_EQ(test::run_command(kCli), 2);
@@ -352,7 +381,7 @@ TEST(Cli, ImplantSubcommandsAndTheirErrors) {
           kCli + " autoplan --json " + dir.path("head.stl") + " -o " + dir.path("a.stl"), &out),
       1);
   EXPECT_EQ(Json::parse(out)["status"].get<std::string>(), "no_defect");
-  EXPECT_EQ(test::run_command(kCli + " evaluate " + dir.path("")), 3);  // no cases in it
+  EXPECT_EQ(test::run_command(kLab + " evaluate " + dir.path("")), 3);  // no cases in it
 }
 
 // A material and perforations on the command line: autoplan builds with them (the clearance
@@ -513,7 +542,7 @@ TEST(Cli, StudyInjectsPlansAndScoresDefects) {
   test::TempDir dir;
   write_mesh(test::make_thick_head(), dir.path("thick.stl"));
   std::string out;
-  ASSERT_EQ(test::run_command(kCli + " study --json --count 2 " + dir.path("thick.stl"), &out), 0);
+  ASSERT_EQ(test::run_command(kLab + " study --json --count 2 " + dir.path("thick.stl"), &out), 0);
   const Json j = Json::parse(out);
   ASSERT_EQ(j["defects"].size(), 2u);
   int printable = 0;
@@ -529,10 +558,10 @@ TEST(Cli, StudyInjectsPlansAndScoresDefects) {
   EXPECT_EQ(j["median"]["printable"].get<int>(), printable);
   // Its two shards, merged, are the same run.
   for (const char* shard : {"1/2", "2/2"})
-    ASSERT_EQ(test::run_command(kCli + " study --count 2 " + dir.path("thick.stl") + " --shard " +
+    ASSERT_EQ(test::run_command(kLab + " study --count 2 " + dir.path("thick.stl") + " --shard " +
                                 shard + " --rows-out " + dir.path("rows")),
               0);
-  ASSERT_EQ(test::run_command(kCli + " merge --json " + dir.path("rows"), &out), 0);
+  ASSERT_EQ(test::run_command(kLab + " merge --json " + dir.path("rows"), &out), 0);
   // The same rows but for the plans' times.
   auto timeless = [](Json run) {
     for (Json& row : run["defects"]) row.erase("seconds");
@@ -551,17 +580,17 @@ TEST(Cli, StudyOfFlapsNeedsTheFloorOfTheSkull) {
   std::string out;
   EXPECT_EQ(
       test::run_command(
-          "(" + kCli + " study --shape flap --count 1 " + dir.path("thick.stl") + " 2>&1)", &out),
+          "(" + kLab + " study --shape flap --count 1 " + dir.path("thick.stl") + " 2>&1)", &out),
       3)
       << out;
   EXPECT_NE(out.find("thick.stl"), std::string::npos) << out;
   EXPECT_NE(out.find("floor of the cranial fossae"), std::string::npos) << out;
-  EXPECT_NE(test::run_command("(" + kCli + " study --shape flap --min-size 90 " +
+  EXPECT_NE(test::run_command("(" + kLab + " study --shape flap --min-size 90 " +
                                   dir.path("thick.stl") + " 2>&1)",
                               &out),
             0);
   EXPECT_NE(out.find("--min-size"), std::string::npos) << out;
-  EXPECT_NE(test::run_command(kCli + " study --shape oval " + dir.path("thick.stl"), &out), 0);
+  EXPECT_NE(test::run_command(kLab + " study --shape oval " + dir.path("thick.stl"), &out), 0);
 }
 
 // autoplan --all-openings: bilateral defects (mirror images of each other) get an implant each,
@@ -640,7 +669,7 @@ TEST(Cli, EvaluateScoresAFolderOfCasesAndWritesTheImplants) {
                         " --implant " + dir.path("cases/007_implant.stl")),
       0);
   std::string out;
-  ASSERT_EQ(test::run_command(kCli + " evaluate --json " + dir.path("cases") + " --implants-out " +
+  ASSERT_EQ(test::run_command(kLab + " evaluate --json " + dir.path("cases") + " --implants-out " +
                                   dir.path("out"),
                               &out),
             0);
@@ -664,7 +693,7 @@ TEST(Cli, EvaluateScoresAFolderOfCasesAndWritesTheImplants) {
   // planned and scored; the exit code (3) says that not every case could be read.
   std::filesystem::copy_file(dir.path("cases/007_implant.stl"), dir.path("cases/008_implant.stl"));
   test::write_bytes(dir.path("cases/008_defective_skull.stl"), "solid truncated\nfacet normal");
-  ASSERT_EQ(test::run_command(kCli + " evaluate --json " + dir.path("cases"), &out), 3);
+  ASSERT_EQ(test::run_command(kLab + " evaluate --json " + dir.path("cases"), &out), 3);
   const Json both = Json::parse(out);
   ASSERT_EQ(both["cases"].size(), 2u) << out;
   EXPECT_EQ(both["cases"][0]["status"].get<std::string>(), "planned");
@@ -677,13 +706,13 @@ TEST(Cli, EvaluateScoresAFolderOfCasesAndWritesTheImplants) {
               1e-9);
   // The same run in two shards (each case in one), merged: the same table and medians (but
   // for the times).
-  ASSERT_EQ(test::run_command(kCli + " evaluate " + dir.path("cases") + " --shard 1/2 --rows-out " +
+  ASSERT_EQ(test::run_command(kLab + " evaluate " + dir.path("cases") + " --shard 1/2 --rows-out " +
                               dir.path("rows1")),
             0);
-  ASSERT_EQ(test::run_command(kCli + " evaluate " + dir.path("cases") + " --shard 2/2 --rows-out " +
+  ASSERT_EQ(test::run_command(kLab + " evaluate " + dir.path("cases") + " --shard 2/2 --rows-out " +
                               dir.path("rows2")),
             3);
-  ASSERT_EQ(test::run_command(kCli + " merge --json " + dir.path("rows1") + " " + dir.path("rows2"),
+  ASSERT_EQ(test::run_command(kLab + " merge --json " + dir.path("rows1") + " " + dir.path("rows2"),
                               &out),
             3);
   Json merged = Json::parse(out), single = both;
@@ -692,14 +721,14 @@ TEST(Cli, EvaluateScoresAFolderOfCasesAndWritesTheImplants) {
     (*t)["median"].erase("median_seconds");
   }
   EXPECT_EQ(merged, single);
-  EXPECT_EQ(test::run_command(kCli + " evaluate " + dir.path("cases") + " --shard 3/2"), 2)
+  EXPECT_EQ(test::run_command(kLab + " evaluate " + dir.path("cases") + " --shard 3/2"), 2)
       << "a shard past the count is a usage error";
   // A skull without a defect cannot be planned: its row says so, it counts as Dice 0 (as a
   // missing prediction does in the challenge), and the exit code is 1.
   std::filesystem::create_directories(dir.path("intact"));
   std::filesystem::copy_file(dir.path("thick.stl"), dir.path("intact/009_defective_skull.stl"));
   std::filesystem::copy_file(dir.path("cases/007_implant.stl"), dir.path("intact/009_implant.stl"));
-  ASSERT_EQ(test::run_command(kCli + " evaluate --json " + dir.path("intact"), &out), 1);
+  ASSERT_EQ(test::run_command(kLab + " evaluate --json " + dir.path("intact"), &out), 1);
   const Json none = Json::parse(out);
   EXPECT_EQ(none["cases"][0]["status"].get<std::string>(), "failed");
   EXPECT_NE(none["cases"][0]["message"].get<std::string>().find("no defect"), std::string::npos);
@@ -707,7 +736,7 @@ TEST(Cli, EvaluateScoresAFolderOfCasesAndWritesTheImplants) {
   EXPECT_EQ(none["median"]["median_dice"].get<double>(), 0.0);
   EXPECT_TRUE(none["median"]["median_hd95_mm"].is_null());
   // --implants-out that is not a folder: bad input (exit 3), naming it.
-  ASSERT_EQ(test::run_command(kCli + " evaluate --json " + dir.path("cases") + " --implants-out " +
+  ASSERT_EQ(test::run_command(kLab + " evaluate --json " + dir.path("cases") + " --implants-out " +
                                   dir.path("missing"),
                               &out),
             3);
