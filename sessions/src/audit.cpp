@@ -477,9 +477,10 @@ std::string readable_time(const std::string& iso) {
 }
 }  // namespace
 
-std::string quality_verdict_html(const QualityReport& r, const ImplantParams& params,
-                                 const SoftTissueCheck* tissue) {
-  const bool finding = tissue && tissue->checked && tissue->finding;
+namespace {
+// The verdict itself: printable (with a finding to check, or not), or refused with what to try.
+std::string verdict(const QualityReport& r, const ImplantParams& params,
+                    const SoftTissueCheck* tissue, bool finding) {
   if (r.printable && finding)
     return "<p style='color:#8a5a00'><b>Printable, with a finding to check before approval:</b> "
            "brain or dura reaches " +
@@ -496,6 +497,21 @@ std::string quality_verdict_html(const QualityReport& r, const ImplantParams& pa
   h += "</ul><p><b>What to try:</b></p><ul>";
   for (const std::string& a : quality_advice(r, params)) h += "<li>" + html_escape(a) + "</li>";
   return h + "</ul>";
+}
+}  // namespace
+
+std::string quality_verdict_html(const QualityReport& r, const ImplantParams& params,
+                                 const SoftTissueCheck* tissue) {
+  const bool finding = tissue && tissue->checked && tissue->finding;
+  // The defect ran into the scan's end: the implant ends there, and what lies beyond was not
+  // scanned. Said with every verdict, printable or not.
+  const std::string scan_end =
+      !r.ends_at_scan_end
+          ? std::string()
+          : "<p style='color:#8a5a00'><b>The implant ends where the scan ended:</b> the defect "
+            "runs into the border of the scan, and the bone beyond it is unknown. Check on the "
+            "patient or a wider scan that the opening ends there.</p>";
+  return scan_end + verdict(r, params, tissue, finding);
 }
 
 std::string quality_report_html(const QualityReport& r, const SoftTissueCheck* tissue) {
@@ -542,6 +558,8 @@ std::string quality_report_html(const QualityReport& r, const SoftTissueCheck* t
         signed_mm(r.clearance_low_mm) + " to " + signed_mm(r.clearance_high_mm) + " mm" + where);
   }
   if (r.penetration_mm3 >= 0) row("Overlap with skull", fixed(r.penetration_mm3, 1) + " mm³");
+  if (r.ends_at_scan_end)
+    row("Ends where the scan ended", "yes: the bone beyond is unknown (no gap counted there)");
   if (r.holes > 0)
     row("Perforations",
         std::to_string(r.holes) +

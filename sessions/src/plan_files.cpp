@@ -138,6 +138,8 @@ Json to_json(const QualityReport& q) {
     j["tab_bone_mm"] = q.tab_bone_mm;
     if (q.tab_midline_mm >= 0) j["tab_midline_mm"] = q.tab_midline_mm;
   }
+  if (q.ends_at_scan_end)
+    j["ends_at_scan_end"] = true;  // only then: older reports read as they did
   if (q.clearance_asked) {
     j["clearance_low_mm"] = q.clearance_low_mm;
     j["clearance_high_mm"] = q.clearance_high_mm;

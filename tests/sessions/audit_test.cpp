@@ -309,6 +309,22 @@ TEST(QualityHtml, ShowsEveryFigureAndEscapesTheReasons) {
             std::string::npos);
   EXPECT_EQ(without.find("Gap to bone"), std::string::npos) << "not measured, not shown";
   EXPECT_EQ(without.find("Problems"), std::string::npos);
+  EXPECT_EQ(without.find("scan ended"), std::string::npos);
+  // A defect that ran into the scan's end: the table and the verdict say the implant ends
+  // there and the bone beyond is unknown, printable or not.
+  r.ends_at_scan_end = true;
+  EXPECT_NE(quality_report_html(r).find(
+                "<td>Ends where the scan ended</td><td><b>yes: the bone beyond is unknown"),
+            std::string::npos);
+  for (bool printable : {true, false}) {
+    r.printable = printable;
+    const std::string v = quality_verdict_html(r, ImplantParams{});
+    EXPECT_NE(v.find("The implant ends where the scan ended:</b> the defect runs into the border "
+                     "of the scan, and the bone beyond it is unknown"),
+              std::string::npos)
+        << v;
+    EXPECT_NE(v.find(printable ? "Printable" : "Not printable"), std::string::npos) << v;
+  }
 }
 
 // The soft tissue in the implant's place: brain or dura reaching into the defect is the finding

@@ -317,6 +317,7 @@ QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
 QualityReport check_implant(const SkullMesh& implant, const SkullMesh* skull,
                             const SurfaceLocator* skull_locator, const QualityParams& params) {
   QualityReport q;
+  q.ends_at_scan_end = !params.scan_ends.empty();
   // The mesh's own checks (its report and its self-intersections, partly on one thread) run
   // beside the checks on the grid; neither uses the other's results.
   std::future<std::pair<MeshReport, long long>> own_checks = std::async(beside(), [&implant] {

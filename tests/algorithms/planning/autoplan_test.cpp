@@ -283,6 +283,7 @@ TEST(Autoplan, ADefectTheScanEndsAcrossIsPlannedUpToTheScansEnd) {
   EXPECT_GT(beyond, -1.0) << "ends at the scan's end, not short of it";
   EXPECT_TRUE(r.quality.printable)
       << (r.quality.reasons.empty() ? std::string() : r.quality.reasons[0]);
+  EXPECT_TRUE(r.quality.ends_at_scan_end) << "the quality report says so";
   const SkullMesh truth = test::scanned_padded(d.implant, at, Eigen::Vector3d::UnitX(), 0.5);
   const CompareResult c = compare_implants(r.implant.mesh, truth, &skull);
   RecordProperty("dice", std::to_string(c.dice));

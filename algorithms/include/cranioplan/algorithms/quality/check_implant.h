@@ -99,6 +99,9 @@ struct QualityReport {
   double penetration_mm3 = -1.0;  ///< −1 without a skull
   bool printable = false;
   std::vector<std::string> reasons;  ///< why not printable, one sentence each
+  /// The opening ran into the scan's end (QualityParams::scan_ends): the implant ends there,
+  /// and the bone beyond it is unknown (no gap to bone is counted along it).
+  bool ends_at_scan_end = false;
 };
 
 /// Checks an implant, optionally against the (defective) skull it is made for.
