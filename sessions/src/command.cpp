@@ -205,62 +205,8 @@ std::optional<CommandType> command_type_from_tag(const std::string& tag) {
   return std::nullopt;
 }
 
+// What each version changed, and how an older one is read: docs/SESSIONS.md, "Command versions".
 int current_version(CommandType type) {
-  // build_implant 2: ImplantParams gained fit_to_bone_mm (version 1 means no fitting).
-  // propose_markers 2: the surfaces fitted to the intact ring ("surfaces"), the opening chosen
-  // near a point ("detect.near"); version 1 is read with their defaults.
-  // propose_markers 3: the command records its result (the proposed markers) when it is first
-  // done, and a replay applies that instead of proposing again; versions 1 and 2 recompute.
-  // fit_plane 2: the refinement starts at a coarse robust scale ("coarse_robust_scale_mm",
-  // "coarse_iterations"; version 1 is read without: 0 coarse updates), and the command records
-  // the fit it gave ("result") and, when the mirror was registered again after it, that
-  // registration ("registration"), which a replay applies instead of computing them again.
-  // build_implant 3: the fit to the bone's parameters ("trim"; versions 1 and 2 are read with
-  // the trim they were made with). load_skull 2: the skull read in canonical form
-  // ("import.canonical"; version 1 is read as the file gives it). load_skull 3: a mesh's length
-  // unit
-  // ("import.mesh_unit_mm", mm when absent) and a skull that winds inward turned outward
-  // ("import.orient_outward", not when absent).
-  // build_implant 4: the fit to the bone holds the implant "clearance_mm" off the bone's
-  // surface and removes thin fills ("thin_fills_removed"); version 3 is read without either.
-  // build_implant 5: the skull's inside decided by votes where its surface is open
-  // ("trim.vote_through_holes"); version 4 is read with parity along z.
-  // build_implant 6: what the implant is made of ("material": thickness, minimum thickness,
-  // edge clearance, under-contour, density, onlay), stretches of the rim with their own
-  // clearance ("clearance_zones") and the holes drilled ("perforations"); version 5 is read
-  // without them.
-  // build_implant 7: fixation tabs ("tabs"); version 6 is read without them.
-  // load_skull 5: a mesh's repeated triangles dropped ("import.drop_repeated_triangles"), its
-  // patches that wind against their neighbours turned to agree ("import.orient_consistently")
-  // and its small holes closed ("import.close_holes_mm"), none of them when absent.
-  // load_skull 6: two small holes that touch at a corner closed as well
-  // ("import.close_holes_through_corners"); absent, both left open as version 5 left them. And
-  // a mesh that declares its coordinates RAS read in LPS ("import.mesh_space_from_header");
-  // absent, taken as LPS.
-  // build_implant 8 and export_implant 2: tabs, holes and a mould meshed with field values kept
-  // 1e-3 off the iso-level (no sliver triangles); earlier versions are meshed as they were.
-  // build_implant 9: holes drilled along the plate's mid-normal and under their whole
-  // footprint (PerforationParams::mid_normal), tabs whose underside follows the implant
-  // however far below the outer table (TabParams::follow_implant); the parameters recorded are
-  // unchanged, and version 8 is made as it was.
-  // build_implant 10: over the implant a tab's underside comes down onto its rounded edge
-  // instead of bridging over it (TabParams::on_implant_edge); version 9 is made as it was.
-  // build_implant 11: fitted to the bone, a rim point that has not crossed the bone's surface
-  // where the bone is first found goes on until it has (ImplantParams::fit_reaches_the_bone),
-  // and the fit's field is meshed kept 1e-3 off the iso-level (TrimToBoneParams::iso_gap);
-  // version 10 is made as it was.
-  // build_implant 12: evenly placed tabs that stand off the bone by more than the quality
-  // report allows are placed again (TabParams::keep_on_bone), and pattern holes whose rim
-  // leaves a corner it refuses are left out (PerforationParams::sound_rims); version 11 is
-  // made as it was.
-  // build_implant 13: fitted to the bone, an implant whose edge stands off the bone by more
-  // than kRimGapTargetMm over an arc is fitted again from other margins
-  // (ImplantParams::fit_margin_search); the parameters recorded are unchanged, and version 12
-  // is made as it was.
-  // build_implant 14: fitted to the bone, the shell at least half a millimetre thicker than the
-  // fit's smallest feature (ImplantParams::fit_keeps_shell_thick), and the implant ends where
-  // the scan ended across the opening ("scan_ends", none when absent); version 13 is made as
-  // it was.
   if (type == CommandType::BuildImplant) return 14;
   if (type == CommandType::ExportImplant) return 2;
   // propose_markers 4: support markers only where the fitted surface describes the ring's bone

@@ -54,9 +54,9 @@ const std::vector<CommandType>& all_command_types();
 /// The JSON tag, e.g. "load_skull".
 const char* type_tag(CommandType type);
 std::optional<CommandType> command_type_from_tag(const std::string& tag);
-/// The version this program writes for the type (propose_markers: 3; build_implant, fit_plane,
-/// register and adjust_plane: 2; the others: 1). Older versions are read as recorded (the journal's
-/// hashes cover them) and applied by their rules.
+/// The version this program writes for the type. Older versions are read as recorded (the
+/// journal's hashes cover them) and applied by their rules (docs/SESSIONS.md, "Command
+/// versions").
 int current_version(CommandType type);
 
 /// When, by whom and in which wizard step a command was done. Not part of what the command
