@@ -56,12 +56,15 @@ std::vector<Subcommand> moved_to(CLI::App& app, const std::vector<std::string>& 
   std::vector<Subcommand> out;
   for (const std::string& name : names) {
     CLI::App* cmd = app.add_subcommand(name, "");
-    cmd->group("");  // hidden from the help
+    cmd->group("");        // hidden from the help
+    cmd->set_help_flag();  // `--help` too says where it went
     cmd->allow_extras();
     cmd->prefix_command();
     out.push_back({cmd, [name, program, &json] {
-                     print_error(name + " is a research tool and moved to " + program + ": run `" +
-                                     program + " " + name + " --help`",
+                     print_error(name + " is a research tool and moved to " + program +
+                                     ", built with the project (build/app/" + program +
+                                     ", not installed): run `" + program + " " + name +
+                                     " --help` (docs/RESEARCH.md)",
                                  kUsage, json);
                      return static_cast<int>(kUsage);
                    }});

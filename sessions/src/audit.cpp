@@ -649,6 +649,9 @@ std::string design_report_html(const Session& session, const std::vector<ReportI
          " mm above the implant's inner surface (Quality, and the CT slices on page 3).</p>";
   else
     h += "<p class=ok><b>Printable:</b> the quality check passes.</p>";
+  if (q.ends_at_scan_end)
+    h += "<p style='color:#8a5a00'><b>The implant ends where the scan ended:</b> the defect runs "
+         "into the border of the scan, and the bone beyond it is unknown.</p>";
   std::string pictures;
   if (!images.empty()) {
     // The views of the skull on one page, the CT slices and the thickness map on the next, two

@@ -209,24 +209,8 @@ std::optional<CommandType> command_type_from_tag(const std::string& tag) {
 int current_version(CommandType type) {
   if (type == CommandType::BuildImplant) return 14;
   if (type == CommandType::ExportImplant) return 2;
-  // propose_markers 4: support markers only where the fitted surface describes the ring's bone
-  // ("max_support_off_fit_mm"; versions 1 to 3 are read with 0, every ring point of the band).
-  // propose_markers 5: the mirror read over a footprint around each ray
-  // ("surfaces.mirror_footprint_mm"; versions 1 to 4 are read with 0, along the one ray).
-  // propose_markers 6: mirror-guided, a fitting site of few rays smoothed more
-  // ("surfaces.weigh_sites_by_rays"; versions 1 to 5 are read with false, every site alike).
-  // propose_markers 7: the rim of a large opening, of one whose rim the rays left unseen over
-  // a long stretch, or of one reaching the scan's end traced on the bone ("detect":
-  // "trace_rim_on_bone", "trace_from_area_mm2", "trace_from_unseen_mm"; versions 1 to 6 are
-  // read without: the rim the rays saw), and inner support markers only on one layer of the
-  // ring's bone ("max_support_layers"; versions 1 to 6 are read with 0, no limit).
   if (type == CommandType::ProposeMarkers) return 7;
-  // load_skull 4: volumes in the patient's frame ("import.patient_frame"), a DICOM folder's
-  // series ("import.dicom_series"), a mesh's far pieces dropped ("import.drop_far_pieces");
-  // absent, as version 3 read them.
   if (type == CommandType::LoadSkull) return 6;
-  // register 2 and adjust_plane 2 record the registration they gave ("result"; adjust_plane:
-  // "registration", when the mirror was registered again), which a replay applies.
   if (type == CommandType::FitPlane || type == CommandType::Register ||
       type == CommandType::AdjustPlane)
     return 2;

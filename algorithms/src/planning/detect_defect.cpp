@@ -535,7 +535,8 @@ constexpr int kBandRings = 8;
 
 void trace_on_bone(const SkullMesh& skull, const SurfaceLocator& locator, const RayFan& fan,
                    const std::vector<int>& comp, const Candidate& c, const RayCaster& cast,
-                   const std::vector<ScanBorder>& borders, DefectRegion& region) {
+                   const std::vector<ScanBorder>& borders, bool runs_into_scan_end,
+                   DefectRegion& region) {
   std::vector<int> near = c.rim;
   for (int j : c.rim)
     for (int w : fan.nbrs[j])
@@ -582,9 +583,11 @@ void trace_on_bone(const SkullMesh& skull, const SurfaceLocator& locator, const 
         front.push_back(w);
       }
   }
+  TraceRimParams trace;
+  trace.along_scan_end = runs_into_scan_end;
   const TracedRim traced =
       trace_rim_on_bone(skull, locator, region.center, region.axis, e1, band, region.outer_rim,
-                        region.inner_rim, outer_seeds, inner_seeds, borders);
+                        region.inner_rim, outer_seeds, inner_seeds, borders, trace);
   if (!traced.traced()) return;
   const std::vector<char> inside =
       inside_loop(fan.dirs, traced.outer, region.center, region.axis, e1);
@@ -652,8 +655,9 @@ void trace_on_bone(const SkullMesh& skull, const SurfaceLocator& locator, const 
       }
 }
 
-// Rays of the opening next to this many rays closed by the scan's end (about 1.6° apart) make
-// it an opening that runs into the scan's end, not one that only touches it at a corner.
+// Rays of the opening next to this many rays closed by the scan's end (neighbours within 1.6
+// ray spacings; 1.4° apart at the default 20,000 rays) make it an opening that runs into the
+// scan's end, not one that only touches it at a corner.
 constexpr int kScanEndRays = 8;
 
 // Whether the opening `comp` runs into the scan's end: rays next to it meet no bone and reach
@@ -721,9 +725,9 @@ DefectRegion detect_defect(const SkullMesh& skull, const SurfaceLocator& locator
     for (int i : comp) region.hole_directions.push_back(fan.dirs[i]);
     region.axis = openings.mean_dir[openings.order[chosen.r]];
     trace_rim(fan, openings, chosen, cast, region);
-    if (params.trace_rim_on_bone &&
-        wants_trace(region, params, reaches_scan_end(fan, comp, center, borders)))
-      trace_on_bone(skull, locator, fan, comp, chosen, cast, borders, region);
+    const bool runs_into_scan_end = reaches_scan_end(fan, comp, center, borders);
+    if (params.trace_rim_on_bone && wants_trace(region, params, runs_into_scan_end))
+      trace_on_bone(skull, locator, fan, comp, chosen, cast, borders, runs_into_scan_end, region);
     // Asked for the opening towards a point, and none lies that way: the nearest was planned,
     // and the message says so (a point on intact bone, or at a cut that did not go through,
     // would otherwise plan another opening without a word).

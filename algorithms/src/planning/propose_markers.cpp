@@ -327,9 +327,11 @@ constexpr double kOnScanEndMm = 1.0;
 std::optional<Eigen::Vector3d> past_the_scans_end(const DefectRegion& defect,
                                                   const DefectSurfaces& surfaces,
                                                   const Eigen::Vector3d& rim) {
-  const Plane* end = nullptr;
+  const Plane* end = nullptr;  // the nearest within kOnScanEndMm
   for (const Plane& e : defect.scan_ends)
-    if (std::abs(e.signed_distance(rim)) < kOnScanEndMm) end = &e;
+    if (std::abs(e.signed_distance(rim)) < kOnScanEndMm &&
+        (!end || std::abs(e.signed_distance(rim)) < std::abs(end->signed_distance(rim))))
+      end = &e;
   if (!end) return std::nullopt;
   const Eigen::Vector3d dir = (rim - defect.center).normalized();
   Eigen::Vector3d away = dir.dot(defect.axis) * dir - defect.axis;  // across dir, off the axis

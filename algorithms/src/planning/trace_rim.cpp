@@ -694,7 +694,8 @@ TableEdge trace_table(const SkullMesh& mesh, const SurfaceLocator& bone,
   std::vector<uint8_t> examined(mesh.n_faces(), 0);
   for (int f : band.faces) examined[f] = 1;
   auto candidates = edge_candidates(mesh, table, examined, project, center, borders);
-  add_scan_end_candidates(candidates, project, center, borders, seeds, band.rays, band.angle);
+  if (params.along_scan_end)
+    add_scan_end_candidates(candidates, project, center, borders, seeds, band.rays, band.angle);
   std::vector<std::optional<Eigen::Vector3d>> seen(kSectors);
   double scale = 0.0;
   for (const Eigen::Vector3d& p : seen_rim) {

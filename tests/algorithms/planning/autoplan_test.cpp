@@ -327,7 +327,6 @@ TEST(Autoplan, ADefectTheScansFieldOfViewCutsAcrossIsPlannedUpToTheScansEnd) {
   const AutoplanResult r = autoplan(skull, Landmarks{});
   ASSERT_TRUE(r.planned()) << r.message;
   EXPECT_TRUE(r.defect.rim_traced) << r.message;
-  EXPECT_EQ(r.message.find("rim not seen"), std::string::npos) << r.message;
   EXPECT_NE(r.message.find("the bone beyond the scan is unknown"), std::string::npos) << r.message;
   ASSERT_EQ(r.defect.scan_ends.size(), 1u) << r.message;
   const Plane end = r.defect.scan_ends[0];

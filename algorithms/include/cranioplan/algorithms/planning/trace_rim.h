@@ -43,6 +43,10 @@ struct TraceRimParams {
   double min_facing = 0.05;
   /// Spacing of the rim's points, mm (0.25..5).
   double spacing_mm = 1.0;
+  /// The opening runs into the scan's end (rays next to it leave through a border): the rim may
+  /// also run along the borders' planes, where the table would cross them. Otherwise only the
+  /// table's own edge is followed.
+  bool along_scan_end = false;
 };
 
 struct TracedRim {
