@@ -110,14 +110,16 @@ Json evaluate_summary(const Json& rows) {
   int failed = 0, unreadable = 0, printable = 0;
   for (const Json& row : rows) {
     const std::string status = row.at("status");
-    if (status == "planned") {
+    if (status == status_name(AutoplanResult::Status::Planned)) {
       dsc.push_back(row.at("dice"));
       bdsc.push_back(row.at("boundary_dice"));
       hd95.push_back(row.at("hd95_mm"));
       printable += row.at("printable").get<bool>();
-    } else if (status == "failed") {
-      // No implant overlaps nothing: a failed plan counts as Dice 0 in the medians (as a
-      // missing prediction does in the challenge); it has no distance.
+    } else if (status == status_name(AutoplanResult::Status::Failed) ||
+               status == status_name(AutoplanResult::Status::NoDefect)) {
+      // No implant overlaps nothing: a case not planned (no defect found, or a stage that
+      // failed) counts as Dice 0 in the medians (as a missing prediction does in the
+      // challenge); it has no distance.
       ++failed;
       dsc.push_back(0.0);
       bdsc.push_back(0.0);
@@ -197,7 +199,7 @@ Json evaluate_case(const std::string& id, const std::string& defective,
     const AutoplanResult r = autoplan(skull, Landmarks{}, planning(params, loaded));
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    row["status"] = r.planned() ? "planned" : "failed";
+    row["status"] = status_name(r.status);
     row["message"] = r.message;
     if (r.planned()) {
       const CompareResult c = compare_implants(r.implant.mesh, truth, &skull);

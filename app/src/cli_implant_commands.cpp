@@ -78,9 +78,7 @@ std::vector<double> unseen_rim_lengths(const std::vector<RimStretch>& stretches)
 }
 
 Json autoplan_json(const AutoplanResult& r) {
-  Json j{{"status", r.planned()                                    ? "planned"
-                    : r.status == AutoplanResult::Status::NoDefect ? "no_defect"
-                                                                   : "failed"},
+  Json j{{"status", status_name(r.status)},
          {"message", r.message},
          {"plane", to_json(r.plane.plane)},
          {"transform", to_json(r.registration.transform)},
@@ -143,10 +141,7 @@ Json autoplan_with_session(const std::string& skull, const ExtractBoneSurfacePar
   a = autoplan_session(skull, lm, params, output, {}, import, all_openings);
   a.session.save(session_path);
   const PlanState& s = a.session.state();
-  Json j{{"status", a.planned()                                     ? "planned"
-                    : a.status == AutoplanSession::Status::NoDefect ? "no_defect"
-                                                                    : "failed"},
-         {"message", a.message}};
+  Json j{{"status", status_name(a.status)}, {"message", a.message}};
   j.update(plan_state_json(s));
   if (s.skull && !s.skull->surface->loaded.warnings.empty())
     j["warnings"] = s.skull->surface->loaded.warnings;
@@ -440,7 +435,14 @@ Subcommand add_qa(CLI::App& app, const bool& json) {
         if (o->min_thickness) o->params.min_thickness_mm = *o->min_thickness;
         const SkullMesh implant = load_surface(o->implant).mesh;
         SkullMesh skull;
-        if (!o->skull.empty()) skull = load_skull(o->skull).mesh;
+        if (!o->skull.empty()) {
+          const LoadedSkull loaded = load_skull(o->skull);
+          skull = loaded.mesh;
+          // An implant planned up to where the skull's scan ended is cut flat there: no gap to
+          // bone is counted along that side, as the plan's own check counts none.
+          o->params.scan_ends = scan_ends_met(
+              implant, scan_borders(loaded.report ? *loaded.report : report_mesh(skull)));
+        }
         const QualityReport q =
             check_implant(implant, o->skull.empty() ? nullptr : &skull, o->params);
         Json j = to_json(q);

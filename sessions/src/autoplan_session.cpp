@@ -7,6 +7,18 @@
 
 namespace cranioplan {
 
+const char* status_name(AutoplanSession::Status status) {
+  switch (status) {
+    case AutoplanSession::Status::Planned:
+      return status_name(AutoplanResult::Status::Planned);
+    case AutoplanSession::Status::NoDefect:
+      return status_name(AutoplanResult::Status::NoDefect);
+    case AutoplanSession::Status::Failed:
+      break;
+  }
+  return status_name(AutoplanResult::Status::Failed);
+}
+
 namespace {
 
 // A search run outside its command, and the time it took, for the command to carry.

@@ -11,6 +11,7 @@
 #include "cranioplan/algorithms/io/read_volume.h"
 #include "cranioplan/algorithms/io/write_3mf.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
+#include "cranioplan/algorithms/quality/inject_defect.h"
 #include "cranioplan/sessions/plan_files.h"
 #include "support/dicom_writer.h"
 #include "support/synthetic.h"
@@ -387,6 +388,54 @@ TEST(Cli, ImplantSubcommandsAndTheirErrors) {
 // A material and perforations on the command line: autoplan builds with them (the clearance
 // kept on every arc, the mass, holes that go through), qa checks an implant against them, and a
 // material or value out of range is a usage error that names it.
+// A defect the scan ended across (the head's right side cut off 12 mm inside the defect's
+// centre, padded as an importer closes it): autoplan plans it up to the scan's end and says so,
+// and `qa` of that implant on the same skull finds the flat side the scan's end cut, counts no
+// gap to bone along it, and passes it as the plan's own check did.
+TEST(Cli, AnImplantCutAtTheScansEndIsCheckedAsPlanned) {
+  test::TempDir dir;
+  const Eigen::Vector3d direction = Eigen::Vector3d(-0.5, 0.1, 0.85).normalized();
+  InjectDefectParams p;
+  p.center = test::head_surface_point(direction) * 0.965;
+  p.size_mm = 55;
+  p.voxel_mm = 0.5;
+  const InjectDefectResult d = inject_defect(test::make_thick_head(), p);
+  ASSERT_TRUE(d.usable()) << d.message;
+  const Eigen::Vector3d at(test::head_surface_point(direction).x() - 12.0, 0.0, 0.0);
+  write_mesh(test::scanned_padded(d.defective, at, Eigen::Vector3d::UnitX(), 0.5),
+             dir.path("skull.stl"));
+  std::string out;
+  ASSERT_EQ(
+      test::run_command(
+          kCli + " autoplan --json " + dir.path("skull.stl") + " -o " + dir.path("i.stl"), &out),
+      0)
+      << out;
+  const Json planned = Json::parse(out);
+  EXPECT_NE(planned["message"].get<std::string>().find("the bone beyond the scan is unknown"),
+            std::string::npos);
+  EXPECT_TRUE(planned["quality"]["printable"].get<bool>());
+  EXPECT_TRUE(planned["quality"].value("ends_at_scan_end", false));
+  ASSERT_EQ(
+      test::run_command(
+          kCli + " qa --json " + dir.path("i.stl") + " --skull " + dir.path("skull.stl"), &out),
+      0)
+      << out;
+  const Json checked = Json::parse(out);
+  EXPECT_TRUE(checked.value("ends_at_scan_end", false)) << out;
+  EXPECT_TRUE(checked["printable"].get<bool>()) << out;
+  EXPECT_LE(checked["rim_gap_mm"].get<double>(), 0.5);
+  // On the uncut skull no scan's end cuts it: its flat side stands off the bone that goes on
+  // there, and it is refused (exit 1).
+  write_mesh(d.defective, dir.path("whole.stl"));
+  EXPECT_EQ(
+      test::run_command(
+          kCli + " qa --json " + dir.path("i.stl") + " --skull " + dir.path("whole.stl"), &out),
+      1);
+  const Json whole = Json::parse(out);
+  EXPECT_FALSE(whole.value("ends_at_scan_end", false)) << out;
+  EXPECT_GT(whole["rim_gap_mm"].get<double>(), 1.0) << out;
+}
+
 TEST(Cli, AutoplanAndQaWithAMaterial) {
   test::TempDir dir;
   write_mesh(test::thick_head_defect().defective, dir.path("skull.stl"));
@@ -723,14 +772,15 @@ TEST(Cli, EvaluateScoresAFolderOfCasesAndWritesTheImplants) {
   EXPECT_EQ(merged, single);
   EXPECT_EQ(test::run_command(kLab + " evaluate " + dir.path("cases") + " --shard 3/2"), 2)
       << "a shard past the count is a usage error";
-  // A skull without a defect cannot be planned: its row says so, it counts as Dice 0 (as a
-  // missing prediction does in the challenge), and the exit code is 1.
+  // A skull without a defect cannot be planned: its row says so with autoplan's own status,
+  // it counts as Dice 0 (as a missing prediction does in the challenge) among the cases not
+  // planned, and the exit code is 1.
   std::filesystem::create_directories(dir.path("intact"));
   std::filesystem::copy_file(dir.path("thick.stl"), dir.path("intact/009_defective_skull.stl"));
   std::filesystem::copy_file(dir.path("cases/007_implant.stl"), dir.path("intact/009_implant.stl"));
   ASSERT_EQ(test::run_command(kLab + " evaluate --json " + dir.path("intact"), &out), 1);
   const Json none = Json::parse(out);
-  EXPECT_EQ(none["cases"][0]["status"].get<std::string>(), "failed");
+  EXPECT_EQ(none["cases"][0]["status"].get<std::string>(), "no_defect");
   EXPECT_NE(none["cases"][0]["message"].get<std::string>().find("no defect"), std::string::npos);
   EXPECT_EQ(none["median"]["failed"].get<int>(), 1);
   EXPECT_EQ(none["median"]["median_dice"].get<double>(), 0.0);

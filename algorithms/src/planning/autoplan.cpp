@@ -13,6 +13,18 @@
 
 namespace cranioplan {
 
+const char* status_name(AutoplanResult::Status status) {
+  switch (status) {
+    case AutoplanResult::Status::Planned:
+      return "planned";
+    case AutoplanResult::Status::NoDefect:
+      return "no_defect";
+    case AutoplanResult::Status::Failed:
+      break;
+  }
+  return "failed";
+}
+
 namespace {
 
 class StageTimer {

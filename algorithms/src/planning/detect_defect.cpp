@@ -72,6 +72,21 @@ bool ScanBorder::reached_by(const Eigen::Vector3d& from, const Eigen::Vector3d& 
   return true;
 }
 
+std::vector<Plane> scan_ends_met(const SkullMesh& implant, const std::vector<ScanBorder>& borders) {
+  std::vector<Plane> met;
+  for (const ScanBorder& b : borders) {
+    int on = 0;
+    bool beyond = false;
+    for (auto vh : implant.vertices()) {
+      const double d = b.normal.dot(to_eigen(implant.point(vh))) - b.offset;
+      if (d > kOnScanEndMm + 0.5) beyond = true;
+      if (std::abs(d) <= kOnScanEndMm) ++on;
+    }
+    if (!beyond && on >= kScanEndVertices) met.push_back(Plane{b.normal, b.offset});
+  }
+  return met;
+}
+
 void take_scan_borders(DetectDefectParams& params, const std::optional<MeshReport>& report) {
   if (!params.scan_borders && report) params.scan_borders = scan_borders(*report);
 }

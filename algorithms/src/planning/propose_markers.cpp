@@ -322,7 +322,6 @@ constexpr double kEdgeRingReach = 12.0;  // beyond the rim clearance, mm
 // distance the rim was put at. None when the rim point is not on a scan's end or the fitted
 // surface does not reach past it.
 constexpr double kBeyondScanEndMm = 1.5, kScanEndStepDeg = 0.5, kScanEndTurnDeg = 20.0;
-constexpr double kOnScanEndMm = 1.0;
 
 std::optional<Eigen::Vector3d> past_the_scans_end(const DefectRegion& defect,
                                                   const DefectSurfaces& surfaces,

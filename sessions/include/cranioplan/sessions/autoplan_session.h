@@ -20,6 +20,9 @@ struct AutoplanSession {
   bool planned() const { return status == Status::Planned; }
 };
 
+/// The status's name, as AutoplanResult's (status_name): "planned", "no_defect" or "failed".
+const char* status_name(AutoplanSession::Status status);
+
 /// Load → landmarks → fit plane → mirror → register → (register around the opening) → inspect
 /// → propose markers → build implant → review, and, when `export_path` is not empty, export.
 /// The searches are autoplan()'s stages (`autoplan_stages`), each recorded in its command with

@@ -59,6 +59,9 @@ struct AutoplanResult {
   bool planned() const { return status == Status::Planned; }
 };
 
+/// The status's name in every command's output: "planned", "no_defect" or "failed".
+const char* status_name(AutoplanResult::Status status);
+
 AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
                         const AutoplanParams& params = {});
 

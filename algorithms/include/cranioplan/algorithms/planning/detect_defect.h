@@ -90,6 +90,15 @@ struct DetectDefectParams {
 /// them again.
 void take_scan_borders(DetectDefectParams& params, const std::optional<MeshReport>& report);
 
+/// The planes of `borders` (where the skull's scan ended) that `implant` was cut at: an implant
+/// planned up to the scan's end is cut flat there (ImplantParams::scan_ends), so at least
+/// kScanEndVertices of its vertices lie within kOnScanEndMm of the plane and none further than
+/// kOnScanEndMm + 0.5 mm beyond it. For checking such an implant on its own (`qa`): its flat side
+/// meets no bone, and no gap to bone is counted along it (QualityParams::scan_ends).
+std::vector<Plane> scan_ends_met(const SkullMesh& implant, const std::vector<ScanBorder>& borders);
+inline constexpr int kScanEndVertices = 30;
+inline constexpr double kOnScanEndMm = 1.0;
+
 /// A stretch of the rim that no ray saw: between two consecutive rim points far apart, where
 /// the outline is interpolated (straight from one to the other).
 struct RimStretch {
