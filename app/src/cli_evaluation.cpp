@@ -83,6 +83,10 @@ void add_scores(Json& row, const AutoplanResult& r, const CompareResult& c) {
   row["printable"] = r.quality.printable;
   row["rim_gap_mm"] = r.quality.rim_gap_mm;
   if (!r.quality.printable) row["not_printable_because"] = r.quality.reasons;
+  if (r.shape_fit) {
+    row["shape_model_rms_mm"] = r.shape_fit->rms_mm;
+    row["shape_model_used"] = r.method_used == PlanMethod::ShapeModel;
+  }
 }
 
 // The printable verdict of a scored row, for the text table.
@@ -187,7 +191,7 @@ std::map<std::string, std::pair<std::string, std::string>> cases_in(const std::s
 // One case of `evaluate`: planned and scored, or its unreadable file as its row.
 Json evaluate_case(const std::string& id, const std::string& defective,
                    const std::string& truth_path, const AutoplanParams& params,
-                   const std::string& implants_out) {
+                   const std::string& implants_out, const ShapeModel* model) {
   Json row{{"case", id}};
   try {
     // The truth is read first (to fail before planning) and not timed: the time is the
@@ -196,7 +200,7 @@ Json evaluate_case(const std::string& id, const std::string& defective,
     const auto t0 = std::chrono::steady_clock::now();
     const LoadedSkull loaded = load_skull(defective);
     const SkullMesh& skull = loaded.mesh;
-    const AutoplanResult r = autoplan(skull, Landmarks{}, planning(params, loaded));
+    const AutoplanResult r = autoplan(skull, Landmarks{}, planning(params, loaded), model);
     const double seconds =
         std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     row["status"] = status_name(r.status);
@@ -235,7 +239,7 @@ void print_evaluate_row(const Json& row) {
 // evaluate
 Subcommand add_evaluate(CLI::App& app, const bool& json) {
   struct Opts {
-    std::string dir, implants_out, rows_out;
+    std::string dir, implants_out, rows_out, shape_model;
     AutoplanParams params;
     Shard shard;
   };
@@ -249,17 +253,19 @@ Subcommand add_evaluate(CLI::App& app, const bool& json) {
                   "folder to write each planned implant to (NNN_planned_implant.stl)");
   add_shard_options(cmd, o->shard, o->rows_out);
   add_fit_option(cmd, o->params);
+  add_shape_model_option(cmd, o->shape_model);
   return Subcommand{cmd, [o, &json] {
                       if (!o->implants_out.empty() && !fs::is_directory(o->implants_out))
                         throw InputError(o->implants_out, "is not a folder (--implants-out)");
                       const auto cases = cases_in(o->dir);
+                      const auto model = shape_model_from(o->shape_model);
                       make_rows_folder(o->rows_out);
                       Json rows = Json::array();
                       size_t k = 0;
                       for (const auto& [id, files] : cases) {
                         if (!o->shard.takes(k++)) continue;
                         const Json row = evaluate_case(id, files.first, files.second, o->params,
-                                                       o->implants_out);
+                                                       o->implants_out, model.get());
                         if (!json) print_evaluate_row(row);
                         write_row(o->rows_out, "evaluate", id, row);
                         rows.push_back(row);
@@ -416,7 +422,7 @@ Subcommand add_study(CLI::App& app, const bool& json) {
     std::optional<double> min_size, max_size;
     AutoplanParams params;
     Shard shard;
-    std::string rows_out;
+    std::string rows_out, shape_model;
   };
   auto o = std::make_shared<Opts>();
   auto* cmd = app.add_subcommand(
@@ -443,9 +449,12 @@ Subcommand add_study(CLI::App& app, const bool& json) {
                   "(K_defective.stl, K_truth.stl, K_planned.stl)");
   add_shard_options(cmd, o->shard, o->rows_out);
   add_fit_option(cmd, o->params);
+  add_shape_model_option(cmd, o->shape_model);
   return Subcommand{
       cmd, [o, &json] {
         const bool spheres = o->shape == "sphere";
+        const auto model = shape_model_from(o->shape_model);
+        if (model) refuse_if_in_model(*model, o->skull);
         plan_method_from_string(o->method, o->params.propose.method);
         if (!spheres && (o->min_size || o->max_size))
           throw CLI::ValidationError("--min-size/--max-size", "are sizes of --shape sphere");
@@ -481,7 +490,7 @@ Subcommand add_study(CLI::App& app, const bool& json) {
           for (const Eigen::Vector3d& point : points) {
             AutoplanParams params = o->params;
             params.propose.detect.near = point;
-            plans.push_back(autoplan(d.defective, Landmarks{}, params));
+            plans.push_back(autoplan(d.defective, Landmarks{}, params, model.get()));
           }
           row["seconds"] =
               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();

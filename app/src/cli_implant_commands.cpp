@@ -95,6 +95,13 @@ Json autoplan_json(const AutoplanResult& r) {
     j["method"] = to_string(r.method_used);
     j["mirror_coverage"] = r.mirror_coverage;
     j["markers"] = r.markers.size();
+    if (r.shape_fit)
+      j["shape_model"] = Json{{"fitted", r.shape_fit->usable()},
+                              {"used", r.method_used == PlanMethod::ShapeModel},
+                              {"rms_mm", r.shape_fit->rms_mm},
+                              {"paired", r.shape_fit->paired},
+                              {"mahalanobis", r.shape_fit->mahalanobis},
+                              {"message", r.shape_fit->message}};
   }
   if (r.planned()) {
     j["implant"] = implant_json(r.implant);
@@ -570,7 +577,7 @@ Subcommand add_inject_defect(CLI::App& app, const bool& json) {
 // autoplan
 Subcommand add_autoplan(CLI::App& app, const bool& json) {
   struct Opts {
-    std::string skull, landmarks, output, markers_out, session, method = "auto";
+    std::string skull, landmarks, output, markers_out, session, method = "auto", shape_model;
     std::vector<double> near;
     bool all_openings = false;
     AutoplanParams params;
@@ -585,11 +592,14 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
   cmd->add_option("SKULL", o->skull, "defective skull (mesh or volume)")->required();
   cmd->add_option("--landmarks", o->landmarks,
                   "landmarks for the midsagittal plane (.json or Slicer .mrk.json)");
-  cmd->add_option("--method", o->method, "auto, mirror or rim-only")
-      ->check(CLI::IsMember({"auto", "mirror", "rim-only"}));
+  cmd->add_option("--method", o->method,
+                  "auto, mirror, rim-only or model (auto: the shape model when one is given "
+                  "and fits, else the mirror where it covers the opening, else the ring)")
+      ->check(CLI::IsMember({"auto", "mirror", "rim-only", "model"}));
   cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
   cmd->add_option("--markers-out", o->markers_out,
                   "proposed markers to write (.json, .csv or Slicer .mrk.json)");
+  add_shape_model_option(cmd, o->shape_model);
   add_units_option(cmd, o->import.mesh_unit_mm);
   add_series_option(cmd, o->import.dicom_series);
   cmd->add_option("--near", o->near,
@@ -621,6 +631,12 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
         auto markers_path = [&](size_t k) {
           return o->markers_out.empty() ? std::string() : numbered_path(o->markers_out, k);
         };
+        const auto model = shape_model_from(o->shape_model);
+        if (o->method == "model" && !model)
+          throw CLI::ValidationError("--method model", "needs --shape-model FILE");
+        if (model && !o->session.empty())
+          throw CLI::ValidationError("--shape-model",
+                                     "is not yet recorded in sessions: plan without --session");
         if (!o->session.empty())
           return autoplan_sessions(o->skull, o->import, lm, o->params, o->output, o->markers_out,
                                    o->session, o->all_openings, json);
@@ -634,7 +650,7 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
           return j;
         };
         if (!o->all_openings) {
-          const AutoplanResult r = autoplan(skull, lm, planning(o->params, loaded));
+          const AutoplanResult r = autoplan(skull, lm, planning(o->params, loaded), model.get());
           print_result(
               with_warnings(write_autoplan(r, o->output, o->markers_out, loaded.file_space)), json);
           return r.planned() ? kOk : kUnusable;
@@ -642,7 +658,7 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
         // Every opening in turn; the first is the one planned without
         // --all-openings.
         const std::vector<AutoplanResult> all =
-            autoplan_all_openings(skull, lm, planning(o->params, loaded));
+            autoplan_all_openings(skull, lm, planning(o->params, loaded), model.get());
         if (!all.front().defect.found()) {  // no defect, or no plane
           print_result(with_warnings(write_autoplan(all.front(), o->output, o->markers_out,
                                                     loaded.file_space)),

@@ -8,6 +8,7 @@
 #include "cli_mesh_commands.h"
 #include "cli_run.h"
 #include "cli_session_commands.h"
+#include "cli_shape_model_commands.h"
 #include "cranioplan/algorithms/geometry/huge_pages.h"
 
 int main(int argc, char** argv) {
@@ -19,7 +20,7 @@ int main(int argc, char** argv) {
   app.set_version_flag("--version", std::string("cranioplan-cli ") + CRANIOPLAN_VERSION);
   bool json = false;
   std::vector<Subcommand> subcommands = add_mesh_commands(app, json);
-  for (auto* add : {&add_implant_commands, &add_session_commands})
+  for (auto* add : {&add_implant_commands, &add_session_commands, &add_shape_model_commands})
     for (auto& c : (*add)(app, json)) subcommands.push_back(std::move(c));
   for (auto& c : moved_to(app, {"bench", "study", "evaluate", "merge"}, "cranioplan-lab", json))
     subcommands.push_back(std::move(c));

@@ -6,6 +6,8 @@
 
 #include "cli_output.h"
 #include "cranioplan/algorithms/io/load_skull.h"
+#include "cranioplan/model/error.h"
+#include "cranioplan/sessions/sha256.h"
 
 namespace cranioplan::cli {
 
@@ -21,6 +23,26 @@ AutoplanParams planning(const AutoplanParams& params, const LoadedSkull& skull) 
   AutoplanParams out = params;
   take_scan_borders(out.propose.detect, skull.report);
   return out;
+}
+
+void add_shape_model_option(CLI::App* cmd, std::string& path) {
+  cmd->add_option("--shape-model", path,
+                  "a model of the normal skull (.cpsm, `shape-model build`) to guide the missing "
+                  "bone's surfaces; a poor fit falls back to the mirror or the ring, and says so");
+}
+
+std::shared_ptr<const ShapeModel> shape_model_from(const std::string& path) {
+  if (path.empty()) return nullptr;
+  return std::make_shared<const ShapeModel>(read_shape_model(path));
+}
+
+void refuse_if_in_model(const ShapeModel& model, const std::string& skull_path) {
+  const std::string hash = sha256_file(skull_path);
+  for (size_t i = 0; i < model.provenance.skull_sha256.size(); ++i)
+    if (model.provenance.skull_sha256[i] == hash)
+      throw InputError(skull_path, "the shape model was built with this skull (as " +
+                                       model.provenance.skull_names[i] +
+                                       "): build one without it to score plans on it");
 }
 
 // --fit-to-bone MM: the automatic planner's implant built beyond the rim and trimmed by the bone.

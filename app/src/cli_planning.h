@@ -1,10 +1,12 @@
 #pragma once
 // Pieces the planning subcommands of cranioplan-cli share (implant, evaluation).
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
 #include "cranioplan/algorithms/planning/autoplan.h"
+#include "cranioplan/algorithms/shape/shape_model.h"
 
 namespace CLI {
 class App;
@@ -22,6 +24,14 @@ SkullMesh load_any(const std::string& path);
 /// `params` planning on `skull` as read: where its scan ended taken from the report made when
 /// it was read (a mesh), not found again.
 AutoplanParams planning(const AutoplanParams& params, const LoadedSkull& skull);
+
+/// --shape-model FILE: a model of the normal skull to guide the plan (shape-model build).
+void add_shape_model_option(CLI::App* cmd, std::string& path);
+/// The model at `path` (read_shape_model's InputError for a bad file); null for an empty path.
+std::shared_ptr<const ShapeModel> shape_model_from(const std::string& path);
+/// Throws InputError naming `skull_path` when the model was built with that very file: a plan
+/// scored against a skull its model has seen would leak the answer.
+void refuse_if_in_model(const ShapeModel& model, const std::string& skull_path);
 
 /// --fit-to-bone MM and --local-registration MM of the automatic planner.
 void add_fit_option(CLI::App* cmd, AutoplanParams& params);

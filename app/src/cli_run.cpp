@@ -11,8 +11,16 @@ namespace cranioplan::cli {
 int run_program(CLI::App& app, const std::vector<Subcommand>& subcommands, bool& json, int argc,
                 char** argv) {
   app.require_subcommand(1);
-  for (CLI::App* sub : app.get_subcommands([](CLI::App*) { return true; }))
-    sub->add_flag("--json", json, "print one JSON object on stdout");
+  // Every subcommand, nested ones too (shape-model build), takes --json.
+  std::vector<CLI::App*> pending{&app};
+  while (!pending.empty()) {
+    CLI::App* parent = pending.back();
+    pending.pop_back();
+    for (CLI::App* sub : parent->get_subcommands([](CLI::App*) { return true; })) {
+      sub->add_flag("--json", json, "print one JSON object on stdout");
+      pending.push_back(sub);
+    }
+  }
   try {
     app.parse(argc, argv);
   } catch (const CLI::CallForHelp& e) {

@@ -44,8 +44,8 @@ class StageTimer {
 // From the detection on: `r` holds the plane and the global registration. `all_openings`: the
 // other openings are planned as well, and the messages say so.
 void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const VertexCloud& cloud,
-                  const AutoplanParams& params, bool all_openings, StageTimer& timer,
-                  AutoplanResult& r) {
+                  const AutoplanParams& params, const ShapeModel* shape_model, bool all_openings,
+                  StageTimer& timer, AutoplanResult& r) {
   const RigidTransform reflection = reflection_across(r.plane.plane);
   r.defect = autoplan_stages::detect(skull, bone, r.plane.plane, params);
   if (all_openings) r.defect.message = r.defect.describe(true);
@@ -68,7 +68,14 @@ void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const Vert
   }
   r.mirror_motion = mirror_motion();
   const SurfaceLocator mirror = bone.moved(r.mirror_motion);
-  MarkerProposal proposal = autoplan_stages::markers(r.defect, bone, mirror, params);
+  std::optional<ShapePrior> prior;
+  if (shape_model) {
+    prior = fit_shape_prior(*shape_model, skull, bone, r.defect, params.shape_prior);
+    r.shape_fit = prior->fit;
+    timer.stage("shape model");
+  }
+  MarkerProposal proposal = autoplan_stages::markers(
+      r.defect, bone, mirror, params, 1, prior && prior->usable() ? prior->locator.get() : nullptr);
   r.mirror_coverage = proposal.mirror_coverage;
   r.method_used = proposal.method_used;
   r.surfaces_message = proposal.surfaces_message;
@@ -94,6 +101,10 @@ void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const Vert
   r.status = AutoplanResult::Status::Planned;
   r.message = r.defect.message + "; " + describe_method(r.method_used, r.mirror_coverage) + "; " +
               r.surfaces_message;
+  if (r.shape_fit)
+    r.message += std::string("; ") +
+                 (r.shape_fit->usable() ? "" : "not guided by the shape model: ") +
+                 r.shape_fit->message;
 }
 
 // The skull's search tree, built on a thread of its own while the plane and the registration
@@ -158,8 +169,9 @@ const RegisterResult& registration_used(const RegisterResult& global,
 }
 
 MarkerProposal markers(const DefectRegion& defect, const SurfaceLocator& bone,
-                       const SurfaceLocator& mirror, const AutoplanParams& params, int first_id) {
-  return propose_markers_for_defect(defect, bone, mirror, params.propose, first_id);
+                       const SurfaceLocator& mirror, const AutoplanParams& params, int first_id,
+                       const SurfaceLocator* model) {
+  return propose_markers_for_defect(defect, bone, mirror, params.propose, first_id, model);
 }
 
 ImplantParams implant_params(const DefectRegion& defect, const Plane& plane,
@@ -178,19 +190,20 @@ Eigen::Vector3d point_towards_other_opening(const DefectRegion& first, size_t k)
 }
 
 AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
-                        const AutoplanParams& params) {
+                        const AutoplanParams& params, const ShapeModel* shape_model) {
   AutoplanResult r;
   StageTimer timer(r.stage_seconds);
   std::future<SurfaceLocator> bone = locator_meanwhile(skull);
   const VertexCloud cloud(skull);
   if (!plane_and_registration(skull, landmarks, cloud, params, timer, r)) return r;
-  plan_opening(skull, bone.get(), cloud, params, false, timer, r);
+  plan_opening(skull, bone.get(), cloud, params, shape_model, false, timer, r);
   return r;
 }
 
 std::vector<AutoplanResult> autoplan_all_openings(const SkullMesh& skull,
                                                   const Landmarks& landmarks,
-                                                  const AutoplanParams& params) {
+                                                  const AutoplanParams& params,
+                                                  const ShapeModel* shape_model) {
   AutoplanResult first;
   StageTimer timer(first.stage_seconds);
   std::future<SurfaceLocator> building = locator_meanwhile(skull);
@@ -200,7 +213,7 @@ std::vector<AutoplanResult> autoplan_all_openings(const SkullMesh& skull,
   shared.plane = first.plane;
   shared.registration = first.registration;
   const SurfaceLocator bone = building.get();
-  plan_opening(skull, bone, cloud, params, true, timer, first);
+  plan_opening(skull, bone, cloud, params, shape_model, true, timer, first);
   std::vector<AutoplanResult> plans;
   plans.push_back(std::move(first));
   if (!plans.front().defect.found()) return plans;
@@ -210,7 +223,7 @@ std::vector<AutoplanResult> autoplan_all_openings(const SkullMesh& skull,
     each.propose.detect.near = point_towards_other_opening(first_opening, k);
     AutoplanResult r = shared;
     StageTimer each_timer(r.stage_seconds);
-    plan_opening(skull, bone, cloud, each, true, each_timer, r);
+    plan_opening(skull, bone, cloud, each, shape_model, true, each_timer, r);
     plans.push_back(std::move(r));
   }
   return plans;

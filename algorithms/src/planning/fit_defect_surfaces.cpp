@@ -191,11 +191,8 @@ double VaultSphere::radius_along(const Eigen::Vector3d& from, const Eigen::Vecto
   return -b + std::sqrt(std::max(0.0, b * b - c));
 }
 
-std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> DefectSurfaces::at(
-    const Eigen::Vector3d& dir_in) const {
-  if (!fitted()) return std::nullopt;
-  const Eigen::Vector3d dir = dir_in.normalized();
-  if (dir.dot(axis_) < max_cos_) return std::nullopt;
+std::optional<std::pair<double, double>> DefectSurfaces::radii(const Eigen::Vector3d& dir) const {
+  if (!fitted() || dir.dot(axis_) < max_cos_) return std::nullopt;
   const Eigen::Vector2d q = uv(dir);
   double r_out = outer_(q) + (vault_ ? vault_->radius_along(center_, dir) : 0.0), t = thickness_(q);
   if (mirror_) {
@@ -203,6 +200,27 @@ std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> DefectSurfaces::at(
     if (!m) return std::nullopt;
     r_out += m->first;
     t += m->second;
+  }
+  return std::make_pair(r_out, t);
+}
+
+void DefectSurfaces::blend_with(std::shared_ptr<const DefectSurfaces> other, double weight) {
+  blend_ = other && other->fitted() && (other->center_ - center_).norm() < 1e-9 ? std::move(other)
+                                                                                : nullptr;
+  blend_weight_ = std::clamp(weight, 0.0, 1.0);
+}
+
+std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> DefectSurfaces::at(
+    const Eigen::Vector3d& dir_in) const {
+  const Eigen::Vector3d dir = dir_in.normalized();
+  auto mine = radii(dir);
+  if (!mine) return std::nullopt;
+  auto [r_out, t] = *mine;
+  if (blend_) {
+    if (const auto theirs = blend_->radii(dir)) {
+      r_out += blend_weight_ * (theirs->first - r_out);
+      t += blend_weight_ * (theirs->second - t);
+    }
   }
   // The bone is at least half a millimetre thick and no thicker than one layer can be.
   const double r_in = r_out - std::clamp(t, 0.5, max_thickness_mm_);

@@ -5,6 +5,7 @@
 #include <cmath>
 #include <cstdio>
 #include <limits>
+#include <memory>
 #include <optional>
 #include <utility>
 #include <vector>
@@ -23,12 +24,15 @@ const char* to_string(PlanMethod m) {
       return "mirror";
     case PlanMethod::RimOnly:
       return "rim-only";
+    case PlanMethod::ShapeModel:
+      return "model";
   }
   return "auto";
 }
 
 bool plan_method_from_string(const std::string& text, PlanMethod& out) {
-  for (PlanMethod m : {PlanMethod::Auto, PlanMethod::Mirror, PlanMethod::RimOnly})
+  for (PlanMethod m :
+       {PlanMethod::Auto, PlanMethod::Mirror, PlanMethod::RimOnly, PlanMethod::ShapeModel})
     if (text == to_string(m)) {
       out = m;
       return true;
@@ -39,7 +43,9 @@ bool plan_method_from_string(const std::string& text, PlanMethod& out) {
 std::string describe_method(PlanMethod method, double mirror_coverage) {
   char buf[80];
   std::snprintf(buf, sizeof(buf), "%s (mirror covers %.0f%% of the opening)",
-                method == PlanMethod::Mirror ? "mirror-guided" : "rim-only fitting",
+                method == PlanMethod::Mirror       ? "mirror-guided"
+                : method == PlanMethod::ShapeModel ? "shape-model-guided"
+                                                   : "rim-only fitting",
                 100.0 * mirror_coverage);
   return buf;
 }
@@ -497,7 +503,7 @@ void add_surface_markers(const DefectRegion& defect, const DefectSurfaces& surfa
 
 MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const SurfaceLocator& bone,
                                           const SurfaceLocator& mirror, const ProposeParams& params,
-                                          int first_id) {
+                                          int first_id, const SurfaceLocator* model) {
   MarkerProposal r;
   r.defect = defect;
   if (!defect.found()) {
@@ -506,12 +512,30 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
   }
   r.mirror_coverage = mirror_coverage(defect, mirror, params);
   r.method_used = params.method == PlanMethod::Auto
-                      ? (r.mirror_coverage >= params.min_mirror_coverage ? PlanMethod::Mirror
-                                                                         : PlanMethod::RimOnly)
+                      ? (model                                             ? PlanMethod::ShapeModel
+                         : r.mirror_coverage >= params.min_mirror_coverage ? PlanMethod::Mirror
+                                                                           : PlanMethod::RimOnly)
                       : params.method;
+  if (r.method_used == PlanMethod::ShapeModel && !model) {
+    r.status = MarkerProposal::Status::Failed;
+    r.message = defect.message + "; the shape model was asked for, and none fits this skull";
+    return r;
+  }
   const bool guided = r.method_used == PlanMethod::Mirror;
-  const DefectSurfaces surfaces =
-      fit_defect_surfaces(defect, bone, guided ? &mirror : nullptr, params.surfaces, params.detect);
+  const SurfaceLocator* prior = guided                                    ? &mirror
+                                : r.method_used == PlanMethod::ShapeModel ? model
+                                                                          : nullptr;
+  DefectSurfaces surfaces =
+      fit_defect_surfaces(defect, bone, prior, params.surfaces, params.detect);
+  if (r.method_used == PlanMethod::ShapeModel && surfaces.fitted() &&
+      params.shape_model_weight < 1.0) {
+    // The shape model's surfaces averaged with today's method's (the mirror where it covers
+    // the opening, else the ring's).
+    const bool mirror_covers = r.mirror_coverage >= params.min_mirror_coverage;
+    auto other = std::make_shared<DefectSurfaces>(fit_defect_surfaces(
+        defect, bone, mirror_covers ? &mirror : nullptr, params.surfaces, params.detect));
+    surfaces.blend_with(other, 1.0 - params.shape_model_weight);
+  }
   r.surfaces_message = surfaces.message;
   if (!surfaces.fitted()) {
     r.status = MarkerProposal::Status::Failed;

@@ -13,6 +13,7 @@
 #include "cranioplan/algorithms/alignment/register_icp.h"
 #include "cranioplan/algorithms/implant/build_implant.h"
 #include "cranioplan/algorithms/planning/propose_markers.h"
+#include "cranioplan/algorithms/planning/shape_prior.h"
 #include "cranioplan/algorithms/quality/check_implant.h"
 #include "cranioplan/model/landmarks.h"
 #include "cranioplan/model/marker.h"
@@ -27,6 +28,8 @@ struct AutoplanParams {
   /// of the opening (mm; 0: off), so the healthy side fits the defect's surroundings rather than
   /// the whole skull.
   double local_registration_mm = 25.0;
+  /// Fitting a shape model of the normal skull, when the plan is given one.
+  ShapePriorParams shape_prior;
   /// The shell, fitted to the bone (built 4 mm over it and the skull subtracted), so that the
   /// automatic implant meets the cut face all around without entering the bone.
   ImplantParams implant = [] {
@@ -51,6 +54,8 @@ struct AutoplanResult {
   DefectRegion defect;
   PlanMethod method_used = PlanMethod::RimOnly;
   double mirror_coverage = 0.0;  ///< fraction of the opening's rays that meet mirrored bone
+  /// The shape model's fit, when the plan was given a model (used or not: `usable()`).
+  std::optional<ShapeFit> shape_fit;
   std::string surfaces_message;  ///< how the defect's surfaces were fitted to the intact ring
   std::vector<Marker> markers;   ///< proposed (after smoothing)
   ImplantResult implant;
@@ -62,8 +67,10 @@ struct AutoplanResult {
 /// The status's name in every command's output: "planned", "no_defect" or "failed".
 const char* status_name(AutoplanResult::Status status);
 
+/// `shape_model` (may be null): a model of the normal skull to guide the missing bone's surfaces
+/// (fitted around the opening; when it fits poorly the plan goes on as without it and says so).
 AutoplanResult autoplan(const SkullMesh& skull, const Landmarks& landmarks,
-                        const AutoplanParams& params = {});
+                        const AutoplanParams& params = {}, const ShapeModel* shape_model = nullptr);
 
 struct VertexCloud;
 
@@ -98,10 +105,11 @@ std::optional<LocalRegistration> local_registration(const SkullMesh& skull, cons
 /// The registration a plan goes on with: the local one when it is usable, else the global one.
 const RegisterResult& registration_used(const RegisterResult& global,
                                         const std::optional<LocalRegistration>& local);
-/// Markers for the opening, from `first_id` on; `mirror` locates the registered mirror.
+/// Markers for the opening, from `first_id` on; `mirror` locates the registered mirror, `model`
+/// (may be null) a fitted shape model (ShapePrior::locator).
 MarkerProposal markers(const DefectRegion& defect, const SurfaceLocator& bone,
-                       const SurfaceLocator& mirror, const AutoplanParams& params,
-                       int first_id = 1);
+                       const SurfaceLocator& mirror, const AutoplanParams& params, int first_id = 1,
+                       const SurfaceLocator* model = nullptr);
 /// The implant's parameters: the automatic plan's, in the frame of the rays that found the
 /// opening, with the plan's plane as the tabs' midline (when tabs are asked without one).
 ImplantParams implant_params(const DefectRegion& defect, const Plane& plane,
@@ -123,6 +131,7 @@ Eigen::Vector3d point_towards_other_opening(const DefectRegion& first, size_t k)
 /// first finds no defect or the plane fails.
 std::vector<AutoplanResult> autoplan_all_openings(const SkullMesh& skull,
                                                   const Landmarks& landmarks,
-                                                  const AutoplanParams& params = {});
+                                                  const AutoplanParams& params = {},
+                                                  const ShapeModel* shape_model = nullptr);
 
 }  // namespace cranioplan

@@ -14,6 +14,7 @@
 //
 // Rays that pass within `rim_clearance_mm` of the opening are not used: at a cut face that is
 // not along the rays they graze the bone and see neither table where it would continue.
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
@@ -116,12 +117,22 @@ class DefectSurfaces {
   /// mirror has no bone there.
   std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> at(const Eigen::Vector3d& dir) const;
 
+  /// From now on at() gives these surfaces' radii averaged with `other`'s (fitted to the same
+  /// opening, so from the same centre), `weight` of `other`'s (0..1), along each ray where both
+  /// have a value; these alone where `other` has none. Two fits guided by different priors
+  /// (a shape model and the ring, say) err differently, and their mean errs less than either.
+  void blend_with(std::shared_ptr<const DefectSurfaces> other, double weight);
+
  private:
   friend struct DefectSurfaceFit;  // the fit's stages (fit_defect_surfaces.cpp)
   Eigen::Vector2d uv(const Eigen::Vector3d& dir) const;
   /// The mirror's outer radius and thickness along `dir` over the footprint; none where it has
   /// too little bone there.
   std::optional<std::pair<double, double>> mirror_along(const Eigen::Vector3d& dir) const;
+  /// The outer radius and the thickness along unit `dir` (no blend), none outside the cap.
+  std::optional<std::pair<double, double>> radii(const Eigen::Vector3d& dir) const;
+  std::shared_ptr<const DefectSurfaces> blend_;
+  double blend_weight_ = 0.0;
   Eigen::Vector3d center_ = Eigen::Vector3d::Zero(), axis_ = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d e1_ = Eigen::Vector3d::UnitX(), e2_ = Eigen::Vector3d::UnitY();
   double scale_ = 1.0;                      // mm per unit of the gnomonic projection

@@ -20,15 +20,22 @@ namespace cranioplan {
 
 class SurfaceLocator;
 
-enum class PlanMethod { Auto, Mirror, RimOnly };
+/// How the missing bone's surfaces are guided: the registered mirror, the ring alone, or a shape
+/// model of the normal skull fitted to the intact bone (shape_prior.h).
+enum class PlanMethod { Auto, Mirror, RimOnly, ShapeModel };
 const char* to_string(PlanMethod m);
-/// "auto", "mirror" or "rim-only"; false for anything else.
+/// "auto", "mirror", "rim-only" or "model"; false for anything else.
 bool plan_method_from_string(const std::string& text, PlanMethod& out);
 
 struct ProposeParams {
   DetectDefectParams detect;
-  PlanMethod method = PlanMethod::Auto;  ///< Auto: mirror where it covers the defect, else rim
+  /// Auto: the shape model when one is given and fits, else the mirror where it covers the
+  /// defect, else the ring.
+  PlanMethod method = PlanMethod::Auto;
   double min_mirror_coverage = 0.8;      ///< Auto uses the mirror above this coverage, 0..1
+  /// Guided by a shape model, the model's surfaces are averaged with the mirror's (where it
+  /// covers the opening) or the ring's, this much of the model's (0..1; 1: the model alone).
+  double shape_model_weight = 0.5;
   double edge_spacing_mm = 4.0;          ///< proposed edge markers along the rim, mm (>0)
   double surface_spacing_mm = 6.0;       ///< proposed surface and support markers, mm (>0)
   /// Inner support markers only where the ring ray's first bone faces it within this angle
@@ -79,10 +86,11 @@ DefectRegion detect_defect_near_plane(const SkullMesh& skull, const SurfaceLocat
 RegionOfInterest local_registration_region(const DefectRegion& defect, double margin_mm);
 
 /// Markers for an already detected defect; `bone` locates the skull it was found in, `mirror`
-/// the registered mirrored skull.
+/// the registered mirrored skull, `model` (may be null) a shape model fitted to the skull
+/// (ShapePrior::locator).
 MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const SurfaceLocator& bone,
                                           const SurfaceLocator& mirror, const ProposeParams& params,
-                                          int first_id = 1);
+                                          int first_id = 1, const SurfaceLocator* model = nullptr);
 
 /// Detects the defect, then proposes markers (status NoDefect when there is none).
 MarkerProposal propose_markers(const SkullMesh& skull, const SurfaceLocator& bone,

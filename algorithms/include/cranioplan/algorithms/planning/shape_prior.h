@@ -1,0 +1,35 @@
+#pragma once
+// A shape model of the normal skull (shape/shape_model.h) fitted to a defective skull's intact
+// bone, the opening and a margin around it left out: a prior for the missing bone's surfaces,
+// read along the planner's rays as the registered mirror is (fit_defect_surfaces.h).
+#include <memory>
+#include <string>
+
+#include "cranioplan/algorithms/planning/detect_defect.h"
+#include "cranioplan/algorithms/shape/fit_shape_model.h"
+#include "cranioplan/model/mesh.h"
+
+namespace cranioplan {
+
+class SurfaceLocator;
+
+struct ShapePriorParams {
+  ShapeFitParams fit;
+  /// Bone within this distance of the opening (along the skull, about) is not fitted, mm: the
+  /// rim's cut face and any bone the trauma or the saw bent (0..50).
+  double margin_mm = 10.0;
+};
+
+struct ShapePrior {
+  ShapeFit fit;
+  SkullMesh mesh;                           ///< the fitted instance's two sheets
+  std::shared_ptr<SurfaceLocator> locator;  ///< over `mesh`; null unless the fit is usable
+  bool usable() const { return fit.usable() && locator != nullptr; }
+};
+
+/// Fits `model` to `skull` (located by `bone`) around the opening `defect`.
+ShapePrior fit_shape_prior(const ShapeModel& model, const SkullMesh& skull,
+                           const SurfaceLocator& bone, const DefectRegion& defect,
+                           const ShapePriorParams& params = {});
+
+}  // namespace cranioplan

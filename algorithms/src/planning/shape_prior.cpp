@@ -1,0 +1,43 @@
+#include "cranioplan/algorithms/planning/shape_prior.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "cranioplan/algorithms/geometry/point_index.h"
+#include "cranioplan/algorithms/geometry/surface_locator.h"
+
+namespace cranioplan {
+
+ShapePrior fit_shape_prior(const ShapeModel& model, const SkullMesh& skull,
+                           const SurfaceLocator& bone, const DefectRegion& defect,
+                           const ShapePriorParams& params) {
+  ShapePrior out;
+  std::vector<Eigen::Vector3d> points;
+  const size_t step = std::max<size_t>(1, skull.n_vertices() / 40000);
+  for (size_t i = 0; i < skull.n_vertices(); i += step)
+    points.push_back(to_eigen(skull.point(SkullMesh::VertexHandle(static_cast<int>(i)))));
+  // The opening seen from the rays' centre, widened by the margin at each point's distance: a
+  // point is left out when a ray through the opening passes within the margin's angle of it.
+  const PointIndex holes(defect.hole_directions);
+  const double margin = std::clamp(params.margin_mm, 0.0, 50.0);
+  const Eigen::Vector3d center = defect.center;
+  auto left_out = [&](const Eigen::Vector3d& p) {
+    if (holes.size() == 0) return false;
+    const Eigen::Vector3d v = p - center;
+    const double r = v.norm();
+    if (r <= 0.0) return false;
+    double d2 = 0.0;
+    holes.nearest(v / r, &d2);
+    // Chord between unit directions ≈ angle; the margin's angle at distance r, plus half the
+    // rays' spacing (the opening's directions are samples).
+    const double angle = 2.0 * std::asin(std::min(1.0, std::sqrt(d2) / 2.0));
+    return angle * r <= margin + 2.0;
+  };
+  out.fit = fit_shape_model(model, bone, points, left_out, params.fit);
+  if (!out.fit.usable()) return out;
+  out.mesh = model.mesh(out.fit.points);
+  out.locator = std::make_shared<SurfaceLocator>(out.mesh);
+  return out;
+}
+
+}  // namespace cranioplan
