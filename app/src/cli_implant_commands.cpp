@@ -144,8 +144,9 @@ void print_plans(const Json& plans, bool json) {
 Json autoplan_with_session(const std::string& skull, const ExtractBoneSurfaceParams& import,
                            const Landmarks& lm, const AutoplanParams& params,
                            const std::string& output, const std::string& markers_out,
-                           const std::string& session_path, bool all_openings, AutoplanSession& a) {
-  a = autoplan_session(skull, lm, params, output, {}, import, all_openings);
+                           const std::string& session_path, bool all_openings,
+                           const std::string& shape_model, AutoplanSession& a) {
+  a = autoplan_session(skull, lm, params, output, {}, import, all_openings, shape_model);
   a.session.save(session_path);
   const PlanState& s = a.session.state();
   Json j{{"status", status_name(a.status)}, {"message", a.message}};
@@ -170,10 +171,10 @@ Json autoplan_with_session(const std::string& skull, const ExtractBoneSurfacePar
 int autoplan_sessions(const std::string& skull, const ExtractBoneSurfaceParams& import,
                       const Landmarks& lm, const AutoplanParams& params, const std::string& output,
                       const std::string& markers_out, const std::string& session, bool all_openings,
-                      bool json) {
+                      const std::string& shape_model, bool json) {
   AutoplanSession first;
   Json j = autoplan_with_session(skull, import, lm, params, output, markers_out, session,
-                                 all_openings, first);
+                                 all_openings, shape_model, first);
   if (!all_openings || !first.defect.found()) {
     print_result(j, json);
     return first.planned() ? kOk : kUnusable;
@@ -186,7 +187,7 @@ int autoplan_sessions(const std::string& skull, const ExtractBoneSurfaceParams& 
     AutoplanSession a;
     Json one = autoplan_with_session(skull, import, lm, each, numbered_path(output, k + 2),
                                      markers_out.empty() ? "" : numbered_path(markers_out, k + 2),
-                                     numbered_path(session, k + 2), true, a);
+                                     numbered_path(session, k + 2), true, shape_model, a);
     plans.push_back(one);
     all_planned = all_planned && a.planned();
   }
@@ -634,12 +635,9 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
         const auto model = shape_model_from(o->shape_model);
         if (o->method == "model" && !model)
           throw CLI::ValidationError("--method model", "needs --shape-model FILE");
-        if (model && !o->session.empty())
-          throw CLI::ValidationError("--shape-model",
-                                     "is not yet recorded in sessions: plan without --session");
         if (!o->session.empty())
           return autoplan_sessions(o->skull, o->import, lm, o->params, o->output, o->markers_out,
-                                   o->session, o->all_openings, json);
+                                   o->session, o->all_openings, o->shape_model, json);
         const LoadedSkull loaded = load_skull(o->skull, o->import);
         const SkullMesh& skull = loaded.mesh;
         // The reader's warnings (a skull turned outward, non-manifold edges) and notes (a flat

@@ -138,16 +138,21 @@ VerifyReport verify_session(const std::string& path) {
   VerifyCheck inputs{"inputs", true, ""};
   int n_inputs = 0;
   for (const auto& c : doc.commands) {
-    if (c.type != CommandType::LoadSkull && c.type != CommandType::AttachCt) continue;
+    // The skull, an attached CT, and a shape model a proposal was guided by.
+    const bool model = c.type == CommandType::ProposeMarkers && c.params.contains("shape_model") &&
+                       c.params["shape_model"].is_object();
+    if (c.type != CommandType::LoadSkull && c.type != CommandType::AttachCt && !model) continue;
+    const Json& input = model ? c.params["shape_model"] : c.params;
     ++n_inputs;
-    const std::string recorded = c.params.value("path", std::string());
+    const std::string recorded = input.value("path", std::string());
     const std::string found = resolve(recorded, dir);
     if (found.empty()) {
       inputs.ok = false;
       inputs.detail += recorded + ": missing. ";
-    } else if (sha256_file(found) != c.params.value("sha256", std::string())) {
+    } else if (sha256_file(found) != input.value("sha256", std::string())) {
       inputs.ok = false;
-      inputs.detail += found + ": the skull file changed since this plan was made. ";
+      inputs.detail += found + (model ? ": the shape model" : ": the skull file") +
+                       " changed since this plan was made. ";
     }
   }
   if (inputs.ok) inputs.detail = std::to_string(n_inputs) + " input file(s) unchanged (SHA-256)";

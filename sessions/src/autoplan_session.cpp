@@ -45,7 +45,7 @@ Command recorded(Command command, const Json& result, double ms) {
 AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks& landmarks,
                                  const AutoplanParams& params, const std::string& export_path,
                                  const SessionInfo& info, const ExtractBoneSurfaceParams& import,
-                                 bool others_planned) {
+                                 bool others_planned, const std::string& shape_model) {
   AutoplanSession out;
   SessionInfo with_case = info;
   if (with_case.case_id.empty())
@@ -101,14 +101,23 @@ AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks&
   }
   if (!step_complete(s.state(), 3)) run(commands::complete_step(3));
   run(commands::complete_step(4));
-  Command propose = commands::propose_markers(params.propose);
+  Command propose = commands::propose_markers(params.propose, shape_model);
   if (out.defect.found() && s.state().mirrored) {
-    // The proposal's search is the detection and the markers.
+    // The proposal's search is the detection, the shape model's fit and the markers.
     const Stopwatch t;
     const PlanState& st = s.state();
-    const Json proposal = proposal_result(autoplan_stages::markers(
-        out.defect, bone, st.mirrored->locator, params, st.next_marker_id));
-    propose = recorded(std::move(propose), proposal, detect_ms + t.ms());
+    std::optional<ShapePrior> prior;
+    if (!shape_model.empty())
+      prior = fit_shape_prior(read_shape_model(shape_model), mesh, bone, out.defect,
+                              params.shape_prior);
+    MarkerProposal markers =
+        autoplan_stages::markers(out.defect, bone, st.mirrored->locator, params, st.next_marker_id,
+                                 prior && prior->usable() ? prior->locator.get() : nullptr);
+    if (prior)
+      markers.surfaces_message += std::string("; ") +
+                                  (prior->usable() ? "" : "not guided by the shape model: ") +
+                                  prior->fit.message;
+    propose = recorded(std::move(propose), proposal_result(markers), detect_ms + t.ms());
   }
   run(std::move(propose));
   if (s.state().markers.empty()) {

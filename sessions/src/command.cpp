@@ -9,6 +9,7 @@
 #include "cranioplan/model/error.h"
 #include "cranioplan/sessions/marker_files.h"
 #include "cranioplan/sessions/session_error.h"
+#include "cranioplan/sessions/sha256.h"
 
 namespace cranioplan {
 
@@ -853,8 +854,14 @@ Command import_markers(const std::vector<Marker>& markers, const std::string& so
 
 Command clear_markers() { return make(CommandType::ClearMarkers, Json::object(), 5); }
 
-Command propose_markers(const ProposeParams& params) {
-  return make(CommandType::ProposeMarkers, {{"params", params_to_json(params)}}, 5);
+Command propose_markers(const ProposeParams& params, const std::string& shape_model,
+                        const std::string& shape_model_sha256) {
+  Json j{{"params", params_to_json(params)}};
+  if (!shape_model.empty())
+    j["shape_model"] = Json{
+        {"path", shape_model},
+        {"sha256", shape_model_sha256.empty() ? sha256_file(shape_model) : shape_model_sha256}};
+  return make(CommandType::ProposeMarkers, j, 5);
 }
 
 Command smooth_markers(const SmoothParams& params, bool project_onto_mirror) {

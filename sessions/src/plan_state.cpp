@@ -14,7 +14,9 @@
 #include "cranioplan/algorithms/io/write_3mf.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/algorithms/planning/propose_markers.h"
+#include "cranioplan/algorithms/planning/shape_prior.h"
 #include "cranioplan/algorithms/quality/ct_agreement.h"
+#include "cranioplan/algorithms/shape/shape_model.h"
 #include "cranioplan/sessions/marker_files.h"
 #include "cranioplan/sessions/session_error.h"
 #include "cranioplan/sessions/sha256.h"
@@ -765,15 +767,45 @@ bool apply_proposal_result(PlanState& s, const Json& j, const std::string& where
 // Proposes markers, or applies the proposal the command recorded when it was first done; both
 // go through the recorded form, so a replay is the live command. A proposal replaces the
 // markers; a failed one leaves them as they were.
-void apply_propose(PlanState& s, const ParamReader& r, Json& record) {
+// The shape model a propose_markers command names, read and checked against its recorded
+// SHA-256 (a SessionError naming the file when it changed).
+ShapeModel recorded_shape_model(const ParamReader& r, const ApplyContext& ctx) {
+  const ParamReader model(r.value("shape_model"), r.where() + " shape_model");
+  const std::string path = resolve_input(model.string("path"), ctx, "shape model");
+  const std::string sha = sha256_file(path), expected = model.string("sha256");
+  if (sha != expected)
+    throw SessionError(path, "the shape model changed since this plan was made (SHA-256 " +
+                                 sha.substr(0, 12) + "… now, " + expected.substr(0, 12) +
+                                 "… recorded)");
+  return read_shape_model(path);
+}
+
+void apply_propose(PlanState& s, const ParamReader& r, const ApplyContext& ctx, Json& record) {
   ProposeParams params;
   params_from_json(ParamReader(r.value("params"), r.where() + " params"), params);
   if (!r.has("result")) {
     take_scan_borders(params.detect, s.skull->surface->loaded.report);
-    const SurfaceLocator& mirror = s.mirrored ? s.mirrored->locator : s.skull->surface->locator;
-    record["result"] =
-        proposal_result(propose_markers(s.skull->surface->mesh, s.skull->surface->locator, *s.plane,
-                                        mirror, params, s.next_marker_id));
+    const SurfaceLocator& bone = s.skull->surface->locator;
+    const SurfaceLocator& mirror = s.mirrored ? s.mirrored->locator : bone;
+    if (r.has("shape_model")) {
+      const ShapeModel model = recorded_shape_model(r, ctx);
+      const DefectRegion defect =
+          detect_defect_near_plane(s.skull->surface->mesh, bone, *s.plane, params.detect);
+      std::optional<ShapePrior> prior;
+      if (defect.found())
+        prior = fit_shape_prior(model, s.skull->surface->mesh, bone, defect, ShapePriorParams{});
+      MarkerProposal proposal =
+          propose_markers_for_defect(defect, bone, mirror, params, s.next_marker_id,
+                                     prior && prior->usable() ? prior->locator.get() : nullptr);
+      if (prior)
+        proposal.surfaces_message += std::string("; ") +
+                                     (prior->usable() ? "" : "not guided by the shape model: ") +
+                                     prior->fit.message;
+      record["result"] = proposal_result(proposal);
+    } else {
+      record["result"] = proposal_result(propose_markers(s.skull->surface->mesh, bone, *s.plane,
+                                                         mirror, params, s.next_marker_id));
+    }
   }
   const Json& result = r.has("result") ? r.value("result") : record["result"];
   if (!apply_proposal_result(s, result, r.where() + " result")) return;
@@ -1005,7 +1037,7 @@ ApplyOutcome apply_command(const PlanState& before, const Command& command,
         apply_marker_edit(s, command.type, r);
         break;
       case CommandType::ProposeMarkers:
-        apply_propose(s, r, out.record);
+        apply_propose(s, r, context, out.record);
         break;
       case CommandType::SmoothMarkers:
         apply_smooth(s, r);

@@ -9,13 +9,17 @@
 #include <QDoubleSpinBox>
 #include <QLabel>
 #include <QPushButton>
+#include <QSettings>
 #include <QSlider>
 #include <QTest>
 #include <QTextBrowser>
 #include <cmath>
+#include <filesystem>
+#include <fstream>
 #include <limits>
 
 #include "cranioplan/algorithms/planning/autoplan.h"
+#include "cranioplan/sessions/sha256.h"
 
 namespace cranioplan::gui {
 namespace {
@@ -172,6 +176,35 @@ TEST(StepPages, MarkersGoOnTheSurfaceTheirTypeBelongsTo) {
   EXPECT_EQ(host.pushed.back().type, CommandType::ProposeMarkers);
   click(edges, "clearMarkers");
   EXPECT_EQ(host.pushed.back().type, CommandType::ClearMarkers);
+}
+
+// The proposal can be guided by a model of the normal skull: the choice (the box and the file)
+// is remembered in the settings, and a proposal made with it ticked names the model, with its
+// SHA-256, in the command; unticked it names none.
+TEST(StepPages, AProposalGuidedByAShapeModelNamesItInTheCommand) {
+  const auto model = std::filesystem::temp_directory_path() / "cranioplan_gui_model.cpsm";
+  std::ofstream(model) << "CRANIOPLAN-SHAPE-MODEL 1\n";
+  QSettings().setValue("shapeModel/path", QString::fromStdString(model.string()));
+  QSettings().setValue("shapeModel/use", false);
+  RecordingHost host;
+  EdgeMarkersPage page(host);
+  auto* use = child<QCheckBox>(page, "useShapeModel");
+  EXPECT_FALSE(use->isChecked());
+  EXPECT_EQ(child<QLabel>(page, "shapeModelFile")->text(), "cranioplan_gui_model.cpsm");
+  click(page, "propose");
+  ASSERT_EQ(host.pushed.back().type, CommandType::ProposeMarkers);
+  EXPECT_FALSE(host.pushed.back().params.contains("shape_model"));
+  use->setChecked(true);
+  EXPECT_TRUE(QSettings().value("shapeModel/use").toBool());
+  click(page, "propose");
+  ASSERT_EQ(host.pushed.back().type, CommandType::ProposeMarkers);
+  EXPECT_EQ(host.pushed.back().params["shape_model"]["path"], model.string());
+  EXPECT_EQ(host.pushed.back().params["shape_model"]["sha256"], sha256_file(model.string()));
+  // Remembered: a new page (the next plan) starts ticked with the same file.
+  EdgeMarkersPage next(host);
+  EXPECT_TRUE(child<QCheckBox>(next, "useShapeModel")->isChecked());
+  QSettings().setValue("shapeModel/use", false);
+  std::filesystem::remove(model);
 }
 
 TEST(StepPages, TheMarkerCountsAndTheProposalNoteShowTheState) {

@@ -4,14 +4,18 @@
 
 #include <cstdio>
 #include <filesystem>
+#include <fstream>
 
 #include "cranioplan/algorithms/io/load_skull.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/algorithms/planning/autoplan.h"
+#include "cranioplan/algorithms/shape/correspond_skull.h"
+#include "cranioplan/algorithms/shape/shape_model.h"
 #include "cranioplan/sessions/audit.h"
 #include "cranioplan/sessions/marker_files.h"
 #include "cranioplan/sessions/sha256.h"
 #include "support/session_cases.h"
+#include "support/synthetic.h"
 
 namespace cranioplan {
 namespace {
@@ -37,6 +41,59 @@ TEST(AutoplanSession, ReplayReproducesTheExportByteForByte) {
   const VerifyReport v = verify_session(c.session_path);
   EXPECT_TRUE(v.ok());
   for (const auto& check : v.checks) EXPECT_TRUE(check.ok) << check.name << ": " << check.detail;
+}
+
+// A plan guided by a shape model records the model as an input (its path and SHA-256) with the
+// proposal: the session replays to the same implant without reading it again, and verify checks
+// the model's bytes like the skull's. The model here is a small one made of the case's intact
+// head stretched three ways (what is tested is the recording, not the model's accuracy).
+TEST(AutoplanSession, AShapeModelIsRecordedAsAnInputAndVerified) {
+  const auto dir = std::filesystem::temp_directory_path() / "cranioplan_session_shape_model";
+  std::filesystem::create_directories(dir);
+  const ShapeTemplate t =
+      make_shape_template(test::make_thick_head(0.93, 0.8), ShapeTemplateParams{4});
+  ASSERT_GT(t.outer_count, 100);
+  std::vector<Eigen::Matrix3Xd> shapes;
+  for (const Eigen::Vector3d& stretch :
+       {Eigen::Vector3d(1.0, 1.0, 1.0), Eigen::Vector3d(1.03, 0.98, 1.0),
+        Eigen::Vector3d(0.98, 1.02, 1.03)})
+    shapes.push_back(stretch.asDiagonal() * t.points);
+  ShapeModel model = build_shape_model(shapes, t.outer_count, t.triangles, {}, false);
+  model.provenance.skull_sha256 = {"a", "b", "c"};
+  model.provenance.skull_names = {"a", "b", "c"};
+  const std::string model_path = (dir / "skulls.cpsm").string();
+  write_shape_model(model, model_path);
+
+  const std::string session_path = (dir / "plan.json").string();
+  AutoplanSession a = autoplan_session(test::defect_skull_stl(), Landmarks{}, AutoplanParams{},
+                                       (dir / "implant.stl").string(), {}, {}, false, model_path);
+  ASSERT_TRUE(a.planned()) << a.message;
+  a.session.save(session_path);
+  bool recorded = false;
+  for (const auto& c : a.session.effective_commands())
+    if (c.type == CommandType::ProposeMarkers) {
+      ASSERT_TRUE(c.params.contains("shape_model"));
+      EXPECT_EQ(c.params["shape_model"]["sha256"], sha256_file(model_path));
+      EXPECT_NE(c.params["result"]["message"].get<std::string>().find("shape model"),
+                std::string::npos);
+      recorded = true;
+    }
+  EXPECT_TRUE(recorded);
+  EXPECT_EQ(test::validate_session_schema(session_path), "");
+  const std::string implant_sha = a.session.state().implant->stl_sha256();
+  EXPECT_EQ(Session::open(session_path).state().implant->stl_sha256(), implant_sha);
+  EXPECT_TRUE(verify_session(session_path).ok());
+
+  // The model changed after the plan: verify says so, naming it.
+  std::ofstream(model_path, std::ios::app) << "x";
+  const VerifyReport v = verify_session(session_path);
+  EXPECT_FALSE(v.ok());
+  bool named = false;
+  for (const auto& check : v.checks)
+    if (check.name == "inputs")
+      named = check.detail.find("shape model changed") != std::string::npos;
+  EXPECT_TRUE(named);
+  std::filesystem::remove_all(dir);
 }
 
 // A skull from 3D Slicer in RAS (SPACE=RAS) is planned in the patient's LPS and its implant

@@ -1,7 +1,10 @@
+#include <QCheckBox>
 #include <QFileDialog>
+#include <QFileInfo>
 #include <QFormLayout>
 #include <QLabel>
 #include <QPushButton>
+#include <QSettings>
 
 #include "step_pages.h"
 
@@ -66,8 +69,20 @@ EdgeMarkersPage::EdgeMarkersPage(PageHost& host)
     // meant (otherwise the largest).
     ProposeParams params;
     params.detect.near = edge_marker_centre(host_.plan().markers);
-    host_.push(commands::propose_markers(params), tr("Finding the defect and proposing markers"));
+    const std::string model = shape_model_path();
+    if (!model.empty() && !QFileInfo::exists(QString::fromStdString(model))) {
+      proposal_note_->setText(tr("The shape model %1 is missing: choose it again, or untick "
+                                 "\"Guide with a model of the normal skull\".")
+                                  .arg(QString::fromStdString(model)));
+      proposal_note_->setVisible(true);
+      return;
+    }
+    host_.push(commands::propose_markers(params, model),
+               model.empty() ? tr("Finding the defect and proposing markers")
+                             : tr("Finding the defect, fitting the shape model and proposing "
+                                  "markers"));
   });
+  add_shape_model_row();
   QPushButton* import = add_button(tr("Import markers…"), "importMarkers");
   connect(import, &QPushButton::clicked, this, &EdgeMarkersPage::import_markers);
   QPushButton* clear = add_button(tr("Clear markers"), "clearMarkers");
@@ -79,6 +94,50 @@ EdgeMarkersPage::EdgeMarkersPage(PageHost& host)
   proposal_note_->setObjectName("proposalNote");
   proposal_note_->setWordWrap(true);
   form_->addRow(proposal_note_);
+}
+
+void EdgeMarkersPage::add_shape_model_row() {
+  QSettings settings;
+  use_model_ = new QCheckBox(tr("Guide with a model of the normal skull"), this);
+  use_model_->setObjectName("useShapeModel");
+  use_model_->setToolTip(
+      tr("A statistical shape model built from normal skulls (cranioplan-cli shape-model "
+         "build; docs/SHAPE_MODEL.md) is fitted to the intact bone and guides the missing "
+         "vault with the mirror or the ring. A poor fit is not used, and the proposal says so."));
+  use_model_->setChecked(settings.value("shapeModel/use", false).toBool());
+  model_file_ = new QLabel(this);
+  model_file_->setObjectName("shapeModelFile");
+  model_file_->setWordWrap(true);
+  const QString path = settings.value("shapeModel/path").toString();
+  model_file_->setText(path.isEmpty() ? tr("No model chosen.") : QFileInfo(path).fileName());
+  model_file_->setToolTip(path);
+  QPushButton* choose = make_button(tr("Choose model…"), "chooseShapeModel");
+  connect(choose, &QPushButton::clicked, this, &EdgeMarkersPage::choose_shape_model);
+  connect(use_model_, &QCheckBox::toggled, this, [this](bool on) {
+    QSettings().setValue("shapeModel/use", on);
+    if (on && QSettings().value("shapeModel/path").toString().isEmpty()) choose_shape_model();
+  });
+  form_->addRow(use_model_);
+  form_->addRow(model_file_, choose);
+}
+
+void EdgeMarkersPage::choose_shape_model() {
+  const QString path = QFileDialog::getOpenFileName(this, tr("Model of the normal skull"),
+                                                    QSettings().value("shapeModel/path").toString(),
+                                                    tr("Shape models (*.cpsm)"));
+  if (path.isEmpty()) {
+    if (QSettings().value("shapeModel/path").toString().isEmpty()) use_model_->setChecked(false);
+    return;
+  }
+  QSettings().setValue("shapeModel/path", path);
+  model_file_->setText(QFileInfo(path).fileName());
+  model_file_->setToolTip(path);
+  use_model_->setChecked(true);
+}
+
+std::string EdgeMarkersPage::shape_model_path() const {
+  if (!use_model_->isChecked()) return {};
+  return QSettings().value("shapeModel/path").toString().toStdString();
 }
 
 void EdgeMarkersPage::import_markers() {

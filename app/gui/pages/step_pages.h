@@ -111,8 +111,16 @@ class EdgeMarkersPage : public MarkersPage {
 
  private:
   void import_markers();
+  /// The shape model's row: a box to guide the proposal with it and the file chosen, both
+  /// remembered in the settings ("shapeModel/use", "shapeModel/path").
+  void add_shape_model_row();
+  void choose_shape_model();
+  /// The model file the next proposal uses: empty unless the box is ticked and a file chosen.
+  std::string shape_model_path() const;
 
   QLabel* proposal_note_;  ///< what the last proposal found
+  QCheckBox* use_model_;   ///< guide the proposal with a model of the normal skull
+  QLabel* model_file_;     ///< the model file chosen
 };
 
 /// Step 6: surface markers on the mirror.

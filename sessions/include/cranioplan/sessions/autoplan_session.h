@@ -30,10 +30,12 @@ const char* status_name(AutoplanSession::Status status);
 /// nothing again. `import`: how the skull file is read (a CT's threshold, a mesh's length unit).
 /// `others_planned`: the skull's other openings are planned in sessions of their own, and the
 /// messages say so. Throws InputError for a bad skull.
+/// `shape_model`: a model of the normal skull (.cpsm) to guide the surfaces, recorded with the
+/// proposal as an input of the plan (path and SHA-256).
 AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks& landmarks,
                                  const AutoplanParams& params, const std::string& export_path,
                                  const SessionInfo& info = {},
                                  const ExtractBoneSurfaceParams& import = {},
-                                 bool others_planned = false);
+                                 bool others_planned = false, const std::string& shape_model = "");
 
 }  // namespace cranioplan

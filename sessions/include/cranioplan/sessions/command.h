@@ -156,7 +156,10 @@ Command retype_marker(int id, MarkerType type);
 Command import_markers(const std::vector<Marker>& markers, const std::string& source,
                        const std::string& sha256);
 Command clear_markers();
-Command propose_markers(const ProposeParams& params = {});
+/// `shape_model`: a model of the normal skull (.cpsm) to guide the surfaces, recorded as an input
+/// of the plan (its path and SHA-256: `shape_model_sha256` when given, else the file's hash).
+Command propose_markers(const ProposeParams& params = {}, const std::string& shape_model = "",
+                        const std::string& shape_model_sha256 = "");
 Command smooth_markers(const SmoothParams& params, bool project_onto_mirror = true);
 Command build_implant(const ImplantParams& params = {});
 /// `sha256` may be empty: the session writes the file and records the hash of its bytes.
