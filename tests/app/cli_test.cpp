@@ -13,6 +13,7 @@
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/algorithms/quality/inject_defect.h"
 #include "cranioplan/sessions/plan_files.h"
+#include "cranioplan/sessions/sha256.h"
 #include "support/dicom_writer.h"
 #include "support/synthetic.h"
 #include "support/test_files.h"
@@ -122,6 +123,54 @@ TEST(Cli, InfoPlaneMirrorRegisterOnASyntheticHead) {
 // negated: the implant of `autoplan -o` without a session, the mould's halves, the defective
 // skull and ground truth of `inject-defect`, and the meshes of `pipeline`. (The session's
 // exports: AutoplanSession.AnImplantPlannedOnARasSkullIsExportedInRas.)
+// shape-model build and info: a model from three skulls (the thick head stretched three ways),
+// its provenance by SHA-256; a file that is not a model, too few skulls and `--method model`
+// without a model are refused with a message.
+TEST(Cli, AShapeModelIsBuiltReportedAndBadInputRefused) {
+  test::TempDir dir;
+  const SkullMesh head = test::make_thick_head(0.93, 0.8);
+  std::vector<std::string> files;
+  for (const Eigen::Vector3d& stretch : {Eigen::Vector3d(1, 1, 1), Eigen::Vector3d(1.04, 0.97, 1),
+                                         Eigen::Vector3d(0.97, 1.03, 1.02)}) {
+    SkullMesh m = head;
+    for (auto v : m.vertices())
+      m.set_point(v, to_point(stretch.asDiagonal() * to_eigen(m.point(v))));
+    files.push_back(dir.path("skull" + std::to_string(files.size()) + ".stl"));
+    write_mesh(m, files.back());
+  }
+  std::string out;
+  ASSERT_EQ(
+      test::run_command(kCli + " shape-model build " + files[0] + " " + files[1] + " " + files[2] +
+                            " --subdivisions 3 -o " + dir.path("m.cpsm") + " --json",
+                        &out),
+      0)
+      << out;
+  const Json built = Json::parse(out);
+  EXPECT_EQ(built["skulls"], 3);
+  EXPECT_GE(built["components"].get<int>(), 1);
+  EXPECT_GT(built["generalization_mm"].get<double>(), 0.0);
+  ASSERT_EQ(test::run_command(kCli + " shape-model info " + dir.path("m.cpsm") + " --json", &out),
+            0);
+  const Json info = Json::parse(out);
+  EXPECT_EQ(info["skull_files"].size(), 3u);
+  EXPECT_EQ(info["skull_files"][1]["sha256"], sha256_file(files[1]));
+  EXPECT_EQ(info["vertices"], built["vertices"]);
+  // Not a model; too few skulls; --method model without one.
+  EXPECT_EQ(test::run_command(kCli + " shape-model info " + files[0] + " --json", &out), 3);
+  EXPECT_NE(out.find("not a Cranioplan shape model"), std::string::npos) << out;
+  EXPECT_NE(out.find("skull0.stl"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(kCli + " shape-model build " + files[0] + " " + files[1] + " -o " +
+                                  dir.path("two.cpsm") + " --json",
+                              &out),
+            3);
+  EXPECT_NE(out.find("at least three"), std::string::npos) << out;
+  EXPECT_EQ(test::run_command(kCli + " autoplan " + files[0] + " --method model -o " +
+                                  dir.path("i.stl") + " --json",
+                              &out),
+            2);
+  EXPECT_NE(out.find("--shape-model"), std::string::npos) << out;
+}
+
 TEST(Cli, MeshesMadeFromARasFileAreWrittenInRas) {
   test::TempDir dir;
   // The thick head's defect for autoplan; a plate on a block for the mould (as

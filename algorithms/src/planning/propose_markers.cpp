@@ -511,30 +511,28 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
     return r;
   }
   r.mirror_coverage = mirror_coverage(defect, mirror, params);
-  r.method_used = params.method == PlanMethod::Auto
-                      ? (model                                             ? PlanMethod::ShapeModel
-                         : r.mirror_coverage >= params.min_mirror_coverage ? PlanMethod::Mirror
-                                                                           : PlanMethod::RimOnly)
-                      : params.method;
+  const bool mirror_covers = r.mirror_coverage >= params.min_mirror_coverage;
+  // Auto: the mirror where it covers the opening; elsewhere the shape model when one fits,
+  // else the ring.
+  r.method_used = params.method == PlanMethod::Auto ? (mirror_covers ? PlanMethod::Mirror
+                                                       : model       ? PlanMethod::ShapeModel
+                                                                     : PlanMethod::RimOnly)
+                                                    : params.method;
   if (r.method_used == PlanMethod::ShapeModel && !model) {
     r.status = MarkerProposal::Status::Failed;
     r.message = defect.message + "; the shape model was asked for, and none fits this skull";
     return r;
   }
-  const bool guided = r.method_used == PlanMethod::Mirror;
-  const SurfaceLocator* prior = guided                                    ? &mirror
-                                : r.method_used == PlanMethod::ShapeModel ? model
-                                                                          : nullptr;
+  const bool guided = r.method_used == PlanMethod::Mirror ||
+                      (r.method_used == PlanMethod::ShapeModel && mirror_covers);
   DefectSurfaces surfaces =
-      fit_defect_surfaces(defect, bone, prior, params.surfaces, params.detect);
-  if (r.method_used == PlanMethod::ShapeModel && surfaces.fitted() &&
-      params.shape_model_weight < 1.0) {
-    // The shape model's surfaces averaged with today's method's (the mirror where it covers
-    // the opening, else the ring's).
-    const bool mirror_covers = r.mirror_coverage >= params.min_mirror_coverage;
-    auto other = std::make_shared<DefectSurfaces>(fit_defect_surfaces(
-        defect, bone, mirror_covers ? &mirror : nullptr, params.surfaces, params.detect));
-    surfaces.blend_with(other, 1.0 - params.shape_model_weight);
+      fit_defect_surfaces(defect, bone, guided ? &mirror : nullptr, params.surfaces, params.detect);
+  if (r.method_used == PlanMethod::ShapeModel && surfaces.fitted()) {
+    // The mirror's or the ring's surfaces with the shape model's averaged in where the model
+    // reaches (its template may stop short of an opening's lower edge).
+    auto shaped = std::make_shared<DefectSurfaces>(
+        fit_defect_surfaces(defect, bone, model, params.surfaces, params.detect));
+    surfaces.blend_with(shaped, params.shape_model_weight);
   }
   r.surfaces_message = surfaces.message;
   if (!surfaces.fitted()) {

@@ -412,7 +412,8 @@ AlignResult align_to_surface(const Eigen::Matrix3Xd& points, const Eigen::Matrix
     c_to = to->center;
     if (params.with_scale) scale = std::clamp(to->radius / from->radius, 0.7, 1.4);
   }
-  const std::vector<Eigen::Index> coarse = every(all, 600);
+  // The starts are sorted out on 200 points, the best refined on 600.
+  const std::vector<Eigen::Index> sparse = every(all, 200), coarse = every(all, 600);
   AlignParams loose = params;
   loose.max_distance_mm = std::max(params.max_distance_mm, 30.0);
   loose.with_scale = false;  // the spheres' ratio until the pose is found: free, ICP shrinks
@@ -420,33 +421,45 @@ AlignResult align_to_surface(const Eigen::Matrix3Xd& points, const Eigen::Matrix
   // distance to bone whose normal agrees (5 mm where there is none). A pose that pairs many
   // points loosely loses to one that lays most of them on the bone.
   constexpr double kCap = 5.0;
-  auto cost_of = [&](const Similarity& T) {
+  auto cost_of = [&](const Similarity& T, const std::vector<Eigen::Index>& which) {
     const SurfacePairs p =
-        pair_with_surface(points, normals, coarse, T, target, kCap, params.max_normal_angle_deg);
-    double cost = kCap * kCap * static_cast<double>(coarse.size() - p.index.size());
+        pair_with_surface(points, normals, which, T, target, kCap, params.max_normal_angle_deg);
+    double cost = kCap * kCap * static_cast<double>(which.size() - p.index.size());
     for (double d : p.distance) cost += d * d;
-    return cost;
+    return cost / static_cast<double>(which.size());
   };
-  // Every start refined a little, the best eight refined further: ICP turns a smooth vault
+  // Every start refined a little, the best four refined further: ICP turns a smooth vault
   // slowly, and a start 25° off needs a few dozen rounds to arrive.
+  // The starts on both cores (each start's rounds are too small to share out).
+  const std::vector<Eigen::Matrix3d> starts = start_rotations();
+  std::vector<std::pair<double, AlignResult>> each(starts.size());
+  parallel_for(
+      starts.size(),
+      [&](size_t begin, size_t end) {
+        for (size_t k = begin; k < end; ++k) {
+          Similarity T = Similarity::Identity();
+          T.topLeftCorner<3, 3>() = scale * starts[k];
+          T.topRightCorner<3, 1>() = c_to - scale * starts[k] * c_from;
+          const AlignResult r = icp(points, normals, sparse, T, target, loose, 8);
+          each[k] = {std::isfinite(r.rms_mm) ? cost_of(r.transform, sparse)
+                                             : std::numeric_limits<double>::infinity(),
+                     r};
+        }
+      },
+      1);
   std::vector<std::pair<double, AlignResult>> tried;
-  for (const Eigen::Matrix3d& R : start_rotations()) {
-    Similarity T = Similarity::Identity();
-    T.topLeftCorner<3, 3>() = scale * R;
-    T.topRightCorner<3, 1>() = c_to - scale * R * c_from;
-    const AlignResult r = icp(points, normals, coarse, T, target, loose, 10);
-    if (std::isfinite(r.rms_mm)) tried.emplace_back(cost_of(r.transform), r);
-  }
+  for (const auto& e : each)
+    if (std::isfinite(e.first)) tried.push_back(e);
   std::sort(tried.begin(), tried.end(),
             [](const auto& a, const auto& b) { return a.first < b.first; });
   AlignResult best;
   best.rms_mm = std::numeric_limits<double>::infinity();
   double best_cost = std::numeric_limits<double>::infinity();
-  for (size_t k = 0; k < std::min<size_t>(8, tried.size()); ++k) {
+  for (size_t k = 0; k < std::min<size_t>(4, tried.size()); ++k) {
     const AlignResult r =
-        icp(points, normals, coarse, tried[k].second.transform, target, loose, 40);
+        icp(points, normals, coarse, tried[k].second.transform, target, loose, 30);
     if (!std::isfinite(r.rms_mm)) continue;
-    const double cost = cost_of(r.transform);
+    const double cost = cost_of(r.transform, coarse);
     if (cost < best_cost) {
       best_cost = cost;
       best = r;
