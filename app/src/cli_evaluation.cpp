@@ -197,6 +197,15 @@ Json evaluate_case(const std::string& id, const std::string& defective,
     // The truth is read first (to fail before planning) and not timed: the time is the
     // plan's, from reading the skull to the implant.
     const SkullMesh truth = load_any(truth_path);
+    if (model) {
+      // A model built with this case's complete skull (SkullFix's NNN_complete_skull beside
+      // its defective one) has seen the answer.
+      std::string complete = defective;
+      const size_t at = complete.rfind("defective_skull");
+      if (at != std::string::npos) complete.replace(at, 15, "complete_skull");
+      std::error_code ec;
+      if (at != std::string::npos && fs::exists(complete, ec)) refuse_if_in_model(*model, complete);
+    }
     const auto t0 = std::chrono::steady_clock::now();
     const LoadedSkull loaded = load_skull(defective);
     const SkullMesh& skull = loaded.mesh;

@@ -594,8 +594,9 @@ Subcommand add_autoplan(CLI::App& app, const bool& json) {
   cmd->add_option("--landmarks", o->landmarks,
                   "landmarks for the midsagittal plane (.json or Slicer .mrk.json)");
   cmd->add_option("--method", o->method,
-                  "auto, mirror, rim-only or model (auto: the shape model when one is given "
-                  "and fits, else the mirror where it covers the opening, else the ring)")
+                  "auto, mirror, rim-only or model (auto: the mirror where it covers the "
+                  "opening; elsewhere the shape model when one is given and fits, else the "
+                  "ring)")
       ->check(CLI::IsMember({"auto", "mirror", "rim-only", "model"}));
   cmd->add_option("-o,--output", o->output, "implant to write (.stl or .ply)")->required();
   cmd->add_option("--markers-out", o->markers_out,

@@ -114,9 +114,8 @@ AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks&
         autoplan_stages::markers(out.defect, bone, st.mirrored->locator, params, st.next_marker_id,
                                  prior && prior->usable() ? prior->locator.get() : nullptr);
     if (prior)
-      markers.surfaces_message += std::string("; ") +
-                                  (prior->usable() ? "" : "not guided by the shape model: ") +
-                                  prior->fit.message;
+      markers.surfaces_message +=
+          "; " + shape_prior_note(prior->fit, markers.method_used == PlanMethod::ShapeModel);
     propose = recorded(std::move(propose), proposal_result(markers), detect_ms + t.ms());
   }
   run(std::move(propose));

@@ -798,9 +798,8 @@ void apply_propose(PlanState& s, const ParamReader& r, const ApplyContext& ctx, 
           propose_markers_for_defect(defect, bone, mirror, params, s.next_marker_id,
                                      prior && prior->usable() ? prior->locator.get() : nullptr);
       if (prior)
-        proposal.surfaces_message += std::string("; ") +
-                                     (prior->usable() ? "" : "not guided by the shape model: ") +
-                                     prior->fit.message;
+        proposal.surfaces_message +=
+            "; " + shape_prior_note(prior->fit, proposal.method_used == PlanMethod::ShapeModel);
       record["result"] = proposal_result(proposal);
     } else {
       record["result"] = proposal_result(propose_markers(s.skull->surface->mesh, bone, *s.plane,

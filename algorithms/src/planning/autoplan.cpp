@@ -102,9 +102,7 @@ void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const Vert
   r.message = r.defect.message + "; " + describe_method(r.method_used, r.mirror_coverage) + "; " +
               r.surfaces_message;
   if (r.shape_fit)
-    r.message += std::string("; ") +
-                 (r.shape_fit->usable() ? "" : "not guided by the shape model: ") +
-                 r.shape_fit->message;
+    r.message += "; " + shape_prior_note(*r.shape_fit, r.method_used == PlanMethod::ShapeModel);
 }
 
 // The skull's search tree, built on a thread of its own while the plane and the registration

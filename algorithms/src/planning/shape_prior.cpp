@@ -8,6 +8,12 @@
 
 namespace cranioplan {
 
+std::string shape_prior_note(const ShapeFit& fit, bool used) {
+  if (used) return fit.message;
+  if (!fit.usable()) return "not guided by the shape model: " + fit.message;
+  return "not guided by the shape model (the mirror covers the opening; " + fit.message + ")";
+}
+
 ShapePrior fit_shape_prior(const ShapeModel& model, const SkullMesh& skull,
                            const SurfaceLocator& bone, const DefectRegion& defect,
                            const ShapePriorParams& params) {

@@ -410,7 +410,8 @@ AlignResult align_to_surface(const Eigen::Matrix3Xd& points, const Eigen::Matrix
   if (from && to) {
     c_from = from->center;
     c_to = to->center;
-    if (params.with_scale) scale = std::clamp(to->radius / from->radius, 0.7, 1.4);
+    const double ratio = from->radius > 1e-6 ? to->radius / from->radius : 1.0;
+    if (params.with_scale && std::isfinite(ratio)) scale = std::clamp(ratio, 0.7, 1.4);
   }
   // The starts are sorted out on 200 points, the best refined on 600.
   const std::vector<Eigen::Index> sparse = every(all, 200), coarse = every(all, 600);
@@ -478,7 +479,7 @@ namespace {
 class SheetSmoother {
  public:
   SheetSmoother(const Eigen::Matrix3Xd& rest, Eigen::Index begin, Eigen::Index end, double width)
-      : begin_(begin), end_(end) {
+      : begin_(begin) {
     std::vector<Eigen::Vector3d> pts;
     for (Eigen::Index i = begin; i < end; ++i) pts.push_back(rest.col(i));
     std::vector<Eigen::Vector3d> src;
@@ -520,7 +521,7 @@ class SheetSmoother {
   }
 
  private:
-  Eigen::Index begin_, end_;
+  Eigen::Index begin_;
   size_t sources_ = 0;
   std::vector<int> owner_;
   std::vector<std::vector<std::pair<int, double>>> near_;

@@ -222,8 +222,8 @@ ShapeModel read_shape_model(const std::string& path) {
   std::memcpy(m.components.data(), p, static_cast<size_t>(3 * n * k) * 8);
   if (!m.mean.allFinite() || !m.variances.allFinite() || !m.components.allFinite())
     throw InputError(path, "the shape model holds values that are not finite numbers");
-  if ((m.variances.array() < 0.0).any())
-    throw InputError(path, "the shape model holds a negative variance");
+  if ((m.variances.array() <= 0.0).any())
+    throw InputError(path, "the shape model holds a variance that is not positive");
   for (const auto& [key, value] : h.values) {
     if (key != "skull") continue;
     const size_t sp = value.find(' ');

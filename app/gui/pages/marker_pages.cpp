@@ -6,6 +6,7 @@
 #include <QPushButton>
 #include <QSettings>
 
+#include "cranioplan/model/error.h"
 #include "step_pages.h"
 
 namespace cranioplan::gui {
@@ -77,7 +78,15 @@ EdgeMarkersPage::EdgeMarkersPage(PageHost& host)
       proposal_note_->setVisible(true);
       return;
     }
-    host_.push(commands::propose_markers(params, model),
+    Command propose;
+    try {
+      propose = commands::propose_markers(params, model);  // hashes the model's file
+    } catch (const Error& e) {
+      proposal_note_->setText(tr("The shape model could not be read: %1").arg(e.what()));
+      proposal_note_->setVisible(true);
+      return;
+    }
+    host_.push(std::move(propose),
                model.empty() ? tr("Finding the defect and proposing markers")
                              : tr("Finding the defect, fitting the shape model and proposing "
                                   "markers"));

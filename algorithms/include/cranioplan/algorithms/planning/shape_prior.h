@@ -27,6 +27,10 @@ struct ShapePrior {
   bool usable() const { return fit.usable() && locator != nullptr; }
 };
 
+/// What a plan says of the model it was given: how well it fitted, and whether it guided the
+/// surfaces (`used`) or why not (a poor fit; the mirror covering the opening).
+std::string shape_prior_note(const ShapeFit& fit, bool used);
+
 /// Fits `model` to `skull` (located by `bone`) around the opening `defect`.
 ShapePrior fit_shape_prior(const ShapeModel& model, const SkullMesh& skull,
                            const SurfaceLocator& bone, const DefectRegion& defect,
