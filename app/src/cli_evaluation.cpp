@@ -424,6 +424,43 @@ std::optional<StudyDefect> flap_study_defect(const std::string& file, const Skul
   return d;
 }
 
+// The plans of one study defect (one per opening it made) scored together against the bone
+// removed, into `row`: their messages, and when all planned the scores of their implants
+// joined, the mirror's alone, the quality verdicts. The joined implant, or none.
+std::optional<SkullMesh> score_study_plans(const std::vector<AutoplanResult>& plans,
+                                           const SkullMesh& skull, const InjectDefectParams& ip,
+                                           const InjectDefectResult& d, Json& row) {
+  std::string message;
+  std::vector<const SkullMesh*> implants;
+  bool all_planned = true, all_printable = true;
+  double worst_gap = 0.0;
+  for (const AutoplanResult& r : plans) {
+    message += (message.empty() ? "" : " | ") + r.message;
+    all_planned = all_planned && r.planned();
+    if (!r.planned()) continue;
+    implants.push_back(&r.implant.mesh);
+    all_printable = all_printable && r.quality.printable;
+    worst_gap = std::max(worst_gap, r.quality.rim_gap_mm);
+  }
+  row["message"] = message;
+  row["implants"] = plans.size();
+  if (!all_planned) return std::nullopt;
+  SkullMesh implant;
+  if (implants.size() == 1)
+    implant = *implants.front();
+  else
+    implant = joined(implants);
+  add_scores(row, plans.front(), compare_implants(implant, d.implant, &d.defective));
+  row["mirror_dice"] = mirror_oracle_dice(skull, plans.front(), ip, d.implant);
+  row["printable"] = all_printable;
+  row["rim_gap_mm"] = worst_gap;
+  Json why = Json::array();
+  for (const AutoplanResult& r : plans)
+    for (const std::string& reason : r.quality.reasons) why.push_back(reason);
+  if (!all_printable) row["not_printable_because"] = why;
+  return implant;
+}
+
 Subcommand add_study(CLI::App& app, const bool& json) {
   struct Opts {
     std::string skull, shape = "sphere", cases_out, method = "auto";
@@ -450,9 +487,9 @@ Subcommand add_study(CLI::App& app, const bool& json) {
       ->check(CLI::PositiveNumber);
   cmd->add_option("--max-size", o->max_size, "largest sphere diameter (mm; default 50)")
       ->check(CLI::PositiveNumber);
-  cmd->add_option("--method", o->method, "auto, mirror or rim-only (as autoplan's)")
+  cmd->add_option("--method", o->method, "auto, mirror, rim-only or model (as autoplan's)")
       ->capture_default_str()
-      ->check(CLI::IsMember({"auto", "mirror", "rim-only"}));
+      ->check(CLI::IsMember({"auto", "mirror", "rim-only", "model"}));
   cmd->add_option("--cases-out", o->cases_out,
                   "folder to write each defective skull, its truth and its plan to "
                   "(K_defective.stl, K_truth.stl, K_planned.stl)");
@@ -464,6 +501,8 @@ Subcommand add_study(CLI::App& app, const bool& json) {
         const bool spheres = o->shape == "sphere";
         const auto model = shape_model_from(o->shape_model);
         if (model) refuse_if_in_model(*model, o->skull);
+        if (o->method == "model" && !model)
+          throw CLI::ValidationError("--method model", "needs --shape-model FILE");
         plan_method_from_string(o->method, o->params.propose.method);
         if (!spheres && (o->min_size || o->max_size))
           throw CLI::ValidationError("--min-size/--max-size", "are sizes of --shape sphere");
@@ -503,33 +542,9 @@ Subcommand add_study(CLI::App& app, const bool& json) {
           }
           row["seconds"] =
               std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-          std::string message;
-          std::vector<const SkullMesh*> implants;
-          bool all_planned = true, all_printable = true;
-          double worst_gap = 0.0;
-          for (const AutoplanResult& r : plans) {
-            message += (message.empty() ? "" : " | ") + r.message;
-            all_planned = all_planned && r.planned();
-            if (!r.planned()) continue;
-            implants.push_back(&r.implant.mesh);
-            all_printable = all_printable && r.quality.printable;
-            worst_gap = std::max(worst_gap, r.quality.rim_gap_mm);
-          }
-          row["message"] = message;
-          row["implants"] = plans.size();
-          if (all_planned) {
-            const SkullMesh implant = implants.size() == 1 ? *implants.front() : joined(implants);
-            add_scores(row, plans.front(), compare_implants(implant, d.implant, &d.defective));
-            row["mirror_dice"] = mirror_oracle_dice(skull, plans.front(), ip, d.implant);
-            row["printable"] = all_printable;
-            row["rim_gap_mm"] = worst_gap;
-            Json why = Json::array();
-            for (const AutoplanResult& r : plans)
-              for (const std::string& reason : r.quality.reasons) why.push_back(reason);
-            if (!all_printable) row["not_printable_because"] = why;
-            if (!o->cases_out.empty())
-              write_mesh(implant, case_file(o->cases_out, k, "planned"), loaded.file_space);
-          }
+          const std::optional<SkullMesh> implant = score_study_plans(plans, skull, ip, d, row);
+          if (implant && !o->cases_out.empty())
+            write_mesh(*implant, case_file(o->cases_out, k, "planned"), loaded.file_space);
           if (!o->cases_out.empty()) {
             write_mesh(d.defective, case_file(o->cases_out, k, "defective"), loaded.file_space);
             write_mesh(d.implant, case_file(o->cases_out, k, "truth"), loaded.file_space);
@@ -541,7 +556,8 @@ Subcommand add_study(CLI::App& app, const bool& json) {
                       << "  " << row.value("method", "-") << "  DSC " << row.value("dice", 0.0)
                       << "  bDSC " << row.value("boundary_dice", 0.0) << "  HD95 "
                       << row.value("hd95_mm", 0.0) << " mm  " << row["seconds"].get<double>()
-                      << " s  " << printable_text(row) << message << std::endl;
+                      << " s  " << printable_text(row) << row["message"].get<std::string>()
+                      << std::endl;
           write_row(o->rows_out, "study", std::to_string(k), row);
           rows.push_back(row);
         }

@@ -33,13 +33,13 @@ struct ProposeParams {
   /// and fits, else the ring. ShapeModel: the model averaged into the mirror's surfaces (where
   /// it covers) or the ring's.
   PlanMethod method = PlanMethod::Auto;
-  double min_mirror_coverage = 0.8;      ///< Auto uses the mirror above this coverage, 0..1
+  double min_mirror_coverage = 0.8;  ///< Auto uses the mirror above this coverage, 0..1
   /// Guided by a shape model, the model's surfaces are averaged into the mirror's (where it
   /// covers the opening) or the ring's, this much of the model's (0..1; 1: the model alone
   /// wherever it reaches).
   double shape_model_weight = 0.5;
-  double edge_spacing_mm = 4.0;          ///< proposed edge markers along the rim, mm (>0)
-  double surface_spacing_mm = 6.0;       ///< proposed surface and support markers, mm (>0)
+  double edge_spacing_mm = 4.0;     ///< proposed edge markers along the rim, mm (>0)
+  double surface_spacing_mm = 6.0;  ///< proposed surface and support markers, mm (>0)
   /// Inner support markers only where the ring ray's first bone faces it within this angle
   /// (the inner table), deg (0..90; 90: every ray). Beside an oblique cut face a ray from the
   /// centre first meets the face, above where the inner table would go on, and a marker there
