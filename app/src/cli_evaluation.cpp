@@ -83,8 +83,10 @@ void add_scores(Json& row, const AutoplanResult& r, const CompareResult& c) {
   row["printable"] = r.quality.printable;
   row["rim_gap_mm"] = r.quality.rim_gap_mm;
   if (!r.quality.printable) row["not_printable_because"] = r.quality.reasons;
+  row["model_share"] = r.sources.with_model;
   if (r.shape_fit) {
-    row["shape_model_rms_mm"] = r.shape_fit->rms_mm;
+    if (r.shape_fit->status != ShapeFit::Status::Skipped)
+      row["shape_model_rms_mm"] = r.shape_fit->rms_mm;
     row["shape_model_used"] = r.method_used == PlanMethod::ShapeModel;
   }
 }

@@ -95,13 +95,21 @@ Json autoplan_json(const AutoplanResult& r) {
     j["method"] = to_string(r.method_used);
     j["mirror_coverage"] = r.mirror_coverage;
     j["markers"] = r.markers.size();
-    if (r.shape_fit)
+    j["sources"] = Json{{"mirror", r.sources.mirror},
+                        {"ring", r.sources.ring},
+                        {"with_model", r.sources.with_model},
+                        {"none", r.sources.none},
+                        {"message", r.sources.describe()}};
+    if (r.shape_fit) {
+      const bool skipped = r.shape_fit->status == ShapeFit::Status::Skipped;
       j["shape_model"] = Json{{"fitted", r.shape_fit->usable()},
                               {"used", r.method_used == PlanMethod::ShapeModel},
-                              {"rms_mm", r.shape_fit->rms_mm},
-                              {"paired", r.shape_fit->paired},
-                              {"mahalanobis", r.shape_fit->mahalanobis},
                               {"message", r.shape_fit->message}};
+      if (!skipped)
+        j["shape_model"].update(Json{{"rms_mm", r.shape_fit->rms_mm},
+                                     {"paired", r.shape_fit->paired},
+                                     {"mahalanobis", r.shape_fit->mahalanobis}});
+    }
   }
   if (r.planned()) {
     j["implant"] = implant_json(r.implant);

@@ -106,16 +106,11 @@ AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks&
     // The proposal's search is the detection, the shape model's fit and the markers.
     const Stopwatch t;
     const PlanState& st = s.state();
-    std::optional<ShapePrior> prior;
-    if (!shape_model.empty())
-      prior = fit_shape_prior(read_shape_model(shape_model), mesh, bone, out.defect,
-                              params.shape_prior);
-    MarkerProposal markers =
-        autoplan_stages::markers(out.defect, bone, st.mirrored->locator, params, st.next_marker_id,
-                                 prior && prior->usable() ? prior->locator.get() : nullptr);
-    if (prior)
-      markers.surfaces_message +=
-          "; " + shape_prior_note(prior->fit, markers.method_used == PlanMethod::ShapeModel);
+    std::optional<ShapeModel> model;
+    if (!shape_model.empty()) model = read_shape_model(shape_model);
+    const MarkerProposal markers =
+        autoplan_stages::markers(out.defect, mesh, bone, st.mirrored->locator, params,
+                                 st.next_marker_id, model ? &*model : nullptr);
     propose = recorded(std::move(propose), proposal_result(markers), detect_ms + t.ms());
   }
   run(std::move(propose));

@@ -791,16 +791,8 @@ void apply_propose(PlanState& s, const ParamReader& r, const ApplyContext& ctx, 
       const ShapeModel model = recorded_shape_model(r, ctx);
       const DefectRegion defect =
           detect_defect_near_plane(s.skull->surface->mesh, bone, *s.plane, params.detect);
-      std::optional<ShapePrior> prior;
-      if (defect.found())
-        prior = fit_shape_prior(model, s.skull->surface->mesh, bone, defect, ShapePriorParams{});
-      MarkerProposal proposal =
-          propose_markers_for_defect(defect, bone, mirror, params, s.next_marker_id,
-                                     prior && prior->usable() ? prior->locator.get() : nullptr);
-      if (prior)
-        proposal.surfaces_message +=
-            "; " + shape_prior_note(prior->fit, proposal.method_used == PlanMethod::ShapeModel);
-      record["result"] = proposal_result(proposal);
+      record["result"] = proposal_result(propose_markers_with_model(
+          defect, s.skull->surface->mesh, bone, mirror, params, s.next_marker_id, &model));
     } else {
       record["result"] = proposal_result(propose_markers(s.skull->surface->mesh, bone, *s.plane,
                                                          mirror, params, s.next_marker_id));

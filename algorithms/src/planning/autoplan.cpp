@@ -68,15 +68,10 @@ void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const Vert
   }
   r.mirror_motion = mirror_motion();
   const SurfaceLocator mirror = bone.moved(r.mirror_motion);
-  std::optional<ShapePrior> prior;
-  if (shape_model) {
-    prior = fit_shape_prior(*shape_model, skull, bone, r.defect, params.shape_prior);
-    r.shape_fit = prior->fit;
-    timer.stage("shape model");
-  }
-  MarkerProposal proposal = autoplan_stages::markers(
-      r.defect, bone, mirror, params, 1, prior && prior->usable() ? prior->locator.get() : nullptr);
+  MarkerProposal proposal =
+      autoplan_stages::markers(r.defect, skull, bone, mirror, params, 1, shape_model, &r.shape_fit);
   r.mirror_coverage = proposal.mirror_coverage;
+  r.sources = proposal.sources;
   r.method_used = proposal.method_used;
   r.surfaces_message = proposal.surfaces_message;
   r.markers = std::move(proposal.markers);
@@ -101,8 +96,6 @@ void plan_opening(const SkullMesh& skull, const SurfaceLocator& bone, const Vert
   r.status = AutoplanResult::Status::Planned;
   r.message = r.defect.message + "; " + describe_method(r.method_used, r.mirror_coverage) + "; " +
               r.surfaces_message;
-  if (r.shape_fit)
-    r.message += "; " + shape_prior_note(*r.shape_fit, r.method_used == PlanMethod::ShapeModel);
 }
 
 // The skull's search tree, built on a thread of its own while the plane and the registration
@@ -166,10 +159,12 @@ const RegisterResult& registration_used(const RegisterResult& global,
   return local && local->result.usable() ? local->result : global;
 }
 
-MarkerProposal markers(const DefectRegion& defect, const SurfaceLocator& bone,
-                       const SurfaceLocator& mirror, const AutoplanParams& params, int first_id,
-                       const SurfaceLocator* model) {
-  return propose_markers_for_defect(defect, bone, mirror, params.propose, first_id, model);
+MarkerProposal markers(const DefectRegion& defect, const SkullMesh& skull,
+                       const SurfaceLocator& bone, const SurfaceLocator& mirror,
+                       const AutoplanParams& params, int first_id, const ShapeModel* model,
+                       std::optional<ShapeFit>* fit) {
+  return propose_markers_with_model(defect, skull, bone, mirror, params.propose, first_id, model,
+                                    params.shape_prior, fit);
 }
 
 ImplantParams implant_params(const DefectRegion& defect, const Plane& plane,

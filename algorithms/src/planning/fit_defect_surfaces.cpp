@@ -210,6 +210,10 @@ void DefectSurfaces::blend_with(std::shared_ptr<const DefectSurfaces> other, dou
   blend_weight_ = std::clamp(weight, 0.0, 1.0);
 }
 
+bool DefectSurfaces::blended_at(const Eigen::Vector3d& dir) const {
+  return blend_ && blend_weight_ > 0.0 && blend_->radii(dir.normalized()).has_value();
+}
+
 std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> DefectSurfaces::at(
     const Eigen::Vector3d& dir_in) const {
   const Eigen::Vector3d dir = dir_in.normalized();

@@ -267,9 +267,27 @@ RegionOfInterest local_registration_region(const DefectRegion& defect, double ma
   return roi;
 }
 
-namespace {
+std::string SurfaceSources::describe() const {
+  std::string parts;
+  auto add = [&](double share, const char* what) {
+    if (share < 0.005) return;
+    char text[80];
+    std::snprintf(text, sizeof text, "%s%.0f%% %s", parts.empty() ? "" : ", ", 100.0 * share, what);
+    parts += text;
+  };
+  const double primary = mirror + ring;
+  // The model is averaged in over `with_model` of the rays, either source's alike: split it in
+  // proportion.
+  const double model_share = primary > 0.0 ? with_model / primary : 0.0;
+  add(mirror * model_share, "mirror with the shape model");
+  add(mirror * (1.0 - model_share), model_share > 0.0 ? "mirror alone" : "mirror");
+  add(ring * model_share, "ring fit with the shape model");
+  add(ring * (1.0 - model_share), model_share > 0.0 ? "ring fit alone" : "ring fit");
+  add(none, "bridged from the surfaces around (no value along those rays)");
+  return "the opening's surfaces: " + (parts.empty() ? std::string("none") : parts) +
+         "; the rim and the ring around it: the skull's own bone";
+}
 
-// The share of the opening's rays that meet the mirrored bone (both tables).
 double mirror_coverage(const DefectRegion& defect, const SurfaceLocator& mirror,
                        const ProposeParams& params) {
   size_t covered = 0;
@@ -281,6 +299,8 @@ double mirror_coverage(const DefectRegion& defect, const SurfaceLocator& mirror,
              ? 0.0
              : static_cast<double>(covered) / defect.hole_directions.size();
 }
+
+namespace {
 
 // How far from the opening the ring's bone carries support markers, mm.
 double support_band_mm(const ProposeParams& params) {
@@ -499,6 +519,26 @@ void add_surface_markers(const DefectRegion& defect, const DefectSurfaces& surfa
   }
 }
 
+// Which sources give the surfaces along the opening's rays.
+SurfaceSources sources_of(const DefectRegion& defect, const DefectSurfaces& surfaces) {
+  SurfaceSources s;
+  if (defect.hole_directions.empty()) return s;
+  size_t primary = 0, blended = 0, none = 0;
+  for (const auto& d : defect.hole_directions) {
+    if (!surfaces.at(d)) {
+      ++none;
+      continue;
+    }
+    ++primary;
+    if (surfaces.blended_at(d)) ++blended;
+  }
+  const double n = static_cast<double>(defect.hole_directions.size());
+  (surfaces.mirror_guided ? s.mirror : s.ring) = primary / n;
+  s.with_model = blended / n;
+  s.none = none / n;
+  return s;
+}
+
 }  // namespace
 
 MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const SurfaceLocator& bone,
@@ -541,6 +581,8 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
     return r;
   }
   r.ring_rms_mm = surfaces.outer_rms_mm;
+  r.sources = sources_of(defect, surfaces);
+  r.surfaces_message += "; " + r.sources.describe();
   int id = first_id;
   const std::vector<FittedPoints> ring_fit = fitted_along_ring(
       defect, surfaces,

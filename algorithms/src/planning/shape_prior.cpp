@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "cranioplan/algorithms/geometry/point_index.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
@@ -44,6 +45,44 @@ ShapePrior fit_shape_prior(const ShapeModel& model, const SkullMesh& skull,
   out.mesh = model.mesh(out.fit.points);
   out.locator = std::make_shared<SurfaceLocator>(out.mesh);
   return out;
+}
+
+MarkerProposal propose_markers_with_model(const DefectRegion& defect, const SkullMesh& skull,
+                                          const SurfaceLocator& bone, const SurfaceLocator& mirror,
+                                          const ProposeParams& params, int first_id,
+                                          const ShapeModel* model,
+                                          const ShapePriorParams& prior_params,
+                                          std::optional<ShapeFit>* fit) {
+  std::optional<ShapePrior> prior;
+  std::optional<ShapeFit> fitted;
+  if (model && defect.found()) {
+    auto skipped = [](const std::string& why) {
+      ShapeFit f;
+      f.status = ShapeFit::Status::Skipped;
+      f.message = why;
+      return f;
+    };
+    if (params.method == PlanMethod::Mirror || params.method == PlanMethod::RimOnly) {
+      fitted = skipped(std::string("not fitted, the plan's method is ") + to_string(params.method));
+    } else if (const double coverage = mirror_coverage(defect, mirror, params);
+               params.method == PlanMethod::Auto && coverage >= params.min_mirror_coverage) {
+      char text[120];
+      std::snprintf(text, sizeof text, "not fitted, the mirror covers %.0f%% of the opening",
+                    100.0 * coverage);
+      fitted = skipped(text);
+    } else {
+      prior = fit_shape_prior(*model, skull, bone, defect, prior_params);
+      fitted = prior->fit;
+    }
+  }
+  MarkerProposal proposal =
+      propose_markers_for_defect(defect, bone, mirror, params, first_id,
+                                 prior && prior->usable() ? prior->locator.get() : nullptr);
+  if (fitted)
+    proposal.surfaces_message +=
+        "; " + shape_prior_note(*fitted, proposal.method_used == PlanMethod::ShapeModel);
+  if (fit) *fit = std::move(fitted);
+  return proposal;
 }
 
 }  // namespace cranioplan

@@ -313,15 +313,59 @@ double median_of(std::vector<double> v) {
   return v[v.size() / 2];
 }
 
-// Trimmed similarity ICP from `T`; returns the transform and its residual.
-AlignResult icp(const Eigen::Matrix3Xd& points, const Eigen::Matrix3Xd& normals,
-                const std::vector<Eigen::Index>& which, Similarity T, const SurfaceLocator& surface,
-                const AlignParams& params, int iterations) {
+// The target's surface sampled at points with their normals, and a search tree over them:
+// nearest-sample pairing costs a small share of a closest-triangle query within a wide reach,
+// and sorting out the pose's starts needs only roughly where the bone is.
+struct SampledTarget {
+  SampledTarget(const SurfaceLocator& surface, std::vector<Eigen::Vector3d> at)
+      : index(std::move(at)) {
+    normal.reserve(index.size());
+    for (const auto& p : index.points()) {
+      const auto c = surface.closest_within(p, 5.0);
+      normal.push_back(c ? surface.face_normal(c->face) : Eigen::Vector3d::Zero());
+    }
+  }
+  PointIndex index;
+  std::vector<Eigen::Vector3d> normal;
+};
+
+// Pairs as pair_with_surface's, with the nearest sample and its tangent plane standing for the
+// surface (the distance is to that plane); one thread (the starts are shared out instead).
+SurfacePairs pair_with_samples(const Eigen::Matrix3Xd& points, const Eigen::Matrix3Xd& normals,
+                               const std::vector<Eigen::Index>& which, const Similarity& T,
+                               const SampledTarget& target, double reach,
+                               double max_normal_angle_deg) {
+  const double cos_normal = std::cos(max_normal_angle_deg * M_PI / 180.0);
+  const Eigen::Matrix3d R = T.topLeftCorner<3, 3>();
+  const double scale = std::cbrt(std::max(1e-12, R.determinant()));
+  const Eigen::Matrix3d rot = R / scale;
+  SurfacePairs out;
+  if (target.index.size() == 0) return out;
+  for (const Eigen::Index i : which) {
+    const Eigen::Vector3d p = R * points.col(i) + T.topRightCorner<3, 1>();
+    double d2 = 0.0;
+    const int nearest = target.index.nearest(p, &d2);
+    if (d2 > reach * reach) continue;
+    const Eigen::Vector3d& n = target.normal[nearest];
+    if (n.dot(rot * normals.col(i)) < cos_normal) continue;
+    const Eigen::Vector3d& q = target.index.points()[nearest];
+    out.index.push_back(i);
+    out.target.push_back(q);
+    out.normal.push_back(n);
+    out.distance.push_back(std::abs((p - q).dot(n)));
+  }
+  return out;
+}
+
+// Trimmed similarity ICP from `T`; returns the transform and its residual. `pair(T, reach,
+// angle)` gives the pairs of `which` moved by T.
+template <typename Pairing>
+AlignResult icp(const Eigen::Matrix3Xd& points, const std::vector<Eigen::Index>& which,
+                Similarity T, const Pairing& pair, const AlignParams& params, int iterations) {
   AlignResult r;
   r.transform = T;
   for (int it = 0; it < iterations; ++it) {
-    const SurfacePairs p = pair_with_surface(points, normals, which, T, surface,
-                                             params.max_distance_mm, params.max_normal_angle_deg);
+    const SurfacePairs p = pair(T, params.max_distance_mm, params.max_normal_angle_deg);
     if (p.index.size() < 10) {
       r.rms_mm = std::numeric_limits<double>::infinity();
       r.used = 0.0;
@@ -378,7 +422,11 @@ AlignResult icp(const Eigen::Matrix3Xd& points, const Eigen::Matrix3Xd& normals,
     D.topRightCorner<3, 1>() = centroid - grow * turn * centroid + step.segment<3>(3);
     T = D * T;
     r.transform = T;
-    if (step.norm() < 1e-7) break;
+    // Settled: a round turns less than 0.001° and moves less than a micrometre at the skull's
+    // size (a tenth of a metre from the centroid).
+    if (angle < 2e-5 && step.segment<3>(3).norm() < 1e-3 &&
+        (!params.with_scale || std::abs(step(6)) < 1e-5))
+      break;
   }
   return r;
 }
@@ -400,7 +448,12 @@ AlignResult align_to_surface(const Eigen::Matrix3Xd& points, const Eigen::Matrix
     return out;
   };
   const std::vector<Eigen::Index> fine = every(all, static_cast<size_t>(params.samples));
-  if (start) return icp(points, normals, fine, *start, target, params, params.iterations);
+  auto on_surface = [&](const std::vector<Eigen::Index>& which) {
+    return [&points, &normals, &target, &which](const Similarity& T, double reach, double angle) {
+      return pair_with_surface(points, normals, which, T, target, reach, angle);
+    };
+  };
+  if (start) return icp(points, fine, *start, on_surface(fine), params, params.iterations);
 
   std::vector<Eigen::Vector3d> mine;
   for (Eigen::Index i : every(all, 20000)) mine.push_back(points.col(i));
@@ -422,16 +475,24 @@ AlignResult align_to_surface(const Eigen::Matrix3Xd& points, const Eigen::Matrix
   // distance to bone whose normal agrees (5 mm where there is none). A pose that pairs many
   // points loosely loses to one that lays most of them on the bone.
   constexpr double kCap = 5.0;
-  auto cost_of = [&](const Similarity& T, const std::vector<Eigen::Index>& which) {
-    const SurfacePairs p =
-        pair_with_surface(points, normals, which, T, target, kCap, params.max_normal_angle_deg);
+  auto cost_from = [&](const SurfacePairs& p, const std::vector<Eigen::Index>& which) {
     double cost = kCap * kCap * static_cast<double>(which.size() - p.index.size());
     for (double d : p.distance) cost += d * d;
     return cost / static_cast<double>(which.size());
   };
+  auto cost_of = [&](const Similarity& T, const std::vector<Eigen::Index>& which) {
+    return cost_from(
+        pair_with_surface(points, normals, which, T, target, kCap, params.max_normal_angle_deg),
+        which);
+  };
   // Every start refined a little, the best four refined further: ICP turns a smooth vault
   // slowly, and a start 25° off needs a few dozen rounds to arrive.
-  // The starts on both cores (each start's rounds are too small to share out).
+  // The starts on both cores (each start's rounds are too small to share out), on the sampled
+  // surface; the best four on the surface itself.
+  const SampledTarget samples(target, target_points);
+  auto on_samples = [&](const Similarity& T, double reach, double angle) {
+    return pair_with_samples(points, normals, sparse, T, samples, reach, angle);
+  };
   const std::vector<Eigen::Matrix3d> starts = start_rotations();
   std::vector<std::pair<double, AlignResult>> each(starts.size());
   parallel_for(
@@ -441,10 +502,12 @@ AlignResult align_to_surface(const Eigen::Matrix3Xd& points, const Eigen::Matrix
           Similarity T = Similarity::Identity();
           T.topLeftCorner<3, 3>() = scale * starts[k];
           T.topRightCorner<3, 1>() = c_to - scale * starts[k] * c_from;
-          const AlignResult r = icp(points, normals, sparse, T, target, loose, 8);
-          each[k] = {std::isfinite(r.rms_mm) ? cost_of(r.transform, sparse)
-                                             : std::numeric_limits<double>::infinity(),
-                     r};
+          const AlignResult r = icp(points, sparse, T, on_samples, loose, 8);
+          each[k] = {
+              std::isfinite(r.rms_mm)
+                  ? cost_from(on_samples(r.transform, kCap, params.max_normal_angle_deg), sparse)
+                  : std::numeric_limits<double>::infinity(),
+              r};
         }
       },
       1);
@@ -458,7 +521,7 @@ AlignResult align_to_surface(const Eigen::Matrix3Xd& points, const Eigen::Matrix
   double best_cost = std::numeric_limits<double>::infinity();
   for (size_t k = 0; k < std::min<size_t>(4, tried.size()); ++k) {
     const AlignResult r =
-        icp(points, normals, coarse, tried[k].second.transform, target, loose, 30);
+        icp(points, coarse, tried[k].second.transform, on_surface(coarse), loose, 30);
     if (!std::isfinite(r.rms_mm)) continue;
     const double cost = cost_of(r.transform, coarse);
     if (cost < best_cost) {
@@ -467,7 +530,7 @@ AlignResult align_to_surface(const Eigen::Matrix3Xd& points, const Eigen::Matrix
     }
   }
   if (!std::isfinite(best.rms_mm)) return best;
-  return icp(points, normals, fine, best.transform, target, params, params.iterations);
+  return icp(points, fine, best.transform, on_surface(fine), params, params.iterations);
 }
 
 namespace {

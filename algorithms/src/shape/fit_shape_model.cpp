@@ -96,8 +96,14 @@ ShapeFit fit_shape_model(const ShapeModel& model, const SurfaceLocator& bone,
     const double noise2 = params.noise_mm * params.noise_mm;
     Eigen::MatrixXd N = A.transpose() * A;
     for (Eigen::Index c = 0; c < k; ++c) N(c, c) += noise2 / std::max(1e-9, model.variances(c));
+    const Eigen::VectorXd before = r.coefficients;
     r.coefficients = N.ldlt().solve(A.transpose() * y);
     shape = model.instance(r.coefficients);
+    // Settled: no coefficient moved by a hundredth of its standard deviation.
+    if (((r.coefficients - before).array() / model.variances.array().max(1e-18).sqrt())
+            .abs()
+            .maxCoeff() < 0.01)
+      break;
   }
   r.pose = T;
   r.points = apply(T, shape);

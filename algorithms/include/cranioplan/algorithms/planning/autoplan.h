@@ -54,8 +54,10 @@ struct AutoplanResult {
   DefectRegion defect;
   PlanMethod method_used = PlanMethod::RimOnly;
   double mirror_coverage = 0.0;  ///< fraction of the opening's rays that meet mirrored bone
-  /// The shape model's fit, when the plan was given a model (used or not: `usable()`).
+  /// The shape model's fit, when the plan was given a model (used or not: `usable()`; Skipped
+  /// when the plan did not need it).
   std::optional<ShapeFit> shape_fit;
+  SurfaceSources sources;        ///< which sources shaped the surfaces over the opening
   std::string surfaces_message;  ///< how the defect's surfaces were fitted to the intact ring
   std::vector<Marker> markers;   ///< proposed (after smoothing)
   ImplantResult implant;
@@ -106,10 +108,12 @@ std::optional<LocalRegistration> local_registration(const SkullMesh& skull, cons
 const RegisterResult& registration_used(const RegisterResult& global,
                                         const std::optional<LocalRegistration>& local);
 /// Markers for the opening, from `first_id` on; `mirror` locates the registered mirror, `model`
-/// (may be null) a fitted shape model (ShapePrior::locator).
-MarkerProposal markers(const DefectRegion& defect, const SurfaceLocator& bone,
-                       const SurfaceLocator& mirror, const AutoplanParams& params, int first_id = 1,
-                       const SurfaceLocator* model = nullptr);
+/// (may be null) a shape model to fit and guide the surfaces where the plan needs it, `fit`
+/// (may be null) receives its fit (propose_markers_with_model).
+MarkerProposal markers(const DefectRegion& defect, const SkullMesh& skull,
+                       const SurfaceLocator& bone, const SurfaceLocator& mirror,
+                       const AutoplanParams& params, int first_id = 1,
+                       const ShapeModel* model = nullptr, std::optional<ShapeFit>* fit = nullptr);
 /// The implant's parameters: the automatic plan's, in the frame of the rays that found the
 /// opening, with the plan's plane as the tabs' midline (when tabs are asked without one).
 ImplantParams implant_params(const DefectRegion& defect, const Plane& plane,

@@ -122,6 +122,8 @@ class DefectSurfaces {
   /// have a value; these alone where `other` has none. Two fits guided by different priors
   /// (a shape model and the ring, say) err differently, and their mean errs less than either.
   void blend_with(std::shared_ptr<const DefectSurfaces> other, double weight);
+  /// Whether at() along unit `dir` averages in the surfaces of blend_with()'s `other`.
+  bool blended_at(const Eigen::Vector3d& dir) const;
 
  private:
   friend struct DefectSurfaceFit;  // the fit's stages (fit_defect_surfaces.cpp)

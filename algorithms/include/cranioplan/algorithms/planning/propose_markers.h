@@ -58,6 +58,20 @@ struct ProposeParams {
   DefectSurfaceParams surfaces;       ///< fitting the surfaces to the intact ring
 };
 
+/// Which sources shaped the missing bone's surfaces: shares of the opening's rays (0..1) whose
+/// outer and inner surface came from the mirror (bent to meet the ring), from the ring alone,
+/// and of those, the share with the shape model averaged in. The edge and support markers lie
+/// on the skull's own bone.
+struct SurfaceSources {
+  double mirror = 0.0;      ///< the registered mirror, corrected to the ring
+  double ring = 0.0;        ///< the fit to the intact ring alone
+  double with_model = 0.0;  ///< of the two, the shape model averaged in
+  double none = 0.0;        ///< no surface (outside the fitted cap, no mirrored bone)
+  /// "the opening's surfaces: 64% mirror with the shape model, 36% mirror alone; the rim and the
+  /// ring: the skull's own bone"
+  std::string describe() const;
+};
+
 struct MarkerProposal {
   enum class Status { Proposed, NoDefect, Failed };  ///< Failed: the surfaces could not be fitted
   Status status = Status::NoDefect;
@@ -67,6 +81,7 @@ struct MarkerProposal {
   double mirror_coverage = 0.0;  ///< fraction of the opening's rays that meet mirrored bone
   std::string surfaces_message;  ///< how the surfaces were fitted (ring rays, residual)
   double ring_rms_mm = 0.0;      ///< DefectSurfaces::outer_rms_mm: the outer fit's residual
+  SurfaceSources sources;        ///< which sources shaped the surfaces over the opening
   std::vector<Marker> markers;   ///< ids from `first_id` on
   bool proposed() const { return status == Status::Proposed; }
 };
@@ -74,6 +89,10 @@ struct MarkerProposal {
 /// How the surfaces were found, for messages: "mirror-guided (mirror covers 97% of the opening)"
 /// or "rim-only fitting (…)".
 std::string describe_method(PlanMethod method, double mirror_coverage);
+
+/// The share of the opening's rays that meet the registered mirror's bone (both tables).
+double mirror_coverage(const DefectRegion& defect, const SurfaceLocator& mirror,
+                       const ProposeParams& params);
 
 /// The defect seen from inside the cavity, on the midsagittal plane: from the vault's centre
 /// (vault_center) moved towards the opening seen from there until it is seen 50° wide (at most
