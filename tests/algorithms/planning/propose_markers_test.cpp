@@ -8,6 +8,9 @@
 
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/planning/fit_defect_surfaces.h"
+#include "cranioplan/algorithms/planning/shape_prior.h"
+#include "cranioplan/algorithms/shape/correspond_skull.h"
+#include "cranioplan/algorithms/shape/shape_model.h"
 #include "support/synthetic.h"
 
 namespace cranioplan {
@@ -151,6 +154,87 @@ TEST(ProposeMarkers, RimOnlyFittingIsUsedWhenAsked) {
       EXPECT_LT(truth.closest(m.position).distance, 2.0);
     }
   }
+}
+
+// A shape model is fitted only where it will guide the surfaces, and the proposal says which
+// source shaped the opening. The model: the intact head itself, stretched three ways, so where
+// it guides, the markers lie on the missing bone (known answer).
+TEST(ProposeMarkers, AShapeModelIsFittedOnlyWhereItGuidesAndTheSourcesAreSaid) {
+  const test::ThickHeadDefect& c = test::thick_head_defect();
+  ASSERT_TRUE(c.defect.found()) << c.defect.message;
+  const ShapeTemplate t = make_shape_template(c.intact, ShapeTemplateParams{4});
+  ASSERT_GT(t.outer_count, 100);
+  std::vector<Eigen::Matrix3Xd> shapes;
+  for (const Eigen::Vector3d& stretch :
+       {Eigen::Vector3d(1.0, 1.0, 1.0), Eigen::Vector3d(1.03, 0.98, 1.0),
+        Eigen::Vector3d(0.98, 1.02, 1.03)})
+    shapes.push_back(stretch.asDiagonal() * t.points);
+  const ShapeModel model = build_shape_model(shapes, t.outer_count, t.triangles, {}, false);
+  const SurfaceLocator bone(c.defective), truth(c.intact);
+
+  // Auto with the mirror covering the opening: the mirror alone, the model not fitted.
+  std::optional<ShapeFit> fit;
+  const MarkerProposal mirrored = propose_markers_with_model(c.defect, c.defective, bone, truth,
+                                                             ProposeParams{}, 1, &model, {}, &fit);
+  ASSERT_TRUE(mirrored.proposed()) << mirrored.message;
+  EXPECT_EQ(mirrored.method_used, PlanMethod::Mirror);
+  ASSERT_TRUE(fit.has_value());
+  EXPECT_EQ(fit->status, ShapeFit::Status::Skipped);
+  EXPECT_NE(mirrored.surfaces_message.find("not fitted, the mirror covers"), std::string::npos)
+      << mirrored.surfaces_message;
+  EXPECT_GT(mirrored.sources.mirror, 0.9);
+  EXPECT_EQ(mirrored.sources.ring, 0.0);
+  EXPECT_EQ(mirrored.sources.with_model, 0.0);
+  EXPECT_NEAR(mirrored.sources.mirror + mirrored.sources.none, 1.0, 1e-9);
+
+  // Asked for the ring alone: not fitted either.
+  ProposeParams rim_only;
+  rim_only.method = PlanMethod::RimOnly;
+  const MarkerProposal ring =
+      propose_markers_with_model(c.defect, c.defective, bone, truth, rim_only, 1, &model, {}, &fit);
+  ASSERT_TRUE(ring.proposed()) << ring.message;
+  EXPECT_EQ(fit->status, ShapeFit::Status::Skipped);
+  EXPECT_GT(ring.sources.ring, 0.9);
+  EXPECT_EQ(ring.sources.with_model, 0.0);
+  EXPECT_NE(ring.surfaces_message.find("100% ring fit;"), std::string::npos)
+      << ring.surfaces_message;
+
+  // Asked for the model: fitted (to the head it was made of) and averaged into the mirror's
+  // surfaces over the whole opening; the markers stay on the missing bone.
+  ProposeParams guided;
+  guided.method = PlanMethod::ShapeModel;
+  const MarkerProposal shaped =
+      propose_markers_with_model(c.defect, c.defective, bone, truth, guided, 1, &model, {}, &fit);
+  ASSERT_TRUE(shaped.proposed()) << shaped.message;
+  ASSERT_TRUE(fit && fit->usable()) << (fit ? fit->message : "no fit");
+  EXPECT_LT(fit->rms_mm, 0.5);
+  EXPECT_EQ(shaped.method_used, PlanMethod::ShapeModel);
+  EXPECT_GT(shaped.sources.with_model, 0.9);
+  EXPECT_LE(shaped.sources.with_model, shaped.sources.mirror + 1e-9);
+  EXPECT_NE(shaped.surfaces_message.find("mirror with the shape model"), std::string::npos)
+      << shaped.surfaces_message;
+  for (const Marker& m : shaped.markers)
+    if (m.type == MarkerType::OuterSurface) EXPECT_LT(truth.closest(m.position).distance, 1.0);
+
+  // No model, no note.
+  const MarkerProposal plain = propose_markers_with_model(c.defect, c.defective, bone, truth,
+                                                          ProposeParams{}, 1, nullptr, {}, &fit);
+  EXPECT_FALSE(fit.has_value());
+  EXPECT_EQ(plain.surfaces_message.find("shape model"), std::string::npos);
+}
+
+// The sentence splits the model's share between the two sources in proportion.
+TEST(ProposeMarkers, TheSourcesSentenceSplitsTheModelsShare) {
+  SurfaceSources s;
+  s.mirror = 0.6;
+  s.with_model = 0.3;
+  s.none = 0.4;
+  EXPECT_EQ(s.describe(),
+            "the opening's surfaces: 30% mirror with the shape model, 30% mirror alone, 40% "
+            "bridged from the surfaces around (no value along those rays); the rim and the ring "
+            "around it: the skull's own bone");
+  EXPECT_EQ(SurfaceSources{}.describe(),
+            "the opening's surfaces: none; the rim and the ring around it: the skull's own bone");
 }
 
 TEST(ProposeMarkers, AnIntactSkullHasNoDefectToPropose) {
