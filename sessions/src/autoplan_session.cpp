@@ -3,7 +3,10 @@
 #include <chrono>
 #include <filesystem>
 
+#include "cranioplan/algorithms/io/file_io.h"
+#include "cranioplan/algorithms/shape/shape_model.h"
 #include "cranioplan/sessions/plan_files.h"
+#include "cranioplan/sessions/sha256.h"
 
 namespace cranioplan {
 
@@ -101,13 +104,20 @@ AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks&
   }
   if (!step_complete(s.state(), 3)) run(commands::complete_step(3));
   run(commands::complete_step(4));
-  Command propose = commands::propose_markers(params.propose, shape_model);
+  // The model's file read once: the model used is the one whose hash is recorded.
+  std::optional<ShapeModel> model;
+  std::string model_sha;
+  if (!shape_model.empty()) {
+    const std::string bytes = read_file_bytes(shape_model);
+    model_sha = sha256_hex(bytes);
+    model = parse_shape_model(bytes, shape_model);
+  }
+  Command propose =
+      commands::propose_markers(params.propose, shape_model, model_sha, params.shape_prior);
   if (out.defect.found() && s.state().mirrored) {
     // The proposal's search is the detection, the shape model's fit and the markers.
     const Stopwatch t;
     const PlanState& st = s.state();
-    std::optional<ShapeModel> model;
-    if (!shape_model.empty()) model = read_shape_model(shape_model);
     const MarkerProposal markers =
         autoplan_stages::markers(out.defect, mesh, bone, st.mirrored->locator, params,
                                  st.next_marker_id, model ? &*model : nullptr);

@@ -210,7 +210,7 @@ std::optional<CommandType> command_type_from_tag(const std::string& tag) {
 int current_version(CommandType type) {
   if (type == CommandType::BuildImplant) return 14;
   if (type == CommandType::ExportImplant) return 2;
-  if (type == CommandType::ProposeMarkers) return 7;
+  if (type == CommandType::ProposeMarkers) return 8;
   if (type == CommandType::LoadSkull) return 6;
   if (type == CommandType::FitPlane || type == CommandType::Register ||
       type == CommandType::AdjustPlane)
@@ -855,12 +855,17 @@ Command import_markers(const std::vector<Marker>& markers, const std::string& so
 Command clear_markers() { return make(CommandType::ClearMarkers, Json::object(), 5); }
 
 Command propose_markers(const ProposeParams& params, const std::string& shape_model,
-                        const std::string& shape_model_sha256) {
+                        const std::string& shape_model_sha256, const ShapePriorParams& prior) {
   Json j{{"params", params_to_json(params)}};
   if (!shape_model.empty())
-    j["shape_model"] = Json{
-        {"path", shape_model},
-        {"sha256", shape_model_sha256.empty() ? sha256_file(shape_model) : shape_model_sha256}};
+    j["shape_model"] =
+        Json{{"path", shape_model},
+             {"sha256", shape_model_sha256.empty() ? sha256_file(shape_model) : shape_model_sha256},
+             {"weight", params.shape_model_weight},
+             {"margin_mm", prior.margin_mm},
+             {"noise_mm", prior.fit.noise_mm},
+             {"max_rms_mm", prior.fit.max_rms_mm},
+             {"min_paired", prior.fit.min_paired}};
   return make(CommandType::ProposeMarkers, j, 5);
 }
 

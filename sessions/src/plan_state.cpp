@@ -767,17 +767,29 @@ bool apply_proposal_result(PlanState& s, const Json& j, const std::string& where
 // Proposes markers, or applies the proposal the command recorded when it was first done; both
 // go through the recorded form, so a replay is the live command. A proposal replaces the
 // markers; a failed one leaves them as they were.
-// The shape model a propose_markers command names, read and checked against its recorded
-// SHA-256 (a SessionError naming the file when it changed).
-ShapeModel recorded_shape_model(const ParamReader& r, const ApplyContext& ctx) {
+// The shape model a propose_markers command names, read once and checked against its recorded
+// SHA-256 (a SessionError naming the file when it changed), and how it was fitted and weighed:
+// version 7 recorded neither and is read with what it was made with (weight 0.5, 10 mm margin,
+// 1 mm noise, a poor fit over 1.0 mm or under half paired).
+ShapeModel recorded_shape_model(const ParamReader& r, const ApplyContext& ctx,
+                                ProposeParams& params, ShapePriorParams& prior) {
   const ParamReader model(r.value("shape_model"), r.where() + " shape_model");
   const std::string path = resolve_input(model.string("path"), ctx, "shape model");
-  const std::string sha = sha256_file(path), expected = model.string("sha256");
+  const std::string bytes = read_file_bytes(path);
+  const std::string sha = sha256_hex(bytes), expected = model.string("sha256");
   if (sha != expected)
     throw SessionError(path, "the shape model changed since this plan was made (SHA-256 " +
                                  sha.substr(0, 12) + "… now, " + expected.substr(0, 12) +
                                  "… recorded)");
-  return read_shape_model(path);
+  auto number_or = [&](const char* name, double version7) {
+    return model.has(name) ? model.number(name) : version7;
+  };
+  params.shape_model_weight = number_or("weight", 0.5);
+  prior.margin_mm = number_or("margin_mm", 10.0);
+  prior.fit.noise_mm = number_or("noise_mm", 1.0);
+  prior.fit.max_rms_mm = number_or("max_rms_mm", 1.0);
+  prior.fit.min_paired = number_or("min_paired", 0.5);
+  return parse_shape_model(bytes, path);
 }
 
 void apply_propose(PlanState& s, const ParamReader& r, const ApplyContext& ctx, Json& record) {
@@ -788,11 +800,12 @@ void apply_propose(PlanState& s, const ParamReader& r, const ApplyContext& ctx, 
     const SurfaceLocator& bone = s.skull->surface->locator;
     const SurfaceLocator& mirror = s.mirrored ? s.mirrored->locator : bone;
     if (r.has("shape_model")) {
-      const ShapeModel model = recorded_shape_model(r, ctx);
+      ShapePriorParams prior;
+      const ShapeModel model = recorded_shape_model(r, ctx, params, prior);
       const DefectRegion defect =
           detect_defect_near_plane(s.skull->surface->mesh, bone, *s.plane, params.detect);
       record["result"] = proposal_result(propose_markers_with_model(
-          defect, s.skull->surface->mesh, bone, mirror, params, s.next_marker_id, &model));
+          defect, s.skull->surface->mesh, bone, mirror, params, s.next_marker_id, &model, prior));
     } else {
       record["result"] = proposal_result(propose_markers(s.skull->surface->mesh, bone, *s.plane,
                                                          mirror, params, s.next_marker_id));

@@ -74,6 +74,13 @@ TEST(AutoplanSession, AShapeModelIsRecordedAsAnInputAndVerified) {
     if (c.type == CommandType::ProposeMarkers) {
       ASSERT_TRUE(c.params.contains("shape_model"));
       EXPECT_EQ(c.params["shape_model"]["sha256"], sha256_file(model_path));
+      // How the model was weighed, fitted and judged, so a re-proposal does the same.
+      const ShapePriorParams prior;
+      EXPECT_EQ(c.params["shape_model"]["weight"], ProposeParams{}.shape_model_weight);
+      EXPECT_EQ(c.params["shape_model"]["margin_mm"], prior.margin_mm);
+      EXPECT_EQ(c.params["shape_model"]["noise_mm"], prior.fit.noise_mm);
+      EXPECT_EQ(c.params["shape_model"]["max_rms_mm"], prior.fit.max_rms_mm);
+      EXPECT_EQ(c.params["shape_model"]["min_paired"], prior.fit.min_paired);
       EXPECT_NE(c.params["result"]["message"].get<std::string>().find("shape model"),
                 std::string::npos);
       recorded = true;
@@ -140,7 +147,7 @@ TEST(AutoplanSession, TheProposalIsRecordedInItsCommand) {
   const auto at = test::first_command(s, CommandType::ProposeMarkers);
   ASSERT_TRUE(at);
   const Command propose = s.effective_commands()[*at];
-  EXPECT_EQ(propose.version, 7);
+  EXPECT_EQ(propose.version, 8);
   ASSERT_TRUE(propose.params.contains("result"));
   const Json& result = propose.params["result"];
   EXPECT_EQ(result["proposed"], true);

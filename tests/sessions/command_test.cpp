@@ -505,7 +505,7 @@ TEST(Commands, ProposeMarkersVersionTwoRoundTripsAndVersionOneGetsDefaults) {
   p.surfaces.mirror_footprint_mm = 2.5;
   p.detect.trace_from_area_mm2 = 2500.0;
   const Json j = to_json(commands::propose_markers(p));
-  EXPECT_EQ(j["version"], 7);
+  EXPECT_EQ(j["version"], 8);
   EXPECT_TRUE(p.surfaces.weigh_sites_by_rays) << "the default";
   EXPECT_EQ(j["params"]["params"]["surfaces"]["weigh_sites_by_rays"], true);
   ProposeParams back;

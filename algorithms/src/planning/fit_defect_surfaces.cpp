@@ -204,14 +204,36 @@ std::optional<std::pair<double, double>> DefectSurfaces::radii(const Eigen::Vect
   return std::make_pair(r_out, t);
 }
 
-void DefectSurfaces::blend_with(std::shared_ptr<const DefectSurfaces> other, double weight) {
+void DefectSurfaces::blend_with(std::shared_ptr<const DefectSurfaces> other, double weight,
+                                const std::vector<Eigen::Vector3d>& directions, double taper_mm) {
   blend_ = other && other->fitted() && (other->center_ - center_).norm() < 1e-9 ? std::move(other)
                                                                                 : nullptr;
   blend_weight_ = std::clamp(weight, 0.0, 1.0);
+  blend_gaps_.reset();
+  blend_taper_mm_ = std::max(0.0, taper_mm);
+  if (!blend_ || blend_taper_mm_ <= 0.0) return;
+  std::vector<Eigen::Vector3d> gaps;
+  for (const Eigen::Vector3d& d : directions) {
+    const Eigen::Vector3d u = d.normalized();
+    if (radii(u) && !blend_->radii(u)) gaps.push_back(u);
+  }
+  if (!gaps.empty()) blend_gaps_ = std::make_shared<const PointIndex>(std::move(gaps));
+}
+
+double DefectSurfaces::blend_taper(const Eigen::Vector3d& dir, double r_out) const {
+  if (!blend_gaps_) return 1.0;
+  double chord2 = 0.0;
+  blend_gaps_->nearest(dir, &chord2);
+  const double mm = 2.0 * std::asin(std::min(1.0, 0.5 * std::sqrt(chord2))) * std::abs(r_out);
+  const double x = std::clamp(mm / blend_taper_mm_, 0.0, 1.0);
+  return x * x * (3.0 - 2.0 * x);  // smoothstep: no kink at either end
 }
 
 bool DefectSurfaces::blended_at(const Eigen::Vector3d& dir) const {
-  return blend_ && blend_weight_ > 0.0 && blend_->radii(dir.normalized()).has_value();
+  const Eigen::Vector3d u = dir.normalized();
+  const auto mine = radii(u);
+  return blend_ && blend_weight_ > 0.0 && mine && blend_->radii(u) &&
+         blend_taper(u, mine->first) > 0.0;
 }
 
 std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> DefectSurfaces::at(
@@ -222,8 +244,9 @@ std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> DefectSurfaces::at(
   auto [r_out, t] = *mine;
   if (blend_) {
     if (const auto theirs = blend_->radii(dir)) {
-      r_out += blend_weight_ * (theirs->first - r_out);
-      t += blend_weight_ * (theirs->second - t);
+      const double w = blend_weight_ * blend_taper(dir, r_out);
+      r_out += w * (theirs->first - r_out);
+      t += w * (theirs->second - t);
     }
   }
   // The bone is at least half a millimetre thick and no thicker than one layer can be.

@@ -572,7 +572,7 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
     // reaches (its template may stop short of an opening's lower edge).
     auto shaped = std::make_shared<DefectSurfaces>(
         fit_defect_surfaces(defect, bone, model, params.surfaces, params.detect));
-    surfaces.blend_with(shaped, params.shape_model_weight);
+    surfaces.blend_with(shaped, params.shape_model_weight, defect.hole_directions);
   }
   r.surfaces_message = surfaces.message;
   if (!surfaces.fitted()) {

@@ -19,10 +19,7 @@ ShapePrior fit_shape_prior(const ShapeModel& model, const SkullMesh& skull,
                            const SurfaceLocator& bone, const DefectRegion& defect,
                            const ShapePriorParams& params) {
   ShapePrior out;
-  std::vector<Eigen::Vector3d> points;
-  const size_t step = std::max<size_t>(1, skull.n_vertices() / 40000);
-  for (size_t i = 0; i < skull.n_vertices(); i += step)
-    points.push_back(to_eigen(skull.point(SkullMesh::VertexHandle(static_cast<int>(i)))));
+  const std::vector<Eigen::Vector3d> points = vertex_sample(skull, 40000);
   // The opening seen from the rays' centre, widened by the margin at each point's distance: a
   // point is left out when a ray through the opening passes within the margin's angle of it.
   const PointIndex holes(defect.hole_directions);

@@ -119,23 +119,10 @@ void keep_largest(const std::vector<std::vector<int>>& nb, std::vector<char>& in
   for (size_t i = 0; i < in.size(); ++i) in[i] = label[i] == best;
 }
 
-// A sample of the mesh's vertices (at most `count`), for sphere fits and the reverse pairing.
-std::vector<Eigen::Vector3d> vertex_sample(const SkullMesh& mesh, size_t count) {
-  std::vector<Eigen::Vector3d> out;
-  const size_t n = mesh.n_vertices(), step = std::max<size_t>(1, n / std::max<size_t>(1, count));
-  for (size_t i = 0; i < n; i += step)
-    out.push_back(to_eigen(mesh.point(SkullMesh::VertexHandle(static_cast<int>(i)))));
-  return out;
-}
-
 std::optional<FittedSphere> sphere_of(const std::vector<Eigen::Vector3d>& pts) {
   std::vector<size_t> idx(pts.size());
   std::iota(idx.begin(), idx.end(), size_t{0});
   return fit_sphere(pts, idx);
-}
-
-Eigen::Matrix3Xd apply(const Similarity& T, const Eigen::Matrix3Xd& p) {
-  return (T.topLeftCorner<3, 3>() * p).colwise() + T.topRightCorner<3, 1>();
 }
 
 // The 24 rotations of a cube.
@@ -167,6 +154,14 @@ std::vector<Eigen::Matrix3d> start_rotations() {
 }
 
 }  // namespace
+
+std::vector<Eigen::Vector3d> vertex_sample(const SkullMesh& mesh, size_t count) {
+  std::vector<Eigen::Vector3d> out;
+  const size_t n = mesh.n_vertices(), step = std::max<size_t>(1, n / std::max<size_t>(1, count));
+  for (size_t i = 0; i < n; i += step)
+    out.push_back(to_eigen(mesh.point(SkullMesh::VertexHandle(static_cast<int>(i)))));
+  return out;
+}
 
 ShapeTemplate make_shape_template(const SkullMesh& skull, const ShapeTemplateParams& params) {
   ShapeTemplate out;
@@ -306,12 +301,6 @@ SurfacePairs pair_with_surface(const Eigen::Matrix3Xd& points, const Eigen::Matr
 }
 
 namespace {
-
-double median_of(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
 
 // The target's surface sampled at points with their normals, and a search tree over them:
 // nearest-sample pairing costs a small share of a closest-triangle query within a wide reach,
@@ -607,7 +596,7 @@ Correspondence correspond_skull(const ShapeTemplate& tmpl, const SkullMesh& skul
     r.message = "the template could not be aligned with the skull (no pose pairs a third of it)";
     return r;
   }
-  Eigen::Matrix3Xd x = apply(pose.transform, tmpl.points);
+  Eigen::Matrix3Xd x = apply_similarity(pose.transform, tmpl.points);
   const Eigen::Index n = x.cols(), outer = tmpl.outer_count;
   const double cos_normal = std::cos(params.max_normal_angle_deg * M_PI / 180.0);
   // The skull's sampled vertices with their normals, for the pairing back.

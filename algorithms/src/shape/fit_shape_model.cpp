@@ -11,16 +11,6 @@
 namespace cranioplan {
 namespace {
 
-Eigen::Matrix3Xd apply(const Similarity& T, const Eigen::Matrix3Xd& p) {
-  return (T.topLeftCorner<3, 3>() * p).colwise() + T.topRightCorner<3, 1>();
-}
-
-double median_of(std::vector<double> v) {
-  if (v.empty()) return 0.0;
-  std::nth_element(v.begin(), v.begin() + v.size() / 2, v.end());
-  return v[v.size() / 2];
-}
-
 // The vertices whose posed position is not left out.
 std::vector<Eigen::Index> kept_vertices(const Eigen::Matrix3Xd& posed,
                                         const std::function<bool(const Eigen::Vector3d&)>& out) {
@@ -56,7 +46,7 @@ ShapeFit fit_shape_model(const ShapeModel& model, const SurfaceLocator& bone,
   double rms = 0.0, paired = 0.0;
   for (int it = 0; it < params.iterations; ++it) {
     const Eigen::Matrix3Xd normals = sheet_normals(model.triangles, shape);
-    const std::vector<Eigen::Index> keep = kept_vertices(apply(T, shape), left_out);
+    const std::vector<Eigen::Index> keep = kept_vertices(apply_similarity(T, shape), left_out);
     if (keep.empty()) break;
     const SurfacePairs p = pair_with_surface(shape, normals, keep, T, bone, params.max_distance_mm,
                                              params.max_normal_angle_deg);
@@ -106,7 +96,7 @@ ShapeFit fit_shape_model(const ShapeModel& model, const SurfaceLocator& bone,
       break;
   }
   r.pose = T;
-  r.points = apply(T, shape);
+  r.points = apply_similarity(T, shape);
   r.rms_mm = rms;
   r.paired = paired;
   r.mahalanobis =

@@ -174,7 +174,10 @@ double header_number(const Header& h, const std::string& key) {
 }  // namespace
 
 ShapeModel read_shape_model(const std::string& path) {
-  const std::string bytes = read_file_bytes(path);
+  return parse_shape_model(read_file_bytes(path), path);
+}
+
+ShapeModel parse_shape_model(const std::string& bytes, const std::string& path) {
   const Header h = parse_header(bytes, path);
   if (h.version < 1 || h.version > ShapeModel::kFormatVersion)
     throw InputError(path, "shape model format version " + std::to_string(h.version) +
@@ -266,11 +269,17 @@ Eigen::Matrix4d similarity_between(const Eigen::Matrix3Xd& a, const Eigen::Matri
   return T;
 }
 
-namespace {
-
-Eigen::Matrix3Xd apply(const Eigen::Matrix4d& T, const Eigen::Matrix3Xd& p) {
-  return (T.topLeftCorner<3, 3>() * p).colwise() + T.topRightCorner<3, 1>();
+Eigen::Matrix3Xd apply_similarity(const Eigen::Matrix4d& T, const Eigen::Matrix3Xd& points) {
+  return (T.topLeftCorner<3, 3>() * points).colwise() + T.topRightCorner<3, 1>();
 }
+
+double median_of(std::vector<double> values) {
+  if (values.empty()) return 0.0;
+  std::nth_element(values.begin(), values.begin() + values.size() / 2, values.end());
+  return values[values.size() / 2];
+}
+
+namespace {
 
 double mean_distance(const Eigen::Matrix3Xd& a, const Eigen::Matrix3Xd& b) {
   return (a - b).colwise().norm().mean();
@@ -318,19 +327,19 @@ ProcrustesResult generalised_procrustes(const std::vector<Eigen::Matrix3Xd>& sha
   r.mean = shapes.front();
   for (int it = 0; it < iterations; ++it) {
     for (size_t i = 0; i < shapes.size(); ++i)
-      r.aligned[i] = apply(similarity_between(shapes[i], r.mean, w, true), shapes[i]);
+      r.aligned[i] = apply_similarity(similarity_between(shapes[i], r.mean, w, true), shapes[i]);
     Eigen::Matrix3Xd next = Eigen::Matrix3Xd::Zero(3, r.mean.cols());
     for (const auto& a : r.aligned) next += a;
     next /= static_cast<double>(r.aligned.size());
     // Keep the mean's size and place at the first skull's: without it the mean shrinks a
     // little each round.
-    next = apply(similarity_between(next, shapes.front(), w, true), next);
+    next = apply_similarity(similarity_between(next, shapes.front(), w, true), next);
     const double moved = mean_distance(next, r.mean);
     r.mean = next;
     if (moved < 1e-4) break;
   }
   for (size_t i = 0; i < shapes.size(); ++i)
-    r.aligned[i] = apply(similarity_between(shapes[i], r.mean, w, true), shapes[i]);
+    r.aligned[i] = apply_similarity(similarity_between(shapes[i], r.mean, w, true), shapes[i]);
   return r;
 }
 
@@ -377,7 +386,8 @@ ShapeModel build_shape_model(const std::vector<Eigen::Matrix3Xd>& skulls, int ou
     const Eigen::Matrix3Xd target = as_points(X.col(i));
     Eigen::Matrix3Xd fit = as_points(mu);
     for (int round = 0; round < 3; ++round) {
-      const Eigen::Matrix3Xd aligned = apply(similarity_between(target, fit, w, true), target);
+      const Eigen::Matrix3Xd aligned =
+          apply_similarity(similarity_between(target, fit, w, true), target);
       const Eigen::VectorXd x = Eigen::Map<const Eigen::VectorXd>(aligned.data(), aligned.size());
       fit = as_points(mu + P * (P.transpose() * (x - mu)));
       if (round == 2) general += mean_distance(aligned, fit);

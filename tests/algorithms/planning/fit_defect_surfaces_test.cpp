@@ -9,6 +9,7 @@
 #include <memory>
 #include <vector>
 
+#include "cranioplan/algorithms/geometry/point_index.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/quality/inject_defect.h"
 #include "support/synthetic.h"
@@ -516,6 +517,93 @@ TEST(FitDefectSurfaces, MirrorGuidedSitesOfFewRaysBendTheCorrectionLess) {
   EXPECT_LT(weighed.worst, alike.worst - 0.015);
   EXPECT_LT(weighed.mean_median, 0.15);
   EXPECT_LT(weighed.worst, 0.5);
+}
+
+// Two fits averaged (a shape model's into the mirror's or the ring's): where the second has no
+// surface over part of the opening (a model's template stopping short), its weight fades over
+// the taper's width instead of stopping with a step of half their difference. Known answer: a
+// prior bulging 3 mm over the opening, with a hole in it there, averaged into the truth's fit
+// (measured: 0.66 mm between neighbouring rays untapered, 0.15 mm tapered).
+TEST(FitDefectSurfaces, ABlendFadesOutWhereTheOtherFitHasNoSurface) {
+  const Case& c = the_case();
+  ASSERT_TRUE(c.defect.found());
+  const Eigen::Vector3d top = test::head_surface_point(c.defect.axis);
+  SkullMesh bulging = c.intact;
+  for (auto vh : bulging.vertices()) {
+    const Eigen::Vector3d p(bulging.point(vh)[0], bulging.point(vh)[1], bulging.point(vh)[2]);
+    const double d = (p - top).norm(), w = std::max(0.0, 1.0 - std::pow(d / 45.0, 2));
+    const Eigen::Vector3d q = p + 3.0 * w * w * p.normalized();
+    bulging.set_point(vh, SkullMesh::Point(q.x(), q.y(), q.z()));
+  }
+  const Eigen::Vector3d side = c.defect.axis.cross(Eigen::Vector3d::UnitZ()).normalized();
+  const SkullMesh holed = test::cut_hole(bulging, top + 10.0 * side, 9.0);
+  const SurfaceLocator bone(c.defective), truth(c.intact), prior(holed);
+  auto other = std::make_shared<DefectSurfaces>(fit_defect_surfaces(c.defect, bone, &prior));
+  ASSERT_TRUE(other->fitted()) << other->message;
+  const DefectSurfaces base = fit_defect_surfaces(c.defect, bone, &truth);
+  ASSERT_TRUE(base.fitted()) << base.message;
+  const auto& dirs = c.defect.hole_directions;
+  size_t gaps = 0;
+  for (const auto& d : dirs)
+    if (base.at(d) && !other->at(d)) ++gaps;
+  ASSERT_GT(gaps, 10u) << "the prior's hole lies in the opening";
+
+  // The blend's departure from the first fit, ray by ray (outer radius, mm), and its largest
+  // change between neighbouring rays (within 2.5 mm of each other at the surface).
+  DefectSurfaces stepped = base, tapered = base;
+  stepped.blend_with(other, 0.5, dirs, 0.0);
+  tapered.blend_with(other, 0.5, dirs, 10.0);
+  std::vector<Eigen::Vector3d> at;
+  std::vector<double> step_dev, taper_dev;
+  std::vector<char> gap;
+  for (const auto& d : dirs) {
+    const auto b = base.at(d), s0 = stepped.at(d), s1 = tapered.at(d);
+    if (!b || !s0 || !s1) continue;
+    const double r = (b->first - c.defect.center).norm();
+    at.push_back(b->first);
+    step_dev.push_back((s0->first - c.defect.center).norm() - r);
+    taper_dev.push_back((s1->first - c.defect.center).norm() - r);
+    gap.push_back(!other->at(d));
+  }
+  auto largest_change = [&](const std::vector<double>& dev) {
+    double worst = 0.0;
+    for (size_t i = 0; i < at.size(); ++i)
+      for (size_t j = i + 1; j < at.size(); ++j)
+        if ((at[i] - at[j]).norm() <= 2.5) worst = std::max(worst, std::abs(dev[i] - dev[j]));
+    return worst;
+  };
+  const double step = largest_change(step_dev), smooth = largest_change(taper_dev);
+  EXPECT_GT(step, 0.4) << "the untapered blend steps by half the bulge's uncorrected part";
+  EXPECT_LT(smooth, 0.5 * step) << "step " << step;
+  std::printf("untapered %.2f mm, tapered %.2f mm between neighbouring rays\n", step, smooth);
+  // On the hole's rays both blends are the first fit; at least the taper's width away from
+  // them the two blends agree; the sources count a ray as the second fit's where it weighs.
+  const PointIndex holes([&] {
+    std::vector<Eigen::Vector3d> h;
+    for (size_t i = 0; i < at.size(); ++i)
+      if (gap[i]) h.push_back(at[i]);
+    return h;
+  }());
+  size_t far = 0;
+  for (size_t i = 0; i < at.size(); ++i) {
+    if (gap[i]) {
+      EXPECT_NEAR(step_dev[i], 0.0, 1e-9);
+      EXPECT_NEAR(taper_dev[i], 0.0, 1e-9);
+      continue;
+    }
+    double d2 = 0.0;
+    holes.nearest(at[i], &d2);
+    if (std::sqrt(d2) > 12.0) {
+      EXPECT_NEAR(step_dev[i], taper_dev[i], 1e-9);
+      ++far;
+    }
+  }
+  EXPECT_GT(far, 20u);
+  for (const auto& d : dirs) {
+    if (base.at(d) && !other->at(d)) {
+      EXPECT_FALSE(tapered.blended_at(d));
+    }
+  }
 }
 
 TEST(FitDefectSurfaces, WithoutIntactBoneAroundItSaysSo) {

@@ -213,8 +213,11 @@ TEST(ProposeMarkers, AShapeModelIsFittedOnlyWhereItGuidesAndTheSourcesAreSaid) {
   EXPECT_LE(shaped.sources.with_model, shaped.sources.mirror + 1e-9);
   EXPECT_NE(shaped.surfaces_message.find("mirror with the shape model"), std::string::npos)
       << shaped.surfaces_message;
-  for (const Marker& m : shaped.markers)
-    if (m.type == MarkerType::OuterSurface) EXPECT_LT(truth.closest(m.position).distance, 1.0);
+  for (const Marker& m : shaped.markers) {
+    if (m.type == MarkerType::OuterSurface) {
+      EXPECT_LT(truth.closest(m.position).distance, 1.0);
+    }
+  }
 
   // No model, no note.
   const MarkerProposal plain = propose_markers_with_model(c.defect, c.defective, bone, truth,

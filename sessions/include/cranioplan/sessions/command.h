@@ -15,6 +15,7 @@
 #include "cranioplan/algorithms/implant/smooth_markers.h"
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
 #include "cranioplan/algorithms/planning/propose_markers.h"
+#include "cranioplan/algorithms/planning/shape_prior.h"
 #include "cranioplan/model/marker.h"
 #include "cranioplan/model/plane.h"
 #include "cranioplan/model/rigid_transform.h"
@@ -157,9 +158,12 @@ Command import_markers(const std::vector<Marker>& markers, const std::string& so
                        const std::string& sha256);
 Command clear_markers();
 /// `shape_model`: a model of the normal skull (.cpsm) to guide the surfaces, recorded as an input
-/// of the plan (its path and SHA-256: `shape_model_sha256` when given, else the file's hash).
+/// of the plan (its path and SHA-256: `shape_model_sha256` when given, else the file's hash)
+/// with the weight it is averaged in with (ProposeParams::shape_model_weight) and `prior`, how
+/// it is fitted and judged.
 Command propose_markers(const ProposeParams& params = {}, const std::string& shape_model = "",
-                        const std::string& shape_model_sha256 = "");
+                        const std::string& shape_model_sha256 = "",
+                        const ShapePriorParams& prior = {});
 Command smooth_markers(const SmoothParams& params, bool project_onto_mirror = true);
 Command build_implant(const ImplantParams& params = {});
 /// `sha256` may be empty: the session writes the file and records the hash of its bytes.

@@ -24,6 +24,7 @@
 
 namespace cranioplan {
 
+class PointIndex;
 class SurfaceLocator;
 
 struct DefectSurfaceParams {
@@ -121,7 +122,11 @@ class DefectSurfaces {
   /// opening, so from the same centre), `weight` of `other`'s (0..1), along each ray where both
   /// have a value; these alone where `other` has none. Two fits guided by different priors
   /// (a shape model and the ring, say) err differently, and their mean errs less than either.
-  void blend_with(std::shared_ptr<const DefectSurfaces> other, double weight);
+  /// Where `other` has no value along some of `directions` (the opening's rays; a model whose
+  /// template stops inside the opening), its weight fades to 0 over `taper_mm` (at the
+  /// surface's radius, smoothly) towards them instead of stopping with a step (0: a step).
+  void blend_with(std::shared_ptr<const DefectSurfaces> other, double weight,
+                  const std::vector<Eigen::Vector3d>& directions = {}, double taper_mm = 10.0);
   /// Whether at() along unit `dir` averages in the surfaces of blend_with()'s `other`.
   bool blended_at(const Eigen::Vector3d& dir) const;
 
@@ -133,8 +138,13 @@ class DefectSurfaces {
   std::optional<std::pair<double, double>> mirror_along(const Eigen::Vector3d& dir) const;
   /// The outer radius and the thickness along unit `dir` (no blend), none outside the cap.
   std::optional<std::pair<double, double>> radii(const Eigen::Vector3d& dir) const;
+  /// The share of blend_with()'s weight along unit `dir` at outer radius `r_out`: 1 at least
+  /// the taper's width from where `other` has no value, fading to 0 there.
+  double blend_taper(const Eigen::Vector3d& dir, double r_out) const;
   std::shared_ptr<const DefectSurfaces> blend_;
   double blend_weight_ = 0.0;
+  std::shared_ptr<const PointIndex> blend_gaps_;  // directions where `blend_` has no value
+  double blend_taper_mm_ = 0.0;
   Eigen::Vector3d center_ = Eigen::Vector3d::Zero(), axis_ = Eigen::Vector3d::UnitZ();
   Eigen::Vector3d e1_ = Eigen::Vector3d::UnitX(), e2_ = Eigen::Vector3d::UnitY();
   double scale_ = 1.0;                      // mm per unit of the gnomonic projection

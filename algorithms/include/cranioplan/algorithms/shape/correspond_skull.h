@@ -52,6 +52,10 @@ struct ShapeTemplateParams {
 /// no points.
 ShapeTemplate make_shape_template(const SkullMesh& skull, const ShapeTemplateParams& params = {});
 
+/// Every k-th vertex of `mesh`, at most about `count` of them (k = vertices / count, at least
+/// 1): for sphere fits, the pose search and the reverse pairing.
+std::vector<Eigen::Vector3d> vertex_sample(const SkullMesh& mesh, size_t count);
+
 /// A similarity (scale, rotation, translation) as a 4×4 matrix.
 using Similarity = Eigen::Matrix4d;
 

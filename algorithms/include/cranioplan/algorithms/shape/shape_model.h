@@ -65,6 +65,15 @@ void write_shape_model(const ShapeModel& model, const std::string& path);
 /// complete model of this format (another file, a truncated one, a newer version, sizes that
 /// do not agree, values that are not finite).
 ShapeModel read_shape_model(const std::string& path);
+/// The same from a file's bytes already read (`path` names it in messages): a caller that
+/// hashes the file reads it once, and the model is the one hashed.
+ShapeModel parse_shape_model(const std::string& bytes, const std::string& path);
+
+/// `points` (3×N) moved by the similarity `T` (scale × rotation, translation; 4×4).
+Eigen::Matrix3Xd apply_similarity(const Eigen::Matrix4d& T, const Eigen::Matrix3Xd& points);
+
+/// The median of `values` (the upper one of an even count), 0 when there are none.
+double median_of(std::vector<double> values);
 
 /// Corresponded skulls (3×N each, the template's vertex order), aligned by similarity.
 struct ProcrustesResult {
