@@ -42,7 +42,6 @@ namespace {
 // copied out: OpenMesh meshes have no move constructor, and a copy of a SkullFix skull is 300 MB.
 
 Json implant_json(const ImplantResult& r) {
-  static const char* names[] = {"built", "too_few_markers", "failed"};
   Json holes = Json::array();
   for (const Hole& h : r.holes)
     holes.push_back(Json{{"center", to_json(h.center)}, {"axis", to_json(h.axis)}});
@@ -58,7 +57,7 @@ Json implant_json(const ImplantResult& r) {
                         {"bone_mm", t.bone_mm},
                         {"midline_mm", std::isnan(t.midline_mm) ? Json() : Json(t.midline_mm)}});
   }
-  return Json{{"status", names[static_cast<int>(r.status)]},
+  return Json{{"status", status_name(r.status)},
               {"holes", holes},
               {"tabs", tabs},
               {"message", r.message},
@@ -380,7 +379,7 @@ Subcommand add_mould(CLI::App& app, const bool& json) {
         const SkullMesh implant = load_surface(o->implant).mesh;
         const LoadedSkull skull = load_skull(o->skull);
         const MouldResult r = make_casting_mould(implant, vertex_centroid(skull.mesh), o->params);
-        Json j{{"status", r.usable() ? "made" : "failed"},
+        Json j{{"status", status_name(r.status)},
                {"message", r.message},
                {"cavity_max_mm", r.cavity_max_mm},
                {"cavity_p95_mm", r.cavity_p95_mm},

@@ -31,6 +31,18 @@
 
 namespace cranioplan {
 
+const char* status_name(ImplantResult::Status status) {
+  switch (status) {
+    case ImplantResult::Status::Built:
+      return "built";
+    case ImplantResult::Status::TooFewMarkers:
+      return "too_few_markers";
+    case ImplantResult::Status::Failed:
+      break;
+  }
+  return "failed";
+}
+
 const char* to_string(ImplantMethod m) {
   return m == ImplantMethod::Shell ? "shell" : "delaunay3d";
 }

@@ -16,6 +16,11 @@
 #include "param_ranges.h"
 
 namespace cranioplan {
+
+const char* status_name(MouldResult::Status status) {
+  return status == MouldResult::Status::Made ? "made" : "failed";
+}
+
 namespace {
 
 std::string range_problem(const char* what, double v, double lo, double hi) {

@@ -43,6 +43,13 @@ const DefectCase& right_parietal_case() {
   return c;
 }
 
+// The words the reports and --json give each status.
+TEST(BuildImplant, EachStatusHasItsWord) {
+  EXPECT_STREQ(status_name(ImplantResult::Status::Built), "built");
+  EXPECT_STREQ(status_name(ImplantResult::Status::TooFewMarkers), "too_few_markers");
+  EXPECT_STREQ(status_name(ImplantResult::Status::Failed), "failed");
+}
+
 TEST(BuildImplant, ShellThroughMarkersIsWatertightAndPassesThroughEdgeMarkers) {
   const DefectCase& c = right_parietal_case();
   const ImplantResult r = build_implant(c.markers, &c.defective);

@@ -20,6 +20,11 @@ const Eigen::Vector3d kInside(20, 20, -60);
 // the plate everywhere, no undercut; the outer half has the pour channel and the vent through it
 // (two tunnels) and sockets for the inner half's keys; the halves fill the block less the plate,
 // the openings and the keys' clearance.
+TEST(CastingMould, EachStatusHasItsWord) {
+  EXPECT_STREQ(status_name(MouldResult::Status::Made), "made");
+  EXPECT_STREQ(status_name(MouldResult::Status::Failed), "failed");
+}
+
 TEST(CastingMould, APlatesMouldHasItsCavityWithinAFifthOfAMillimetre) {
   const SkullMesh implant = plate();
   MouldParams p;

@@ -114,6 +114,8 @@ struct ImplantResult {
   std::vector<std::pair<std::string, double>> stage_seconds;
   bool usable() const { return status == Status::Built; }
 };
+/// "built", "too_few_markers" or "failed": the word reports and `--json` give the status.
+const char* status_name(ImplantResult::Status status);
 
 /// Builds an implant from markers (types 0–3). `skull` is the original skull: the shell's rims
 /// are snapped onto it and the default thickness is measured on it; may be null.

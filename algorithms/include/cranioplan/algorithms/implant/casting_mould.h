@@ -53,6 +53,8 @@ struct MouldResult {
   double seconds = 0.0;
   bool usable() const { return status == Status::Made; }
 };
+/// "made" or "failed".
+const char* status_name(MouldResult::Status status);
 
 /// The mould of `implant` (closed, outward-oriented); `inside`: a point inside the skull, which
 /// tells the implant's outer surface from its inner one.
