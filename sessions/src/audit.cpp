@@ -5,6 +5,7 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <functional>
 #include <limits>
 #include <sstream>
 
@@ -607,81 +608,96 @@ std::string quality_report_html(const QualityReport& r, const SoftTissueCheck* t
   return h;
 }
 
-std::string design_report_html(const Session& session, const std::vector<ReportImage>& images,
-                               const std::string& program_version, const SoftTissueCheck* tissue) {
-  const PlanState& st = session.state();
-  const ImplantData& implant = *st.implant;
-  const QualityReport& q = implant.quality();
-  const SkullMesh& mesh = implant.result().mesh;
-  auto fixed = [](double v, int decimals) {
-    return fmt(("%." + std::to_string(decimals) + "f").c_str(), v);
-  };
-  auto point = [&](const Eigen::Vector3d& x) {
-    return fixed(x.x(), 1) + ", " + fixed(x.y(), 1) + ", " + fixed(x.z(), 1);
-  };
+namespace {
+
+// The design report's parts, each a piece of HTML.
+
+std::string fixed_mm(double v, int decimals) {
+  return fmt(("%." + std::to_string(decimals) + "f").c_str(), v);
+}
+
+std::string point_mm(const Eigen::Vector3d& x) {
+  return fixed_mm(x.x(), 1) + ", " + fixed_mm(x.y(), 1) + ", " + fixed_mm(x.z(), 1);
+}
+
+std::string table_row(const std::string& k, const std::string& v) {
+  return "<tr><th>" + k + "</th><td>" + v + "</td></tr>";
+}
+
+// "2026-12-07T06:09:07.055Z" as "2026-12-07 06:09 UTC".
+std::string minutes_utc(const std::string& iso) {
+  if (iso.size() < 16 || iso[10] != 'T') return iso.empty() ? std::string("—") : iso;
+  return iso.substr(0, 10) + " " + iso.substr(11, 5) + " UTC";
+}
+
+// Identity: whose plan this is, who made it, when, with what.
+std::string identity_html(const Session& session, const std::string& case_id,
+                          const std::string& program_version) {
   const SessionHeader& header = session.header();
-  const std::string case_id = header.info.case_id.empty() ? "(no case ID)" : header.info.case_id;
-  std::string h = html_head("Cranioplan design report — " + case_id) +
-                  "<h1>Implant design report — " + html_escape(case_id) + "</h1>";
-  auto row = [&](const std::string& k, const std::string& v) {
-    h += "<tr><th>" + k + "</th><td>" + v + "</td></tr>";
-  };
-  // Identity: whose plan this is, who made it, when, with what.
   std::string skull_file;
   for (const Command& cmd : session.effective_commands())
     if (cmd.type == CommandType::LoadSkull) skull_file = cmd.params.value("path", std::string());
-  h += "<table width=100%>";
-  row("Case (patient) ID", "<b>" + html_escape(case_id) + "</b>");
-  row("Planned by", html_escape(header.info.user.empty() ? "—" : header.info.user));
-  // "2026-12-07T06:09:07.055Z" as "2026-12-07 06:09 UTC".
-  const auto when = [](const std::string& iso) {
-    if (iso.size() < 16 || iso[10] != 'T') return iso.empty() ? std::string("—") : iso;
-    return iso.substr(0, 10) + " " + iso.substr(11, 5) + " UTC";
-  };
-  row("Plan started", html_escape(when(header.info.created)));
-  row("Last change",
-      html_escape(when(session.journal().empty() ? std::string() : session.journal().back().time)));
-  row("Skull from", html_escape(std::filesystem::path(skull_file).filename().string()));
-  row("Program", "Cranioplan " + html_escape(program_version));
-  h += "</table>";
-  // The verdict, then the implant and the checks it passed or failed.
+  return "<table width=100%>" +
+         table_row("Case (patient) ID", "<b>" + html_escape(case_id) + "</b>") +
+         table_row("Planned by", html_escape(header.info.user.empty() ? "—" : header.info.user)) +
+         table_row("Plan started", html_escape(minutes_utc(header.info.created))) +
+         table_row("Last change", html_escape(minutes_utc(session.journal().empty()
+                                                              ? std::string()
+                                                              : session.journal().back().time))) +
+         table_row("Skull from",
+                   html_escape(std::filesystem::path(skull_file).filename().string())) +
+         table_row("Program", "Cranioplan " + html_escape(program_version)) + "</table>";
+}
+
+// The verdict: printable or not, a finding to check, an implant cut at the scan's end.
+std::string verdict_html(const QualityReport& q, const SoftTissueCheck* tissue) {
+  std::string h;
   if (!q.printable)
     h += "<p class=bad>NOT printable: the quality check refuses this implant.</p>";
   else if (tissue && tissue->checked && tissue->finding)
     h += "<p style='color:#8a5a00'><b>Printable, with a finding to check before approval:</b> "
          "brain or dura reaches " +
-         fixed(tissue->intrusion_reach_mm, 1) +
+         fixed_mm(tissue->intrusion_reach_mm, 1) +
          " mm above the implant's inner surface (Quality, and the CT slices on page 3).</p>";
   else
     h += "<p class=ok><b>Printable:</b> the quality check passes.</p>";
   if (q.ends_at_scan_end)
     h += "<p style='color:#8a5a00'><b>The implant ends where the scan ended:</b> the defect runs "
          "into the border of the scan, and the bone beyond it is unknown.</p>";
+  return h;
+}
+
+// The views of the skull on one page, the CT slices and the thickness map on the next, two
+// pictures to a row.
+std::string pictures_html(const std::vector<ReportImage>& images) {
   std::string pictures;
-  if (!images.empty()) {
-    // The views of the skull on one page, the CT slices and the thickness map on the next, two
-    // pictures to a row.
-    const std::pair<std::vector<ReportImage::Kind>, const char*> pages[] = {
-        {{ReportImage::Kind::View}, "The implant on the skull"},
-        {{ReportImage::Kind::Slice, ReportImage::Kind::Thickness},
-         "CT slices through the implant (its outline orange), and its thickness"}};
-    for (const auto& [kinds, title] : pages) {
-      std::vector<const ReportImage*> of;
-      for (ReportImage::Kind kind : kinds)
-        for (const ReportImage& image : images)
-          if (image.kind == kind) of.push_back(&image);
-      if (of.empty()) continue;
-      pictures += std::string("<h2 style=\"page-break-before: always\">") + title + "</h2><table>";
-      for (size_t k = 0; k < of.size(); ++k) {
-        if (k % 2 == 0) pictures += "<tr>";
-        pictures += "<td><img src=\"" + html_escape(of[k]->file) + "\" width=300><br>" +
-                    html_escape(of[k]->caption) + "</td>";
-        if (k % 2 == 1 || k + 1 == of.size()) pictures += "</tr>";
-      }
-      pictures += "</table>";
+  const std::pair<std::vector<ReportImage::Kind>, const char*> pages[] = {
+      {{ReportImage::Kind::View}, "The implant on the skull"},
+      {{ReportImage::Kind::Slice, ReportImage::Kind::Thickness},
+       "CT slices through the implant (its outline orange), and its thickness"}};
+  for (const auto& [kinds, title] : pages) {
+    std::vector<const ReportImage*> of;
+    for (ReportImage::Kind kind : kinds)
+      for (const ReportImage& image : images)
+        if (image.kind == kind) of.push_back(&image);
+    if (of.empty()) continue;
+    pictures += std::string("<h2 style=\"page-break-before: always\">") + title + "</h2><table>";
+    for (size_t k = 0; k < of.size(); ++k) {
+      if (k % 2 == 0) pictures += "<tr>";
+      pictures += "<td><img src=\"" + html_escape(of[k]->file) + "\" width=300><br>" +
+                  html_escape(of[k]->caption) + "</td>";
+      if (k % 2 == 1 || k + 1 == of.size()) pictures += "</tr>";
     }
+    pictures += "</table>";
   }
-  // Dimensions along the implant's principal axes.
+  return pictures;
+}
+
+// The implant: material, extent along its principal axes, area, volume, mass, fit to the bone.
+std::string implant_html(const PlanState& st, const ImplantData& implant) {
+  const QualityReport& q = implant.quality();
+  const ImplantResult& built = implant.result();
+  const SkullMesh& mesh = built.mesh;
   const Eigen::Vector3d c = vertex_centroid(mesh);
   Eigen::Matrix3d cov = Eigen::Matrix3d::Zero();
   for (auto vh : mesh.vertices()) {
@@ -696,69 +712,75 @@ std::string design_report_html(const Session& session, const std::vector<ReportI
     hi = hi.cwiseMax(d);
   }
   const Eigen::Vector3d extent = hi - lo;
-  h += "<h2>Implant</h2><table width=100%>";
-  if (st.implant_params && st.implant_params->material)
-    row("Material", html_escape(describe(*st.implant_params->material)));
-  else
-    row("Material", "none chosen (the plan's surfaces as they are)");
-  row("Extent (principal axes)",
-      fixed(extent.z(), 1) + " × " + fixed(extent.y(), 1) + " × " + fixed(extent.x(), 1) + " mm");
-  row("Surface area", fixed(q.area_mm2, 0) + " mm²");
-  row("Volume", fixed(q.volume_mm3, 0) + " mm³");
-  if (st.implant_params && st.implant_params->material)
-    row("Mass", fixed(q.volume_mm3 * 1e-3 * st.implant_params->material->density_g_cm3, 1) + " g");
-  row("Triangles", std::to_string(mesh.n_faces()));
-  const ImplantResult& built = implant.result();
+  const std::optional<Material>& material =
+      st.implant_params ? st.implant_params->material : std::optional<Material>();
+  std::string h = "<h2>Implant</h2><table width=100%>";
+  h += table_row("Material", material
+                                 ? html_escape(describe(*material))
+                                 : std::string("none chosen (the plan's surfaces as they are)"));
+  h += table_row("Extent (principal axes)", fixed_mm(extent.z(), 1) + " × " +
+                                                fixed_mm(extent.y(), 1) + " × " +
+                                                fixed_mm(extent.x(), 1) + " mm");
+  h += table_row("Surface area", fixed_mm(q.area_mm2, 0) + " mm²");
+  h += table_row("Volume", fixed_mm(q.volume_mm3, 0) + " mm³");
+  if (material)
+    h += table_row("Mass", fixed_mm(q.volume_mm3 * 1e-3 * material->density_g_cm3, 1) + " g");
+  h += table_row("Triangles", std::to_string(mesh.n_faces()));
   if (built.fit_to_bone_used_mm > 0.0)
-    row("Fitted to the bone",
-        fixed(built.fit_to_bone_used_mm, 1) + " mm over it" +
+    h += table_row(
+        "Fitted to the bone",
+        fixed_mm(built.fit_to_bone_used_mm, 1) + " mm over it" +
             (built.fit_margin_note.empty() ? std::string()
                                            : " (" + html_escape(built.fit_margin_note) + ")"));
-  h += "</table><h2>Quality</h2>" + quality_report_html(q, tissue);
-  h += pictures;
-  // After the pictures, on a page of their own: the perforations and tabs, the approval and the
-  // provenance.
-  const char* const kNewPage = "<h2 style=\"page-break-before: always\">";
-  bool paged = false;
-  const auto heading = [&](const char* title) {
-    h += std::string(paged ? "<h2>" : kNewPage) + title + "</h2>";
-    paged = true;
-  };
+  return h + "</table>";
+}
+
+// The perforations and the fixation tabs, a table each (`heading` starts each).
+std::string holes_and_tabs_html(const ImplantResult& built,
+                                const std::function<std::string(const char*)>& heading) {
+  std::string h;
   if (!built.holes.empty()) {
-    heading("Perforations");
+    h += heading("Perforations");
     h += "<table><tr><th>#</th><th>Centre (mm)</th><th>Axis</th>"
          "<th>Placed</th></tr>";
     for (size_t k = 0; k < built.holes.size(); ++k) {
       const Hole& hole = built.holes[k];
-      h += "<tr><td>" + std::to_string(k + 1) + "</td><td>" + point(hole.center) + "</td><td>" +
-           fixed(hole.axis.x(), 2) + ", " + fixed(hole.axis.y(), 2) + ", " +
-           fixed(hole.axis.z(), 2) + "</td><td>" + (hole.added ? "by hand" : "pattern") +
+      h += "<tr><td>" + std::to_string(k + 1) + "</td><td>" + point_mm(hole.center) + "</td><td>" +
+           fixed_mm(hole.axis.x(), 2) + ", " + fixed_mm(hole.axis.y(), 2) + ", " +
+           fixed_mm(hole.axis.z(), 2) + "</td><td>" + (hole.added ? "by hand" : "pattern") +
            "</td></tr>";
     }
     h += "</table>";
   }
   if (!built.tabs.empty()) {
-    heading("Fixation tabs");
+    h += heading("Fixation tabs");
     h += "<table><tr><th>#</th><th>At the rim (mm)</th><th>Length × "
          "width × thickness</th><th>Screws</th><th>Bone under the screws</th><th>From the "
          "midline</th></tr>";
     for (size_t k = 0; k < built.tabs.size(); ++k) {
       const Tab& t = built.tabs[k];
-      h += "<tr><td>" + std::to_string(k + 1) + "</td><td>" + point(t.rim) + "</td><td>" +
-           fixed(t.length_mm, 1) + " × " + fixed(t.width_mm, 1) + " × " + fixed(t.thickness_mm, 1) +
-           " mm</td><td>" + std::to_string(t.screws.size()) + "</td><td>" + fixed(t.bone_mm, 1) +
-           " mm</td><td>" +
-           (std::isnan(t.midline_mm) ? std::string("—") : fixed(t.midline_mm, 1) + " mm") +
+      h += "<tr><td>" + std::to_string(k + 1) + "</td><td>" + point_mm(t.rim) + "</td><td>" +
+           fixed_mm(t.length_mm, 1) + " × " + fixed_mm(t.width_mm, 1) + " × " +
+           fixed_mm(t.thickness_mm, 1) + " mm</td><td>" + std::to_string(t.screws.size()) +
+           "</td><td>" + fixed_mm(t.bone_mm, 1) + " mm</td><td>" +
+           (std::isnan(t.midline_mm) ? std::string("—") : fixed_mm(t.midline_mm, 1) + " mm") +
            "</td></tr>";
     }
     h += "</table>";
   }
-  // What is approved, and by whom: each line on its own, nothing to wrap.
-  heading("Approval");
-  h += "<p>The approver confirms having "
-       "checked the implant above — its "
-       "shape on the skull, its fit to the bone on the CT slices, its thickness and every "
-       "finding of the quality table — and approves it for manufacture";
+  return h;
+}
+
+// What is approved, and by whom (each line on its own, nothing to wrap), and the lines to sign
+// by hand on paper, whatever the plan records.
+std::string approval_html(const Session& session, const ImplantData& implant,
+                          const std::string& case_id) {
+  const PlanState& st = session.state();
+  std::string h =
+      "<p>The approver confirms having "
+      "checked the implant above — its "
+      "shape on the skull, its fit to the bone on the CT slices, its thickness and every "
+      "finding of the quality table — and approves it for manufacture";
   if (st.implant_params && st.implant_params->material)
     h += " in " + html_escape(st.implant_params->material->name);
   h += " as the binary STL with SHA-256 <code>" + implant.stl_sha256() + "</code>, for case " +
@@ -778,24 +800,58 @@ std::string design_report_html(const Session& session, const std::vector<ReportI
   } else {
     h += "<p><b>Not approved yet.</b></p>";
   }
-  // The lines to sign by hand, on paper, whatever the plan records.
   h += "<table width=100%>";
   for (const char* line : {"Name", "Role", "Date", "Signature"})
     h += std::string("<tr><th width=25%>") + line + "</th><td height=34>&nbsp;</td></tr>";
-  h += "</table>";
-  h += "<h2>Provenance</h2><table>";
+  return h + "</table>";
+}
+
+// The inputs' and the outputs' hashes.
+std::string provenance_html(const Session& session, const ImplantData& implant,
+                            const std::string& program_version) {
+  std::string h = "<h2>Provenance</h2><table>";
   for (const Command& cmd : session.effective_commands())
     if (cmd.type == CommandType::LoadSkull || cmd.type == CommandType::AttachCt)
-      row(cmd.type == CommandType::LoadSkull ? "Skull" : "CT",
-          html_escape(cmd.params.value("path", std::string())) + "<br><code>SHA-256 " +
-              cmd.params.value("sha256", std::string()) + "</code>");
-  row("Plan (journal's last hash)",
+      h += table_row(cmd.type == CommandType::LoadSkull ? "Skull" : "CT",
+                     html_escape(cmd.params.value("path", std::string())) + "<br><code>SHA-256 " +
+                         cmd.params.value("sha256", std::string()) + "</code>");
+  h += table_row(
+      "Plan (journal's last hash)",
       "<code>" + (session.journal().empty() ? std::string("—") : session.journal().back().hash) +
           "</code>");
-  row("Implant (binary STL SHA-256)", "<code>" + implant.stl_sha256() + "</code>");
-  row("Program", "Cranioplan " + html_escape(program_version));
-  h += "</table></body></html>";
-  return h;
+  h += table_row("Implant (binary STL SHA-256)", "<code>" + implant.stl_sha256() + "</code>");
+  h += table_row("Program", "Cranioplan " + html_escape(program_version));
+  return h + "</table>";
+}
+
+}  // namespace
+
+std::string design_report_html(const Session& session, const std::vector<ReportImage>& images,
+                               const std::string& program_version, const SoftTissueCheck* tissue) {
+  const PlanState& st = session.state();
+  const ImplantData& implant = *st.implant;
+  const std::string& case_id_given = session.header().info.case_id;
+  const std::string case_id = case_id_given.empty() ? "(no case ID)" : case_id_given;
+  std::string h = html_head("Cranioplan design report — " + case_id) +
+                  "<h1>Implant design report — " + html_escape(case_id) + "</h1>";
+  // Page 1: identity, verdict, the implant and its quality; then the pictures; then, on a page
+  // of their own, the perforations and tabs, the approval and the provenance.
+  h += identity_html(session, case_id, program_version);
+  h += verdict_html(implant.quality(), tissue);
+  h += implant_html(st, implant);
+  h += "<h2>Quality</h2>" + quality_report_html(implant.quality(), tissue);
+  h += pictures_html(images);
+  bool paged = false;
+  const auto heading = [&paged](const char* title) {
+    const std::string tag = paged ? "<h2>" : "<h2 style=\"page-break-before: always\">";
+    paged = true;
+    return tag + title + "</h2>";
+  };
+  h += holes_and_tabs_html(implant.result(), heading);
+  h += heading("Approval");
+  h += approval_html(session, implant, case_id);
+  h += provenance_html(session, implant, program_version);
+  return h + "</body></html>";
 }
 
 }  // namespace cranioplan
