@@ -85,8 +85,7 @@ void add_scores(Json& row, const AutoplanResult& r, const CompareResult& c) {
   if (!r.quality.printable) row["not_printable_because"] = r.quality.reasons;
   row["model_share"] = r.sources.with_model;
   if (r.shape_fit) {
-    if (r.shape_fit->status != ShapeFit::Status::Skipped)
-      row["shape_model_rms_mm"] = r.shape_fit->rms_mm;
+    if (r.shape_fit->measured()) row["shape_model_rms_mm"] = r.shape_fit->rms_mm;
     row["shape_model_used"] = r.method_used == PlanMethod::ShapeModel;
   }
 }

@@ -100,11 +100,11 @@ Json autoplan_json(const AutoplanResult& r) {
                         {"none", r.sources.none},
                         {"message", r.sources.describe()}};
     if (r.shape_fit) {
-      const bool skipped = r.shape_fit->status == ShapeFit::Status::Skipped;
-      j["shape_model"] = Json{{"fitted", r.shape_fit->usable()},
+      j["shape_model"] = Json{{"status", status_name(r.shape_fit->status)},
+                              {"fitted", r.shape_fit->usable()},
                               {"used", r.method_used == PlanMethod::ShapeModel},
                               {"message", r.shape_fit->message}};
-      if (!skipped)
+      if (r.shape_fit->measured())
         j["shape_model"].update(Json{{"rms_mm", r.shape_fit->rms_mm},
                                      {"paired", r.shape_fit->paired},
                                      {"mahalanobis", r.shape_fit->mahalanobis}});

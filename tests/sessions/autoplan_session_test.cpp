@@ -50,15 +50,8 @@ TEST(AutoplanSession, ReplayReproducesTheExportByteForByte) {
 TEST(AutoplanSession, AShapeModelIsRecordedAsAnInputAndVerified) {
   const auto dir = std::filesystem::temp_directory_path() / "cranioplan_session_shape_model";
   std::filesystem::create_directories(dir);
-  const ShapeTemplate t =
-      make_shape_template(test::make_thick_head(0.93, 0.8), ShapeTemplateParams{4});
-  ASSERT_GT(t.outer_count, 100);
-  std::vector<Eigen::Matrix3Xd> shapes;
-  for (const Eigen::Vector3d& stretch :
-       {Eigen::Vector3d(1.0, 1.0, 1.0), Eigen::Vector3d(1.03, 0.98, 1.0),
-        Eigen::Vector3d(0.98, 1.02, 1.03)})
-    shapes.push_back(stretch.asDiagonal() * t.points);
-  ShapeModel model = build_shape_model(shapes, t.outer_count, t.triangles, {}, false);
+  ShapeModel model = test::stretched_head_model(test::make_thick_head(0.93, 0.8));
+  ASSERT_GT(model.outer_count, 100);
   model.provenance.skull_sha256 = {"a", "b", "c"};
   model.provenance.skull_names = {"a", "b", "c"};
   const std::string model_path = (dir / "skulls.cpsm").string();

@@ -8,8 +8,20 @@
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
 #include "cranioplan/algorithms/quality/inject_defect.h"
+#include "cranioplan/algorithms/shape/correspond_skull.h"
+#include "cranioplan/algorithms/shape/shape_model.h"
 
 namespace cranioplan::test {
+
+ShapeModel stretched_head_model(const SkullMesh& head) {
+  const ShapeTemplate t = make_shape_template(head, ShapeTemplateParams{4});
+  std::vector<Eigen::Matrix3Xd> shapes;
+  for (const Eigen::Vector3d& stretch :
+       {Eigen::Vector3d(1.0, 1.0, 1.0), Eigen::Vector3d(1.03, 0.98, 1.0),
+        Eigen::Vector3d(0.98, 1.02, 1.03)})
+    shapes.push_back(stretch.asDiagonal() * t.points);
+  return build_shape_model(shapes, t.outer_count, t.triangles, {}, false);
+}
 namespace {
 
 // Icosphere with vertices symmetric under x ↦ −x.

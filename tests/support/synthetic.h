@@ -10,7 +10,16 @@
 #include "cranioplan/model/rigid_transform.h"
 #include "cranioplan/model/volume.h"
 
+namespace cranioplan {
+struct ShapeModel;
+}
+
 namespace cranioplan::test {
+
+/// A small shape model of `head` stretched three ways (as it is; 3 %, 2 % and 2 % along the
+/// axes), its template on `head` (4 subdivisions): a model whose mean is the head itself, for
+/// tests of how plans use a model rather than of its accuracy.
+ShapeModel stretched_head_model(const SkullMesh& head);
 
 /// A closed, outward-oriented head-like surface, mirror-symmetric across x = 0 exactly (the
 /// vertex set is symmetric), about 140 × 180 × 150 mm, with a nose ridge at +y and a flattened

@@ -229,11 +229,11 @@ double DefectSurfaces::blend_taper(const Eigen::Vector3d& dir, double r_out) con
   return x * x * (3.0 - 2.0 * x);  // smoothstep: no kink at either end
 }
 
-bool DefectSurfaces::blended_at(const Eigen::Vector3d& dir) const {
+double DefectSurfaces::blend_share(const Eigen::Vector3d& dir) const {
   const Eigen::Vector3d u = dir.normalized();
+  if (!blend_ || blend_weight_ <= 0.0 || !blend_->radii(u)) return 0.0;
   const auto mine = radii(u);
-  return blend_ && blend_weight_ > 0.0 && mine && blend_->radii(u) &&
-         blend_taper(u, mine->first) > 0.0;
+  return mine ? blend_taper(u, mine->first) : 0.0;
 }
 
 std::optional<std::pair<Eigen::Vector3d, Eigen::Vector3d>> DefectSurfaces::at(

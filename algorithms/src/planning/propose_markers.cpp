@@ -285,7 +285,7 @@ std::string SurfaceSources::describe() const {
   add(ring * (1.0 - model_share), model_share > 0.0 ? "ring fit alone" : "ring fit");
   add(none, "bridged from the surfaces around (no value along those rays)");
   return "the opening's surfaces: " + (parts.empty() ? std::string("none") : parts) +
-         "; the rim and the ring around it: the skull's own bone";
+         "; edge markers on them along the rim, support markers on the skull's own bone";
 }
 
 double mirror_coverage(const DefectRegion& defect, const SurfaceLocator& mirror,
@@ -523,14 +523,15 @@ void add_surface_markers(const DefectRegion& defect, const DefectSurfaces& surfa
 SurfaceSources sources_of(const DefectRegion& defect, const DefectSurfaces& surfaces) {
   SurfaceSources s;
   if (defect.hole_directions.empty()) return s;
-  size_t primary = 0, blended = 0, none = 0;
+  size_t primary = 0, none = 0;
+  double blended = 0.0;
   for (const auto& d : defect.hole_directions) {
     if (!surfaces.at(d)) {
       ++none;
       continue;
     }
     ++primary;
-    if (surfaces.blended_at(d)) ++blended;
+    blended += surfaces.blend_share(d);
   }
   const double n = static_cast<double>(defect.hole_directions.size());
   (surfaces.mirror_guided ? s.mirror : s.ring) = primary / n;
@@ -572,7 +573,11 @@ MarkerProposal propose_markers_for_defect(const DefectRegion& defect, const Surf
     // reaches (its template may stop short of an opening's lower edge).
     auto shaped = std::make_shared<DefectSurfaces>(
         fit_defect_surfaces(defect, bone, model, params.surfaces, params.detect));
-    surfaces.blend_with(shaped, params.shape_model_weight, defect.hole_directions);
+    // The taper looks for where the model stops among the opening's rays and the rim's (the
+    // edge markers stand on these surfaces along the rim).
+    std::vector<Eigen::Vector3d> directions = defect.hole_directions;
+    for (const auto& p : defect.outer_rim) directions.push_back((p - defect.center).normalized());
+    surfaces.blend_with(shaped, params.shape_model_weight, directions);
   }
   r.surfaces_message = surfaces.message;
   if (!surfaces.fitted()) {

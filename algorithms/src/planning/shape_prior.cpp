@@ -77,7 +77,8 @@ MarkerProposal propose_markers_with_model(const DefectRegion& defect, const Skul
                                  prior && prior->usable() ? prior->locator.get() : nullptr);
   if (fitted)
     proposal.surfaces_message +=
-        "; " + shape_prior_note(*fitted, proposal.method_used == PlanMethod::ShapeModel);
+        (proposal.surfaces_message.empty() ? "" : "; ") +
+        shape_prior_note(*fitted, proposal.method_used == PlanMethod::ShapeModel);
   if (fit) *fit = std::move(fitted);
   return proposal;
 }

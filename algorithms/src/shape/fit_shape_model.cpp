@@ -22,6 +22,20 @@ std::vector<Eigen::Index> kept_vertices(const Eigen::Matrix3Xd& posed,
 
 }  // namespace
 
+const char* status_name(ShapeFit::Status status) {
+  switch (status) {
+    case ShapeFit::Status::Fitted:
+      return "fitted";
+    case ShapeFit::Status::Poor:
+      return "poor";
+    case ShapeFit::Status::Skipped:
+      return "skipped";
+    case ShapeFit::Status::Failed:
+      break;
+  }
+  return "failed";
+}
+
 ShapeFit fit_shape_model(const ShapeModel& model, const SurfaceLocator& bone,
                          const std::vector<Eigen::Vector3d>& bone_points,
                          const std::function<bool(const Eigen::Vector3d&)>& left_out,

@@ -88,8 +88,8 @@ EdgeMarkersPage::EdgeMarkersPage(PageHost& host)
     }
     host_.push(std::move(propose),
                model.empty() ? tr("Finding the defect and proposing markers")
-                             : tr("Finding the defect, fitting the shape model and proposing "
-                                  "markers"));
+                             : tr("Finding the defect and proposing markers (the shape model "
+                                  "fitted where the mirror does not cover it)"));
   });
   add_shape_model_row();
   QPushButton* import = add_button(tr("Import markers…"), "importMarkers");

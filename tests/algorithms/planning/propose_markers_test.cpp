@@ -162,14 +162,8 @@ TEST(ProposeMarkers, RimOnlyFittingIsUsedWhenAsked) {
 TEST(ProposeMarkers, AShapeModelIsFittedOnlyWhereItGuidesAndTheSourcesAreSaid) {
   const test::ThickHeadDefect& c = test::thick_head_defect();
   ASSERT_TRUE(c.defect.found()) << c.defect.message;
-  const ShapeTemplate t = make_shape_template(c.intact, ShapeTemplateParams{4});
-  ASSERT_GT(t.outer_count, 100);
-  std::vector<Eigen::Matrix3Xd> shapes;
-  for (const Eigen::Vector3d& stretch :
-       {Eigen::Vector3d(1.0, 1.0, 1.0), Eigen::Vector3d(1.03, 0.98, 1.0),
-        Eigen::Vector3d(0.98, 1.02, 1.03)})
-    shapes.push_back(stretch.asDiagonal() * t.points);
-  const ShapeModel model = build_shape_model(shapes, t.outer_count, t.triangles, {}, false);
+  const ShapeModel model = test::stretched_head_model(c.intact);
+  ASSERT_GT(model.outer_count, 100);
   const SurfaceLocator bone(c.defective), truth(c.intact);
 
   // Auto with the mirror covering the opening: the mirror alone, the model not fitted.
@@ -219,6 +213,27 @@ TEST(ProposeMarkers, AShapeModelIsFittedOnlyWhereItGuidesAndTheSourcesAreSaid) {
     }
   }
 
+  // Auto where the mirror does not cover the opening (its bone there cut away): the model is
+  // fitted and guides the ring's surfaces, and the markers stay on the missing bone.
+  const SkullMesh uncovered_mesh =
+      test::cut_hole(c.intact, test::head_surface_point(c.defect.axis), 45.0);
+  const SurfaceLocator uncovered(uncovered_mesh);
+  const MarkerProposal modelled = propose_markers_with_model(c.defect, c.defective, bone, uncovered,
+                                                             ProposeParams{}, 1, &model, {}, &fit);
+  ASSERT_TRUE(modelled.proposed()) << modelled.message;
+  EXPECT_LT(modelled.mirror_coverage, ProposeParams{}.min_mirror_coverage);
+  EXPECT_EQ(modelled.method_used, PlanMethod::ShapeModel);
+  ASSERT_TRUE(fit && fit->usable()) << (fit ? fit->message : "no fit");
+  EXPECT_GT(modelled.sources.ring, 0.9);
+  EXPECT_GT(modelled.sources.with_model, 0.8);
+  EXPECT_NE(modelled.surfaces_message.find("ring fit with the shape model"), std::string::npos)
+      << modelled.surfaces_message;
+  for (const Marker& m : modelled.markers) {
+    if (m.type == MarkerType::OuterSurface) {
+      EXPECT_LT(truth.closest(m.position).distance, 1.0);
+    }
+  }
+
   // No model, no note.
   const MarkerProposal plain = propose_markers_with_model(c.defect, c.defective, bone, truth,
                                                           ProposeParams{}, 1, nullptr, {}, &fit);
@@ -234,10 +249,11 @@ TEST(ProposeMarkers, TheSourcesSentenceSplitsTheModelsShare) {
   s.none = 0.4;
   EXPECT_EQ(s.describe(),
             "the opening's surfaces: 30% mirror with the shape model, 30% mirror alone, 40% "
-            "bridged from the surfaces around (no value along those rays); the rim and the ring "
-            "around it: the skull's own bone");
+            "bridged from the surfaces around (no value along those rays); edge markers on them "
+            "along the rim, support markers on the skull's own bone");
   EXPECT_EQ(SurfaceSources{}.describe(),
-            "the opening's surfaces: none; the rim and the ring around it: the skull's own bone");
+            "the opening's surfaces: none; edge markers on them along the rim, support markers "
+            "on the skull's own bone");
 }
 
 TEST(ProposeMarkers, AnIntactSkullHasNoDefectToPropose) {

@@ -127,8 +127,9 @@ class DefectSurfaces {
   /// surface's radius, smoothly) towards them instead of stopping with a step (0: a step).
   void blend_with(std::shared_ptr<const DefectSurfaces> other, double weight,
                   const std::vector<Eigen::Vector3d>& directions = {}, double taper_mm = 10.0);
-  /// Whether at() along unit `dir` averages in the surfaces of blend_with()'s `other`.
-  bool blended_at(const Eigen::Vector3d& dir) const;
+  /// How much of blend_with()'s weight at() gives `other`'s surfaces along unit `dir` (0..1: 1
+  /// where it weighs fully, 0 where it has no value or none was given).
+  double blend_share(const Eigen::Vector3d& dir) const;
 
  private:
   friend struct DefectSurfaceFit;  // the fit's stages (fit_defect_surfaces.cpp)

@@ -60,15 +60,16 @@ struct ProposeParams {
 
 /// Which sources shaped the missing bone's surfaces: shares of the opening's rays (0..1) whose
 /// outer and inner surface came from the mirror (bent to meet the ring), from the ring alone,
-/// and of those, the share with the shape model averaged in. The edge and support markers lie
-/// on the skull's own bone.
+/// and of those, the shape model's weight averaged over the rays (`with_model`: 1 where it
+/// weighs fully, less where its weight fades). The edge markers lie on these surfaces along the
+/// rim; the support markers on the skull's own bone.
 struct SurfaceSources {
   double mirror = 0.0;      ///< the registered mirror, corrected to the ring
   double ring = 0.0;        ///< the fit to the intact ring alone
-  double with_model = 0.0;  ///< of the two, the shape model averaged in
+  double with_model = 0.0;  ///< of the two, the shape model's share (its weight's fraction)
   double none = 0.0;        ///< no surface (outside the fitted cap, no mirrored bone)
-  /// "the opening's surfaces: 64% mirror with the shape model, 36% mirror alone; the rim and the
-  /// ring: the skull's own bone"
+  /// "the opening's surfaces: 64% mirror with the shape model, 36% mirror alone; edge markers on
+  /// them along the rim, support markers on the skull's own bone"
   std::string describe() const;
 };
 

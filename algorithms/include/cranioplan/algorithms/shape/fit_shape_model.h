@@ -28,9 +28,9 @@ struct ShapeFitParams {
   double noise_mm = 1.0;
   /// A fit whose residual on the intact bone (RMS over the pairs) exceeds this is poor, mm: a
   /// model that does not describe the skull where it is seen does not know the missing part.
-  /// Fits of the library's model on SkullFix and on the library's flaps that laid it on the
-  /// bone came to 0.30-0.67 mm, pairing 95-99 % of the vertices; those that went astray or met a
-  /// skull unlike the model's, 0.76-1.24 mm pairing 67-92 % (docs/SHAPE_MODEL.md).
+  /// The library's model on SkullFix 000-003 and on 6 of 14 flaps: 0.30-0.67 mm, pairing 95-99 %
+  /// of the vertices; on SkullFix 004 0.86 mm at 76 % (used, it made the plan worse); on the
+  /// other flaps 0.76-1.24 mm, those over 0.8 mm pairing 67-89 % (docs/SHAPE_MODEL.md).
   double max_rms_mm = 0.8;
   /// A fit that pairs fewer of the model's vertices left in than this share is poor (a model
   /// reaching past the scan's bone pairs less without fitting worse: a synthetic shell cut
@@ -50,7 +50,12 @@ struct ShapeFit {
   double paired = 0.0;                       ///< share of the vertices left in that paired
   double mahalanobis = 0.0;                  ///< |b| in units of the prior's σ
   bool usable() const { return status == Status::Fitted; }
+  /// Whether the residual, the pairing and the Mahalanobis distance were measured (fitted, well
+  /// or poorly).
+  bool measured() const { return status == Status::Fitted || status == Status::Poor; }
 };
+/// "fitted", "poor", "failed" or "skipped".
+const char* status_name(ShapeFit::Status status);
 
 /// Fits `model` to the surface `bone` (the skull's vertices `bone_points` for the starting
 /// pose). `left_out(p)` says whether a point of the skull's frame lies in the region not to fit
