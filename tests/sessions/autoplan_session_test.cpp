@@ -84,6 +84,33 @@ TEST(AutoplanSession, AShapeModelIsRecordedAsAnInputAndVerified) {
   EXPECT_EQ(Session::open(session_path).state().implant->stl_sha256(), implant_sha);
   EXPECT_TRUE(verify_session(session_path).ok());
 
+  // Proposed again from the command alone, guided by the model throughout (method model): the
+  // recorded weight is the one used, and a version-7 command (none recorded) is read with the
+  // 0.5 it was made with.
+  {
+    Session s = Session::open(session_path);
+    const auto at = test::first_command(s, CommandType::ProposeMarkers);
+    ASSERT_TRUE(at);
+    Command fresh = s.effective_commands()[*at];
+    fresh.params.erase("result");
+    fresh.params["params"]["method"] = "model";
+    auto markers_of = [&](const Command& c) {
+      const ApplyOutcome out = apply_command(s.state_at(*at), c);
+      EXPECT_TRUE(out.accepted) << out.message;
+      return out.record["result"]["markers"];
+    };
+    Command half = fresh, whole = fresh, seven = fresh;
+    half.params["shape_model"]["weight"] = 0.5;
+    whole.params["shape_model"]["weight"] = 1.0;
+    seven.version = 7;
+    for (const char* recorded_since_8 :
+         {"weight", "margin_mm", "noise_mm", "max_rms_mm", "min_paired"})
+      seven.params["shape_model"].erase(recorded_since_8);
+    const Json by_half = markers_of(half);
+    EXPECT_EQ(markers_of(seven), by_half);
+    EXPECT_NE(markers_of(whole), by_half);
+  }
+
   // The model changed after the plan: verify says so, naming it.
   std::ofstream(model_path, std::ios::app) << "x";
   const VerifyReport v = verify_session(session_path);
