@@ -10,9 +10,8 @@
 namespace cranioplan {
 
 std::string shape_prior_note(const ShapeFit& fit, bool used) {
-  if (used) return fit.message;
-  if (!fit.usable()) return "not guided by the shape model: " + fit.message;
-  return "not guided by the shape model (the mirror covers the opening; " + fit.message + ")";
+  // A usable fit always guides the plan (propose_markers_with_model fits only where it will).
+  return used ? fit.message : "not guided by the shape model: " + fit.message;
 }
 
 ShapePrior fit_shape_prior(const ShapeModel& model, const SkullMesh& skull,
@@ -61,7 +60,9 @@ MarkerProposal propose_markers_with_model(const DefectRegion& defect, const Skul
     };
     if (params.method == PlanMethod::Mirror || params.method == PlanMethod::RimOnly) {
       fitted = skipped(std::string("not fitted, the plan's method is ") + to_string(params.method));
-    } else if (const double coverage = mirror_coverage(defect, mirror, params);
+    } else if (const double coverage = params.method == PlanMethod::Auto
+                                           ? mirror_coverage(defect, mirror, params)
+                                           : 0.0;
                params.method == PlanMethod::Auto && coverage >= params.min_mirror_coverage) {
       char text[120];
       std::snprintf(text, sizeof text, "not fitted, the mirror covers %.0f%% of the opening",
