@@ -19,6 +19,32 @@
 
 namespace cranioplan::gui {
 
+namespace {
+
+// The PDF: the report's HTML laid out by Qt on A4, its pictures read from `dir` beside it.
+// Whether it was written.
+bool write_report_pdf(const QString& html, const std::vector<ReportImage>& images,
+                      const QString& dir, const QString& pdf_path, const QString& title) {
+  QTextDocument document;
+  for (const ReportImage& image : images) {
+    const QString file = QString::fromStdString(image.file);
+    document.addResource(QTextDocument::ImageResource, QUrl(file), QImage(dir + "/" + file));
+  }
+  // 8 pt on A4: the first page holds the identity, the implant and the whole quality table.
+  QFont font = document.defaultFont();
+  font.setPointSizeF(8.0);
+  document.setDefaultFont(font);
+  document.setHtml(html);
+  QPdfWriter pdf(pdf_path);
+  pdf.setPageSize(QPageSize(QPageSize::A4));
+  pdf.setTitle(title);
+  pdf.setCreator(QStringLiteral("Cranioplan " CRANIOPLAN_VERSION));
+  document.print(&pdf);
+  return QFileInfo(pdf_path).exists() && QFileInfo(pdf_path).size() > 0;
+}
+
+}  // namespace
+
 bool MainWindow::write_design_report(const QString& html_path) {
   if (!controller_->state().implant) {
     show_message(tr("There is no implant to report on: build it first (step 7)."), true);
@@ -140,24 +166,8 @@ bool MainWindow::write_design_report(const QString& html_path) {
     return false;
   }
   out.close();
-  // The PDF: the same HTML laid out by Qt on A4, its pictures read from beside it.
   const QString pdf_path = dir + "/" + stem + ".pdf";
-  QTextDocument document;
-  for (const ReportImage& image : images) {
-    const QString file = QString::fromStdString(image.file);
-    document.addResource(QTextDocument::ImageResource, QUrl(file), QImage(dir + "/" + file));
-  }
-  // 8 pt on A4: the first page holds the identity, the implant and the whole quality table.
-  QFont font = document.defaultFont();
-  font.setPointSizeF(8.0);
-  document.setDefaultFont(font);
-  document.setHtml(html);
-  QPdfWriter pdf(pdf_path);
-  pdf.setPageSize(QPageSize(QPageSize::A4));
-  pdf.setTitle(tr("Cranioplan design report"));
-  pdf.setCreator(QStringLiteral("Cranioplan " CRANIOPLAN_VERSION));
-  document.print(&pdf);
-  if (!QFileInfo(pdf_path).exists() || QFileInfo(pdf_path).size() == 0) {
+  if (!write_report_pdf(html, images, dir, pdf_path, tr("Cranioplan design report"))) {
     show_message(tr("Cannot write %1.").arg(pdf_path), true);
     return false;
   }

@@ -628,7 +628,7 @@ void MainWindow::build_steps_dock() {
       "QLabel{background:#f4f1e8;color:#222;padding:6px;border-radius:4px}");
   layout->addWidget(instructions_);
   pages_ = new QStackedWidget(panel);
-  for (int step = 1; step <= 9; ++step) {
+  for (int step = kLoadStep; step <= kStepCount; ++step) {
     StepPage* page = make_step_page(step, *this).release();
     pages_->addWidget(page);
     step_pages_.push_back(page);
@@ -649,7 +649,7 @@ void MainWindow::build_steps_dock() {
   connect(done_button_, &QPushButton::clicked, this, [this] {
     const PlanState& s = controller_->state();
     // Step 7 with an implant the quality check refuses: said, and asked, not passed silently.
-    if (s.current_step == 7 && s.implant && s.implant->result().usable() &&
+    if (s.current_step == kBuildStep && s.implant && s.implant->result().usable() &&
         !s.implant->quality().printable) {
       const QString what =
           tr("The quality check refuses this implant: %1. Step 7's page says what to try.")
@@ -769,14 +769,14 @@ void MainWindow::refresh() {
 
 void MainWindow::refresh_steps() {
   const PlanState& s = controller_->state();
-  for (int step = 1; step <= 9; ++step) {
+  for (int step = kLoadStep; step <= kStepCount; ++step) {
     QListWidgetItem* item = steps_->item(step - 1);
     std::string missing, why;
     const bool done = step_complete(s, step, &missing);
     const bool unlocked = step_unlocked(s, step, &why);
     // An implant the quality check refuses is built, but the step is not done well: marked
     // ✘, its page says what is wrong and what to try.
-    const bool refused = step == 7 && done && refused_implant();
+    const bool refused = step == kBuildStep && done && refused_implant();
     QString text = QStringLiteral("%1 %2  %3")
                        .arg(refused ? QStringLiteral("✘")
                             : done  ? QStringLiteral("✔")
@@ -805,16 +805,18 @@ void MainWindow::refresh_steps() {
   if (shown_step_ != s.current_step) {
     // Another step: its page opens at its top, and the view is set as the step needs it.
     page_scroll_->verticalScrollBar()->setValue(0);
-    clip_->setChecked(s.current_step == 4);
+    clip_->setChecked(s.current_step == kClipStep);
   }
   shown_step_ = s.current_step;
   pages_->setCurrentIndex(s.current_step - 1);
   StepPage* page = step_pages_[static_cast<size_t>(s.current_step - 1)];
   instructions_->setText(page->instructions_html(s));
   done_button_->setEnabled(!controller_->read_only());
-  done_button_->setText(s.current_step == 9 ? tr("Done") : tr("Done — next step"));
-  step_label_->setText(
-      tr("Step %1 of 9: %2").arg(s.current_step).arg(tr(wizard_steps()[s.current_step - 1].title)));
+  done_button_->setText(s.current_step == kExportStep ? tr("Done") : tr("Done — next step"));
+  step_label_->setText(tr("Step %1 of %2: %3")
+                           .arg(s.current_step)
+                           .arg(kStepCount)
+                           .arg(tr(wizard_steps()[s.current_step - 1].title)));
   if (timed_step_ != s.current_step) {
     timed_step_ = s.current_step;
     step_timer_.restart();
@@ -923,7 +925,7 @@ void MainWindow::show_mould(bool shown) {
 
 void MainWindow::update_mould() {
   const PlanState& s = controller_->state();
-  if (!mould_wanted_ || !s.implant || s.current_step != 9) {
+  if (!mould_wanted_ || !s.implant || s.current_step != kExportStep) {
     if (mould_of_) view_->set_mould(nullptr);
     for (StepPage* page : step_pages_) page->show_mould_message(QString());
     mould_of_ = nullptr;
@@ -1321,7 +1323,7 @@ void MainWindow::start_training(const QString& reference) {
 
 void MainWindow::finish_training_if_done() {
   if (training_reference_.isEmpty() || !training_html_.isEmpty()) return;
-  if (!step_complete(controller_->state(), 9)) return;
+  if (!step_complete(controller_->state(), kExportStep)) return;
   try {
     const Session reference = Session::open(training_reference_.toStdString());
     training_html_ =

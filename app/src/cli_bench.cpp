@@ -101,13 +101,8 @@ double peak_rss_mb() {
 
 }  // namespace
 
-Json run_bench(const BenchOptions& options) {
-  const std::string input = options.input.empty() ? sample_case_path() : options.input;
-  const int runs = std::max(1, options.runs);
-  Json out;
-  out["input"] = input;
-  out["runs"] = runs;
-
+// Reading: the import of the input, and its STL read by the project and by VTK.
+LoadedSkull bench_reading(const std::string& input, int runs, Json& out) {
   LoadedSkull skull;
   out["import_s"] = median_seconds(runs, [&] { skull = load_skull(input); });
   out["triangles"] = skull.mesh.n_faces();
@@ -130,7 +125,11 @@ Json run_bench(const BenchOptions& options) {
   out["stl_load_with_halfedges_speedup_vs_vtk"] =
       out["vtk_stl_reader_s"].get<double>() / out["stl_load_s"].get<double>();
   std::filesystem::remove(tmp);
+  return skull;
+}
 
+// The plane, the mirror and its registration, each alone.
+void bench_alignment(const LoadedSkull& skull, int runs, Json& out) {
   PlaneFit fit;
   out["plane_s"] = median_seconds(runs, [&] { fit = fit_sagittal_plane(skull.mesh, Landmarks{}); });
   SkullMesh mirrored;
@@ -141,94 +140,106 @@ Json run_bench(const BenchOptions& options) {
                                    out["register_s"].get<double>();
   out["symmetry_rms_mm"] = fit.symmetry_rms_mm;
   out["register_rms_mm"] = reg.rms_mm;
+}
 
-  // The wizard's inner loop: smooth the markers and rebuild the shell after a marker edit,
-  // with the skull's and the mirror's locators built once.
+// The wizard's inner loop: smooth the markers and rebuild the shell after a marker edit, with
+// the skull's and the mirror's locators built once; on at least 300 markers, as a dense manual
+// plan has (re-planned with closer spacing if needed).
+void bench_editing(const LoadedSkull& skull, AutoplanResult plan, int runs, Json& out) {
+  AutoplanParams dense;
+  for (double spacing = 5.0; plan.markers.size() < 300 && spacing >= 2.0; spacing -= 1.0) {
+    dense.propose.surface_spacing_mm = spacing;
+    dense.propose.edge_spacing_mm = std::min(4.0, spacing);
+    plan = autoplan(skull.mesh, Landmarks{}, dense);
+  }
+  const SurfaceLocator bone(skull.mesh), mirror = bone.moved(plan.mirror_motion);
+  out["skull_locator_mb"] = static_cast<double>(bone.memory_bytes()) / 1e6;
+  out["edit_markers"] = plan.markers.size();
+  // While markers are edited the shell is rebuilt as it stands (the wizard's live preview);
+  // fitting it to the bone (automatic plans, and the wizard's "Fit to the bone") costs more.
+  ImplantParams live = AutoplanParams{}.implant;
+  live.fit_to_bone_mm = 0.0;
+  out["smooth_and_rebuild_s"] = median_seconds(runs, [&] {
+    const SmoothResult s = smooth_markers(plan.markers, SmoothParams{10.0, 2.0, 1}, &mirror);
+    build_implant(s.markers, &skull.mesh, &bone, live);
+  });
+  // The fitted rebuild's stages (ImplantResult::stage_seconds), each the median of the runs:
+  // where a committed drag's time goes.
+  std::vector<std::vector<std::pair<std::string, double>>> stages;
+  out["smooth_and_rebuild_fitted_s"] = median_seconds(runs, [&] {
+    const SmoothResult s = smooth_markers(plan.markers, SmoothParams{10.0, 2.0, 1}, &mirror);
+    stages.push_back(
+        build_implant(s.markers, &skull.mesh, &bone, AutoplanParams{}.implant).stage_seconds);
+  });
+  Json profile = Json::object();
+  for (size_t k = 0; !stages.empty() && k < stages.front().size(); ++k) {
+    std::vector<double> t;
+    for (const auto& run : stages)
+      if (k < run.size() && run[k].first == stages.front()[k].first) t.push_back(run[k].second);
+    std::sort(t.begin(), t.end());
+    if (!t.empty()) profile[stages.front()[k].first] = t[t.size() / 2];
+  }
+  out["fitted_rebuild_stages_s"] = profile;
+}
+
+// The same plan as session commands: one marker drag (the implant follows), then undo and redo
+// of it, which the session serves from its cache of states.
+void bench_session(const std::string& input, int runs, Json& out) {
+  AutoplanSession a = autoplan_session(input, Landmarks{}, AutoplanParams{}, "");
+  if (!a.planned() || a.session.state().markers.empty()) return;
+  Session& session = a.session;
+  const Marker m = session.state().markers.back();
+  const SurfaceLocator& surface = m.surface == MarkerSurface::Mirrored
+                                      ? session.state().mirrored->locator
+                                      : session.state().skull->surface->locator;
+  int k = 0;
+  out["session_move_marker_s"] = median_seconds(runs, [&] {
+    const Eigen::Vector3d to = surface.closest(m.position + Eigen::Vector3d(0, 0, 0.2 * ++k)).point;
+    session.push(commands::note("separates the drags"));
+    session.push(commands::move_marker(m.id, to));
+  });
+  // What the wizard does for every mouse move while the marker is dragged: the same move
+  // applied with the implant previewed without the fit (the fitted one is computed on a worker
+  // once the marker is let go).
+  if (session.state().implant_params) {
+    int n = 0;
+    out["drag_preview_s"] = median_seconds(runs, [&] {
+      const Eigen::Vector3d to =
+          surface.closest(m.position + Eigen::Vector3d(0, 0.2 * ++n, 0)).point;
+      preview_command_quickly(session.state(), commands::move_marker(m.id, to), session.context());
+    });
+  }
+  out["session_undo_s"] = median_seconds(runs,
+                                         [&] {
+                                           session.undo();
+                                           session.redo();
+                                         }) /
+                          2.0;
+  out["session_commands"] = session.index();
+}
+
+Json run_bench(const BenchOptions& options) {
+  const std::string input = options.input.empty() ? sample_case_path() : options.input;
+  const int runs = std::max(1, options.runs);
+  Json out;
+  out["input"] = input;
+  out["runs"] = runs;
+  const LoadedSkull skull = bench_reading(input, runs, out);
+  bench_alignment(skull, runs, out);
   AutoplanResult plan;
   out["autoplan_s"] = median_seconds(1, [&] { plan = autoplan(skull.mesh, Landmarks{}); });
-  // The paper's steps in plain VTK on the same skull, plane and markers, in the same run.
   if (plan.planned()) {
+    // The paper's steps in plain VTK on the same skull, plane and markers, in the same run.
+    const std::filesystem::path tmp = std::filesystem::temp_directory_path() /
+                                      ("cranioplan-bench-" + std::to_string(::getpid()) + ".stl");
     write_mesh(skull.mesh, tmp.string(), MeshFormat::BinarySTL);
     out["vtk_reference_s"] = median_seconds(
         runs, [&] { vtk_reference_pipeline(tmp.string(), plan.plane.plane, plan.markers); });
     std::filesystem::remove(tmp);
     out["autoplan_over_vtk_reference"] =
         out["autoplan_s"].get<double>() / out["vtk_reference_s"].get<double>();
-  }
-  if (plan.planned()) {
-    // At least 300 markers, as a dense manual plan has: re-plan with closer spacing if needed.
-    AutoplanParams dense;
-    for (double spacing = 5.0; plan.markers.size() < 300 && spacing >= 2.0; spacing -= 1.0) {
-      dense.propose.surface_spacing_mm = spacing;
-      dense.propose.edge_spacing_mm = std::min(4.0, spacing);
-      plan = autoplan(skull.mesh, Landmarks{}, dense);
-    }
-    const SurfaceLocator bone(skull.mesh), mirror = bone.moved(plan.mirror_motion);
-    out["skull_locator_mb"] = static_cast<double>(bone.memory_bytes()) / 1e6;
-    out["edit_markers"] = plan.markers.size();
-    // While markers are edited the shell is rebuilt as it stands (the wizard's live preview);
-    // fitting it to the bone (automatic plans, and the wizard's "Fit to the bone") costs more.
-    ImplantParams live = AutoplanParams{}.implant;
-    live.fit_to_bone_mm = 0.0;
-    out["smooth_and_rebuild_s"] = median_seconds(runs, [&] {
-      const SmoothResult s = smooth_markers(plan.markers, SmoothParams{10.0, 2.0, 1}, &mirror);
-      build_implant(s.markers, &skull.mesh, &bone, live);
-    });
-    // The fitted rebuild's stages (ImplantResult::stage_seconds), each the median of the runs:
-    // where a committed drag's time goes.
-    std::vector<std::vector<std::pair<std::string, double>>> stages;
-    out["smooth_and_rebuild_fitted_s"] = median_seconds(runs, [&] {
-      const SmoothResult s = smooth_markers(plan.markers, SmoothParams{10.0, 2.0, 1}, &mirror);
-      stages.push_back(
-          build_implant(s.markers, &skull.mesh, &bone, AutoplanParams{}.implant).stage_seconds);
-    });
-    Json profile = Json::object();
-    for (size_t k = 0; !stages.empty() && k < stages.front().size(); ++k) {
-      std::vector<double> t;
-      for (const auto& run : stages)
-        if (k < run.size() && run[k].first == stages.front()[k].first) t.push_back(run[k].second);
-      std::sort(t.begin(), t.end());
-      if (!t.empty()) profile[stages.front()[k].first] = t[t.size() / 2];
-    }
-    out["fitted_rebuild_stages_s"] = profile;
-  }
-  // The same plan as session commands: one marker drag (the implant follows), then undo and
-  // redo of it, which the session serves from its cache of states.
-  if (plan.planned()) {
-    AutoplanSession a = autoplan_session(input, Landmarks{}, AutoplanParams{}, "");
-    if (a.planned() && !a.session.state().markers.empty()) {
-      Session& session = a.session;
-      const Marker m = session.state().markers.back();
-      const SurfaceLocator& surface = m.surface == MarkerSurface::Mirrored
-                                          ? session.state().mirrored->locator
-                                          : session.state().skull->surface->locator;
-      int k = 0;
-      out["session_move_marker_s"] = median_seconds(runs, [&] {
-        const Eigen::Vector3d to =
-            surface.closest(m.position + Eigen::Vector3d(0, 0, 0.2 * ++k)).point;
-        session.push(commands::note("separates the drags"));
-        session.push(commands::move_marker(m.id, to));
-      });
-      // What the wizard does for every mouse move while the marker is dragged: the same move
-      // applied with the implant previewed without the fit (the fitted one is computed on a
-      // worker once the marker is let go).
-      if (session.state().implant_params) {
-        int n = 0;
-        out["drag_preview_s"] = median_seconds(runs, [&] {
-          const Eigen::Vector3d to =
-              surface.closest(m.position + Eigen::Vector3d(0, 0.2 * ++n, 0)).point;
-          preview_command_quickly(session.state(), commands::move_marker(m.id, to),
-                                  session.context());
-        });
-      }
-      out["session_undo_s"] = median_seconds(runs,
-                                             [&] {
-                                               session.undo();
-                                               session.redo();
-                                             }) /
-                              2.0;
-      out["session_commands"] = session.index();
-    }
+    bench_editing(skull, std::move(plan), runs, out);
+    bench_session(input, runs, out);
   }
   out["peak_memory_mb"] = peak_rss_mb();
   return out;

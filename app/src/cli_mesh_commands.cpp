@@ -54,20 +54,20 @@ void add_import_options(CLI::App* cmd, ImportOptions& o) {
 }
 
 Json skull_json(const LoadedSkull& s) {
-  Json j{{"source", s.source_kind},
+  Json j{{"source", to_string(s.source_kind)},
          {"format", s.description},
          {"frame", s.frame},
          {"load_s", s.seconds}};
   // The coordinate system a mesh file declares (3D Slicer's SPACE=), and whether it was
   // turned to LPS on reading (and so is written back in it).
-  if (s.source_kind == "mesh") {
+  if (s.source_kind == SkullSource::Mesh) {
     j["space"] = s.declared_space == MeshSpace::RAS   ? "RAS"
                  : s.declared_space == MeshSpace::LPS ? "LPS"
                                                       : "undeclared";
     j["turned_to_lps"] = s.file_space == MeshSpace::RAS;
   }
   if (s.pieces_dropped > 0) j["pieces_dropped"] = s.pieces_dropped;
-  if (s.source_kind == "volume") {
+  if (s.source_kind == SkullSource::Volume) {
     j["threshold"] = s.surface.threshold_used;
     j["pieces_found"] = s.surface.pieces_found;
     j["pieces_kept"] = s.surface.pieces_kept;
@@ -115,7 +115,8 @@ Subcommand add_info(CLI::App& app, const bool& json) {
             Json r = to_json(report_mesh(s.mesh));
             // The file as it is; read as a skull, it is repaired (load_skull) on the file's own
             // triangles: what that would do, which a non-manifold count alone would misname.
-            TriangleSoup soup = s.source_kind == "mesh" ? read_mesh_soup(o->path) : to_soup(s.mesh);
+            TriangleSoup soup =
+                s.source_kind == SkullSource::Mesh ? read_mesh_soup(o->path) : to_soup(s.mesh);
             const SoupRepair repairs = repair_soup(soup, skull_repairs(o->import.params()));
             r["repeated_triangles"] = repairs.repeated_dropped;
             r["wound_against_neighbours"] = {{"triangles", repairs.orientation.triangles_turned},

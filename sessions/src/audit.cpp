@@ -213,7 +213,7 @@ StepDurations step_durations(const SessionHeader& header, const std::vector<Jour
   for (const auto& e : journal) {
     int step = last_step;
     if (e.event == "do" || e.event == "merge") {
-      if (e.command->meta.step >= 1) step = e.command->meta.step;
+      if (e.command->meta.step >= kLoadStep) step = e.command->meta.step;
       if (e.event == "do") {
         stack.resize(index);
         stack.push_back(*e.command);

@@ -102,8 +102,8 @@ AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks&
     if (local)
       run(recorded(commands::register_mirror(local->params), to_json(local->result), t.ms()));
   }
-  if (!step_complete(s.state(), 3)) run(commands::complete_step(3));
-  run(commands::complete_step(4));
+  if (!step_complete(s.state(), kMirrorStep)) run(commands::complete_step(kMirrorStep));
+  run(commands::complete_step(kClipStep));
   // The model's file read once: the model used is the one whose hash is recorded.
   std::optional<ShapeModel> model;
   std::string model_sha;
@@ -132,7 +132,7 @@ AutoplanSession autoplan_session(const std::string& skull_path, const Landmarks&
   if (implant.tabs.any() && !implant.tabs.midline) implant.tabs.midline = plane;
   run(commands::build_implant(implant));
   if (!s.state().implant) return stop(s.state().message);
-  run(commands::complete_step(8));
+  run(commands::complete_step(kSmoothStep));
   if (!export_path.empty() && !run(commands::export_implant(export_path))) return out;
   out.status = AutoplanSession::Status::Planned;
   out.message = s.state().proposal_message;

@@ -68,7 +68,7 @@ const Marker* PlanState::find_marker(int id) const {
 
 std::optional<AttachedCt> plan_ct(const PlanState& s) {
   if (s.ct) return s.ct;
-  if (!s.skull || s.skull->surface->loaded.source_kind != "volume") return std::nullopt;
+  if (!s.skull || s.skull->surface->loaded.source_kind != SkullSource::Volume) return std::nullopt;
   AttachedCt ct;
   ct.path = s.skull->surface->path;
   ct.recorded_path = s.skull->path;
@@ -78,44 +78,44 @@ std::optional<AttachedCt> plan_ct(const PlanState& s) {
   return ct;
 }
 
-const std::array<WizardStep, 9>& wizard_steps() {
-  static const std::array<WizardStep, 9> steps = {{
-      {1, "Load skull",
+const std::array<WizardStep, kStepCount>& wizard_steps() {
+  static const std::array<WizardStep, kStepCount> steps = {{
+      {kLoadStep, "Load skull",
        "Open the patient's skull: a surface mesh (STL, PLY, OBJ, OFF, VTK, VTP) or a CT "
        "(InVesalius .inv3, NRRD, NIfTI, DICOM folder), which is turned into a bone surface at "
        "step 1's threshold (automatic: 300 HU for a CT, 0.5 for a mask). Done when a skull is "
        "loaded."},
-      {2, "Landmarks and midsagittal plane",
+      {kPlaneStep, "Landmarks and midsagittal plane",
        "Click the nasion and the centres of the left and right orbits (optional: points on the "
        "midline), then press Fit: the plane is refined from the landmarks and the skull's "
        "symmetry. Adjust it by hand if needed. Done when a plane is set."},
-      {3, "Mirror and register",
+      {kMirrorStep, "Mirror and register",
        "Mirror the skull across the plane, then Register: the mirror (green) is fitted onto the "
        "healthy bone (whole skull or a region). Nudge it by hand if needed. Done when the mirror "
        "is registered (or accepted as it is)."},
-      {4, "Clip and inspect",
+      {kClipStep, "Clip and inspect",
        "Move the clip plane through the defect to see its inner edge and the mirrored bone that "
        "will fill it. Press Done when you have seen enough."},
-      {5, "Edge markers",
+      {kEdgeMarkersStep, "Edge markers",
        "Place outer edge markers (key 0) along the outer rim of the defect on the skull, and "
        "optionally inner edge markers (key 1) along its inner rim — or press Propose to place "
        "them automatically and edit them. Green: edge markers; magenta: surface markers "
        "(spheres outer, cubes inner); an orange line: a stretch of the rim no ray saw. Done "
        "with at least 3 outer edge markers (and either no inner edge markers or at least 3)."},
-      {6, "Surface markers",
+      {kSurfaceMarkersStep, "Surface markers",
        "Place outer surface markers (key 2) and inner surface markers (key 3) on the mirrored "
        "skull inside the defect (a proposal also places some on the intact bone around it, "
        "where the implant must meet the skull's curve). Done with at least 3 outer surface "
        "markers."},
-      {7, "Build implant",
+      {kBuildStep, "Build implant",
        "Build the implant (the defaults are the automatic plan's: a shell fitted to the bone); "
        "or choose the method (shell: smooth fitted surfaces, or Delaunay 3D as in Egger et al. "
        "2017), the material, holes and tabs first. Done when an implant is built that the "
        "quality check passes."},
-      {8, "Smooth and refine",
+      {kSmoothStep, "Smooth and refine",
        "Smooth the surface markers (radius, edge-marker weight; edge markers stay fixed) and "
        "move markers where needed: the implant follows. Press Done when satisfied."},
-      {9, "Check and export",
+      {kExportStep, "Check and export",
        "Read the quality report (watertight, thickness, gap to bone, overlap) and export the "
        "implant as STL, PLY or 3MF (with a casting mould if wanted); the surgeon approves it. "
        "Done when the current implant has been exported."},
@@ -172,17 +172,17 @@ std::string landmark_words(const std::string& name) {
 
 bool step_complete(const PlanState& s, int step, std::string* missing) {
   switch (step) {
-    case 1:
+    case kLoadStep:
       return s.skull ? true : fail(missing, "load a skull");
-    case 2:
+    case kPlaneStep:
       return s.plane ? true : fail(missing, "fit the midsagittal plane (or set it by hand)");
-    case 3:
+    case kMirrorStep:
       if (!s.mirrored) return fail(missing, "mirror the skull");
-      if ((s.registration && s.registration->usable()) || s.acknowledged[3]) return true;
+      if ((s.registration && s.registration->usable()) || s.acknowledged[kMirrorStep]) return true;
       return fail(missing, "register the mirrored skull (or accept it as it is)");
-    case 4:
-      return s.acknowledged[4] ? true : fail(missing, "inspect the defect and press Done");
-    case 5: {
+    case kClipStep:
+      return s.acknowledged[kClipStep] ? true : fail(missing, "inspect the defect and press Done");
+    case kEdgeMarkersStep: {
       const int outer = count_type(s, MarkerType::OuterEdge);
       const int inner = count_type(s, MarkerType::InnerEdge);
       if (outer < 3)
@@ -194,19 +194,21 @@ bool step_complete(const PlanState& s, int step, std::string* missing) {
                                  "follows the bone thickness)");
       return true;
     }
-    case 6: {
+    case kSurfaceMarkersStep: {
       const int outer = count_type(s, MarkerType::OuterSurface);
       return outer >= 3 ? true
                         : fail(missing, "place at least 3 outer surface markers (" +
                                             std::to_string(outer) + " so far)");
     }
-    case 7:
+    case kBuildStep:
       if (s.implant && s.implant->result().usable()) return true;
       return fail(missing, s.implant_params ? "the implant could not be built: " + s.message
                                             : std::string("build the implant"));
-    case 8:
-      return s.acknowledged[8] ? true : fail(missing, "review the markers and implant, press Done");
-    case 9:
+    case kSmoothStep:
+      return s.acknowledged[kSmoothStep]
+                 ? true
+                 : fail(missing, "review the markers and implant, press Done");
+    case kExportStep:
       for (const auto& e : s.exports)
         if (s.implant && e.implant_sha256 == s.implant->stl_sha256()) return true;
       return fail(missing, "export the implant");
@@ -216,7 +218,7 @@ bool step_complete(const PlanState& s, int step, std::string* missing) {
 }
 
 bool step_unlocked(const PlanState& s, int step, std::string* why) {
-  for (int k = 1; k < step && k <= 9; ++k) {
+  for (int k = kLoadStep; k < step && k <= kStepCount; ++k) {
     std::string missing;
     if (!step_complete(s, k, &missing))
       return fail(why, "step " + std::to_string(step) + " (" + wizard_steps()[step - 1].title +
@@ -227,29 +229,31 @@ bool step_unlocked(const PlanState& s, int step, std::string* why) {
 }
 
 int command_step(const PlanState& s, const Command& c) {
-  auto marker_step = [](MarkerType t) { return is_edge(t) ? 5 : 6; };
+  auto marker_step = [](MarkerType t) -> int {
+    return is_edge(t) ? kEdgeMarkersStep : kSurfaceMarkersStep;
+  };
   const Json& p = c.params;
   switch (c.type) {
     case CommandType::LoadSkull:
-      return 1;
+      return kLoadStep;
     case CommandType::SetLandmark:
     case CommandType::ClearLandmark:
     case CommandType::FitPlane:
     case CommandType::AdjustPlane:
-      return 2;
+      return kPlaneStep;
     case CommandType::Mirror:
     case CommandType::Register:
     case CommandType::MoveMirrored:
-      return 3;
+      return kMirrorStep;
     case CommandType::SetClipPlane:
-      return 4;
+      return kClipStep;
     case CommandType::AddMarker:
       return marker_step(static_cast<MarkerType>(std::clamp(p.value("type", 0), 0, 3)));
     case CommandType::MoveMarker:
     case CommandType::DeleteMarker:
     case CommandType::RetypeMarker: {
       const Marker* m = s.find_marker(p.value("id", -1));
-      int step = m ? marker_step(m->type) : 5;
+      int step = m ? marker_step(m->type) : kEdgeMarkersStep;
       if (c.type == CommandType::RetypeMarker)
         step = std::max(step,
                         marker_step(static_cast<MarkerType>(std::clamp(p.value("type", 0), 0, 3))));
@@ -258,18 +262,18 @@ int command_step(const PlanState& s, const Command& c) {
     case CommandType::ImportMarkers:
     case CommandType::ClearMarkers:
     case CommandType::ProposeMarkers:
-      return 5;
+      return kEdgeMarkersStep;
     case CommandType::BuildImplant:
-      return 7;
+      return kBuildStep;
     case CommandType::SmoothMarkers:
-      return 8;
+      return kSmoothStep;
     case CommandType::ExportImplant:
-      return 9;
+      return kExportStep;
     case CommandType::GoToStep:
     case CommandType::CompleteStep:
-      return std::clamp(p.value("step", 1), 1, 9);
+      return std::clamp(p.value("step", 1), static_cast<int>(kLoadStep), kStepCount);
     case CommandType::Approve:
-      return 9;
+      return kExportStep;
     case CommandType::Note:
     case CommandType::AttachCt:
       return 0;
@@ -297,10 +301,11 @@ void update_mirrored(PlanState& s, const std::string& why) {
   const RigidTransform placement = s.mirror_transform() * reflection_across(*s.plane);
   s.mirrored = std::make_shared<const MovedSurface>(
       MovedSurface{s.skull->surface, placement, s.skull->surface->locator.moved(placement)});
-  unacknowledge(s, 4, why);
+  unacknowledge(s, kClipStep, why);
   for (const auto& m : s.markers)
     if (m.surface == MarkerSurface::Mirrored) {
-      s.stale[6] = why + ": surface markers were placed on the mirror before it moved";
+      s.stale[kSurfaceMarkersStep] =
+          why + ": surface markers were placed on the mirror before it moved";
       break;
     }
 }
@@ -359,7 +364,7 @@ void rebuild_implant(PlanState& s) {
 }
 
 void markers_changed(PlanState& s) {
-  unacknowledge(s, 8, "the markers changed");
+  unacknowledge(s, kSmoothStep, "the markers changed");
   rebuild_implant(s);
 }
 
@@ -367,7 +372,7 @@ void markers_changed(PlanState& s) {
 // registered again; that registration is recorded in the command as "registration" (and
 // applied from there on replay) when `record` is given.
 void plane_changed(PlanState& s, const ParamReader* r = nullptr, Json* record = nullptr) {
-  unacknowledge(s, 4, "the plane changed");
+  unacknowledge(s, kClipStep, "the plane changed");
   if (!s.mirror_requested) return;
   std::string why = "the plane changed: mirror recomputed";
   if (s.register_params) {
@@ -380,7 +385,7 @@ void plane_changed(PlanState& s, const ParamReader* r = nullptr, Json* record = 
     why += " and registered again";
     s.message = plane_message + "; " + s.message;
   }
-  s.stale[3] = why;
+  s.stale[kMirrorStep] = why;
   update_mirrored(s, "the plane changed");
 }
 
@@ -460,7 +465,7 @@ void apply_load(PlanState& s, const ParamReader& r, const ApplyContext& ctx, Jso
   PlanState fresh;
   fresh.notes = s.notes;
   fresh.skull = std::move(input);
-  fresh.current_step = 2;
+  fresh.current_step = kPlaneStep;
   fresh.message = "loaded " + loaded.description + ": " +
                   format_count(static_cast<long long>(fresh.skull->surface->mesh.n_faces())) +
                   " triangles";
@@ -813,6 +818,10 @@ void apply_propose(PlanState& s, const ParamReader& r, const ApplyContext& ctx, 
   }
   const Json& result = r.has("result") ? r.value("result") : record["result"];
   if (!apply_proposal_result(s, result, r.where() + " result")) return;
+  s.proposal_shape_model =
+      r.has("shape_model")
+          ? ParamReader(r.value("shape_model"), r.where() + " shape_model").string("path")
+          : std::string();
   for (const auto& m : s.markers) s.next_marker_id = std::max(s.next_marker_id, m.id + 1);
   s.message = s.proposal_message;
   markers_changed(s);
@@ -863,7 +872,7 @@ void apply_build(PlanState& s, const ParamReader& r, int version) {
   // Before version 14, the shell fitted to the bone kept the surfaces' own thickness.
   params.fit_keeps_shell_thick = version >= 14;
   s.implant_params = params;
-  unacknowledge(s, 8, "the implant was built again");
+  unacknowledge(s, kSmoothStep, "the implant was built again");
   rebuild_implant(s);
 }
 
@@ -950,22 +959,24 @@ void apply_approve(PlanState& s, const ParamReader& r) {
 
 void apply_step(PlanState& s, CommandType type, const ParamReader& r) {
   const int step = r.integer("step");
-  if (step < 1 || step > 9) throw Refusal{"there is no step " + std::to_string(step)};
+  if (step < kLoadStep || step > kStepCount)
+    throw Refusal{"there is no step " + std::to_string(step)};
   if (type == CommandType::GoToStep) {
     s.current_step = step;
     s.message = std::string("step ") + std::to_string(step) + ": " + wizard_steps()[step - 1].title;
     return;
   }
   std::string missing;
-  const bool by_hand = step == 3 || step == 4 || step == 8;
-  if (step == 3 && !s.mirrored) throw Refusal{"step 3 cannot be done: mirror the skull first"};
-  if (step == 8 && !(s.implant && s.implant->result().usable()))
+  const bool by_hand = step == kMirrorStep || step == kClipStep || step == kSmoothStep;
+  if (step == kMirrorStep && !s.mirrored)
+    throw Refusal{"step 3 cannot be done: mirror the skull first"};
+  if (step == kSmoothStep && !(s.implant && s.implant->result().usable()))
     throw Refusal{"step 8 cannot be done: build the implant first"};
   if (!by_hand && !step_complete(s, step, &missing))
     throw Refusal{"step " + std::to_string(step) + " is not done: " + missing};
   if (by_hand) s.acknowledged[step] = true;
   s.stale.erase(step);
-  s.current_step = std::min(9, step + 1);
+  s.current_step = std::min(kStepCount, step + 1);
   s.message = std::string("step ") + std::to_string(step) + " done";
 }
 
@@ -994,7 +1005,7 @@ ApplyOutcome apply_command(const PlanState& before, const Command& command,
   ApplyOutcome out;
   const int step = command_step(before, command);
   std::string why;
-  if (step >= 1 && !step_unlocked(before, step, &why)) {
+  if (step >= kLoadStep && !step_unlocked(before, step, &why)) {
     out.message = why;
     out.state = before;
     return out;
@@ -1078,7 +1089,7 @@ ApplyOutcome apply_command(const PlanState& before, const Command& command,
     s.approval.reset();
     s.message += (s.message.empty() ? "" : "; ") + s.approval_withdrawn + ": approval withdrawn";
   }
-  if (step >= 1) s.stale.erase(step);
+  if (step >= kLoadStep) s.stale.erase(step);
   out.accepted = true;
   out.message = s.message;
   out.state = std::move(s);

@@ -419,7 +419,7 @@ PreparedCommand Session::prepare(Command command) {
   command.meta.user = header_.info.user;
   if (command.meta.started.empty()) command.meta.started = now_iso8601();
   std::string why;
-  if (command.meta.step >= 1 && !step_unlocked(before, command.meta.step, &why)) {
+  if (command.meta.step >= kLoadStep && !step_unlocked(before, command.meta.step, &why)) {
     p.message = why;
     return p;
   }

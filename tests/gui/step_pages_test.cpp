@@ -207,6 +207,43 @@ TEST(StepPages, AProposalGuidedByAShapeModelNamesItInTheCommand) {
   std::filesystem::remove(model);
 }
 
+// A reopened plan shows the model its last proposal was guided by, whatever the settings say,
+// and proposes again with it; the settings keep the user's own choice. A proposal without a
+// model unticks the box; the user's change after a proposal stays.
+TEST(StepPages, AReopenedPlanShowsTheModelItsProposalUsed) {
+  const auto model = std::filesystem::temp_directory_path() / "cranioplan_plan_model.cpsm";
+  std::ofstream(model) << "CRANIOPLAN-SHAPE-MODEL 1\n";
+  QSettings().setValue("shapeModel/path", QString("/elsewhere/settings_model.cpsm"));
+  QSettings().setValue("shapeModel/use", false);
+  RecordingHost host;
+  EdgeMarkersPage page(host);
+  auto* use = child<QCheckBox>(page, "useShapeModel");
+  EXPECT_FALSE(use->isChecked());
+  host.state.proposal_message = "12 markers proposed; guided by the shape model";
+  host.state.proposal_shape_model = model.string();
+  page.show_state(host.state);
+  EXPECT_TRUE(use->isChecked());
+  EXPECT_EQ(child<QLabel>(page, "shapeModelFile")->text(), "cranioplan_plan_model.cpsm");
+  EXPECT_FALSE(QSettings().value("shapeModel/use").toBool());
+  click(page, "propose");
+  ASSERT_EQ(host.pushed.back().type, CommandType::ProposeMarkers);
+  EXPECT_EQ(host.pushed.back().params["shape_model"]["path"], model.string());
+  // Unticked by the user: the same proposal shown again leaves it so.
+  use->setChecked(false);
+  page.show_state(host.state);
+  EXPECT_FALSE(use->isChecked());
+  // A new proposal without a model: unticked, the settings' file named.
+  use->setChecked(true);
+  host.state.proposal_message = "10 markers proposed";
+  host.state.proposal_shape_model.clear();
+  page.show_state(host.state);
+  EXPECT_FALSE(use->isChecked());
+  EXPECT_EQ(child<QLabel>(page, "shapeModelFile")->text(), "settings_model.cpsm");
+  QSettings().setValue("shapeModel/use", false);
+  QSettings().remove("shapeModel/path");
+  std::filesystem::remove(model);
+}
+
 TEST(StepPages, TheMarkerCountsAndTheProposalNoteShowTheState) {
   RecordingHost host;
   EdgeMarkersPage page(host);

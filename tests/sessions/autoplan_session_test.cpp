@@ -81,7 +81,10 @@ TEST(AutoplanSession, AShapeModelIsRecordedAsAnInputAndVerified) {
   EXPECT_TRUE(recorded);
   EXPECT_EQ(test::validate_session_schema(session_path), "");
   const std::string implant_sha = a.session.state().implant->stl_sha256();
-  EXPECT_EQ(Session::open(session_path).state().implant->stl_sha256(), implant_sha);
+  // Reopened, the plan knows which model its proposal named (the wizard shows it so).
+  const Session reopened = Session::open(session_path);
+  EXPECT_EQ(reopened.state().implant->stl_sha256(), implant_sha);
+  EXPECT_EQ(reopened.state().proposal_shape_model, model_path);
   EXPECT_TRUE(verify_session(session_path).ok());
 
   // Proposed again from the command alone, guided by the model throughout (method model): the

@@ -226,6 +226,73 @@ bool near_hole(const std::vector<uint8_t>& mask, const VoxelGrid& g, const Hole&
 }
 
 // perforate, the drilled implant meshed in `into` (the result's own mesh, or the caller's).
+// The holes: the user's (on the implant's surface), then the pattern's that keep clear of them
+// and of the removed, into `holes`; a problem to say when two of the user's lie too close.
+std::string place_holes(const Faces& faces, const SurfaceLocator& self, const PointIndex& outer,
+                        const PointIndex& wall, const Eigen::Vector3d& inside,
+                        const PerforationParams& p, std::vector<Hole>& holes) {
+  for (const Eigen::Vector3d& a : p.added) {
+    const Eigen::Vector3d at = self.closest(a).point;
+    holes.push_back({at, normal_near(faces, outer, at, inside), true});
+  }
+  for (size_t i = 0; i < holes.size(); ++i)
+    for (size_t j = i + 1; j < holes.size(); ++j)
+      if ((holes[i].center - holes[j].center).norm() < p.diameter_mm + 1.0)
+        return "holes " + std::to_string(i + 1) + " and " + std::to_string(j + 1) +
+               " are less than 1 mm apart: move or remove one";
+  if (p.pattern)
+    for (const Eigen::Vector3d& c : pattern_centres(faces, self, wall, p)) {
+      bool keep = true;
+      for (const Eigen::Vector3d& x : p.removed) keep = keep && (x - c).norm() > 0.5 * p.spacing_mm;
+      for (const Eigen::Vector3d& x : p.added) keep = keep && (x - c).norm() > 0.5 * p.spacing_mm;
+      if (keep) holes.push_back({c, normal_near(faces, outer, c, inside), false});
+    }
+  return {};
+}
+
+// One hole's cylinder taken from the implant's field (their smooth minimum, so that the rim
+// comes out rounded). The drill goes from above the outer surface to below the inner one under
+// all of it (plate_under; as plans saved before mid_normal: at the centre), not on into another
+// part of a curved implant.
+void carve(std::vector<float>& field, const VoxelGrid& g, const SurfaceLocator& self,
+           const Hole& hole, const PerforationParams& p) {
+  const double radius = 0.5 * p.diameter_mm, h = g.spacing;
+  PlateUnder span;
+  if (p.mid_normal) {
+    span = plate_under(self, hole.center, hole.axis, radius + kRimRoundMm);
+  } else {
+    const auto under =
+        self.first_hit(hole.center - 1e-3 * hole.axis, hole.center - 16.0 * hole.axis);
+    span.depth = under ? under->distance : 15.0;
+  }
+  const double depth = span.depth + 1.0 + 2.0 * h, above = span.above + 1.0 + 2.0 * h;
+  const double reach = p.mid_normal ? radius + kRimRoundMm + 2.0 * h + std::max(depth, above)
+                                    : radius + 2.0 * h + 16.0;
+  for_voxels_near(g, hole.center, reach, [&](int i, int j, int k) {
+    const Eigen::Vector3d q = g.center(i, j, k) - hole.center;
+    const double t = q.dot(hole.axis);
+    if (t > above || t < -depth) return;
+    const double off_axis = (q - t * hole.axis).norm();
+    float& v = field[g.index(i, j, k)];
+    v = static_cast<float>(smooth_min(v, off_axis - radius, kRimRoundMm));
+  });
+}
+
+std::string drilled_message(size_t holes, double diameter_mm, int blocked, int left_out) {
+  char buf[160];
+  std::snprintf(buf, sizeof(buf), "%zu %s of %.1f mm drilled", holes, holes == 1 ? "hole" : "holes",
+                diameter_mm);
+  std::string message = buf;
+  if (blocked > 0)
+    message +=
+        " (" + std::to_string(blocked) + (blocked == 1 ? " does" : " do") + " not go through)";
+  if (left_out > 0)
+    message += "; " + std::to_string(left_out) + " of the pattern's left out (" +
+               (left_out == 1 ? "its rim" : "their rims") +
+               " would leave a corner thinner than the material allows)";
+  return message;
+}
+
 void perforate_into(const SkullMesh& implant, const Eigen::Vector3d& inside,
                     const PerforationParams& p, PerforateResult& r, SkullMesh& into) {
   assert(&into != &implant && "the holes are meshed into another mesh than the implant");
@@ -248,28 +315,14 @@ void perforate_into(const SkullMesh& implant, const Eigen::Vector3d& inside,
   const PointIndex outer(faces.outer_centres);
   const PointIndex wall(faces.wall_points.empty() ? std::vector<Eigen::Vector3d>{inside}
                                                   : faces.wall_points);
-  // The holes: the user's, then the pattern's that keep clear of them and of the removed.
   const double radius = 0.5 * p.diameter_mm;
-  for (const Eigen::Vector3d& a : p.added) {
-    const Eigen::Vector3d at = self.closest(a).point;
-    r.holes.push_back({at, normal_near(faces, outer, at, inside), true});
+  if (std::string problem = place_holes(faces, self, outer, wall, inside, p, r.holes);
+      !problem.empty()) {
+    r.message = std::move(problem);
+    into = implant;
+    r.holes.clear();
+    return done(r);
   }
-  for (size_t i = 0; i < r.holes.size(); ++i)
-    for (size_t j = i + 1; j < r.holes.size(); ++j)
-      if ((r.holes[i].center - r.holes[j].center).norm() < p.diameter_mm + 1.0) {
-        r.message = "holes " + std::to_string(i + 1) + " and " + std::to_string(j + 1) +
-                    " are less than 1 mm apart: move or remove one";
-        into = implant;
-        r.holes.clear();
-        return done(r);
-      }
-  if (p.pattern)
-    for (const Eigen::Vector3d& c : pattern_centres(faces, self, wall, p)) {
-      bool keep = true;
-      for (const Eigen::Vector3d& x : p.removed) keep = keep && (x - c).norm() > 0.5 * p.spacing_mm;
-      for (const Eigen::Vector3d& x : p.added) keep = keep && (x - c).norm() > 0.5 * p.spacing_mm;
-      if (keep) r.holes.push_back({c, normal_near(faces, outer, c, inside), false});
-    }
   if (r.holes.empty()) {  // nothing to drill: the implant as it is
     into = implant;
     r.status = PerforateResult::Status::Drilled;
@@ -285,35 +338,10 @@ void perforate_into(const SkullMesh& implant, const Eigen::Vector3d& inside,
   const auto [lo, hi] = mesh_bounds(implant);
   const double h0 = std::clamp(std::min(p.voxel_mm, p.diameter_mm / 4.0), 0.05, 1.0);
   const VoxelGrid g = VoxelGrid::covering_at_most(lo, hi, h0, std::max(1e5, p.max_voxels), 3);
-  const double h = g.spacing;
   const std::vector<uint8_t> solid = voxelize_mesh(implant, g);
   // The implant's signed distance (mm, positive inside): exact near its surface, ±10 mm (no
   // more than needed) elsewhere.
   const std::vector<float> whole = signed_distance_near_surface(self, solid, g);
-  auto carve = [&](std::vector<float>& field, const Hole& hole) {
-    // The drill goes from above the outer surface to below the inner one under all of it
-    // (plate_under; as plans saved before mid_normal: at the centre), not on into another part
-    // of a curved implant.
-    PlateUnder span;
-    if (p.mid_normal) {
-      span = plate_under(self, hole.center, hole.axis, radius + kRimRoundMm);
-    } else {
-      const auto under =
-          self.first_hit(hole.center - 1e-3 * hole.axis, hole.center - 16.0 * hole.axis);
-      span.depth = under ? under->distance : 15.0;
-    }
-    const double depth = span.depth + 1.0 + 2.0 * h, above = span.above + 1.0 + 2.0 * h;
-    const double reach = p.mid_normal ? radius + kRimRoundMm + 2.0 * h + std::max(depth, above)
-                                      : radius + 2.0 * h + 16.0;
-    for_voxels_near(g, hole.center, reach, [&](int i, int j, int k) {
-      const Eigen::Vector3d q = g.center(i, j, k) - hole.center;
-      const double t = q.dot(hole.axis);
-      if (t > above || t < -depth) return;
-      const double off_axis = (q - t * hole.axis).norm();
-      float& v = field[g.index(i, j, k)];
-      v = static_cast<float>(smooth_min(v, off_axis - radius, kRimRoundMm));
-    });
-  };
   // Drilled; then, with `sound_rims`, the pattern's holes whose rim leaves a corner thinner
   // than the material allows, reaching further out of the material that is thick enough than
   // the quality report allows (as it measures thin material), are left out and the rest
@@ -323,7 +351,7 @@ void perforate_into(const SkullMesh& implant, const Eigen::Vector3d& inside,
   int left_out = 0;
   for (int round = 0;; ++round) {
     field = whole;
-    for (const Hole& hole : r.holes) carve(field, hole);
+    for (const Hole& hole : r.holes) carve(field, g, self, hole, p);
     if (!p.sound_rims || !p.pattern || round == kDrillRounds) break;
     // Only the corners the holes made: the implant's own thin edge may lie within reach.
     if (before.empty()) before = thin_corners(whole, g, p.min_thickness_mm);
@@ -348,17 +376,7 @@ void perforate_into(const SkullMesh& implant, const Eigen::Vector3d& inside,
   int blocked = 0;
   for (const Hole& hole : r.holes) blocked += !hole_goes_through(drilled, hole);
   r.status = PerforateResult::Status::Drilled;
-  char buf[160];
-  std::snprintf(buf, sizeof(buf), "%zu %s of %.1f mm drilled", r.holes.size(),
-                r.holes.size() == 1 ? "hole" : "holes", p.diameter_mm);
-  r.message = buf;
-  if (blocked > 0)
-    r.message +=
-        " (" + std::to_string(blocked) + (blocked == 1 ? " does" : " do") + " not go through)";
-  if (left_out > 0)
-    r.message += "; " + std::to_string(left_out) + " of the pattern's left out (" +
-                 (left_out == 1 ? "its rim" : "their rims") +
-                 " would leave a corner thinner than the material allows)";
+  r.message = drilled_message(r.holes.size(), p.diameter_mm, blocked, left_out);
   return done(r);
 }
 

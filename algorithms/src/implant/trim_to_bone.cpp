@@ -388,6 +388,50 @@ std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const Vo
 namespace {
 
 // trim_to_bone, meshed in `into` (the result's own mesh, or the caller's).
+// A clearance wider than a voxel cut from `mask` to the voxels' resolution: voxels nearer the
+// bone's than the clearance there (the zone's at the skull's closest point). Returns the
+// distance to the bone's voxels it measured, asked against the clearances, the band beyond
+// them and the fills' millimetre only.
+std::vector<float> cut_wide_clearance(Mask& mask, const Mask& bone, const VoxelGrid& grid,
+                                      const SurfaceLocator& locator, const TrimToBoneParams& params,
+                                      double widest) {
+  std::vector<float> to_bone =
+      distance_to_mask(bone, grid, std::max(widest + 2.0 * grid.spacing, 1.0));
+  for (int k = 0; k < grid.dims[2]; ++k)
+    for (int j = 0; j < grid.dims[1]; ++j)
+      for (int i = 0; i < grid.dims[0]; ++i) {
+        const size_t c = grid.index(i, j, k);
+        if (!mask[c] || to_bone[c] >= widest) continue;
+        const double want = params.zones.empty()
+                                ? *params.clearance_mm
+                                : clearance_at(locator.closest(grid.center(i, j, k)).point,
+                                               *params.clearance_mm, params.zones);
+        if (to_bone[c] < want) mask[c] = 0;
+      }
+  return to_bone;
+}
+
+// What the fills (`bridged` beyond `mask`) leave thinner than the feature size away from the
+// bone goes (a rod between the implant's edge and a fragment; a wall between the implant and a
+// cut face is thick along the cut): what lies within a millimetre of the bone is the fill's
+// contact. `to_bone`, when measured, is the distance to the bone's voxels.
+void remove_thin_fills(Mask& bridged, const Mask& mask, const Mask& bone, const VoxelGrid& grid,
+                       double radius_mm, const std::vector<float>& to_bone) {
+  Mask far(bridged.size(), 0);
+  bool any = false;
+  const LocalDistance from_bone(bone, grid, 1.0f);
+  for (size_t c = 0; c < bridged.size(); ++c)
+    if (bridged[c] && !mask[c])
+      any |= far[c] = to_bone.empty() ? from_bone.farther(c) : to_bone[c] > 1.0f;
+  if (!any) return;
+  // Whether each far fill lies in the fills' opening, from the voxels around it.
+  LocalOpening opening(bridged, grid, radius_mm);
+  std::vector<size_t> thin;
+  for (size_t c = 0; c < bridged.size(); ++c)
+    if (far[c] && !opening.contains(c)) thin.push_back(c);
+  for (size_t c : thin) bridged[c] = 0;
+}
+
 void trim_into(const SkullMesh& implant, const SkullMesh& skull,
                const SurfaceLocator* skull_locator, const TrimToBoneParams& params,
                TrimToBoneResult& result, SkullMesh& into) {
@@ -436,19 +480,7 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull,
   // implant reaching between two pieces of bone narrows by the clearance from both sides.
   std::vector<float> to_bone;  // the distance to the bone's voxels, when a clearance needs it
   if (locator && widest > h) {
-    // Asked against the clearances, the band beyond them and the fills' millimetre only.
-    to_bone = distance_to_mask(bone, grid, std::max(widest + 2.0 * h, 1.0));
-    for (int k = 0; k < grid.dims[2]; ++k)
-      for (int j = 0; j < grid.dims[1]; ++j)
-        for (int i = 0; i < grid.dims[0]; ++i) {
-          const size_t c = grid.index(i, j, k);
-          if (!mask[c] || to_bone[c] >= widest) continue;
-          const double want = params.zones.empty()
-                                  ? *params.clearance_mm
-                                  : clearance_at(locator->closest(grid.center(i, j, k)).point,
-                                                 *params.clearance_mm, params.zones);
-          if (to_bone[c] < want) mask[c] = 0;
-        }
+    to_bone = cut_wide_clearance(mask, bone, grid, *locator, params, widest);
     clock.mark("clearance cut");
   }
   // Opening by a ball: slivers thinner than the feature size (left on top of intact bone, and
@@ -467,23 +499,8 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull,
   if (bridge > 0) {
     Mask bridged = bridge_cracks(mask, bone, grid, bridge);
     clock.mark("cracks");
-    // What the fills leave thinner than the feature size away from the bone goes (a rod
-    // between the implant's edge and a fragment; a wall between the implant and a cut face is
-    // thick along the cut): what lies within a millimetre of the bone is the fill's contact.
     if (params.thin_fills_removed && params.min_feature_mm > 0) {
-      Mask far(bridged.size(), 0);
-      bool any = false;
-      const LocalDistance from_bone(bone, grid, 1.0f);
-      for (size_t c = 0; c < bridged.size(); ++c)
-        if (bridged[c] && !mask[c])
-          any |= far[c] = to_bone.empty() ? from_bone.farther(c) : to_bone[c] > 1.0f;
-      if (any) {  // whether each far fill lies in the fills' opening, from the voxels around it
-        LocalOpening opening(bridged, grid, 0.5 * params.min_feature_mm);
-        std::vector<size_t> thin;
-        for (size_t c = 0; c < bridged.size(); ++c)
-          if (far[c] && !opening.contains(c)) thin.push_back(c);
-        for (size_t c : thin) bridged[c] = 0;
-      }
+      remove_thin_fills(bridged, mask, bone, grid, 0.5 * params.min_feature_mm, to_bone);
       clock.mark("thin fills");
     }
     mask = std::move(bridged);

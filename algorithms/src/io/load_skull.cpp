@@ -13,6 +13,10 @@
 
 namespace cranioplan {
 
+const char* to_string(SkullSource source) {
+  return source == SkullSource::Volume ? "volume" : "mesh";
+}
+
 std::string sample_case_path() {
   const char* env = std::getenv("CRANIOPLAN_SAMPLE");
   if (env && *env) return env;
@@ -42,7 +46,7 @@ LoadedSkull load(const std::string& path, const ExtractBoneSurfaceParams& import
     // Built in place: OpenMesh meshes cannot be moved (assigning one copies it).
     out.surface = extract_bone_surface(volume, import, out.mesh);
     if (!out.surface.usable()) throw InputError(path, out.surface.message);
-    out.source_kind = "volume";
+    out.source_kind = SkullSource::Volume;
     out.description = volume.description;
     out.frame = volume.frame;
     out.warnings = volume.warnings;
@@ -64,7 +68,7 @@ LoadedSkull load(const std::string& path, const ExtractBoneSurfaceParams& import
       declared = out.declared_space = file.space;
       if (file.turned_to_lps) out.file_space = MeshSpace::RAS;
     }
-    out.source_kind = "mesh";
+    out.source_kind = SkullSource::Mesh;
     if (import.mesh_unit_mm != 1.0) {
       char unit[48];
       std::snprintf(unit, sizeof(unit), "units of %g mm", import.mesh_unit_mm);
@@ -110,7 +114,8 @@ LoadedSkull load_surface(const std::string& path, const ExtractBoneSurfaceParams
 
 LoadedSkull load_skull(const std::string& path, const ExtractBoneSurfaceParams& import) {
   LoadedSkull out = load(path, import, true);
-  check_skull_size(out.mesh, path, out.source_kind == "mesh" ? import.mesh_unit_mm : 0.0);
+  check_skull_size(out.mesh, path,
+                   out.source_kind == SkullSource::Mesh ? import.mesh_unit_mm : 0.0);
   return out;
 }
 

@@ -174,15 +174,30 @@ void keep_bone_segment(const std::string& path, const std::map<std::string, std:
 
 }  // namespace
 
-Volume read_nrrd(const std::string& path, bool patient_frame) {
-  const std::string bytes = read_file_bytes(path);
+namespace {
+
+// A NRRD header: its fields (keys in lower case), its key:=value pairs (Slicer's segment
+// fields), and where the attached data starts.
+struct NrrdHeader {
+  std::map<std::string, std::string> fields, custom;
+  size_t data_pos = 0;
+  bool done = false;  ///< ended by a blank line
+
+  std::string field(const std::string& k) const {
+    auto it = fields.find(k);
+    return it == fields.end() ? std::string() : it->second;
+  }
+  std::string data_file() const {
+    return !field("data file").empty() ? field("data file") : field("datafile");
+  }
+};
+
+NrrdHeader parse_nrrd_header(const std::string& path, const std::string& bytes) {
   if (bytes.compare(0, 4, "NRRD") != 0) throw InputError(path, "not a NRRD file (no 'NRRD' magic)");
-  std::map<std::string, std::string> fields;
-  std::map<std::string, std::string> custom;  // key:=value pairs (Slicer's segment fields)
+  NrrdHeader h;
   size_t pos = bytes.find('\n');
   if (pos == std::string::npos) throw InputError(path, "NRRD header is not terminated");
   ++pos;
-  bool header_done = false;
   while (pos < bytes.size()) {
     size_t eol = bytes.find('\n', pos);
     if (eol == std::string::npos) eol = bytes.size();
@@ -190,13 +205,13 @@ Volume read_nrrd(const std::string& path, bool patient_frame) {
     pos = eol + 1;
     if (!line.empty() && line.back() == '\r') line.pop_back();
     if (line.empty()) {
-      header_done = true;
+      h.done = true;
       break;
     }
     if (line[0] == '#') continue;
     const size_t assign = line.find(":=");
     if (assign != std::string::npos) {
-      custom[line.substr(0, assign)] = line.substr(assign + 2);
+      h.custom[line.substr(0, assign)] = line.substr(assign + 2);
       continue;
     }
     const size_t colon = line.find(": ");
@@ -204,69 +219,70 @@ Volume read_nrrd(const std::string& path, bool patient_frame) {
     std::string key = line.substr(0, colon);
     std::transform(key.begin(), key.end(), key.begin(),
                    [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-    fields[key] = trim(line.substr(colon + 2));
+    h.fields[key] = trim(line.substr(colon + 2));
   }
-  auto field = [&](const std::string& k) -> std::string {
-    auto it = fields.find(k);
-    return it == fields.end() ? std::string() : it->second;
-  };
-  const std::string data_file =
-      !field("data file").empty() ? field("data file") : field("datafile");
-  if (!header_done && data_file.empty())
+  h.data_pos = pos;
+  if (!h.done && h.data_file().empty())
     throw InputError(path, "NRRD header does not end with a blank line before the data");
-  if (field("dimension") != "3") {
-    if (custom.count("Segment0_ID"))
+  if (h.field("dimension") != "3") {
+    if (h.custom.count("Segment0_ID"))
       throw InputError(path,
                        "a segmentation of overlapping segments (layers) is not read: in 3D Slicer, "
                        "export the bone's segment alone, or save the segments without overlap");
     throw InputError(path, "only 3-dimensional NRRD volumes are supported (dimension: " +
-                               field("dimension") + ")");
+                               h.field("dimension") + ")");
   }
-  if (field("type").empty() || field("sizes").empty() || field("encoding").empty())
+  if (h.field("type").empty() || h.field("sizes").empty() || h.field("encoding").empty())
     throw InputError(path, "NRRD header lacks type, sizes or encoding");
-  const SampleType type = parse_type(path, field("type"));
-  Volume v;
-  {
-    std::istringstream in(field("sizes"));
-    for (int a = 0; a < 3; ++a) {
-      long long s = 0;
-      if (!(in >> s) || s < 1 || s > 100000)
-        throw InputError(path, "NRRD sizes must be 3 positive numbers ('" + field("sizes") + "')");
-      v.dims[a] = static_cast<int>(s);
-    }
+  return h;
+}
+
+// The grid's sizes, axes and origin from the header into `v`.
+void nrrd_geometry(const std::string& path, const NrrdHeader& h, Volume& v) {
+  std::istringstream sizes(h.field("sizes"));
+  for (int a = 0; a < 3; ++a) {
+    long long s = 0;
+    if (!(sizes >> s) || s < 1 || s > 100000)
+      throw InputError(path, "NRRD sizes must be 3 positive numbers ('" + h.field("sizes") + "')");
+    v.dims[a] = static_cast<int>(s);
   }
-  if (!field("space directions").empty()) {
-    const auto dirs = parse_vectors(path, "space directions", field("space directions"));
+  if (!h.field("space directions").empty()) {
+    const auto dirs = parse_vectors(path, "space directions", h.field("space directions"));
     if (dirs.size() != 3)
       throw InputError(path, "NRRD 'space directions' must give 3 vectors for a 3D volume");
     for (int a = 0; a < 3; ++a) v.directions.col(a) = dirs[a];
-  } else if (!field("spacings").empty()) {
-    std::istringstream in(field("spacings"));
+  } else if (!h.field("spacings").empty()) {
+    std::istringstream in(h.field("spacings"));
     Eigen::Vector3d s;
     if (!(in >> s.x() >> s.y() >> s.z()) || !(s.array() > 0).all())
       throw InputError(path, "NRRD 'spacings' must be 3 positive numbers");
     v.directions = s.asDiagonal();
   }
-  if (!field("space origin").empty()) {
-    const auto o = parse_vectors(path, "space origin", field("space origin"));
+  if (!h.field("space origin").empty()) {
+    const auto o = parse_vectors(path, "space origin", h.field("space origin"));
     if (o.size() != 1) throw InputError(path, "NRRD 'space origin' must be one vector");
     v.origin = o[0];
   }
-  frame_from_space(path, field("space"), patient_frame, v);
-  const std::string encoding = field("encoding");
-  const bool big_endian = field("endian") == "big";
+}
+
+// The samples (attached after the header in `bytes`, or in the detached data file), raw or
+// gzip, into v.data.
+void read_nrrd_samples(const std::string& path, const NrrdHeader& h, const std::string& bytes,
+                       SampleType type, Volume& v) {
+  const std::string encoding = h.field("encoding");
+  const bool big_endian = h.field("endian") == "big";
   std::string detached;
   const char* data = nullptr;
   size_t available = 0;
-  if (!data_file.empty()) {
+  if (const std::string data_file = h.data_file(); !data_file.empty()) {
     std::filesystem::path dp(data_file);
     if (dp.is_relative()) dp = std::filesystem::path(path).parent_path() / dp;
     detached = read_file_bytes(dp.string());
     data = detached.data();
     available = detached.size();
   } else {
-    data = bytes.data() + pos;
-    available = bytes.size() - std::min(pos, bytes.size());
+    data = bytes.data() + h.data_pos;
+    available = bytes.size() - std::min(h.data_pos, bytes.size());
   }
   const size_t need = v.size() * sample_size(type);
   if (encoding == "gzip" || encoding == "gz") {
@@ -285,7 +301,7 @@ Volume read_nrrd(const std::string& path, bool patient_frame) {
     samples.finish();
   } else if (encoding == "raw") {
     // "byte skip: -1" means the data is the last `need` bytes; otherwise sizes must agree.
-    if (field("byte skip") == "-1" && available > need) {
+    if (h.field("byte skip") == "-1" && available > need) {
       data += available - need;
       available = need;
     } else if (available > need) {
@@ -297,11 +313,23 @@ Volume read_nrrd(const std::string& path, bool patient_frame) {
   } else {
     throw InputError(path, "NRRD encoding '" + encoding + "' is not supported (use raw or gzip)");
   }
+}
+
+}  // namespace
+
+Volume read_nrrd(const std::string& path, bool patient_frame) {
+  const std::string bytes = read_file_bytes(path);
+  const NrrdHeader h = parse_nrrd_header(path, bytes);
+  const SampleType type = parse_type(path, h.field("type"));
+  Volume v;
+  nrrd_geometry(path, h, v);
+  frame_from_space(path, h.field("space"), patient_frame, v);
+  read_nrrd_samples(path, h, bytes, type, v);
   std::ostringstream d;
-  d << "NRRD " << v.dims[0] << "×" << v.dims[1] << "×" << v.dims[2] << " " << field("type");
+  d << "NRRD " << v.dims[0] << "×" << v.dims[1] << "×" << v.dims[2] << " " << h.field("type");
   v.description = d.str();
-  if (custom.count("Segment0_ID"))
-    keep_bone_segment(path, custom, v);
+  if (h.custom.count("Segment0_ID"))
+    keep_bone_segment(path, h.custom, v);
   else
     classify_kind(v);
   return v;

@@ -14,6 +14,69 @@
 
 namespace cranioplan {
 
+namespace {
+
+// The scalp's thickness over the intact bone around the defect: from points a few mm beyond the
+// implant's side wall (`wall`), outward through the bone to the skin; the median, or the
+// parameters' default where no such point reaches skin.
+double scalp_thickness(const Volume& ct, const SurfaceSamples& all, const std::vector<char>& wall,
+                       const Eigen::Vector3d& inside, const Eigen::Vector3d& centre, double step,
+                       const SoftTissueParams& params) {
+  std::vector<double> thickness;
+  for (size_t i = 0; i < all.points.size(); i += std::max<size_t>(1, all.points.size() / 3000)) {
+    if (!wall[i]) continue;
+    const Eigen::Vector3d radial = (all.points[i] - inside).normalized();
+    Eigen::Vector3d away = all.points[i] - centre;
+    away -= away.dot(radial) * radial;
+    if (away.norm() < 1e-6) continue;
+    const Eigen::Vector3d from = all.points[i] + params.ring_mm * away.normalized();
+    bool bone = false;
+    double bone_end = 0.0;
+    for (double t = -10.0; t < 40.0; t += step) {
+      const double hu = sample_volume(ct, from + t * radial);
+      if (!std::isfinite(hu)) break;
+      if (hu >= params.bone_hu) {
+        bone = true;
+        bone_end = t;
+      } else if (bone && hu < params.air_hu) {
+        thickness.push_back(t - bone_end);
+        break;
+      }
+    }
+  }
+  if (thickness.empty()) return params.default_scalp_mm;
+  std::nth_element(thickness.begin(), thickness.begin() + thickness.size() / 2, thickness.end());
+  return thickness[thickness.size() / 2];
+}
+
+std::string soft_tissue_message(const SoftTissueCheck& out, const SoftTissueParams& params) {
+  char buf[320];
+  if (out.intrusion_mm3 > 0.0)
+    std::snprintf(buf, sizeof(buf),
+                  "%.0f mm³ of the implant's inner half lie where the CT shows soft tissue "
+                  "(%.0f–%.0f HU) deeper than the scalp: brain or dura reaching up to %.1f mm "
+                  "above the implant's inner surface%s",
+                  out.intrusion_mm3, params.soft_min_hu, params.soft_max_hu, out.intrusion_reach_mm,
+                  out.finding ? "" : " (within the tolerance: dura and partial volume)");
+  else if (std::isfinite(out.closest_mm))
+    std::snprintf(buf, sizeof(buf), "soft tissue lies %.1f mm under the implant's inner surface",
+                  out.closest_mm);
+  else
+    std::snprintf(buf, sizeof(buf), "no soft tissue within %.0f mm under the implant",
+                  params.probe_mm);
+  std::string message = buf;
+  if (out.sunken_scalp_mm3 > 0.0) {
+    std::snprintf(buf, sizeof(buf),
+                  "; %.0f mm³ of it are scalp sunk into the defect (within the scalp's %.1f mm "
+                  "under the skin), which the implant lifts",
+                  out.sunken_scalp_mm3, out.scalp_mm);
+    message += buf;
+  }
+  return message;
+}
+
+}  // namespace
+
 SoftTissueCheck check_soft_tissue(const SkullMesh& implant, const Volume& ct,
                                   const Eigen::Vector3d& inside, const SoftTissueParams& params) {
   SoftTissueCheck out;
@@ -66,36 +129,7 @@ SoftTissueCheck check_soft_tissue(const SkullMesh& implant, const Volume& ct,
     }
     return std::numeric_limits<double>::infinity();
   };
-  // The scalp's thickness over the intact bone around the defect: from points a few mm beyond
-  // the implant's side wall, outward through the bone to the skin; the median.
-  std::vector<double> thickness;
-  for (size_t i = 0; i < all.points.size(); i += std::max<size_t>(1, all.points.size() / 3000)) {
-    if (!wall[i]) continue;
-    const Eigen::Vector3d radial = (all.points[i] - inside).normalized();
-    Eigen::Vector3d away = all.points[i] - centre;
-    away -= away.dot(radial) * radial;
-    if (away.norm() < 1e-6) continue;
-    const Eigen::Vector3d from = all.points[i] + params.ring_mm * away.normalized();
-    bool bone = false;
-    double bone_end = 0.0;
-    for (double t = -10.0; t < 40.0; t += step) {
-      const double hu = sample_volume(ct, from + t * radial);
-      if (!std::isfinite(hu)) break;
-      if (hu >= params.bone_hu) {
-        bone = true;
-        bone_end = t;
-      } else if (bone && hu < params.air_hu) {
-        thickness.push_back(t - bone_end);
-        break;
-      }
-    }
-  }
-  if (!thickness.empty()) {
-    std::nth_element(thickness.begin(), thickness.begin() + thickness.size() / 2, thickness.end());
-    out.scalp_mm = thickness[thickness.size() / 2];
-  } else {
-    out.scalp_mm = params.default_scalp_mm;
-  }
+  out.scalp_mm = scalp_thickness(ct, all, wall, inside, centre, step, params);
   // Tissue within the scalp's thickness under the skin (and a voxel's slack) is scalp: where
   // the implant's place holds some, the scalp has sunk into the defect. Deeper is brain or dura.
   const double scalp_reach = out.scalp_mm + voxel_mm;
@@ -148,28 +182,7 @@ SoftTissueCheck check_soft_tissue(const SkullMesh& implant, const Volume& ct,
   out.intrusion_mm3 = static_cast<double>(count) * voxel_mm3;
   out.sunken_scalp_mm3 = static_cast<double>(sunken) * voxel_mm3;
   if (count > 0) out.closest_mm = 0.0;
-  char buf[320];
-  if (out.intrusion_mm3 > 0.0)
-    std::snprintf(buf, sizeof(buf),
-                  "%.0f mm³ of the implant's inner half lie where the CT shows soft tissue "
-                  "(%.0f–%.0f HU) deeper than the scalp: brain or dura reaching up to %.1f mm "
-                  "above the implant's inner surface%s",
-                  out.intrusion_mm3, params.soft_min_hu, params.soft_max_hu, out.intrusion_reach_mm,
-                  out.finding ? "" : " (within the tolerance: dura and partial volume)");
-  else if (std::isfinite(out.closest_mm))
-    std::snprintf(buf, sizeof(buf), "soft tissue lies %.1f mm under the implant's inner surface",
-                  out.closest_mm);
-  else
-    std::snprintf(buf, sizeof(buf), "no soft tissue within %.0f mm under the implant",
-                  params.probe_mm);
-  out.message = buf;
-  if (out.sunken_scalp_mm3 > 0.0) {
-    std::snprintf(buf, sizeof(buf),
-                  "; %.0f mm³ of it are scalp sunk into the defect (within the scalp's %.1f mm "
-                  "under the skin), which the implant lifts",
-                  out.sunken_scalp_mm3, out.scalp_mm);
-    out.message += buf;
-  }
+  out.message = soft_tissue_message(out, params);
   return out;
 }
 

@@ -23,7 +23,28 @@ const ImplantParams& automatic_implant() {
 }
 }  // namespace
 
-BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
+BuildPage::BuildPage(PageHost& host) : StepPage(kBuildStep, host) {
+  add_build_and_result();
+  add_shell_controls();
+  add_material_controls();
+  add_zone_controls();
+  show_material(0);
+  add_perforation_controls();
+  add_tab_controls();
+  watch_controls();
+}
+
+QDoubleSpinBox* BuildPage::spin(const char* name, double lo, double hi, double step,
+                                const QString& suffix) {
+  auto* b = new QDoubleSpinBox(this);
+  b->setObjectName(name);
+  b->setRange(lo, hi);
+  b->setSingleStep(step);
+  b->setSuffix(suffix);
+  return b;
+}
+
+void BuildPage::add_build_and_result() {
   // The step's action first, with what became of it, so it is in sight whatever the options.
   build_ = add_button(tr("Build implant"), "build");
   connect(build_, &QPushButton::clicked, this,
@@ -45,7 +66,9 @@ BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
   verdict_->setTextFormat(Qt::RichText);
   verdict_->hide();
   form_->addRow(verdict_);
+}
 
+void BuildPage::add_shell_controls() {
   method_ = new QComboBox(this);
   method_->setObjectName("implantMethod");
   method_->addItems({tr("Shell (fitted surfaces)"), tr("Delaunay 3D (Egger et al. 2017)")});
@@ -78,21 +101,15 @@ BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
   fit_note_->setWordWrap(true);
   fit_note_->hide();
   form_->addRow(fit_note_);
+}
 
+void BuildPage::add_material_controls() {
   // The material: a preset fills its values, which may then be changed.
   material_ = new QComboBox(this);
   material_->setObjectName("implantMaterial");
   material_->addItem(tr("None (the plan's surfaces)"));
   for (const Material& m : material_presets()) material_->addItem(QString::fromStdString(m.name));
   material_->addItem(tr("Custom"));
-  auto spin = [this](const char* name, double lo, double hi, double step, const QString& suffix) {
-    auto* b = new QDoubleSpinBox(this);
-    b->setObjectName(name);
-    b->setRange(lo, hi);
-    b->setSingleStep(step);
-    b->setSuffix(suffix);
-    return b;
-  };
   clearance_ = spin("materialClearance", 0, 3, 0.1, " mm");
   clearance_->setToolTip(tr("Gap left between the implant's edge and the bone's cut edge"));
   under_contour_ = spin("materialUnderContour", 0, 1, 0.1, " mm");
@@ -112,7 +129,9 @@ BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
     // Clearance and under-contour are made by the fit to the bone.
     if (i > 0 && fit_->value() == 0) fit_->setValue(4.0);
   });
+}
 
+void BuildPage::add_zone_controls() {
   // Clearance zones: a wider gap along stretches of the rim the user marks.
   mark_zone_ = make_button(tr("Mark a wider clearance on the rim"), "markZone");
   mark_zone_->setCheckable(true);
@@ -133,8 +152,9 @@ BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
   form_->addRow(tr("Zone radius"), zone_radius_);
   form_->addRow(tr("Zone clearance"), zone_clearance_);
   form_->addRow(remove_zone_);
-  show_material(0);
+}
 
+void BuildPage::add_perforation_controls() {
   // Perforations: a pattern, and single holes added or taken away by clicks on the implant.
   perforate_ = new QCheckBox(tr("Perforations on a pattern"), this);
   perforate_->setObjectName("perforate");
@@ -159,7 +179,9 @@ BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
   hole_buttons->addWidget(add_hole_);
   hole_buttons->addWidget(remove_hole_);
   form_->addRow(hole_buttons);
+}
 
+void BuildPage::add_tab_controls() {
   // Fixation tabs: evenly placed, or where the user clicks on the bone beyond the edge.
   tabs_ = new QCheckBox(tr("Fixation tabs along the rim"), this);
   tabs_->setObjectName("tabs");
@@ -197,7 +219,9 @@ BuildPage::BuildPage(PageHost& host) : StepPage(7, host) {
                                this);
   drag_hint->setWordWrap(true);
   form_->addRow(drag_hint);
+}
 
+void BuildPage::watch_controls() {
   // Any control changed after a build: the implant shown is not what the controls say.
   for (auto* b : findChildren<QDoubleSpinBox*>())
     connect(b, &QDoubleSpinBox::valueChanged, this, &BuildPage::mark_changed);

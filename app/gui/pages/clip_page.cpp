@@ -8,7 +8,7 @@
 
 namespace cranioplan::gui {
 
-ClipPage::ClipPage(PageHost& host) : StepPage(4, host) {
+ClipPage::ClipPage(PageHost& host) : StepPage(kClipStep, host) {
   clip_on_ = new QCheckBox(tr("Clip the skulls"), this);
   clip_on_->setObjectName("clipOn");
   clip_axis_ = new QComboBox(this);

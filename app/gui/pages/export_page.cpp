@@ -11,7 +11,7 @@
 
 namespace cranioplan::gui {
 
-ExportPage::ExportPage(PageHost& host) : StepPage(9, host) {
+ExportPage::ExportPage(PageHost& host) : StepPage(kExportStep, host) {
   verdict_ = new QLabel(this);
   verdict_->setObjectName("exportVerdict");
   verdict_->setWordWrap(true);

@@ -16,7 +16,7 @@ namespace {
 constexpr double kAutomatic = -1001.0;  // the threshold field's "automatic"
 }  // namespace
 
-LoadPage::LoadPage(PageHost& host) : StepPage(1, host) {
+LoadPage::LoadPage(PageHost& host) : StepPage(kLoadStep, host) {
   QPushButton* open = add_button(tr("Open mesh or CT…"), "pageOpen");
   connect(open, &QPushButton::clicked, this, [this] {
     const QString path = QFileDialog::getOpenFileName(

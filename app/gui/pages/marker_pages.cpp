@@ -5,6 +5,7 @@
 #include <QLabel>
 #include <QPushButton>
 #include <QSettings>
+#include <QSignalBlocker>
 
 #include "cranioplan/model/error.h"
 #include "step_pages.h"
@@ -63,7 +64,7 @@ SkullView::PickTarget MarkersPage::pick_target() const {
 QString MarkersPage::keys_hint() const { return marker_keys_hint(); }
 
 EdgeMarkersPage::EdgeMarkersPage(PageHost& host)
-    : MarkersPage(5, host, MarkerType::OuterEdge, MarkerType::InnerEdge) {
+    : MarkersPage(kEdgeMarkersStep, host, MarkerType::OuterEdge, MarkerType::InnerEdge) {
   QPushButton* propose = add_button(tr("Propose markers automatically"), "propose");
   connect(propose, &QPushButton::clicked, this, [this] {
     // With several openings in the skull, the one where the user has put edge markers is
@@ -117,9 +118,7 @@ void EdgeMarkersPage::add_shape_model_row() {
   model_file_ = new QLabel(this);
   model_file_->setObjectName("shapeModelFile");
   model_file_->setWordWrap(true);
-  const QString path = settings.value("shapeModel/path").toString();
-  model_file_->setText(path.isEmpty() ? tr("No model chosen.") : QFileInfo(path).fileName());
-  model_file_->setToolTip(path);
+  show_model_file(settings.value("shapeModel/path").toString());
   QPushButton* choose = make_button(tr("Choose model…"), "chooseShapeModel");
   connect(choose, &QPushButton::clicked, this, &EdgeMarkersPage::choose_shape_model);
   connect(use_model_, &QCheckBox::toggled, this, [this](bool on) {
@@ -139,14 +138,31 @@ void EdgeMarkersPage::choose_shape_model() {
     return;
   }
   QSettings().setValue("shapeModel/path", path);
-  model_file_->setText(QFileInfo(path).fileName());
-  model_file_->setToolTip(path);
+  plan_model_.clear();
+  show_model_file(path);
   use_model_->setChecked(true);
+}
+
+void EdgeMarkersPage::show_model_file(const QString& path) {
+  model_file_->setText(path.isEmpty() ? tr("No model chosen.") : QFileInfo(path).fileName());
+  model_file_->setToolTip(path);
 }
 
 std::string EdgeMarkersPage::shape_model_path() const {
   if (!use_model_->isChecked()) return {};
+  if (!plan_model_.isEmpty()) return plan_model_.toStdString();
   return QSettings().value("shapeModel/path").toString().toStdString();
+}
+
+void EdgeMarkersPage::show_plan_model(const PlanState& s) {
+  const std::string proposal = s.proposal_message + '\n' + s.proposal_shape_model;
+  if (s.proposal_message.empty() || proposal == shown_proposal_) return;
+  shown_proposal_ = proposal;
+  plan_model_ = QString::fromStdString(s.proposal_shape_model);
+  const QSignalBlocker quiet(use_model_);  // the settings keep the user's own choice
+  use_model_->setChecked(!plan_model_.isEmpty());
+  show_model_file(plan_model_.isEmpty() ? QSettings().value("shapeModel/path").toString()
+                                        : plan_model_);
 }
 
 void EdgeMarkersPage::import_markers() {
@@ -157,6 +173,7 @@ void EdgeMarkersPage::import_markers() {
 
 void EdgeMarkersPage::show_state(const PlanState& s) {
   MarkersPage::show_state(s);
+  show_plan_model(s);
   QString note = s.proposal_message.empty()
                      ? QString()
                      : tr("Last proposal: %1").arg(QString::fromStdString(s.proposal_message));
@@ -169,7 +186,7 @@ void EdgeMarkersPage::show_state(const PlanState& s) {
 }
 
 SurfaceMarkersPage::SurfaceMarkersPage(PageHost& host)
-    : MarkersPage(6, host, MarkerType::OuterSurface, MarkerType::InnerSurface) {
+    : MarkersPage(kSurfaceMarkersStep, host, MarkerType::OuterSurface, MarkerType::InnerSurface) {
   add_counts_row();
 }
 

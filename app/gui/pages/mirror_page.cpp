@@ -12,7 +12,7 @@
 
 namespace cranioplan::gui {
 
-MirrorPage::MirrorPage(PageHost& host) : StepPage(3, host) {
+MirrorPage::MirrorPage(PageHost& host) : StepPage(kMirrorStep, host) {
   QPushButton* mirror = add_button(tr("Mirror skull"), "mirror");
   connect(mirror, &QPushButton::clicked, this,
           [this] { host_.push(commands::mirror(), tr("Mirroring")); });

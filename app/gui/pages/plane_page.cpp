@@ -32,7 +32,7 @@ QSlider* linked_slider(QDoubleSpinBox* field, QWidget* parent) {
 
 }  // namespace
 
-PlanePage::PlanePage(PageHost& host) : StepPage(2, host) {
+PlanePage::PlanePage(PageHost& host) : StepPage(kPlaneStep, host) {
   landmark_ = new QComboBox(this);
   landmark_->setObjectName("landmark");
   landmark_->addItems(

@@ -10,7 +10,7 @@
 
 namespace cranioplan::gui {
 
-SmoothPage::SmoothPage(PageHost& host) : StepPage(8, host) {
+SmoothPage::SmoothPage(PageHost& host) : StepPage(kSmoothStep, host) {
   radius_ = new QSlider(Qt::Horizontal, this);
   radius_->setObjectName("smoothRadius");
   radius_->setRange(2, 40);

@@ -117,10 +117,18 @@ class EdgeMarkersPage : public MarkersPage {
   void choose_shape_model();
   /// The model file the next proposal uses: empty unless the box is ticked and a file chosen.
   std::string shape_model_path() const;
+  /// The box and the file as the plan's last proposal had them (a plan reopened shows what it
+  /// was made with, not the settings), once per proposal: the user may change them after.
+  void show_plan_model(const PlanState& state);
+  void show_model_file(const QString& path);
 
   QLabel* proposal_note_;  ///< what the last proposal found
   QCheckBox* use_model_;   ///< guide the proposal with a model of the normal skull
   QLabel* model_file_;     ///< the model file chosen
+  /// The model file of the plan's last proposal, used instead of the settings' while the box
+  /// stays ticked (empty: the settings').
+  QString plan_model_;
+  std::string shown_proposal_;  ///< the proposal show_plan_model last followed
 };
 
 /// Step 6: surface markers on the mirror.
@@ -145,6 +153,16 @@ class BuildPage : public StepPage {
   static Eigen::Vector3d tab_handle(const Tab& tab);
 
  private:
+  // The page's controls, added in this order by the constructor.
+  void add_build_and_result();
+  void add_shell_controls();
+  void add_material_controls();
+  void add_zone_controls();
+  void add_perforation_controls();
+  void add_tab_controls();
+  /// Any control changed after a build marks the implant shown as not what the controls say.
+  void watch_controls();
+  QDoubleSpinBox* spin(const char* name, double lo, double hi, double step, const QString& suffix);
   ImplantParams params() const;
   /// The chosen preset's values into the fields (none: the fields off).
   void show_material(int index);

@@ -27,7 +27,7 @@ TEST(ReadVolume, ALoadedVolumeHoldsItsSurfaceOnce) {
   const std::string p = dir.path("ball.nrrd");
   test::write_nrrd(test::oblique_ball_volume(Eigen::Vector3d(-120, 40, 17)), p, false);
   const LoadedSkull loaded = load_surface(p);
-  EXPECT_EQ(loaded.source_kind, "volume");
+  EXPECT_EQ(loaded.source_kind, SkullSource::Volume);
   EXPECT_GT(loaded.mesh.n_faces(), 1000u);
   EXPECT_EQ(loaded.surface.mesh.n_vertices(), 0u);
   EXPECT_TRUE(loaded.surface.usable());

@@ -33,7 +33,7 @@ VerifyReport verify_session(const std::string& path);
 /// next counts for the step of the later event (notes count for the step before them). Idle
 /// gaps longer than `idle_cap_s` count as `idle_cap_s`.
 struct StepDurations {
-  std::array<double, 10> seconds{};  ///< [1..9] used
+  std::array<double, kStepCount + 1> seconds{};  ///< by step number (kLoadStep..kExportStep)
   double total = 0.0;
 };
 StepDurations step_durations(const SessionHeader& header, const std::vector<JournalEntry>& journal,

@@ -124,6 +124,21 @@ struct AttachedCt {
   std::string message;
 };
 
+/// The wizard's steps, by the numbers the session file (`go_to_step`, `complete_step`), the
+/// user and `PlanState::current_step` use.
+enum StepNumber : int {
+  kLoadStep = 1,
+  kPlaneStep,
+  kMirrorStep,
+  kClipStep,
+  kEdgeMarkersStep,
+  kSurfaceMarkersStep,
+  kBuildStep,
+  kSmoothStep,
+  kExportStep,
+};
+inline constexpr int kStepCount = kExportStep;
+
 struct PlanState {
   // Step 1
   std::shared_ptr<const SkullInput> skull;
@@ -145,6 +160,8 @@ struct PlanState {
   int next_marker_id = 1;                        ///< ids are never reused
   std::optional<Eigen::Vector3d> defect_center;  ///< from the last proposal
   std::string proposal_message;
+  /// From the last proposal: the shape model file it was guided by, as recorded (empty: none).
+  std::string proposal_shape_model;
   /// From the last proposal: stretches of the rim no ray saw, where the outline between the
   /// edge markers is interpolated (the view draws them for the surgeon to check).
   std::vector<RimStretch> unseen_rim;
@@ -164,9 +181,9 @@ struct PlanState {
   std::optional<Approval> approval;
   std::string approval_withdrawn;
   // Wizard
-  std::array<bool, 10> acknowledged{};  ///< steps completed by hand (3, 4, 8)
+  std::array<bool, kStepCount + 1> acknowledged{};  ///< steps done by hand (mirror, clip, smooth)
   std::map<int, std::string> stale;     ///< step → why its results were recomputed
-  int current_step = 1;
+  int current_step = kLoadStep;
   std::vector<std::string> notes;
   std::string message;  ///< what the last command did, or why it had no effect
 
@@ -196,7 +213,7 @@ const char* registration_verdict(const RegisterResult& result);
 std::string landmark_words(const std::string& name);
 
 /// The nine steps of the wizard, 1..9.
-const std::array<WizardStep, 9>& wizard_steps();
+const std::array<WizardStep, kStepCount>& wizard_steps();
 /// Whether step `step` (1..9) is done; when not, `missing` says what is missing.
 bool step_complete(const PlanState& state, int step, std::string* missing = nullptr);
 /// Whether every step before `step` is done; when not, `why` names the first that is not.

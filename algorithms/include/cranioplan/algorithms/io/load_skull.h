@@ -17,9 +17,14 @@ namespace cranioplan {
 /// variable CRANIOPLAN_SAMPLE).
 std::string sample_case_path();
 
+/// What a skull was read from: a surface mesh, or a volume (CT or mask) made into its bone.
+enum class SkullSource { Mesh, Volume };
+/// "mesh" or "volume", as `inspect --json` says it.
+const char* to_string(SkullSource source);
+
 struct LoadedSkull {
   SkullMesh mesh;
-  std::string source_kind;            ///< "mesh" or "volume"
+  SkullSource source_kind = SkullSource::Mesh;
   std::string description;            ///< format / volume description
   std::vector<std::string> warnings;  ///< reader warnings, each naming the file
   /// What a skull mesh has that needs no repair (a flat cap where the scan ended), each naming
