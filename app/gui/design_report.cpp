@@ -11,6 +11,7 @@
 #include <QUrl>
 #include <algorithm>
 #include <array>
+#include <optional>
 #include <tuple>
 
 #include "cranioplan/algorithms/geometry/slices.h"
@@ -20,6 +21,26 @@
 namespace cranioplan::gui {
 
 namespace {
+
+// The report's pictures of the 3D view: caption, file suffix, the standard view (none: along
+// the defect), and whether the thickness map is shown.
+struct Shot {
+  const char* caption;
+  const char* suffix;
+  std::optional<SkullView::StandardView> view;
+  bool thickness;
+};
+const Shot kShots[] = {
+    {"Along the defect", "defect", std::nullopt, false},
+    {"From the front", "front", SkullView::StandardView::Front, false},
+    {"From the right", "right", SkullView::StandardView::Right, false},
+    {"From above", "top", SkullView::StandardView::Top, false},
+    {"Thickness of the implant and its gap to the bone (mm)", "thickness", std::nullopt, true}};
+
+bool write_text(const QString& path, const QString& text) {
+  QFile out(path);
+  return out.open(QIODevice::WriteOnly | QIODevice::Truncate) && out.write(text.toUtf8()) >= 0;
+}
 
 // The PDF: the report's HTML laid out by Qt on A4, its pictures read from `dir` beside it.
 // Whether it was written.
@@ -74,19 +95,6 @@ bool MainWindow::write_design_report(const QString& html_path) {
     set_layout(layout_was);
     view_->set_camera(camera_was);  // the view as the user left it
   };
-  struct Shot {
-    const char* caption;
-    const char* suffix;
-    std::optional<SkullView::StandardView> view;  // none: along the defect
-    bool thickness;
-  };
-  using V = SkullView::StandardView;
-  const Shot shots[] = {
-      {"Along the defect", "defect", std::nullopt, false},
-      {"From the front", "front", V::Front, false},
-      {"From the right", "right", V::Right, false},
-      {"From above", "top", V::Top, false},
-      {"Thickness of the implant and its gap to the bone (mm)", "thickness", std::nullopt, true}};
   std::vector<ReportImage> images;
   const auto save = [&](const QImage& grabbed, const QString& suffix, const char* caption,
                         ReportImage::Kind kind) {
@@ -107,7 +115,7 @@ bool MainWindow::write_design_report(const QString& html_path) {
   // Square pictures drawn square (the layout gives the view its size back afterwards), so that
   // the legends and letters at the view's edges are in them.
   const int side_3d = std::min(view_->width(), view_->height());
-  for (const Shot& shot : shots) {
+  for (const Shot& shot : kShots) {
     set_thickness_map_shown(shot.thickness);
     wait_quality();  // the thickness map is computed with the quality report
     view_->resize(side_3d, side_3d);
@@ -160,12 +168,10 @@ bool MainWindow::write_design_report(const QString& html_path) {
       controller_->session(), images, CRANIOPLAN_VERSION,
       judged_tissue_ && judged_implant_ == controller_->state().implant ? &*judged_tissue_
                                                                         : nullptr));
-  QFile out(html_path);
-  if (!out.open(QIODevice::WriteOnly | QIODevice::Truncate) || out.write(html.toUtf8()) < 0) {
+  if (!write_text(html_path, html)) {
     show_message(tr("Cannot write %1.").arg(html_path), true);
     return false;
   }
-  out.close();
   const QString pdf_path = dir + "/" + stem + ".pdf";
   if (!write_report_pdf(html, images, dir, pdf_path, tr("Cranioplan design report"))) {
     show_message(tr("Cannot write %1.").arg(pdf_path), true);

@@ -422,6 +422,10 @@ struct SkullView::Impl {
   int height_px() const { return window->GetSize()[1]; }
   int display_x(const QPoint& p) const { return static_cast<int>(p.x() * dpr); }
   int display_y(const QPoint& p) const { return height_px() - 1 - static_cast<int>(p.y() * dpr); }
+
+  void set_up_layers();
+  void set_up_legends();
+  void set_up_labels();
 };
 
 void SkullView::set_default_surface_format() {
@@ -470,75 +474,86 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
   d.style->AddObserver(vtkCommand::StartInteractionEvent, on_move);
   d.style->AddObserver(vtkCommand::EndInteractionEvent, on_move);
 
+  d.set_up_layers();
+  d.set_up_legends();
+  d.set_up_labels();
+}
+
+// The renderers' settings and the layers' looks; every layer's actor added, hidden.
+void SkullView::Impl::set_up_layers() {
   // Depth peeling for the translucent mirror and plane: order-independent transparency
   // (VTK's default without it) draws wrong colours under Mesa's llvmpipe. Four peels, stopping
   // once fewer than 5 % of the pixels change: on the sample's step 8, 8 of the view's 513,000
   // pixels differ by more than 40 from six exact peels, and a frame takes 0.8–1.1 s instead of
   // 2 s under llvmpipe (cranioplan --pauses).
-  d.window->SetAlphaBitPlanes(1);
-  d.window->SetMultiSamples(0);
-  d.renderer->SetUseDepthPeeling(1);
-  d.renderer->SetMaximumNumberOfPeels(4);
-  d.renderer->SetOcclusionRatio(0.05);
-  d.renderer->GradientBackgroundOn();
-  d.renderer->SetBackground(0.10, 0.11, 0.14);
-  d.renderer->SetBackground2(0.30, 0.33, 0.40);
-  d.skull.actor->GetProperty()->SetColor(kBone[0], kBone[1], kBone[2]);
-  d.skull.actor->GetProperty()->SetSpecular(0.15);
-  d.mirror.actor->GetProperty()->SetColor(kMirror[0], kMirror[1], kMirror[2]);
-  d.mirror.actor->GetProperty()->SetOpacity(0.45);
-  d.implant.actor->GetProperty()->SetColor(kImplant[0], kImplant[1], kImplant[2]);
-  d.implant.actor->GetProperty()->SetSpecular(0.3);
-  d.selected.actor->GetProperty()->SetOpacity(0.55);
-  for (MeshLayer* half : {&d.mould_outer, &d.mould_inner}) {
+  window->SetAlphaBitPlanes(1);
+  window->SetMultiSamples(0);
+  renderer->SetUseDepthPeeling(1);
+  renderer->SetMaximumNumberOfPeels(4);
+  renderer->SetOcclusionRatio(0.05);
+  renderer->GradientBackgroundOn();
+  renderer->SetBackground(0.10, 0.11, 0.14);
+  renderer->SetBackground2(0.30, 0.33, 0.40);
+  skull.actor->GetProperty()->SetColor(kBone[0], kBone[1], kBone[2]);
+  skull.actor->GetProperty()->SetSpecular(0.15);
+  mirror.actor->GetProperty()->SetColor(kMirror[0], kMirror[1], kMirror[2]);
+  mirror.actor->GetProperty()->SetOpacity(0.45);
+  implant.actor->GetProperty()->SetColor(kImplant[0], kImplant[1], kImplant[2]);
+  implant.actor->GetProperty()->SetSpecular(0.3);
+  selected.actor->GetProperty()->SetOpacity(0.55);
+  for (MeshLayer* half : {&mould_outer, &mould_inner}) {
     half->actor->GetProperty()->SetColor(0.55, 0.72, 0.90);
     half->actor->GetProperty()->SetOpacity(0.5);
     half->actor->GetProperty()->SetSpecular(0.2);
   }
-  d.plane_actor->SetMapper(d.plane_mapper);
-  d.plane_mapper->SetInputConnection(d.plane_source->GetOutputPort());
-  d.plane_actor->GetProperty()->SetColor(0.30, 0.55, 1.0);
-  d.plane_actor->GetProperty()->SetOpacity(0.25);
-  d.window->SetNumberOfLayers(2);
-  d.overlay->SetLayer(1);
-  d.overlay->InteractiveOff();
-  d.overlay->SetActiveCamera(d.renderer->GetActiveCamera());
-  d.window->AddRenderer(d.overlay);
-  d.unseen_mapper->SetInputData(d.unseen_data);
-  d.unseen_actor->SetMapper(d.unseen_mapper);
-  d.unseen_actor->GetProperty()->SetColor(1.0, 0.45, 0.05);
-  d.unseen_actor->GetProperty()->SetLineWidth(7.0);
-  d.unseen_actor->GetProperty()->SetAmbient(1.0);  // flat: the same orange from any side
-  d.unseen_actor->GetProperty()->SetDiffuse(0.0);
-  d.unseen_actor->GetProperty()->RenderLinesAsTubesOn();
+  plane_actor->SetMapper(plane_mapper);
+  plane_mapper->SetInputConnection(plane_source->GetOutputPort());
+  plane_actor->GetProperty()->SetColor(0.30, 0.55, 1.0);
+  plane_actor->GetProperty()->SetOpacity(0.25);
+  window->SetNumberOfLayers(2);
+  overlay->SetLayer(1);
+  overlay->InteractiveOff();
+  overlay->SetActiveCamera(renderer->GetActiveCamera());
+  window->AddRenderer(overlay);
+  unseen_mapper->SetInputData(unseen_data);
+  unseen_actor->SetMapper(unseen_mapper);
+  unseen_actor->GetProperty()->SetColor(1.0, 0.45, 0.05);
+  unseen_actor->GetProperty()->SetLineWidth(7.0);
+  unseen_actor->GetProperty()->SetAmbient(1.0);  // flat: the same orange from any side
+  unseen_actor->GetProperty()->SetDiffuse(0.0);
+  unseen_actor->GetProperty()->RenderLinesAsTubesOn();
   for (vtkActor* a :
-       {d.skull.actor.Get(), d.mirror.actor.Get(), d.implant.actor.Get(), d.mould_outer.actor.Get(),
-        d.mould_inner.actor.Get(), d.outer_edge.actor.Get(), d.inner_edge.actor.Get(),
-        d.outer_surface.actor.Get(), d.inner_surface.actor.Get(), d.landmarks.actor.Get(),
-        d.selected.actor.Get(), d.cursor.actor.Get(), d.zones.actor.Get(),
-        d.handle_balls.actor.Get(), d.handle_drop.actor.Get(), d.plane_actor.Get()}) {
+       {skull.actor.Get(), mirror.actor.Get(), implant.actor.Get(), mould_outer.actor.Get(),
+        mould_inner.actor.Get(), outer_edge.actor.Get(), inner_edge.actor.Get(),
+        outer_surface.actor.Get(), inner_surface.actor.Get(), landmarks.actor.Get(),
+        selected.actor.Get(), cursor.actor.Get(), zones.actor.Get(), handle_balls.actor.Get(),
+        handle_drop.actor.Get(), plane_actor.Get()}) {
     a->SetVisibility(false);
-    d.renderer->AddActor(a);
+    renderer->AddActor(a);
   }
-  d.unseen_actor->SetVisibility(false);
-  d.overlay->AddActor(d.unseen_actor);
+  unseen_actor->SetVisibility(false);
+  overlay->AddActor(unseen_actor);
   // The rim gap's ball on the same layer: it sits on the implant's edge by the bone, where the
   // bone or the mirror would hide it.
-  d.rim_gap.actor->SetVisibility(false);
-  d.rim_gap.actor->GetProperty()->SetAmbient(0.6);
-  d.overlay->AddActor(d.rim_gap.actor);
+  rim_gap.actor->SetVisibility(false);
+  rim_gap.actor->GetProperty()->SetAmbient(0.6);
+  overlay->AddActor(rim_gap.actor);
+}
+
+// The colour maps of the thickness and the bone's gap, and their legends (hidden).
+void SkullView::Impl::set_up_legends() {
   // Thickness 0 (red) to 6 mm (blue); the bone's gap to the implant 0 (white) to 3 mm (dark
   // violet), the bone's colour beyond the map's reach. Both in mm.
-  d.thickness_colors->SetRange(0.0, 6.0);
-  d.thickness_colors->SetHueRange(0.0, 0.66);
-  d.thickness_colors->Build();
-  d.gap_colors->SetRange(0.0, 3.0);
-  d.gap_colors->SetHueRange(0.8, 0.8);
-  d.gap_colors->SetSaturationRange(0.0, 0.9);
-  d.gap_colors->SetValueRange(1.0, 0.45);
-  d.gap_colors->SetNanColor(kBone[0], kBone[1], kBone[2], 1.0);
-  d.gap_colors->Build();
-  auto legend = [&](vtkScalarBarActor* bar, vtkLookupTable* lut, const char* title, double x) {
+  thickness_colors->SetRange(0.0, 6.0);
+  thickness_colors->SetHueRange(0.0, 0.66);
+  thickness_colors->Build();
+  gap_colors->SetRange(0.0, 3.0);
+  gap_colors->SetHueRange(0.8, 0.8);
+  gap_colors->SetSaturationRange(0.0, 0.9);
+  gap_colors->SetValueRange(1.0, 0.45);
+  gap_colors->SetNanColor(kBone[0], kBone[1], kBone[2], 1.0);
+  gap_colors->Build();
+  auto legend = [this](vtkScalarBarActor* bar, vtkLookupTable* lut, const char* title, double x) {
     bar->SetLookupTable(lut);
     bar->SetTitle(title);
     bar->SetNumberOfLabels(4);
@@ -557,18 +572,23 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
     bar->GetLabelTextProperty()->ItalicOff();
     bar->GetLabelTextProperty()->ShadowOff();
     bar->SetVisibility(false);
-    d.overlay->AddActor2D(bar);
+    overlay->AddActor2D(bar);
   };
-  legend(d.thickness_bar, d.thickness_colors, "Thickness\n(mm)", 0.87);
-  legend(d.gap_bar, d.gap_colors, "Bone gap\n(mm)", 0.70);
-  for (vtkScalarBarActor* bar : {d.thickness_bar.Get(), d.gap_bar.Get()})
+  legend(thickness_bar, thickness_colors, "Thickness\n(mm)", 0.87);
+  legend(gap_bar, gap_colors, "Bone gap\n(mm)", 0.70);
+  for (vtkScalarBarActor* bar : {thickness_bar.Get(), gap_bar.Get()})
     for (vtkTextProperty* t : {bar->GetTitleTextProperty(), bar->GetLabelTextProperty()}) {
       // Light text on a dark card of its own: readable over bone and over the background.
       t->SetColor(1.0, 1.0, 1.0);
       t->SetBackgroundColor(0.0, 0.0, 0.0);
       t->SetBackgroundOpacity(0.75);
     }
-  for (vtkBillboardTextActor3D* t : d.landmark_names) {
+}
+
+// The landmarks' names, the patient's directions at the view's edges, the clearance zones'
+// balls and the orientation cube.
+void SkullView::Impl::set_up_labels() {
+  for (vtkBillboardTextActor3D* t : landmark_names) {
     vtkTextProperty* tp = t->GetTextProperty();
     tp->SetFontSize(15);
     tp->BoldOn();
@@ -579,11 +599,11 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
     tp->SetVerticalJustificationToBottom();
     t->SetDisplayOffset(10, 6);
     t->SetVisibility(false);
-    d.overlay->AddActor(t);
+    overlay->AddActor(t);
   }
   const double edge_at[4][2] = {{0.012, 0.5}, {0.988, 0.5}, {0.5, 0.985}, {0.5, 0.015}};
   for (int k = 0; k < 4; ++k) {
-    vtkTextActor* t = d.edge_text[k];
+    vtkTextActor* t = edge_text[k];
     t->GetPositionCoordinate()->SetCoordinateSystemToNormalizedViewport();
     t->SetPosition(edge_at[k][0], edge_at[k][1]);
     vtkTextProperty* tp = t->GetTextProperty();
@@ -595,14 +615,14 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
                                  : k == 3 ? VTK_TEXT_BOTTOM
                                           : VTK_TEXT_CENTERED);
     tp->ShadowOn();
-    d.overlay->AddActor2D(t);
+    overlay->AddActor2D(t);
   }
-  d.zones.mapper->ScalingOn();
-  d.zones.mapper->SetScaleArray("radius");
-  d.zones.mapper->SetScaleModeToScaleByMagnitude();
-  d.zones.actor->GetProperty()->SetOpacity(0.3);
-  setup_orientation_marker(d.orientation, d.orientation_cube);
-  d.window->AddRenderer(d.orientation);
+  zones.mapper->ScalingOn();
+  zones.mapper->SetScaleArray("radius");
+  zones.mapper->SetScaleModeToScaleByMagnitude();
+  zones.actor->GetProperty()->SetOpacity(0.3);
+  setup_orientation_marker(orientation, orientation_cube);
+  window->AddRenderer(orientation);
 }
 
 SkullView::~SkullView() {

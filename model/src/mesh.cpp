@@ -281,14 +281,17 @@ SkullMesh build_mesh(const TriangleSoup& soup, BuildMeshStats* stats) {
   return mesh;
 }
 
-void build_mesh(const TriangleSoup& soup, SkullMesh& mesh, BuildMeshStats* stats) {
-  // Complex faces are counted in the stats and reported by the callers in plain words;
-  // OpenMesh's own log lines on stderr would only confuse.
-  omerr().disable();
-  BuildMeshStats local;
-  const int n_in = static_cast<int>(soup.vertices.size());
+namespace {
 
-  // Non-degenerate faces and the vertices they use, renumbered in input order.
+// The soup's non-degenerate faces (`faces`, by soup index) and the vertices they use, renumbered
+// in input order (`source`: the soup vertex of each), and each face's three corners in that
+// numbering.
+struct UsedCorners {
+  std::vector<int> faces, source, corner;
+};
+
+UsedCorners used_corners(const TriangleSoup& soup, BuildMeshStats& stats) {
+  const int n_in = static_cast<int>(soup.vertices.size());
   std::vector<char> degenerate(soup.triangles.size());
   parallel_for(soup.triangles.size(), [&](size_t begin, size_t end) {
     for (size_t i = begin; i < end; ++i) {
@@ -297,52 +300,54 @@ void build_mesh(const TriangleSoup& soup, SkullMesh& mesh, BuildMeshStats* stats
       degenerate[i] = is_degenerate(soup, t) ? 1 : 0;
     }
   });
-  std::vector<int> faces;
-  faces.reserve(soup.triangles.size());
+  UsedCorners out;
+  out.faces.reserve(soup.triangles.size());
   std::vector<int> id(n_in, -1);
   for (size_t i = 0; i < soup.triangles.size(); ++i) {
     if (degenerate[i]) {
-      ++local.degenerate_dropped;
+      ++stats.degenerate_dropped;
       continue;
     }
-    faces.push_back(static_cast<int>(i));
+    out.faces.push_back(static_cast<int>(i));
     for (int k = 0; k < 3; ++k) id[soup.triangles[i][k]] = 0;
   }
-  std::vector<int> source;  // input vertex of each mesh vertex
-  source.reserve(n_in);
+  out.source.reserve(n_in);
   for (int i = 0; i < n_in; ++i)
     if (id[i] == 0) {
-      id[i] = static_cast<int>(source.size());
-      source.push_back(i);
+      id[i] = static_cast<int>(out.source.size());
+      out.source.push_back(i);
     }
-  int nv = static_cast<int>(source.size());
-  const size_t nf = faces.size(), nh = nf * 3;
-  std::vector<int> corner(nh);
+  const size_t nf = out.faces.size();
+  out.corner.resize(nf * 3);
   parallel_for(nf, [&](size_t begin, size_t end) {
     for (size_t f = begin; f < end; ++f)
-      for (int k = 0; k < 3; ++k) corner[f * 3 + k] = id[soup.triangles[faces[f]][k]];
+      for (int k = 0; k < 3; ++k) out.corner[f * 3 + k] = id[soup.triangles[out.faces[f]][k]];
   });
+  return out;
+}
 
-  // 1. Accept faces in order unless one of their directed edges is taken by an accepted face.
-  // A face none of whose directed edges another face repeats is accepted in any order; only
-  // the faces with a repeated directed edge (found on all threads) are decided in order.
-  std::vector<char> accepted(nf, 1);
-  auto lists = std::make_unique<OutgoingLists>(corner, nv, accepted);
+// Accepts faces in order unless one of their directed edges is taken by an accepted face. A
+// face none of whose directed edges another face repeats is accepted in any order; only the
+// faces with a repeated directed edge (found on all threads) are decided in order. Returns the
+// faces set aside (`accepted` 0), in order.
+std::vector<int> accept_faces(const std::vector<int>& corner, int nv, const OutgoingLists& lists,
+                              std::vector<char>& accepted) {
+  const size_t nf = accepted.size(), nh = nf * 3;
   std::vector<char> repeated(nh, 0);  // per halfedge: another face has the same directed edge
   parallel_for(static_cast<size_t>(nv), [&](size_t begin, size_t end) {
     for (size_t u = begin; u < end; ++u) {
-      const int a = lists->start[u], b = lists->start[u + 1];
+      const int a = lists.start[u], b = lists.start[u + 1];
       auto dest = [&](int he) { return corner[next_corner(static_cast<size_t>(he))]; };
-      if (lists->is_long(static_cast<int>(u))) {  // runs of one destination, in `by_dest`
+      if (lists.is_long(static_cast<int>(u))) {  // runs of one destination, in `by_dest`
         for (int i = a; i + 1 < b; ++i)
-          if (dest(lists->by_dest[i]) == dest(lists->by_dest[i + 1]))
-            repeated[lists->by_dest[i]] = repeated[lists->by_dest[i + 1]] = 1;
+          if (dest(lists.by_dest[i]) == dest(lists.by_dest[i + 1]))
+            repeated[lists.by_dest[i]] = repeated[lists.by_dest[i + 1]] = 1;
         continue;
       }
       for (int i = a; i < b; ++i)
         for (int j = i + 1; j < b; ++j)
-          if (dest(lists->out[i]) == dest(lists->out[j]))
-            repeated[lists->out[i]] = repeated[lists->out[j]] = 1;
+          if (dest(lists.out[i]) == dest(lists.out[j]))
+            repeated[lists.out[i]] = repeated[lists.out[j]] = 1;
     }
   });
   std::vector<int> deferred;
@@ -356,26 +361,31 @@ void build_mesh(const TriangleSoup& soup, SkullMesh& mesh, BuildMeshStats* stats
     bool ok = true;
     for (size_t he = f * 3; he < f * 3 + 3 && ok; ++he) {
       const int u = corner[he], v = corner[next_corner(he)];
-      lists->each_to(corner, u, v,
-                     [&](size_t other) { ok = ok && !(other / 3 != f && accepted[other / 3]); });
+      lists.each_to(corner, u, v,
+                    [&](size_t other) { ok = ok && !(other / 3 != f && accepted[other / 3]); });
     }
     if (ok)
       accepted[f] = 1;
     else
       deferred.push_back(static_cast<int>(f));
   }
-  if (!deferred.empty()) lists = std::make_unique<OutgoingLists>(corner, nv, accepted);
+  return deferred;
+}
 
-  // 2. Give each extra fan of a complex vertex its own copy of the vertex.
-  const int original_count = nv;
-  split_complex_vertices(*lists, corner, nv, source, local);
-  if (nv != original_count) lists = std::make_unique<OutgoingLists>(corner, nv, accepted);
-
-  // 3. Twins, then edges: the first halfedge of a pair creates the edge; its twin reuses it.
+// The accepted faces as the mesh's connectivity: twins, then edges (the first halfedge of a
+// pair creates the edge; its twin reuses it), each face's halfedges (and the twin of one on the
+// border, which has no face to set it), each vertex's point and its last outgoing halfedge in
+// input order, or the border halfedge that leaves it. Room is kept for `extra` vertices and
+// edges and `extra_faces` faces.
+void link_accepted(const TriangleSoup& soup, const std::vector<int>& corner,
+                   const std::vector<int>& source, int nv, const OutgoingLists& lists,
+                   const std::vector<char>& accepted, size_t extra, size_t extra_faces,
+                   SkullMesh& mesh) {
+  const size_t nf = accepted.size(), nh = nf * 3;
   std::vector<int> twin(nh, -1);
   parallel_for(nh, [&](size_t begin, size_t end) {
     for (size_t he = begin; he < end; ++he)
-      if (accepted[he / 3]) twin[he] = lists->find(corner, corner[next_corner(he)], corner[he]);
+      if (accepted[he / 3]) twin[he] = lists.find(corner, corner[next_corner(he)], corner[he]);
   });
   std::vector<int> halfedge(nh, -1);  // mesh halfedge index of each accepted face halfedge
   std::vector<int> face_index(nf, -1);
@@ -386,17 +396,9 @@ void build_mesh(const TriangleSoup& soup, SkullMesh& mesh, BuildMeshStats* stats
     halfedge[he] = opp >= 0 && static_cast<size_t>(opp) < he ? (halfedge[opp] ^ 1) : 2 * ne++;
     if (he % 3 == 0) face_index[he / 3] = n_accepted++;
   }
-
   mesh.clear();
-  // Room for the deferred faces too (each may bring three vertices and three edges of its
-  // own): OpenMesh grows its arrays and every property one element at a time otherwise, and
-  // the first deferred face would copy the whole mesh.
-  const size_t extra = 3 * deferred.size();
-  mesh.reserve(nv + extra, ne + extra, n_accepted + deferred.size());
+  mesh.reserve(nv + extra, ne + extra, n_accepted + extra_faces);
   mesh.resize(nv, ne, n_accepted);
-  // Each face sets its own halfedges (and the twin of a halfedge on the border, which has no
-  // face to set it); each vertex starts on its last outgoing halfedge in input order, or on
-  // the border halfedge that leaves it.
   parallel_for(nf, [&](size_t begin, size_t end) {
     for (size_t f = begin; f < end; ++f) {
       if (!accepted[f]) continue;
@@ -415,12 +417,12 @@ void build_mesh(const TriangleSoup& soup, SkullMesh& mesh, BuildMeshStats* stats
   parallel_for(static_cast<size_t>(nv), [&](size_t begin, size_t end) {
     for (size_t v = begin; v < end; ++v) {
       mesh.set_point(VH(static_cast<int>(v)), to_point(soup.vertices[source[v]]));
-      const int a = lists->start[v], b = lists->start[v + 1];
+      const int a = lists.start[v], b = lists.start[v + 1];
       if (a == b) continue;
-      mesh.set_halfedge_handle(VH(static_cast<int>(v)), HH(halfedge[lists->out[b - 1]]));
+      mesh.set_halfedge_handle(VH(static_cast<int>(v)), HH(halfedge[lists.out[b - 1]]));
       for (int i = a; i < b; ++i) {
         // The face's halfedge arriving at v; with no twin, the border leaves v along it.
-        const size_t in = prev_corner(static_cast<size_t>(lists->out[i]));
+        const size_t in = prev_corner(static_cast<size_t>(lists.out[i]));
         if (twin[in] >= 0) continue;
         boundary_out[v] = halfedge[in] ^ 1;
         boundary_to[v] = corner[in];
@@ -432,13 +434,44 @@ void build_mesh(const TriangleSoup& soup, SkullMesh& mesh, BuildMeshStats* stats
     mesh.set_next_halfedge_handle(HH(boundary_out[v]), HH(boundary_out[boundary_to[v]]));
     mesh.set_halfedge_handle(VH(v), HH(boundary_out[v]));  // boundary vertices start on it
   }
+}
+
+}  // namespace
+
+void build_mesh(const TriangleSoup& soup, SkullMesh& mesh, BuildMeshStats* stats) {
+  // Complex faces are counted in the stats and reported by the callers in plain words;
+  // OpenMesh's own log lines on stderr would only confuse.
+  omerr().disable();
+  BuildMeshStats local;
+  UsedCorners used = used_corners(soup, local);
+  std::vector<int>& corner = used.corner;
+  int nv = static_cast<int>(used.source.size());
+  const size_t nf = used.faces.size();
+
+  // 1. Faces accepted in order; those whose directed edges an accepted face took, set aside.
+  std::vector<char> accepted(nf, 1);
+  auto lists = std::make_unique<OutgoingLists>(corner, nv, accepted);
+  const std::vector<int> deferred = accept_faces(corner, nv, *lists, accepted);
+  if (!deferred.empty()) lists = std::make_unique<OutgoingLists>(corner, nv, accepted);
+
+  // 2. Give each extra fan of a complex vertex its own copy of the vertex.
+  const int original_count = nv;
+  split_complex_vertices(*lists, corner, nv, used.source, local);
+  if (nv != original_count) lists = std::make_unique<OutgoingLists>(corner, nv, accepted);
+
+  // 3. The mesh's connectivity. Room for the deferred faces too (each may bring three
+  // vertices and three edges of its own): OpenMesh grows its arrays and every property one
+  // element at a time otherwise, and the first deferred face would copy the whole mesh.
+  link_accepted(soup, corner, used.source, nv, *lists, accepted, 3 * deferred.size(),
+                deferred.size(), mesh);
+
   // 4. The faces step 1 set aside.
   for (int f : deferred) {
     std::array<Eigen::Vector3d, 3> p;
     std::array<VH, 3> v;
     for (int k = 0; k < 3; ++k) {
       const int c = corner[static_cast<size_t>(f) * 3 + k];
-      p[k] = soup.vertices[source[c]];
+      p[k] = soup.vertices[used.source[c]];
       v[k] = VH(c);
     }
     add_face_or_split(mesh, p, v, local);

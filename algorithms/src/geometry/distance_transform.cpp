@@ -148,61 +148,56 @@ std::vector<float> distance_to_mask(const std::vector<uint8_t>& mask, const Voxe
 
 namespace {
 
-// The squared distances (voxel units) within `reach` voxels, exact, by windows instead of
-// envelopes: along x the nearest site on the line (capped at reach + 1), then along y and z the
-// smallest of the 2·reach + 1 neighbours' values plus the squared step. A squared distance of at
-// most reach² is made of steps of at most `reach` along each axis, so the window holds it; a
-// larger one comes out larger than reach² (no term is ever below the true value). The same
-// integers as the envelope, as floats, where they are at most reach²; +infinity beyond.
-std::vector<float> distance_within(const std::vector<uint8_t>& mask, const VoxelGrid& grid,
-                                   int reach) {
+// What a row (along x) holds after a pass, as two spans: where its values are other than 0
+// (outside it every voxel is in the mask) and where they are below the cap (outside it they are
+// capped). A window's minimum is 0 outside its middle row's first span (that row's term is 0
+// and none is below it) and capped outside the union of its rows' second spans; only what lies
+// in both is summed: the same values as summing whole rows. A mask fills a shell of its grid:
+// most rows are all in it or all far from it, and the others cross its surface in short spans.
+struct Span {
+  int lo = 1, hi = 0;  // empty
+  bool empty() const { return lo > hi; }
+  void add(int i) {
+    if (empty()) lo = i;
+    hi = i;
+  }
+};
+struct Spans {
+  Span nonzero, below_cap;
+};
+
+Spans spans_of(const float* row, int n, float capped) {
+  Spans s;
+  for (int i = 0; i < n; ++i) {
+    if (row[i] != 0.0f) s.nonzero.add(i);
+    if (row[i] < capped) s.below_cap.add(i);
+  }
+  return s;
+}
+
+// The union of the second spans of rows at(t), t in [lo, hi].
+template <class At>
+Span union_below_cap(int lo, int hi, const At& at) {
+  Span u;
+  for (int t = lo; t <= hi; ++t) {
+    const Span& s = at(t).below_cap;
+    if (s.empty()) continue;
+    if (u.empty()) {
+      u = s;
+    } else {
+      u.lo = std::min(u.lo, s.lo);
+      u.hi = std::max(u.hi, s.hi);
+    }
+  }
+  return u;
+}
+
+// Along x, and along y within each slice (slices on all threads): the squared distances within
+// each slice into `sq`, each row's spans into `spans`.
+void within_slices(const std::vector<uint8_t>& mask, const VoxelGrid& grid, int reach, float capped,
+                   std::vector<float>& sq, std::vector<Spans>& spans) {
   const int nx = grid.dims[0], ny = grid.dims[1], nz = grid.dims[2];
   const size_t sy = static_cast<size_t>(nx), sz = sy * ny;
-  const float capped = static_cast<float>(reach + 1) * static_cast<float>(reach + 1);
-  // What each row (along x) holds after a pass, as two spans: where its values are other than
-  // 0 (outside it every voxel is in the mask) and where they are below the cap (outside it
-  // they are capped). A window's minimum is 0 outside its middle row's first span (that row's
-  // term is 0 and none is below it) and capped outside the union of its rows' second spans;
-  // only what lies in both is summed: the same values as summing whole rows. A mask fills a
-  // shell of its grid: most rows are all in it or all far from it, and the others cross its
-  // surface in short spans.
-  struct Span {
-    int lo = 1, hi = 0;  // empty
-    bool empty() const { return lo > hi; }
-    void add(int i) {
-      if (empty()) lo = i;
-      hi = i;
-    }
-  };
-  struct Spans {
-    Span nonzero, below_cap;
-  };
-  auto spans_of = [capped](const float* row, int n) {
-    Spans s;
-    for (int i = 0; i < n; ++i) {
-      if (row[i] != 0.0f) s.nonzero.add(i);
-      if (row[i] < capped) s.below_cap.add(i);
-    }
-    return s;
-  };
-  // The union of the second spans of rows at(t), t in [lo, hi].
-  auto union_below_cap = [](int lo, int hi, const auto& at) {
-    Span u;
-    for (int t = lo; t <= hi; ++t) {
-      const Span& s = at(t).below_cap;
-      if (s.empty()) continue;
-      if (u.empty()) {
-        u = s;
-      } else {
-        u.lo = std::min(u.lo, s.lo);
-        u.hi = std::max(u.hi, s.hi);
-      }
-    }
-    return u;
-  };
-  std::vector<float> sq(mask.size());
-  std::vector<Spans> spans(static_cast<size_t>(ny) * nz);
-  // Along x, and along y within each slice (slices on all threads).
   parallel_for(
       static_cast<size_t>(nz),
       [&](size_t first, size_t last) {
@@ -231,7 +226,7 @@ std::vector<float> distance_within(const std::vector<uint8_t>& mask, const Voxel
               const float g = std::min(out[i], static_cast<float>(gap));
               out[i] = g * g;
             }
-            row_spans[j] = spans_of(out, nx);
+            row_spans[j] = spans_of(out, nx, capped);
           }
           for (int j = 0; j < ny; ++j) {
             float* out = &sq[k * sz + j * sy];
@@ -249,13 +244,19 @@ std::vector<float> distance_within(const std::vector<uint8_t>& mask, const Voxel
                 for (int i = from; i <= to; ++i) out[i] = std::min(out[i], in[i] + step);
               }
             }
-            spans[k * static_cast<size_t>(ny) + j] = spans_of(out, nx);
+            spans[k * static_cast<size_t>(ny) + j] = spans_of(out, nx, capped);
           }
         }
       },
       2);
-  // Along z (slices on all threads), and the distance in mm.
-  std::vector<float> d(mask.size());
+}
+
+// Along z (slices on all threads), and the distance in mm: within the reach, +infinity beyond.
+std::vector<float> along_z(const std::vector<float>& sq, const std::vector<Spans>& spans,
+                           const VoxelGrid& grid, int reach, float capped) {
+  const int nx = grid.dims[0], ny = grid.dims[1], nz = grid.dims[2];
+  const size_t sy = static_cast<size_t>(nx), sz = sy * ny;
+  std::vector<float> d(sq.size());
   const float limit = static_cast<float>(reach) * static_cast<float>(reach);
   parallel_for(
       static_cast<size_t>(nz),
@@ -293,6 +294,21 @@ std::vector<float> distance_within(const std::vector<uint8_t>& mask, const Voxel
       },
       2);
   return d;
+}
+
+// The squared distances (voxel units) within `reach` voxels, exact, by windows instead of
+// envelopes: along x the nearest site on the line (capped at reach + 1), then along y and z the
+// smallest of the 2·reach + 1 neighbours' values plus the squared step. A squared distance of at
+// most reach² is made of steps of at most `reach` along each axis, so the window holds it; a
+// larger one comes out larger than reach² (no term is ever below the true value). The same
+// integers as the envelope, as floats, where they are at most reach²; +infinity beyond.
+std::vector<float> distance_within(const std::vector<uint8_t>& mask, const VoxelGrid& grid,
+                                   int reach) {
+  const float capped = static_cast<float>(reach + 1) * static_cast<float>(reach + 1);
+  std::vector<float> sq(mask.size());
+  std::vector<Spans> spans(static_cast<size_t>(grid.dims[1]) * grid.dims[2]);
+  within_slices(mask, grid, reach, capped, sq, spans);
+  return along_z(sq, spans, grid, reach, capped);
 }
 
 // The border layer of the grid and the voxels outside the mask: what depth_in_mask measures to.

@@ -296,18 +296,23 @@ SoupOrientation orient(TriangleSoup& soup, const EdgeUses& uses) {
   return out;
 }
 
-HoleClosing close_holes(TriangleSoup& soup, const std::vector<int>& id, const EdgeUses& uses,
-                        double max_length_mm, bool through_corners) {
-  HoleClosing out;
-  // Open edges (used by one triangle), as it runs them; from each corner (by position id) the
-  // open edge that leaves it, -2 where several do (holes that touch there).
-  struct Open {
-    int from, to;  // vertex indices
-    int to_id;
-    uint32_t tri;
-  };
-  std::vector<Open> open;
-  std::vector<long> leaving(soup.vertices.size(), -1);
+// An open edge (used by one triangle), as its triangle runs it.
+struct OpenEdge {
+  int from, to;  // vertex indices
+  int to_id;
+  uint32_t tri;
+};
+
+// The open edges, and from each corner (by position id) the open edge that leaves it, -2 where
+// several do (holes that touch there).
+struct OpenEdges {
+  std::vector<OpenEdge> edges;
+  std::vector<long> leaving;
+};
+
+OpenEdges open_edges(const TriangleSoup& soup, const std::vector<int>& id, const EdgeUses& uses) {
+  OpenEdges out;
+  out.leaving.assign(soup.vertices.size(), -1);
   for_each_edge(uses, [&](int lo, const EdgeUse* i, const EdgeUse* j) {
     if (j - i != 1) return;
     // As the triangle runs it now (orient may have turned it since the uses were listed).
@@ -315,53 +320,55 @@ HoleClosing close_holes(TriangleSoup& soup, const std::vector<int>& id, const Ed
     int k = 0;
     while (k < 2 && std::minmax(id[t[k]], id[t[(k + 1) % 3]]) != std::minmax(lo, i->other)) ++k;
     const int from = t[k], to = t[(k + 1) % 3];
-    long& slot = leaving[id[from]];
-    slot = slot == -1 ? static_cast<long>(open.size()) : -2;
-    open.push_back({from, to, id[to], i->tri()});
+    long& slot = out.leaving[id[from]];
+    slot = slot == -1 ? static_cast<long>(out.edges.size()) : -2;
+    out.edges.push_back({from, to, id[to], i->tri()});
   });
-  if (open.empty()) return out;
-  // Where two holes touch at a corner (two lost triangles sharing a vertex), two open edges
-  // leave it. Around the corner lie hole, fan of triangles, hole, fan: turning from the edge
-  // that arrived through its own fan (across shared edges) reaches the edge that leaves into
-  // the other hole, so the hole goes on along the other. More than two holes at a corner, or
-  // a fan that cannot be turned through (an edge of three triangles, patches wound against
-  // each other), are not followed.
-  std::unordered_map<int, std::vector<long>> leaving_at;
-  std::unordered_map<int, std::vector<uint32_t>> fan_at;
-  for (size_t e = 0; e < open.size(); ++e)
-    if (leaving[id[open[e].from]] == -2)
-      leaving_at[id[open[e].from]].push_back(static_cast<long>(e));
-  if (!through_corners) leaving_at.clear();
-  if (!leaving_at.empty())
-    for (size_t t = 0; t < soup.triangles.size(); ++t)
-      for (int k = 0; k < 3; ++k)
-        if (const auto at = leaving_at.find(id[soup.triangles[t][k]]); at != leaving_at.end())
-          fan_at[at->first].push_back(static_cast<uint32_t>(t));
-  auto corner_of = [&](uint32_t t, int p) {
-    const Eigen::Vector3i& f = soup.triangles[t];
-    int k = -1;
-    for (int c = 0; c < 3; ++c)
-      if (id[f[c]] == p) k = k < 0 ? c : 3;  // 3: the corner twice, a degenerate triangle
-    return k;
-  };
-  auto next_at_corner = [&](long arrived) -> long {
-    const int p = open[arrived].to_id;
-    const std::vector<uint32_t>& fan = fan_at[p];
-    const auto at = leaving_at.find(p);
-    if (at == leaving_at.end() || at->second.size() != 2) return -1;
+  return out;
+}
+
+// Where two holes touch at a corner (two lost triangles sharing a vertex), two open edges leave
+// it. Around the corner lie hole, fan of triangles, hole, fan: turning from the edge that
+// arrived through its own fan (across shared edges) reaches the edge that leaves into the other
+// hole, so the hole goes on along the other. More than two holes at a corner, or a fan that
+// cannot be turned through (an edge of three triangles, patches wound against each other), are
+// not followed.
+class CornerTurns {
+ public:
+  CornerTurns(const TriangleSoup& soup, const std::vector<int>& id, const OpenEdges& open,
+              bool through_corners)
+      : soup_(soup), id_(id), open_(open.edges) {
+    for (size_t e = 0; e < open_.size(); ++e)
+      if (open.leaving[id[open_[e].from]] == -2)
+        leaving_at_[id[open_[e].from]].push_back(static_cast<long>(e));
+    if (!through_corners) leaving_at_.clear();
+    if (!leaving_at_.empty())
+      for (size_t t = 0; t < soup.triangles.size(); ++t)
+        for (int k = 0; k < 3; ++k)
+          if (const auto at = leaving_at_.find(id[soup.triangles[t][k]]); at != leaving_at_.end())
+            fan_at_[at->first].push_back(static_cast<uint32_t>(t));
+  }
+
+  // The open edge the hole goes on along after `arrived`, at a corner two holes touch; -1 where
+  // the way is not clear.
+  long next(long arrived) {
+    const int p = open_[arrived].to_id;
+    const std::vector<uint32_t>& fan = fan_at_[p];
+    const auto at = leaving_at_.find(p);
+    if (at == leaving_at_.end() || at->second.size() != 2) return -1;
     const std::vector<long>& leave = at->second;
-    uint32_t t = open[arrived].tri;
+    uint32_t t = open_[arrived].tri;
     for (size_t step = 0; step <= fan.size(); ++step) {
       const int k = corner_of(t, p);
       if (k < 0 || k > 2) return -1;
-      const int after = id[soup.triangles[t][(k + 1) % 3]];
+      const int after = id_[soup_.triangles[t][(k + 1) % 3]];
       for (int i = 0; i < 2; ++i)
-        if (open[leave[i]].tri == t && open[leave[i]].to_id == after) return leave[1 - i];
+        if (open_[leave[i]].tri == t && open_[leave[i]].to_id == after) return leave[1 - i];
       // The triangle across the edge from p to `after` runs it the other way.
       long across = -1;
       for (uint32_t s : fan) {
         const int ks = s == t ? -1 : corner_of(s, p);
-        if (ks < 0 || ks > 2 || id[soup.triangles[s][(ks + 2) % 3]] != after) continue;
+        if (ks < 0 || ks > 2 || id_[soup_.triangles[s][(ks + 2) % 3]] != after) continue;
         if (across >= 0) return -1;  // an edge of more than two triangles
         across = s;
       }
@@ -369,25 +376,46 @@ HoleClosing close_holes(TriangleSoup& soup, const std::vector<int>& id, const Ed
       t = static_cast<uint32_t>(across);
     }
     return -1;
-  };
-  std::vector<char> used(open.size(), 0);
-  // The chains of open edges: closed loops, or parts where the way round a corner is not
-  // clear (an edge of three triangles there, or patches wound against each other).
-  struct Chain {
-    std::vector<int> corners;
-    double length = 0.0;
-    bool loop = true;
-  };
+  }
+
+ private:
+  int corner_of(uint32_t t, int p) const {
+    const Eigen::Vector3i& f = soup_.triangles[t];
+    int k = -1;
+    for (int c = 0; c < 3; ++c)
+      if (id_[f[c]] == p) k = k < 0 ? c : 3;  // 3: the corner twice, a degenerate triangle
+    return k;
+  }
+
+  const TriangleSoup& soup_;
+  const std::vector<int>& id_;
+  const std::vector<OpenEdge>& open_;
+  std::unordered_map<int, std::vector<long>> leaving_at_;
+  std::unordered_map<int, std::vector<uint32_t>> fan_at_;
+};
+
+// A chain of open edges: a closed loop, or a part where the way round a corner is not clear (an
+// edge of three triangles there, or patches wound against each other).
+struct Chain {
+  std::vector<int> corners;
+  double length = 0.0;
+  bool loop = true;
+};
+
+std::vector<Chain> open_chains(const TriangleSoup& soup, const OpenEdges& open,
+                               CornerTurns& turns) {
+  const std::vector<OpenEdge>& edges = open.edges;
+  std::vector<char> used(edges.size(), 0);
   std::vector<Chain> chains;
-  for (size_t start = 0; start < open.size(); ++start) {
+  for (size_t start = 0; start < edges.size(); ++start) {
     if (used[start]) continue;
     Chain c;
     for (long e = static_cast<long>(start);;) {
       used[e] = 1;
-      c.corners.push_back(open[e].from);
-      c.length += (soup.vertices[open[e].to] - soup.vertices[open[e].from]).norm();
-      long n = leaving[open[e].to_id];
-      if (n == -2) n = next_at_corner(e);
+      c.corners.push_back(edges[e].from);
+      c.length += (soup.vertices[edges[e].to] - soup.vertices[edges[e].from]).norm();
+      long n = open.leaving[edges[e].to_id];
+      if (n == -2) n = turns.next(e);
       if (n == static_cast<long>(start)) break;
       if (n < 0 || used[n]) {
         c.loop = false;
@@ -397,11 +425,17 @@ HoleClosing close_holes(TriangleSoup& soup, const std::vector<int>& id, const Ed
     }
     chains.push_back(std::move(c));
   }
-  // The planes of long flat chains: where the scan ended, or the surface was cropped. Small
-  // loops in such a plane (around bone the cut crosses) are part of that end and left open,
-  // so that a scan's end reads the same whatever else the surface lost.
-  constexpr double kFlatMm = 1.0;
-  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> ends;  // (a point, the normal)
+  return chains;
+}
+
+// Chains and loops this far from a plane lie in it (mm).
+constexpr double kFlatMm = 1.0;
+
+// The planes of long flat chains (a point, the normal): where the scan ended, or the surface was
+// cropped.
+std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> scan_end_planes(
+    const TriangleSoup& soup, const std::vector<Chain>& chains, double max_length_mm) {
+  std::vector<std::pair<Eigen::Vector3d, Eigen::Vector3d>> ends;
   for (const Chain& c : chains) {
     if (c.length <= max_length_mm || c.corners.size() < 8) continue;
     Eigen::Vector3d mean = Eigen::Vector3d::Zero();
@@ -417,6 +451,19 @@ HoleClosing close_holes(TriangleSoup& soup, const std::vector<int>& id, const Ed
       flatness = std::max(flatness, std::abs((soup.vertices[v] - mean).dot(normal)));
     if (flatness <= kFlatMm) ends.emplace_back(mean, normal);
   }
+  return ends;
+}
+
+HoleClosing close_holes(TriangleSoup& soup, const std::vector<int>& id, const EdgeUses& uses,
+                        double max_length_mm, bool through_corners) {
+  HoleClosing out;
+  const OpenEdges open = open_edges(soup, id, uses);
+  if (open.edges.empty()) return out;
+  CornerTurns turns(soup, id, open, through_corners);
+  const std::vector<Chain> chains = open_chains(soup, open, turns);
+  // Small loops in the plane of a scan's end (around bone the cut crosses) are part of that end
+  // and left open, so that a scan's end reads the same whatever else the surface lost.
+  const auto ends = scan_end_planes(soup, chains, max_length_mm);
   for (const Chain& c : chains) {
     const std::vector<int>& loop = c.corners;
     if (!c.loop || loop.size() < 3 || c.length > max_length_mm) continue;

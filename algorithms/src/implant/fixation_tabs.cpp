@@ -157,6 +157,47 @@ struct Candidate {
   double bone_turn_deg = 0.0;  // the largest angle between the bone's faces there and its normal
 };
 
+// The bone's outer normal under a tab at rim point r (u outward, v along the rim, n0 the
+// radial direction): the mean of its faces' under four points of the tab; none where fewer
+// than three of them meet bone.
+std::optional<Eigen::Vector3d> bone_normal_under(const SurfaceLocator& bone,
+                                                 const Eigen::Vector3d& r, const Eigen::Vector3d& u,
+                                                 const Eigen::Vector3d& v,
+                                                 const Eigen::Vector3d& n0, const TabParams& p) {
+  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
+  int hits = 0;
+  for (const Eigen::Vector2d& ab : {Eigen::Vector2d(0.4 * p.length_mm, -0.25 * p.width_mm),
+                                    Eigen::Vector2d(0.4 * p.length_mm, 0.25 * p.width_mm),
+                                    Eigen::Vector2d(p.length_mm - 0.25 * p.width_mm, 0.0),
+                                    Eigen::Vector2d(0.7 * p.length_mm, 0.0)}) {
+    const Eigen::Vector3d m = r + ab.x() * u + ab.y() * v;
+    const auto hit = bone.first_hit(m + 8.0 * n0, m - 8.0 * n0);
+    if (!hit) continue;
+    Eigen::Vector3d f = bone.face_normal(hit->face);
+    if (f.dot(n0) < 0) f = -f;
+    normal += f;
+    ++hits;
+  }
+  if (hits < 3 || normal.norm() == 0) return std::nullopt;
+  return normal.normalized();
+}
+
+// The nearest of a tab's outline and screws to the midsagittal plane (0 when it straddles it);
+// v: across the tab.
+double midline_distance(const Plane& midline, const Tab& tab, const Eigen::Vector3d& v) {
+  double lo = 1e9, hi = -1e9;
+  auto see = [&](const Eigen::Vector3d& x) {
+    const double d = midline.signed_distance(x);
+    lo = std::min(lo, d);
+    hi = std::max(hi, d);
+  };
+  for (const double at : {0.0, 0.5 * tab.length_mm, tab.length_mm})
+    for (const double across : {-0.5, 0.0, 0.5})
+      see(tab.rim + at * tab.outward + across * tab.width_mm * v);
+  for (const Hole& s : tab.screws) see(s.center);
+  return lo <= 0.0 && hi >= 0.0 ? 0.0 : std::min(std::abs(lo), std::abs(hi));
+}
+
 Candidate make_tab(const Rim& rim, size_t i, const SurfaceLocator& self, const SurfaceLocator& bone,
                    const Eigen::Vector3d& inside, const TabParams& p) {
   Candidate out;
@@ -180,26 +221,12 @@ Candidate make_tab(const Rim& rim, size_t i, const SurfaceLocator& self, const S
     return u;
   };
   Eigen::Vector3d u = frame(n0), v = n0.cross(u);
-  // The bone's outer normal under the tab: the mean of its faces' under four points of it.
-  Eigen::Vector3d normal = Eigen::Vector3d::Zero();
-  int hits = 0;
-  for (const Eigen::Vector2d& ab : {Eigen::Vector2d(0.4 * p.length_mm, -0.25 * p.width_mm),
-                                    Eigen::Vector2d(0.4 * p.length_mm, 0.25 * p.width_mm),
-                                    Eigen::Vector2d(p.length_mm - 0.25 * p.width_mm, 0.0),
-                                    Eigen::Vector2d(0.7 * p.length_mm, 0.0)}) {
-    const Eigen::Vector3d m = r + ab.x() * u + ab.y() * v;
-    const auto hit = bone.first_hit(m + 8.0 * n0, m - 8.0 * n0);
-    if (!hit) continue;
-    Eigen::Vector3d f = bone.face_normal(hit->face);
-    if (f.dot(n0) < 0) f = -f;
-    normal += f;
-    ++hits;
-  }
-  if (hits < 3 || normal.norm() == 0) {
+  const std::optional<Eigen::Vector3d> under = bone_normal_under(bone, r, u, v, n0, p);
+  if (!under) {
     out.problem = "no bone beyond the implant's edge there";
     return out;
   }
-  normal.normalize();
+  const Eigen::Vector3d normal = *under;
   u = frame(normal);
   v = normal.cross(u);
   for (double at = 0.0; at <= p.length_mm + 1e-9; at += 0.25 * p.length_mm)
@@ -268,19 +295,7 @@ Candidate make_tab(const Rim& rim, size_t i, const SurfaceLocator& self, const S
     tab.bone_mm = std::min(tab.bone_mm, under ? under->distance : 30.0);
     tab.screws.push_back({top->point + (kUndersideMm + p.thickness_mm) * normal, normal, false});
   }
-  if (p.midline) {
-    // The nearest of the tab's outline and screws to the plane (0 when it straddles it).
-    double lo = 1e9, hi = -1e9;
-    auto see = [&](const Eigen::Vector3d& x) {
-      const double d = p.midline->signed_distance(x);
-      lo = std::min(lo, d);
-      hi = std::max(hi, d);
-    };
-    for (const double at : {0.0, 0.5 * p.length_mm, p.length_mm})
-      for (const double across : {-0.5, 0.0, 0.5}) see(r + at * u + across * p.width_mm * v);
-    for (const Hole& s : tab.screws) see(s.center);
-    tab.midline_mm = lo <= 0.0 && hi >= 0.0 ? 0.0 : std::min(std::abs(lo), std::abs(hi));
-  }
+  if (p.midline) tab.midline_mm = midline_distance(*p.midline, tab, v);
   return out;
 }
 
