@@ -611,8 +611,8 @@ void MainWindow::build_steps_dock() {
   steps_->setObjectName("steps");
   for (const auto& s : wizard_steps())
     steps_->addItem(QStringLiteral("%1  %2").arg(s.number).arg(tr(s.title)));
-  steps_->setMaximumHeight(9 * 24 + 8);
-  steps_->setMinimumHeight(9 * 24 + 8);  // every step in sight, however long the page
+  steps_->setMaximumHeight(kStepCount * 24 + 8);
+  steps_->setMinimumHeight(kStepCount * 24 + 8);  // every step in sight, however long the page
   connect(steps_, &QListWidget::itemClicked, this, [this](QListWidgetItem* item) {
     const int step = steps_->row(item) + 1;
     if (step == controller_->state().current_step) return;

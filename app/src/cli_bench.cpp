@@ -144,8 +144,8 @@ void bench_alignment(const LoadedSkull& skull, int runs, Json& out) {
 
 // The wizard's inner loop: smooth the markers and rebuild the shell after a marker edit, with
 // the skull's and the mirror's locators built once; on at least 300 markers, as a dense manual
-// plan has (re-planned with closer spacing if needed).
-void bench_editing(const LoadedSkull& skull, AutoplanResult plan, int runs, Json& out) {
+// plan has (re-planned with closer spacing if needed). Whether the re-plan was made.
+bool bench_editing(const LoadedSkull& skull, AutoplanResult plan, int runs, Json& out) {
   AutoplanParams dense;
   for (double spacing = 5.0; plan.markers.size() < 300 && spacing >= 2.0; spacing -= 1.0) {
     dense.propose.surface_spacing_mm = spacing;
@@ -180,6 +180,7 @@ void bench_editing(const LoadedSkull& skull, AutoplanResult plan, int runs, Json
     if (!t.empty()) profile[stages.front()[k].first] = t[t.size() / 2];
   }
   out["fitted_rebuild_stages_s"] = profile;
+  return plan.planned();
 }
 
 // The same plan as session commands: one marker drag (the implant follows), then undo and redo
@@ -238,8 +239,7 @@ Json run_bench(const BenchOptions& options) {
     std::filesystem::remove(tmp);
     out["autoplan_over_vtk_reference"] =
         out["autoplan_s"].get<double>() / out["vtk_reference_s"].get<double>();
-    bench_editing(skull, std::move(plan), runs, out);
-    bench_session(input, runs, out);
+    if (bench_editing(skull, std::move(plan), runs, out)) bench_session(input, runs, out);
   }
   out["peak_memory_mb"] = peak_rss_mb();
   return out;

@@ -10,6 +10,7 @@
 #include "cranioplan/sessions/marker_files.h"
 #include "cranioplan/sessions/session_error.h"
 #include "cranioplan/sessions/sha256.h"
+#include "cranioplan/sessions/steps.h"
 
 namespace cranioplan {
 
@@ -788,30 +789,32 @@ Command attach_ct(const std::string& path, const ExtractBoneSurfaceParams& impor
 Command load_skull(const std::string& path, const ExtractBoneSurfaceParams& import,
                    const std::string& sha256) {
   return make(CommandType::LoadSkull,
-              {{"path", path}, {"sha256", sha256}, {"import", params_to_json(import)}}, 1);
+              {{"path", path}, {"sha256", sha256}, {"import", params_to_json(import)}}, kLoadStep);
 }
 
 Command set_landmark(const std::string& name, const Eigen::Vector3d& position) {
-  return make(CommandType::SetLandmark, {{"name", name}, {"position", to_json(position)}}, 2);
+  return make(CommandType::SetLandmark, {{"name", name}, {"position", to_json(position)}},
+              kPlaneStep);
 }
 
 Command clear_landmark(const std::string& name) {
-  return make(CommandType::ClearLandmark, {{"name", name}}, 2);
+  return make(CommandType::ClearLandmark, {{"name", name}}, kPlaneStep);
 }
 
 Command fit_plane(const PlaneFitParams& params) {
-  return make(CommandType::FitPlane, {{"params", params_to_json(params)}}, 2);
+  return make(CommandType::FitPlane, {{"params", params_to_json(params)}}, kPlaneStep);
 }
 
 Command adjust_plane(const Eigen::Vector3d& axis, double angle_deg, double shift_mm) {
   return make(CommandType::AdjustPlane,
-              {{"axis", to_json(axis)}, {"angle_deg", angle_deg}, {"shift_mm", shift_mm}}, 2);
+              {{"axis", to_json(axis)}, {"angle_deg", angle_deg}, {"shift_mm", shift_mm}},
+              kPlaneStep);
 }
 
-Command mirror() { return make(CommandType::Mirror, Json::object(), 3); }
+Command mirror() { return make(CommandType::Mirror, Json::object(), kMirrorStep); }
 
 Command register_mirror(const RegisterParams& params) {
-  return make(CommandType::Register, {{"params", params_to_json(params)}}, 3);
+  return make(CommandType::Register, {{"params", params_to_json(params)}}, kMirrorStep);
 }
 
 Command move_mirrored(const Eigen::Vector3d& axis, double angle_deg, const Eigen::Vector3d& center,
@@ -821,19 +824,21 @@ Command move_mirrored(const Eigen::Vector3d& axis, double angle_deg, const Eigen
                {"angle_deg", angle_deg},
                {"center", to_json(center)},
                {"translation", to_json(translation)}},
-              3);
+              kMirrorStep);
 }
 
 Command set_clip_plane(const Plane& plane) {
-  return make(CommandType::SetClipPlane, {{"enabled", true}, {"plane", to_json(plane)}}, 4);
+  return make(CommandType::SetClipPlane, {{"enabled", true}, {"plane", to_json(plane)}}, kClipStep);
 }
 
-Command clear_clip_plane() { return make(CommandType::SetClipPlane, {{"enabled", false}}, 4); }
+Command clear_clip_plane() {
+  return make(CommandType::SetClipPlane, {{"enabled", false}}, kClipStep);
+}
 
 Command add_marker(MarkerType type, const Eigen::Vector3d& position) {
   return make(CommandType::AddMarker,
               {{"type", static_cast<int>(type)}, {"position", to_json(position)}},
-              is_edge(type) ? 5 : 6);
+              is_edge(type) ? kEdgeMarkersStep : kSurfaceMarkersStep);
 }
 
 Command move_marker(int id, const Eigen::Vector3d& position) {
@@ -849,10 +854,13 @@ Command retype_marker(int id, MarkerType type) {
 Command import_markers(const std::vector<Marker>& markers, const std::string& source,
                        const std::string& sha256) {
   return make(CommandType::ImportMarkers,
-              {{"source", source}, {"sha256", sha256}, {"markers", markers_to_json(markers)}}, 5);
+              {{"source", source}, {"sha256", sha256}, {"markers", markers_to_json(markers)}},
+              kEdgeMarkersStep);
 }
 
-Command clear_markers() { return make(CommandType::ClearMarkers, Json::object(), 5); }
+Command clear_markers() {
+  return make(CommandType::ClearMarkers, Json::object(), kEdgeMarkersStep);
+}
 
 Command propose_markers(const ProposeParams& params, const std::string& shape_model,
                         const std::string& shape_model_sha256, const ShapePriorParams& prior) {
@@ -866,17 +874,17 @@ Command propose_markers(const ProposeParams& params, const std::string& shape_mo
              {"noise_mm", prior.fit.noise_mm},
              {"max_rms_mm", prior.fit.max_rms_mm},
              {"min_paired", prior.fit.min_paired}};
-  return make(CommandType::ProposeMarkers, j, 5);
+  return make(CommandType::ProposeMarkers, j, kEdgeMarkersStep);
 }
 
 Command smooth_markers(const SmoothParams& params, bool project_onto_mirror) {
   return make(CommandType::SmoothMarkers,
               {{"params", params_to_json(params)}, {"project_onto_mirror", project_onto_mirror}},
-              8);
+              kSmoothStep);
 }
 
 Command build_implant(const ImplantParams& params) {
-  return make(CommandType::BuildImplant, {{"params", params_to_json(params)}}, 7);
+  return make(CommandType::BuildImplant, {{"params", params_to_json(params)}}, kBuildStep);
 }
 
 Command export_implant(const std::string& path, const std::string& sha256,
@@ -892,12 +900,12 @@ Command export_implant(const std::string& path, const std::string& sha256,
       throw InputError(path, "a mould is exported in a .3mf package with the implant");
     params["mould"] = to_json(*mould);
   }
-  return make(CommandType::ExportImplant, std::move(params), 9);
+  return make(CommandType::ExportImplant, std::move(params), kExportStep);
 }
 
 Command approve(const std::string& by, const std::string& role, const std::string& implant_sha256) {
   return make(CommandType::Approve,
-              {{"by", by}, {"role", role}, {"implant_sha256", implant_sha256}}, 9);
+              {{"by", by}, {"role", role}, {"implant_sha256", implant_sha256}}, kExportStep);
 }
 
 Command go_to_step(int step) { return make(CommandType::GoToStep, {{"step", step}}, step); }

@@ -818,10 +818,17 @@ void apply_propose(PlanState& s, const ParamReader& r, const ApplyContext& ctx, 
   }
   const Json& result = r.has("result") ? r.value("result") : record["result"];
   if (!apply_proposal_result(s, result, r.where() + " result")) return;
-  s.proposal_shape_model =
-      r.has("shape_model")
-          ? ParamReader(r.value("shape_model"), r.where() + " shape_model").string("path")
-          : std::string();
+  // Where the replay finds it (beside the session when moved with it); as recorded when gone.
+  s.proposal_shape_model.clear();
+  if (r.has("shape_model")) {
+    const std::string recorded =
+        ParamReader(r.value("shape_model"), r.where() + " shape_model").string("path");
+    try {
+      s.proposal_shape_model = resolve_input(recorded, ctx, "shape model");
+    } catch (const InputError&) {
+      s.proposal_shape_model = recorded;
+    }
+  }
   for (const auto& m : s.markers) s.next_marker_id = std::max(s.next_marker_id, m.id + 1);
   s.message = s.proposal_message;
   markers_changed(s);

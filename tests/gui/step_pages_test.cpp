@@ -209,7 +209,8 @@ TEST(StepPages, AProposalGuidedByAShapeModelNamesItInTheCommand) {
 
 // A reopened plan shows the model its last proposal was guided by, whatever the settings say,
 // and proposes again with it; the settings keep the user's own choice. A proposal without a
-// model unticks the box; the user's change after a proposal stays.
+// model unticks the box; the user's change after a proposal stays; a plan without a proposal
+// shows the settings' choice.
 TEST(StepPages, AReopenedPlanShowsTheModelItsProposalUsed) {
   const auto model = std::filesystem::temp_directory_path() / "cranioplan_plan_model.cpsm";
   std::ofstream(model) << "CRANIOPLAN-SHAPE-MODEL 1\n";
@@ -235,6 +236,18 @@ TEST(StepPages, AReopenedPlanShowsTheModelItsProposalUsed) {
   // A new proposal without a model: unticked, the settings' file named.
   use->setChecked(true);
   host.state.proposal_message = "10 markers proposed";
+  host.state.proposal_shape_model.clear();
+  page.show_state(host.state);
+  EXPECT_FALSE(use->isChecked());
+  EXPECT_EQ(child<QLabel>(page, "shapeModelFile")->text(), "settings_model.cpsm");
+  // Back to a plan guided by the model, then a new plan (no proposal yet): the settings' choice
+  // again (here unticked), not the last plan's model.
+  host.state.proposal_message = "12 markers proposed; guided by the shape model";
+  host.state.proposal_shape_model = model.string();
+  page.show_state(host.state);
+  EXPECT_TRUE(use->isChecked());
+  QSettings().setValue("shapeModel/use", false);
+  host.state.proposal_message.clear();
   host.state.proposal_shape_model.clear();
   page.show_state(host.state);
   EXPECT_FALSE(use->isChecked());

@@ -225,7 +225,6 @@ bool near_hole(const std::vector<uint8_t>& mask, const VoxelGrid& g, const Hole&
   return near;
 }
 
-// perforate, the drilled implant meshed in `into` (the result's own mesh, or the caller's).
 // The holes: the user's (on the implant's surface), then the pattern's that keep clear of them
 // and of the removed, into `holes`; a problem to say when two of the user's lie too close.
 std::string place_holes(const Faces& faces, const SurfaceLocator& self, const PointIndex& outer,
@@ -293,6 +292,7 @@ std::string drilled_message(size_t holes, double diameter_mm, int blocked, int l
   return message;
 }
 
+// perforate, the drilled implant meshed in `into` (the result's own mesh, or the caller's).
 void perforate_into(const SkullMesh& implant, const Eigen::Vector3d& inside,
                     const PerforationParams& p, PerforateResult& r, SkullMesh& into) {
   assert(&into != &implant && "the holes are meshed into another mesh than the implant");

@@ -387,7 +387,6 @@ std::vector<float> fit_against_bone(const Mask& mask, const Mask& bone, const Vo
 
 namespace {
 
-// trim_to_bone, meshed in `into` (the result's own mesh, or the caller's).
 // A clearance wider than a voxel cut from `mask` to the voxels' resolution: voxels nearer the
 // bone's than the clearance there (the zone's at the skull's closest point). Returns the
 // distance to the bone's voxels it measured, asked against the clearances, the band beyond
@@ -432,6 +431,7 @@ void remove_thin_fills(Mask& bridged, const Mask& mask, const Mask& bone, const 
   for (size_t c : thin) bridged[c] = 0;
 }
 
+// trim_to_bone, meshed in `into` (the result's own mesh, or the caller's).
 void trim_into(const SkullMesh& implant, const SkullMesh& skull,
                const SurfaceLocator* skull_locator, const TrimToBoneParams& params,
                TrimToBoneResult& result, SkullMesh& into) {

@@ -156,12 +156,18 @@ std::string EdgeMarkersPage::shape_model_path() const {
 
 void EdgeMarkersPage::show_plan_model(const PlanState& s) {
   const std::string proposal = s.proposal_message + '\n' + s.proposal_shape_model;
-  if (s.proposal_message.empty() || proposal == shown_proposal_) return;
+  if (proposal == shown_proposal_) return;
   shown_proposal_ = proposal;
   plan_model_ = QString::fromStdString(s.proposal_shape_model);
   const QSignalBlocker quiet(use_model_);  // the settings keep the user's own choice
+  QSettings settings;
+  if (s.proposal_message.empty()) {  // no proposal (a new plan, or undone): the settings' choice
+    use_model_->setChecked(settings.value("shapeModel/use", false).toBool());
+    show_model_file(settings.value("shapeModel/path").toString());
+    return;
+  }
   use_model_->setChecked(!plan_model_.isEmpty());
-  show_model_file(plan_model_.isEmpty() ? QSettings().value("shapeModel/path").toString()
+  show_model_file(plan_model_.isEmpty() ? settings.value("shapeModel/path").toString()
                                         : plan_model_);
 }
 

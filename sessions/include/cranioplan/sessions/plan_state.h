@@ -22,6 +22,7 @@
 #include "cranioplan/model/marker.h"
 #include "cranioplan/model/mesh.h"
 #include "cranioplan/sessions/command.h"
+#include "cranioplan/sessions/steps.h"
 
 namespace cranioplan {
 
@@ -123,21 +124,6 @@ struct AttachedCt {
   double median_mm = 0.0, p90_mm = 0.0;  ///< the skull's distance to its bone surface
   std::string message;
 };
-
-/// The wizard's steps, by the numbers the session file (`go_to_step`, `complete_step`), the
-/// user and `PlanState::current_step` use.
-enum StepNumber : int {
-  kLoadStep = 1,
-  kPlaneStep,
-  kMirrorStep,
-  kClipStep,
-  kEdgeMarkersStep,
-  kSurfaceMarkersStep,
-  kBuildStep,
-  kSmoothStep,
-  kExportStep,
-};
-inline constexpr int kStepCount = kExportStep;
 
 struct PlanState {
   // Step 1
