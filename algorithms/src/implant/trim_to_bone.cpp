@@ -431,6 +431,19 @@ void remove_thin_fills(Mask& bridged, const Mask& mask, const Mask& bone, const 
   for (size_t c : thin) bridged[c] = 0;
 }
 
+// The skull's triangles near the grid, which suffice for distances up to a few voxels beyond
+// the widest clearance; none when no triangle lies near it.
+std::unique_ptr<SurfaceLocator> locator_near_grid(const SkullMesh& skull, const VoxelGrid& grid,
+                                                  double widest) {
+  const double reach = 3.0 * grid.spacing + widest;
+  const SkullMesh local =
+      faces_in_box(skull, grid.origin - Eigen::Vector3d::Constant(reach),
+                   grid.center(grid.dims[0] - 1, grid.dims[1] - 1, grid.dims[2] - 1) +
+                       Eigen::Vector3d::Constant(reach));
+  if (local.n_faces() == 0) return nullptr;
+  return std::make_unique<SurfaceLocator>(local);
+}
+
 // trim_to_bone, meshed in `into` (the result's own mesh, or the caller's).
 void trim_into(const SkullMesh& implant, const SkullMesh& skull,
                const SurfaceLocator* skull_locator, const TrimToBoneParams& params,
@@ -456,25 +469,17 @@ void trim_into(const SkullMesh& implant, const SkullMesh& skull,
   // Beyond the scan's end the bone is unknown: the implant ends there.
   for_each_beyond(grid, params.scan_ends, [&](size_t c) { mask[c] = 0; });
   clock.mark("voxels");
-  // The skull's triangles near the grid suffice for distances up to a few voxels beyond the
-  // widest clearance.
   double widest = params.clearance_mm.value_or(0.0);
   for (const ClearanceZone& z : params.zones) widest = std::max(widest, z.clearance_mm);
-  // The caller's locator of the whole skull gives the same distances: the nearest triangle
-  // is the same one, and where no triangle lies near the grid, every distance asked is beyond
-  // the band (the caps are then 1 outside the bone and 0 inside, as without a locator).
-  const SurfaceLocator* locator = nullptr;
+  // The caller's locator of the whole skull gives the same distances as one of the triangles
+  // near the grid: the nearest triangle is the same one, and where no triangle lies near the
+  // grid, every distance asked is beyond the band (the caps are then 1 outside the bone and 0
+  // inside, as without a locator).
   std::unique_ptr<SurfaceLocator> own;
-  SkullMesh local;
-  if (params.clearance_mm && skull_locator) {
-    locator = skull_locator;
-  } else if (params.clearance_mm) {
-    const double reach = 3.0 * h + widest;
-    local = faces_in_box(skull, grid.origin - Eigen::Vector3d::Constant(reach),
-                         grid.center(grid.dims[0] - 1, grid.dims[1] - 1, grid.dims[2] - 1) +
-                             Eigen::Vector3d::Constant(reach));
-    if (local.n_faces() > 0) locator = (own = std::make_unique<SurfaceLocator>(local)).get();
-  }
+  if (params.clearance_mm && !skull_locator) own = locator_near_grid(skull, grid, widest);
+  const SurfaceLocator* locator = !params.clearance_mm ? nullptr
+                                  : skull_locator      ? skull_locator
+                                                       : own.get();
   // A clearance wider than a voxel is cut first (to the voxels' resolution; the surface is held
   // at it exactly below), so that the opening also takes what it leaves thin: a tongue of the
   // implant reaching between two pieces of bone narrows by the clearance from both sides.

@@ -168,7 +168,7 @@ struct PlanState {
   std::string approval_withdrawn;
   // Wizard
   std::array<bool, kStepCount + 1> acknowledged{};  ///< steps done by hand (mirror, clip, smooth)
-  std::map<int, std::string> stale;     ///< step → why its results were recomputed
+  std::map<int, std::string> stale;                 ///< step → why its results were recomputed
   int current_step = kLoadStep;
   std::vector<std::string> notes;
   std::string message;  ///< what the last command did, or why it had no effect
