@@ -349,22 +349,7 @@ Subcommand add_mould(CLI::App& app, const bool& json) {
   cmd->add_option("--skull", o->skull,
                   "the skull it is made for (its centre tells the implant's outer surface)")
       ->required();
-  cmd->add_option("--wall", o->params.wall_mm, "the block beyond the cavity (mm)")
-      ->capture_default_str()
-      ->check(CLI::Range(4.0, 30.0));
-  cmd->add_option("--key-diameter", o->params.key_diameter_mm, "alignment keys (mm)")
-      ->capture_default_str()
-      ->check(CLI::Range(2.0, 12.0));
-  cmd->add_option("--key-clearance", o->params.key_clearance_mm,
-                  "sockets wider than the keys by this (mm)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 1.0));
-  cmd->add_option("--channel-diameter", o->params.channel_diameter_mm, "pour channel (mm)")
-      ->capture_default_str()
-      ->check(CLI::Range(2.0, 12.0));
-  cmd->add_option("--vent-diameter", o->params.vent_diameter_mm, "air vent (mm)")
-      ->capture_default_str()
-      ->check(CLI::Range(1.0, 6.0));
+  add_declared_options(cmd, o->params);
   cmd->add_option("-o,--output", o->output,
                   "OUT.3mf (the implant and both halves, named) or OUT.stl (OUT_outer.stl and "
                   "OUT_inner.stl)")

@@ -125,20 +125,34 @@ std::vector<ClearanceZone> zones_from(const MaterialOptions& o) {
   return zones;
 }
 
+namespace {
+
+std::string declared_help(const ParamSpec& s) {
+  return *s.unit ? std::string(s.help) + " (" + s.unit + ")" : std::string(s.help);
+}
+
+}  // namespace
+
+void add_declared_option(CLI::App* cmd, const ParamSpec& s, double& value,
+                         const std::string& prefix) {
+  auto* option = cmd->add_option("--" + prefix + s.option, value, declared_help(s))
+                     ->check(CLI::Range(s.min, s.max));
+  if (!s.unset_allowed) option->capture_default_str();
+}
+
+void add_declared_option(CLI::App* cmd, const ParamSpec& s, int& value, const std::string& prefix) {
+  cmd->add_option("--" + prefix + s.option, value, declared_help(s))
+      ->capture_default_str()
+      ->check(CLI::Range(static_cast<int>(s.min), static_cast<int>(s.max)));
+}
+
+void add_declared_option(CLI::App* cmd, const ParamSpec& s, bool& value,
+                         const std::string& prefix) {
+  cmd->add_flag("--" + prefix + s.option, value, s.help);
+}
+
 void add_hole_options(CLI::App* cmd, HoleOptions& o) {
-  cmd->add_flag("--perforate", o.params.pattern,
-                "drill holes on a hexagonal pattern through the implant (drainage, dura "
-                "suspension)");
-  cmd->add_option("--hole-diameter", o.params.diameter_mm, "diameter of the holes (mm)")
-      ->capture_default_str()
-      ->check(CLI::Range(1.0, 6.0));
-  cmd->add_option("--hole-spacing", o.params.spacing_mm, "between the pattern's holes (mm)")
-      ->capture_default_str()
-      ->check(CLI::Range(4.0, 40.0));
-  cmd->add_option("--hole-edge-distance", o.params.edge_distance_mm,
-                  "the pattern's holes at least this far from the implant's edge (mm)")
-      ->capture_default_str()
-      ->check(CLI::Range(1.0, 20.0));
+  add_declared_options(cmd, o.params);
   cmd->add_option("--hole", o.added, "X,Y,Z: a single hole there (repeatable)");
   cmd->add_option("--no-hole", o.removed,
                   "X,Y,Z: leave out the pattern's hole nearest there (repeatable)");
@@ -154,41 +168,7 @@ PerforationParams perforations_from(const HoleOptions& o) {
 }
 
 void add_tab_options(CLI::App* cmd, TabOptions& o) {
-  cmd->add_flag("--tabs", o.params.automatic,
-                "fixation tabs onto the outer table, evenly along the rim (away from thin bone "
-                "and the midline)");
-  cmd->add_option("--tab-count", o.params.count, "how many tabs (0: one per 40 mm of rim)")
-      ->capture_default_str()
-      ->check(CLI::Range(0, 12));
-  cmd->add_option("--tab-length", o.params.length_mm, "beyond the implant's edge (mm)")
-      ->capture_default_str()
-      ->check(CLI::Range(4.0, 25.0));
-  cmd->add_option("--tab-width", o.params.width_mm,
-                  "of the tabs (mm; default: the countersink with a ring of the material's "
-                  "minimum thickness + 0.5 mm, at least 6)")
-      ->check(CLI::Range(3.0, 15.0));
-  cmd->add_option("--tab-thickness", o.params.thickness_mm,
-                  "of the tabs (mm; default: the material's minimum under the countersink "
-                  "+ 0.4 mm, at least 1.5)")
-      ->check(CLI::Range(0.5, 5.0));
-  cmd->add_option("--tab-screws", o.params.screws, "screws per tab (1 or 2, along the tab)")
-      ->capture_default_str()
-      ->check(CLI::Range(1, 2));
-  cmd->add_option("--screw-diameter", o.params.screw_diameter_mm, "the screw holes' (mm)")
-      ->capture_default_str()
-      ->check(CLI::Range(1.0, 3.0));
-  cmd->add_option("--countersink", o.params.countersink_diameter_mm,
-                  "the countersinks' diameter at the tab's top (mm, 90°; 0: none)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 8.0));
-  cmd->add_option("--tab-midline-distance", o.params.midline_distance_mm,
-                  "tabs at least this far from the midsagittal plane (mm; the sagittal sinus)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 40.0));
-  cmd->add_option("--tab-min-bone", o.params.min_bone_mm,
-                  "screws only into bone at least this thick (mm)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 10.0));
+  add_declared_options(cmd, o.params);
   cmd->add_option("--tab", o.at,
                   "X,Y,Z: a tab at the rim point nearest there (repeatable; instead of --tabs' "
                   "even placement)");

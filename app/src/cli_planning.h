@@ -3,10 +3,12 @@
 #include <memory>
 #include <optional>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "cranioplan/algorithms/planning/autoplan.h"
 #include "cranioplan/algorithms/shape/shape_model.h"
+#include "cranioplan/model/param_spec.h"
 
 namespace CLI {
 class App;
@@ -32,6 +34,25 @@ std::shared_ptr<const ShapeModel> shape_model_from(const std::string& path);
 /// Throws InputError naming `skull_path` when the model was built with that very file: a plan
 /// scored against a skull its model has seen would leak the answer.
 void refuse_if_in_model(const ShapeModel& model, const std::string& skull_path);
+
+/// The option `s` declares, bound to `value`, its range checked and (unless it may be left unset)
+/// its default shown; `prefix` goes before its name ("mould-": --mould-wall).
+void add_declared_option(CLI::App* cmd, const ParamSpec& s, double& value,
+                         const std::string& prefix);
+void add_declared_option(CLI::App* cmd, const ParamSpec& s, int& value, const std::string& prefix);
+void add_declared_option(CLI::App* cmd, const ParamSpec& s, bool& value, const std::string& prefix);
+/// The options `params`' type declares (for_each_field), bound to its fields.
+template <class P>
+void add_declared_options(CLI::App* cmd, P& params, const std::string& prefix = "") {
+  for_each_field(
+      [&](const ParamSpec& s, auto& value) {
+        using T = std::decay_t<decltype(value)>;
+        if constexpr (std::is_same_v<T, double> || std::is_same_v<T, int> ||
+                      std::is_same_v<T, bool>)
+          if (s.option) add_declared_option(cmd, s, value, prefix);
+      },
+      params);
+}
 
 /// --fit-to-bone MM and --local-registration MM of the automatic planner.
 void add_fit_option(CLI::App* cmd, AutoplanParams& params);

@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "cli_output.h"
+#include "cli_planning.h"
 #include "cranioplan/algorithms/io/file_io.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
 #include "cranioplan/sessions/audit.h"
@@ -115,9 +116,7 @@ Subcommand add_export(CLI::App& app, const bool& json) {
   cmd->add_option("-o,--output", o->output, "the implant (.stl, .ply or .3mf)")->required();
   cmd->add_flag("--mould", o->mould,
                 "a .3mf with the two halves of a casting mould beside the implant");
-  cmd->add_option("--mould-wall", o->mould_params.wall_mm, "the mould's wall (mm)")
-      ->capture_default_str()
-      ->check(CLI::Range(4.0, 30.0));
+  add_declared_options(cmd, o->mould_params, "mould-");
   return {
       cmd, [o, &json] {
         Session s = Session::open(o->session);

@@ -343,113 +343,74 @@ Json params_to_json(const ImplantParams& p) {
   return j;
 }
 
-Json to_json(const TabParams& p) {
-  Json positions = Json::array();
-  for (const auto& v : p.positions) positions.push_back(to_json(v));
-  auto mm = [](double v) { return std::isnan(v) ? Json(nullptr) : Json(v); };
-  return Json{{"automatic", p.automatic},
-              {"count", p.count},
-              {"positions", positions},
-              {"length_mm", p.length_mm},
-              {"width_mm", mm(p.width_mm)},
-              {"thickness_mm", mm(p.thickness_mm)},
-              {"screws", p.screws},
-              {"screw_diameter_mm", p.screw_diameter_mm},
-              {"countersink_diameter_mm", p.countersink_diameter_mm},
-              {"midline_distance_mm", p.midline_distance_mm},
-              {"midline", p.midline ? Json{{"normal", to_json(p.midline->normal)},
-                                           {"offset", p.midline->offset}}
-                                    : Json(nullptr)},
-              {"min_bone_mm", p.min_bone_mm},
-              {"voxel_mm", p.voxel_mm},
-              {"max_voxels", p.max_voxels}};
-}
+namespace {
 
-Json to_json(const MouldParams& p) {
-  return Json{{"wall_mm", p.wall_mm},
-              {"key_diameter_mm", p.key_diameter_mm},
-              {"key_clearance_mm", p.key_clearance_mm},
-              {"channel_diameter_mm", p.channel_diameter_mm},
-              {"vent_diameter_mm", p.vent_diameter_mm},
-              {"voxel_mm", p.voxel_mm},
-              {"max_voxels", p.max_voxels}};
-}
-
-MouldParams mould_from_json(const ParamReader& r) {
-  MouldParams p;
-  p.wall_mm = r.number("wall_mm");
-  p.key_diameter_mm = r.number("key_diameter_mm");
-  p.key_clearance_mm = r.number("key_clearance_mm");
-  p.channel_diameter_mm = r.number("channel_diameter_mm");
-  p.vent_diameter_mm = r.number("vent_diameter_mm");
-  p.voxel_mm = r.number("voxel_mm");
-  p.max_voxels = r.number("max_voxels");
-  if (const std::string problem = mould_problem(p); !problem.empty())
-    throw SessionError(r.where(), problem);
-  return p;
-}
-
-TabParams tabs_from_json(const ParamReader& r) {
-  TabParams p;
-  p.automatic = r.boolean("automatic");
-  p.count = r.integer("count");
-  const Json& points = r.value("positions");
-  if (!points.is_array()) throw SessionError(r.where(), "positions must be a list");
-  if (points.size() > 1000) throw SessionError(r.where(), "too many tab positions");
-  for (const Json& v : points) p.positions.push_back(vector_from_json(v, r.where(), "a tab"));
-  p.length_mm = r.number("length_mm");
-  p.width_mm = r.number("width_mm");          // null: from the material
-  p.thickness_mm = r.number("thickness_mm");  // null: from the material
-  p.screws = r.integer("screws");
-  p.screw_diameter_mm = r.number("screw_diameter_mm");
-  p.countersink_diameter_mm = r.number("countersink_diameter_mm");
-  p.midline_distance_mm = r.number("midline_distance_mm");
-  if (!r.value("midline").is_null()) {
-    const ParamReader m(r.value("midline"), r.where() + " midline");
-    p.midline = Plane{m.vector3("normal"), m.number("offset")};
+// Writes and reads the fields a Params struct declares (for_each_field, ParamSpec).
+struct DeclaredWriter {
+  Json& j;
+  void operator()(const ParamSpec& s, const double& v) { j[s.key] = number_or_null(v); }
+  void operator()(const ParamSpec& s, const int& v) { j[s.key] = v; }
+  void operator()(const ParamSpec& s, const bool& v) { j[s.key] = v; }
+  void operator()(const ParamSpec& s, const std::vector<Eigen::Vector3d>& points) {
+    Json list = Json::array();
+    for (const auto& v : points) list.push_back(to_json(v));
+    j[s.key] = list;
   }
-  p.min_bone_mm = r.number("min_bone_mm");
-  p.voxel_mm = r.number("voxel_mm");
-  p.max_voxels = r.number("max_voxels");
-  if (const std::string problem = tab_problem(p); !problem.empty())
-    throw SessionError(r.where(), problem);
+  void operator()(const ParamSpec& s, const std::optional<Plane>& plane) {
+    j[s.key] =
+        plane ? Json{{"normal", to_json(plane->normal)}, {"offset", plane->offset}} : Json(nullptr);
+  }
+};
+
+struct DeclaredReader {
+  static constexpr size_t kMaxPoints = 1000;
+  const ParamReader& r;
+  void operator()(const ParamSpec& s, double& v) { v = r.number(s.key); }
+  void operator()(const ParamSpec& s, int& v) { v = r.integer(s.key); }
+  void operator()(const ParamSpec& s, bool& v) { v = r.boolean(s.key); }
+  void operator()(const ParamSpec& s, std::vector<Eigen::Vector3d>& points) {
+    const Json& list = r.value(s.key);
+    if (!list.is_array()) throw SessionError(r.where(), std::string(s.key) + " must be a list");
+    if (list.size() > kMaxPoints)
+      throw SessionError(r.where(),
+                         "more than " + format_count(kMaxPoints) + " points in " + s.key);
+    for (const Json& v : list)
+      points.push_back(vector_from_json(v, r.where(), std::string("a point in ") + s.key));
+  }
+  void operator()(const ParamSpec& s, std::optional<Plane>& plane) {
+    plane.reset();
+    if (r.value(s.key).is_null()) return;
+    const ParamReader m(r.value(s.key), r.where() + " " + s.key);
+    plane = Plane{m.vector3("normal"), m.number("offset")};
+  }
+};
+
+template <class P>
+Json declared_to_json(const P& p) {
+  Json j = Json::object();
+  for_each_field(DeclaredWriter{j}, const_cast<P&>(p));  // the writer only reads
+  return j;
+}
+
+// The fields `P` declares, read and checked by `problem` (the operation's own rules).
+template <class P>
+P declared_from_json(const ParamReader& r, std::string (*problem)(const P&)) {
+  P p;
+  for_each_field(DeclaredReader{r}, p);
+  if (const std::string why = problem(p); !why.empty()) throw SessionError(r.where(), why);
   return p;
 }
 
-Json to_json(const PerforationParams& p) {
-  Json added = Json::array(), removed = Json::array();
-  for (const auto& v : p.added) added.push_back(to_json(v));
-  for (const auto& v : p.removed) removed.push_back(to_json(v));
-  return Json{{"pattern", p.pattern},
-              {"diameter_mm", p.diameter_mm},
-              {"spacing_mm", p.spacing_mm},
-              {"edge_distance_mm", p.edge_distance_mm},
-              {"min_thickness_mm", p.min_thickness_mm},
-              {"voxel_mm", p.voxel_mm},
-              {"max_voxels", p.max_voxels},
-              {"added", added},
-              {"removed", removed}};
-}
+}  // namespace
 
+Json to_json(const TabParams& p) { return declared_to_json(p); }
+Json to_json(const MouldParams& p) { return declared_to_json(p); }
+Json to_json(const PerforationParams& p) { return declared_to_json(p); }
+
+MouldParams mould_from_json(const ParamReader& r) { return declared_from_json(r, &mould_problem); }
+TabParams tabs_from_json(const ParamReader& r) { return declared_from_json(r, &tab_problem); }
 PerforationParams perforations_from_json(const ParamReader& r) {
-  PerforationParams p;
-  p.pattern = r.boolean("pattern");
-  p.diameter_mm = r.number("diameter_mm");
-  p.spacing_mm = r.number("spacing_mm");
-  p.edge_distance_mm = r.number("edge_distance_mm");
-  p.min_thickness_mm = r.number("min_thickness_mm");
-  p.voxel_mm = r.number("voxel_mm");
-  p.max_voxels = r.number("max_voxels");
-  for (const char* list : {"added", "removed"}) {
-    const Json& points = r.value(list);
-    if (!points.is_array()) throw SessionError(r.where(), std::string(list) + " must be a list");
-    for (const Json& v : points)
-      (list[0] == 'a' ? p.added : p.removed)
-          .push_back(vector_from_json(v, r.where(), std::string("a hole in ") + list));
-  }
-  if (const std::string problem = perforation_problem(p); !problem.empty())
-    throw SessionError(r.where(), problem);
-  return p;
+  return declared_from_json(r, &perforation_problem);
 }
 
 Json to_json(const Material& m) {

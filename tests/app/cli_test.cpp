@@ -356,6 +356,26 @@ TEST(Cli, ExitCodesForUsageAndBadInput) {
       test::run_command(kCli + " import-ct " + dir.path("h.stl") + " -o " + dir.path("x.stl")), 3);
 }
 
+// The options of a declared parameter (ParamSpec) carry its range and default wherever they are
+// offered: `mould --wall` and `export --mould-wall` alike, the mould's other options too.
+TEST(Cli, DeclaredOptionsCarryTheirRangeOnEverySubcommand) {
+  std::string out;
+  EXPECT_EQ(test::run_command(kCli + " export --help", &out), 0);
+  for (const char* option : {"--mould-wall", "--mould-key-diameter", "--mould-vent-diameter"})
+    EXPECT_NE(out.find(option), std::string::npos) << option;
+  EXPECT_NE(out.find("[4 - 30]=8"), std::string::npos) << out;  // the wall's range and default
+  // Refused before any file is read, naming the option and its range (stderr read as well).
+  const std::pair<const char*, const char*> refused[] = {
+      {" mould i.stl --skull s.stl -o m.3mf --wall 3", "--wall"},
+      {" export s.json -o m.3mf --mould --mould-vent-diameter 7", "--mould-vent-diameter"},
+      {" implant s.stl --tab-screws 3 -o i.stl", "--tab-screws"}};
+  for (const auto& [args, option] : refused) {
+    EXPECT_EQ(test::run_command("sh -c '" + kCli + args + " 2>&1'", &out), 2) << args;
+    EXPECT_NE(out.find(option), std::string::npos) << out;
+    EXPECT_NE(out.find("range"), std::string::npos) << out;
+  }
+}
+
 // STL carries no unit: a head exported in metres is refused as a skull (exit 3, naming the unit
 // it looks to be in) by the subcommands that plan on it, and read in it with --units.
 TEST(Cli, AHeadInMetresIsRefusedUntilItsUnitIsGiven) {

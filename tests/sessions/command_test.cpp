@@ -4,7 +4,9 @@
 
 #include <cmath>
 #include <filesystem>
+#include <set>
 #include <tuple>
+#include <type_traits>
 
 #include "cranioplan/algorithms/io/mesh_report.h"
 #include "cranioplan/algorithms/io/write_mesh.h"
@@ -262,6 +264,71 @@ TEST(Commands, TheBuildRecordsItsTabs) {
     EXPECT_NE(std::string(e.what()).find("length must be 4 to 25 mm (40 given)"), std::string::npos)
         << e.what();
   }
+}
+
+// The manufacturing parameters are declared once (for_each_field): every default lies in its
+// range, the session writes exactly the declared fields in the declared order and reads them
+// back, the CLI options of tabs and holes (given to the same subcommands) do not clash, and a
+// value out of its declared range is refused by the reader in the declaration's words.
+template <class P>
+std::vector<std::string> declared_keys(std::set<std::string>* options) {
+  std::vector<std::string> keys;
+  P p;
+  for_each_field(
+      [&](const ParamSpec& s, auto& value) {
+        keys.push_back(s.key);
+        using T = std::decay_t<decltype(value)>;
+        if constexpr (std::is_arithmetic_v<T> && !std::is_same_v<T, bool>) {
+          if (s.ranged()) {
+            EXPECT_TRUE(s.allows(static_cast<double>(value))) << s.key << " default out of range";
+          }
+        }
+        if (s.option) {
+          EXPECT_TRUE(options->insert(s.option).second) << s.option << " twice";
+        }
+      },
+      p);
+  return keys;
+}
+
+template <class P>
+void expect_written_as_declared(const Json& j, std::set<std::string>* options) {
+  std::vector<std::string> written;
+  for (auto it = j.begin(); it != j.end(); ++it) written.push_back(it.key());
+  EXPECT_EQ(written, declared_keys<P>(options));
+}
+
+TEST(Commands, ManufacturingParametersAreWrittenAndCheckedAsDeclared) {
+  std::set<std::string> options;  // tabs and holes share the implant and autoplan subcommands
+  TabParams tabs;
+  tabs.positions = {{1, 2, 3}};
+  tabs.midline = Plane{Eigen::Vector3d::UnitX(), 4.0};
+  expect_written_as_declared<TabParams>(to_json(tabs), &options);
+  PerforationParams holes;
+  holes.added = {{5, 6, 7}};
+  expect_written_as_declared<PerforationParams>(to_json(holes), &options);
+  std::set<std::string> mould_options;
+  expect_written_as_declared<MouldParams>(to_json(MouldParams{}), &mould_options);
+
+  const TabParams tabs_back = tabs_from_json(ParamReader(to_json(tabs), "test"));
+  EXPECT_EQ(to_json(tabs_back), to_json(tabs));
+  EXPECT_EQ(to_json(perforations_from_json(ParamReader(to_json(holes), "test"))), to_json(holes));
+  EXPECT_EQ(to_json(mould_from_json(ParamReader(to_json(MouldParams{}), "test"))),
+            to_json(MouldParams{}));
+
+  Json bad = to_json(MouldParams{});
+  bad["vent_diameter_mm"] = 7.0;
+  try {
+    mould_from_json(ParamReader(bad, "plan.json"));
+    ADD_FAILURE() << "a vent 7 mm wide was read";
+  } catch (const SessionError& e) {
+    EXPECT_NE(std::string(e.what()).find("the mould's vent's diameter must be 1 to 6 mm (7 given)"),
+              std::string::npos)
+        << e.what();
+  }
+  Json not_a_list = to_json(holes);
+  not_a_list["added"] = 3;
+  EXPECT_THROW(perforations_from_json(ParamReader(not_a_list, "plan.json")), SessionError);
 }
 
 // A mesh's length unit is part of the load: recorded, replayed, and read as millimetres from

@@ -14,7 +14,6 @@
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
 #include "cranioplan/model/parallel.h"
-#include "param_ranges.h"
 
 namespace cranioplan {
 
@@ -23,10 +22,6 @@ const char* status_name(MouldResult::Status status) {
 }
 
 namespace {
-
-std::string range_problem(const char* what, double v, double lo, double hi) {
-  return parameter_range_problem("the mould's", what, v, lo, hi);
-}
 
 // The parting surface's grid over the plane across the axis, mm.
 constexpr double kPartingStep = 0.5;
@@ -178,20 +173,11 @@ Pull part_along(const SkullMesh& implant, const SurfaceLocator& self, const Eige
 }  // namespace
 
 std::string mould_problem(const MouldParams& p) {
-  if (!within(p.wall_mm, 4.0, 30.0)) return range_problem("wall", p.wall_mm, 4, 30);
-  if (!within(p.key_diameter_mm, 2.0, 12.0))
-    return range_problem("keys' diameter", p.key_diameter_mm, 2, 12);
+  if (std::string problem = range_problems("the mould's", p); !problem.empty()) return problem;
+  const ParamSpec wall = spec_of<MouldParams>("wall_mm");
   if (p.key_diameter_mm + 2.0 > p.wall_mm)
-    return range_problem("wall", p.wall_mm, p.key_diameter_mm + 2.0, 30) + " for its keys";
-  if (!within(p.key_clearance_mm, 0.0, 1.0))
-    return range_problem("keys' clearance", p.key_clearance_mm, 0, 1);
-  if (!within(p.channel_diameter_mm, 2.0, 12.0))
-    return range_problem("pour channel's diameter", p.channel_diameter_mm, 2, 12);
-  if (!within(p.vent_diameter_mm, 1.0, 6.0))
-    return range_problem("vent's diameter", p.vent_diameter_mm, 1, 6);
-  if (!within(p.voxel_mm, 0.05, 1.0)) return range_problem("grid", p.voxel_mm, 0.05, 1.0);
-  if (!(p.max_voxels >= 1e5 && p.max_voxels <= 1e8))
-    return "the mould's grid must have 100,000 to 100,000,000 voxels";
+    return wall.problem("the mould's", p.wall_mm, p.key_diameter_mm + 2.0, wall.max) +
+           " for its keys";
   return {};
 }
 

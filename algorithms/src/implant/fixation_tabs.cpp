@@ -15,17 +15,11 @@
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
 #include "cranioplan/model/parallel.h"
-#include "param_ranges.h"
 
 namespace cranioplan {
 
 namespace {
 
-std::string range_problem(const char* what, double v, double lo, double hi) {
-  return parameter_range_problem("the tabs'", what, v, lo, hi);
-}
-
-constexpr size_t kMaxTabs = 12;
 // A tab's underside keeps this far off the bone (the quality report's overlap grid then counts
 // none of it inside the bone), mm.
 constexpr double kUndersideMm = 0.05;
@@ -471,48 +465,38 @@ TabMaps tab_maps(const Candidate& c, const SurfaceLocator& self, const SurfaceLo
 }  // namespace
 
 std::string tab_problem(const TabParams& p) {
-  if (!within(p.length_mm, 4.0, 25.0)) return range_problem("length", p.length_mm, 4, 25);
-  if (!std::isnan(p.width_mm) && !within(p.width_mm, 3.0, 15.0))
-    return range_problem("width", p.width_mm, 3, 15);
-  if (!std::isnan(p.thickness_mm) && !within(p.thickness_mm, 0.5, 5.0))
-    return range_problem("thickness", p.thickness_mm, 0.5, 5);
-  if (p.screws != 1 && p.screws != 2) return "a tab has one or two screws";
-  if (p.count < 0 || p.count > static_cast<int>(kMaxTabs))
-    return "the tabs' count must be 0 (from the rim's length) to " + std::to_string(kMaxTabs);
-  if (p.positions.size() > kMaxTabs)
-    return "at most " + std::to_string(kMaxTabs) + " tabs may be placed";
+  constexpr const char* kWhose = "the tabs'";
+  if (std::string problem = range_problems(kWhose, p); !problem.empty()) return problem;
+  // As many tabs placed by hand as the even placement may put.
+  const auto max_tabs = static_cast<size_t>(spec_of<TabParams>("count").max);
+  if (p.positions.size() > max_tabs)
+    return "at most " + std::to_string(max_tabs) + " tabs may be placed";
   for (const auto& x : p.positions)
     if (!x.allFinite()) return "a tab's position is not a point";
-  if (!within(p.screw_diameter_mm, 1.0, 3.0))
-    return range_problem("screw holes' diameter", p.screw_diameter_mm, 1, 3);
-  if (p.countersink_diameter_mm != 0.0 &&
-      !within(p.countersink_diameter_mm, p.screw_diameter_mm + 0.2, 8.0))
-    return range_problem("countersinks' diameter", p.countersink_diameter_mm,
-                         p.screw_diameter_mm + 0.2, 8.0);
+  const ParamSpec countersink = spec_of<TabParams>("countersink_diameter_mm");
+  if (p.countersink_diameter_mm != 0.0 && p.countersink_diameter_mm < p.screw_diameter_mm + 0.2)
+    return countersink.problem(kWhose, p.countersink_diameter_mm, p.screw_diameter_mm + 0.2,
+                               countersink.max);
   const double head = std::max(p.countersink_diameter_mm, p.screw_diameter_mm);
+  const ParamSpec width = spec_of<TabParams>("width_mm");
   if (!std::isnan(p.width_mm) && head > p.width_mm - 1.0)
-    return range_problem("width", p.width_mm, head + 1.0, 15);
+    return width.problem(kWhose, p.width_mm, head + 1.0, width.max);
+  const ParamSpec thickness = spec_of<TabParams>("thickness_mm");
   if (!std::isnan(p.thickness_mm) && p.thickness_mm - countersink_depth(p) < 0.5)
-    return range_problem("thickness", p.thickness_mm, countersink_depth(p) + 0.5, 5) +
+    return thickness.problem(kWhose, p.thickness_mm, countersink_depth(p) + 0.5, thickness.max) +
            " (the countersink is " + std::to_string(countersink_depth(p)).substr(0, 4) +
            " mm deep)";
   // The innermost screw's head clear of the gap at the implant's edge (up to 3 mm).
   if (!std::isnan(p.width_mm)) {
     const double inner = screw_positions(p).back() - 0.5 * head;
+    const ParamSpec length = spec_of<TabParams>("length_mm");
     if (inner < 3.5)
-      return range_problem("length", p.length_mm, p.length_mm + 3.5 - inner, 25) +
+      return length.problem(kWhose, p.length_mm, p.length_mm + 3.5 - inner, length.max) +
              (p.screws == 2 ? " for two screws" : "");
   }
-  if (!within(p.midline_distance_mm, 0.0, 40.0))
-    return range_problem("distance from the midline", p.midline_distance_mm, 0, 40);
   if (p.midline && (!p.midline->normal.allFinite() || !std::isfinite(p.midline->offset) ||
                     std::abs(p.midline->normal.norm() - 1.0) > 1e-6))
     return "the midline plane for the tabs is not a plane";
-  if (!within(p.min_bone_mm, 0.0, 10.0))
-    return range_problem("bone thickness under the screws", p.min_bone_mm, 0, 10);
-  if (!within(p.voxel_mm, 0.05, 1.0)) return range_problem("grid", p.voxel_mm, 0.05, 1.0);
-  if (!(p.max_voxels >= 1e5 && p.max_voxels <= 5e7))
-    return "the tabs' grid must have 100,000 to 50,000,000 voxels";
   return {};
 }
 

@@ -14,7 +14,6 @@
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/voxelize_mesh.h"
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
-#include "param_ranges.h"
 
 namespace cranioplan {
 
@@ -32,10 +31,6 @@ constexpr double kRimRoundMm = 1.0;
 // drilled again, at most this many times.
 constexpr double kCornerMm = 0.8, kCornerNearMm = 2.0;
 constexpr int kDrillRounds = 3;
-
-std::string range_problem(const char* what, double v, double lo, double hi) {
-  return parameter_range_problem("the holes'", what, v, lo, hi);
-}
 
 // The implant's faces by the side they face: away from the inside point (outer), towards it
 // (inner), or across (the side wall).
@@ -113,17 +108,10 @@ std::vector<Eigen::Vector3d> pattern_centres(const Faces& f, const SurfaceLocato
 }  // namespace
 
 std::string perforation_problem(const PerforationParams& p) {
-  if (!within(p.diameter_mm, 1.0, 6.0)) return range_problem("diameter", p.diameter_mm, 1, 6);
-  if (!within(p.spacing_mm, 4.0, 40.0)) return range_problem("spacing", p.spacing_mm, 4, 40);
+  if (std::string problem = range_problems("the holes'", p); !problem.empty()) return problem;
+  const ParamSpec spacing = spec_of<PerforationParams>("spacing_mm");
   if (p.spacing_mm < p.diameter_mm + 2.0)
-    return range_problem("spacing", p.spacing_mm, p.diameter_mm + 2.0, 40);
-  if (!within(p.min_thickness_mm, 0.3, 10.0))
-    return range_problem("minimum thickness around them", p.min_thickness_mm, 0.3, 10);
-  if (!within(p.edge_distance_mm, 1.0, 20.0))
-    return range_problem("distance from the edge", p.edge_distance_mm, 1, 20);
-  if (!within(p.voxel_mm, 0.05, 1.0)) return range_problem("grid", p.voxel_mm, 0.05, 1.0);
-  if (!(p.max_voxels >= 1e5 && p.max_voxels <= 5e7))
-    return "the holes' grid must have 100,000 to 50,000,000 voxels";
+    return spacing.problem("the holes'", p.spacing_mm, p.diameter_mm + 2.0, spacing.max);
   if (p.added.size() > kMaxHoles || p.removed.size() > kMaxHoles)
     return "at most " + std::to_string(kMaxHoles) + " holes may be added or taken away";
   for (const auto& v : p.added)

@@ -21,6 +21,28 @@ const ImplantParams& automatic_implant() {
   static const ImplantParams p = AutoplanParams{}.implant;
   return p;
 }
+
+// A field for a declared parameter: its range, unit and meaning from its ParamSpec.
+QDoubleSpinBox* declared_spin(QWidget* parent, const char* name, const ParamSpec& s, double value,
+                              double step) {
+  auto* b = new QDoubleSpinBox(parent);
+  b->setObjectName(name);
+  b->setRange(s.min, s.max);
+  b->setSingleStep(step);
+  if (*s.unit) b->setSuffix(QStringLiteral(" ") + QString::fromUtf8(s.unit));
+  b->setToolTip(QString::fromUtf8(s.help));
+  b->setValue(value);
+  return b;
+}
+
+QSpinBox* declared_count(QWidget* parent, const char* name, const ParamSpec& s, int value) {
+  auto* b = new QSpinBox(parent);
+  b->setObjectName(name);
+  b->setRange(static_cast<int>(s.min), static_cast<int>(s.max));
+  b->setToolTip(QString::fromUtf8(s.help));
+  b->setValue(value);
+  return b;
+}
 }  // namespace
 
 BuildPage::BuildPage(PageHost& host) : StepPage(kBuildStep, host) {
@@ -159,12 +181,13 @@ void BuildPage::add_perforation_controls() {
   perforate_ = new QCheckBox(tr("Perforations on a pattern"), this);
   perforate_->setObjectName("perforate");
   perforate_->setToolTip(tr("Holes through the implant for drainage and dura suspension"));
-  hole_diameter_ = spin("holeDiameter", 1, 6, 0.5, " mm");
-  hole_diameter_->setValue(2.0);
-  hole_spacing_ = spin("holeSpacing", 4, 40, 1, " mm");
-  hole_spacing_->setValue(10.0);
-  hole_edge_ = spin("holeEdge", 1, 20, 0.5, " mm");
-  hole_edge_->setValue(5.0);
+  const PerforationParams holes;
+  hole_diameter_ = declared_spin(this, "holeDiameter", spec_of<PerforationParams>("diameter_mm"),
+                                 holes.diameter_mm, 0.5);
+  hole_spacing_ = declared_spin(this, "holeSpacing", spec_of<PerforationParams>("spacing_mm"),
+                                holes.spacing_mm, 1);
+  hole_edge_ = declared_spin(this, "holeEdge", spec_of<PerforationParams>("edge_distance_mm"),
+                             holes.edge_distance_mm, 0.5);
   add_hole_ = make_button(tr("Add a hole"), "addHole");
   remove_hole_ = make_button(tr("Remove a hole"), "removeHole");
   for (QPushButton* b : {add_hole_, remove_hole_}) {
@@ -188,15 +211,12 @@ void BuildPage::add_tab_controls() {
   tabs_->setToolTip(
       tr("Tabs onto the outer table with a countersunk screw hole each, away from thin bone "
          "and from the midline"));
-  tab_count_ = new QSpinBox(this);
-  tab_count_->setObjectName("tabCount");
-  tab_count_->setRange(0, 12);
+  const TabParams tabs;
+  tab_count_ = declared_count(this, "tabCount", spec_of<TabParams>("count"), tabs.count);
   tab_count_->setSpecialValueText(tr("one per 40 mm of rim"));
-  tab_screws_ = new QSpinBox(this);
-  tab_screws_->setObjectName("tabScrews");
-  tab_screws_->setRange(1, 2);
-  tab_length_ = spin("tabLength", 4, 25, 0.5, " mm");
-  tab_length_->setValue(TabParams{}.length_mm);
+  tab_screws_ = declared_count(this, "tabScrews", spec_of<TabParams>("screws"), tabs.screws);
+  tab_length_ =
+      declared_spin(this, "tabLength", spec_of<TabParams>("length_mm"), tabs.length_mm, 0.5);
   add_tab_ = make_button(tr("Add a tab"), "addTab");
   remove_tab_ = make_button(tr("Remove a tab"), "removeTab");
   add_tab_->setToolTip(tr("Then click the bone beyond the implant's edge"));

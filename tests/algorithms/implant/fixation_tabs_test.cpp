@@ -475,7 +475,7 @@ TEST(FixationTabs, ParametersOutOfRangeAreNamed) {
   p.length_mm = 20.0;
   EXPECT_EQ(tab_problem(resolved(p, 2.0)), "");
   p.screws = 3;
-  EXPECT_EQ(tab_problem(p), "a tab has one or two screws");
+  EXPECT_EQ(tab_problem(p), "the tabs' number of screws must be 1 to 2 (3 given)");
   p.screws = 1;
   p.thickness_mm = 0.6;
   p.countersink_diameter_mm = 3.4;

@@ -7,22 +7,44 @@
 #include <string>
 
 #include "cranioplan/model/mesh.h"
+#include "cranioplan/model/param_spec.h"
 
 namespace cranioplan {
 
+// The fields' ranges, units and meanings are declared in for_each_field below.
 struct MouldParams {
-  double wall_mm = 8.0;              ///< the block beyond the cavity, mm (4..30)
-  double key_diameter_mm = 5.0;      ///< the alignment keys' hemispheres, mm (2..12)
-  double key_clearance_mm = 0.2;     ///< sockets wider than the keys by this, mm (0..1)
-  double channel_diameter_mm = 5.0;  ///< the pour channel, mm (2..12)
-  double vent_diameter_mm = 2.0;     ///< the air vent, mm (1..6)
-  double voxel_mm = 0.2;             ///< grid of the halves, mm (0.05..1)
-  double max_voxels = 3e7;           ///< a large mould's grid is coarsened to this many voxels
+  double wall_mm = 8.0;
+  double key_diameter_mm = 5.0;
+  double key_clearance_mm = 0.2;
+  double channel_diameter_mm = 5.0;
+  double vent_diameter_mm = 2.0;
+  double voxel_mm = 0.2;
+  double max_voxels = 3e7;  ///< a large mould's grid is coarsened to this many voxels
   /// Field values within 1e-3 of the meshing's iso-level are moved that far off it (no sliver
   /// triangles); false: only a value exactly at it, as plans saved before this were meshed (set
   /// from the session command's version, not recorded).
   bool iso_gap = true;
 };
+/// MouldParams' fields, each declared once (ParamSpec), in the order a session writes them.
+template <class Visit>
+void for_each_field(Visit&& visit, MouldParams& p) {
+  visit(length_mm("wall_mm", "wall", 4, 30).with_option("wall", "the block beyond the cavity"),
+        p.wall_mm);
+  visit(length_mm("key_diameter_mm", "keys' diameter", 2, 12)
+            .with_option("key-diameter", "the alignment keys' hemispheres"),
+        p.key_diameter_mm);
+  visit(length_mm("key_clearance_mm", "keys' clearance", 0, 1)
+            .with_option("key-clearance", "sockets wider than the keys by this"),
+        p.key_clearance_mm);
+  visit(length_mm("channel_diameter_mm", "pour channel's diameter", 2, 12)
+            .with_option("channel-diameter", "the pour channel"),
+        p.channel_diameter_mm);
+  visit(length_mm("vent_diameter_mm", "vent's diameter", 1, 6)
+            .with_option("vent-diameter", "the air vent"),
+        p.vent_diameter_mm);
+  visit(length_mm("voxel_mm", "grid", 0.05, 1), p.voxel_mm);
+  visit(number("max_voxels", "number of grid voxels", 1e5, 1e8), p.max_voxels);
+}
 /// Why the parameters cannot be used (a value out of its range), or empty.
 std::string mould_problem(const MouldParams& p);
 

@@ -13,37 +13,35 @@
 
 #include "cranioplan/algorithms/implant/perforate.h"
 #include "cranioplan/model/mesh.h"
+#include "cranioplan/model/param_spec.h"
 #include "cranioplan/model/plane.h"
 
 namespace cranioplan {
 
 class SurfaceLocator;
 
+// The fields' ranges, units and meanings are declared in for_each_field below.
 struct TabParams {
   /// Tabs placed evenly along the rim (with `count`), unless `positions` are given.
   bool automatic = false;
-  /// How many tabs the even placement puts, 1..12; 0: one per 40 mm of rim (3 to 8).
-  int count = 0;
+  int count = 0;  ///< 0: one per 40 mm of rim (3 to 8)
   /// A tab at the rim point nearest each of these points (the user's tabs); when given, the
   /// even placement is not used.
   std::vector<Eigen::Vector3d> positions;
-  double length_mm = 9.0;  ///< how far a tab reaches beyond the implant's edge, mm (4..25)
-  /// Across, mm (3..15; its far end is round); NaN: the countersink (or hole) with a ring of the
-  /// material's minimum thickness plus 0.5 mm on either side, at least 6 mm.
+  double length_mm = 9.0;
+  /// NaN: the countersink (or hole) with a ring of the material's minimum thickness plus 0.5 mm
+  /// on either side, at least 6 mm. Its far end is round.
   double width_mm = std::numeric_limits<double>::quiet_NaN();
-  /// Of the tab, mm (0.5..5); NaN: the material's minimum thickness under the countersink plus
-  /// 0.4 mm, at least 1.5 mm (without a material, a minimum of 1 mm).
+  /// NaN: the material's minimum thickness under the countersink plus 0.4 mm, at least 1.5 mm
+  /// (without a material, a minimum of 1 mm).
   double thickness_mm = std::numeric_limits<double>::quiet_NaN();
-  int screws = 1;                        ///< per tab, 1 or 2 (two lie along the tab)
-  double screw_diameter_mm = 1.8;        ///< hole for the screw's shank, mm (1..3)
-  double countersink_diameter_mm = 3.0;  ///< at the tab's top (90°), mm (0: none; else > the hole)
-  /// The even placement keeps the tabs this far from the midsagittal plane (the superior
-  /// sagittal sinus lies under the midline), mm (0..40); used with `midline`.
-  double midline_distance_mm = 10.0;
-  std::optional<Plane> midline;  ///< the plan's midsagittal plane
-  /// The even placement puts screws only into bone at least this thick, mm (0..10).
+  int screws = 1;                        ///< two lie along the tab
+  double screw_diameter_mm = 1.8;        ///< the hole for the screw's shank
+  double countersink_diameter_mm = 3.0;  ///< 90°; 0: none, else wider than the hole
+  double midline_distance_mm = 10.0;     ///< used with `midline`
+  std::optional<Plane> midline;          ///< the plan's midsagittal plane
   double min_bone_mm = 2.0;
-  double voxel_mm = 0.2;      ///< grid of the union, mm (0.05..1)
+  double voxel_mm = 0.2;
   double max_voxels = 1.2e7;  ///< a large implant's grid is coarsened to this many voxels
   /// Field values within 1e-3 of the meshing's iso-level are moved that far off it (no sliver
   /// triangles); false: only a value exactly at it, as plans saved before this were meshed (set
@@ -72,6 +70,54 @@ struct TabParams {
   bool keep_on_bone = true;
   bool any() const { return automatic || !positions.empty(); }
 };
+/// TabParams' fields, each declared once (ParamSpec), in the order a session writes them.
+template <class Visit>
+void for_each_field(Visit&& visit, TabParams& p) {
+  visit(field("automatic")
+            .with_option("tabs",
+                         "fixation tabs onto the outer table, evenly along the rim "
+                         "(away from thin bone and the midline)"),
+        p.automatic);
+  visit(number("count", "count", 0, 12)
+            .with_option("tab-count", "how many tabs (0: one per 40 mm of rim)"),
+        p.count);
+  visit(field("positions"), p.positions);
+  visit(length_mm("length_mm", "length", 4, 25)
+            .with_option("tab-length", "beyond the implant's edge"),
+        p.length_mm);
+  visit(length_mm("width_mm", "width", 3, 15)
+            .with_option("tab-width",
+                         "of the tabs; default: the countersink with a ring of the material's "
+                         "minimum thickness + 0.5 mm, at least 6")
+            .unset_derived(),
+        p.width_mm);
+  visit(length_mm("thickness_mm", "thickness", 0.5, 5)
+            .with_option("tab-thickness",
+                         "of the tabs; default: the material's minimum under the countersink "
+                         "+ 0.4 mm, at least 1.5")
+            .unset_derived(),
+        p.thickness_mm);
+  visit(number("screws", "number of screws", 1, 2)
+            .with_option("tab-screws", "screws per tab (1 or 2, along the tab)"),
+        p.screws);
+  visit(length_mm("screw_diameter_mm", "screw holes' diameter", 1, 3)
+            .with_option("screw-diameter", "the screw holes'"),
+        p.screw_diameter_mm);
+  visit(
+      length_mm("countersink_diameter_mm", "countersinks' diameter", 0, 8)
+          .with_option("countersink", "the countersinks' diameter at the tab's top, 90° (0: none)"),
+      p.countersink_diameter_mm);
+  visit(length_mm("midline_distance_mm", "distance from the midline", 0, 40)
+            .with_option("tab-midline-distance",
+                         "tabs at least this far from the midsagittal plane (the sagittal sinus)"),
+        p.midline_distance_mm);
+  visit(field("midline"), p.midline);
+  visit(length_mm("min_bone_mm", "bone thickness under the screws", 0, 10)
+            .with_option("tab-min-bone", "screws only into bone at least this thick"),
+        p.min_bone_mm);
+  visit(length_mm("voxel_mm", "grid", 0.05, 1), p.voxel_mm);
+  visit(number("max_voxels", "number of grid voxels", 1e5, 5e7), p.max_voxels);
+}
 /// Why the parameters cannot be used (a value out of its range), or empty.
 std::string tab_problem(const TabParams& p);
 

@@ -9,25 +9,26 @@
 #include <vector>
 
 #include "cranioplan/model/mesh.h"
+#include "cranioplan/model/param_spec.h"
 
 namespace cranioplan {
 
+// The fields' ranges, units and meanings are declared in for_each_field below.
 struct PerforationParams {
-  bool pattern = false;      ///< holes on a hexagonal pattern over the implant
-  double diameter_mm = 2.0;  ///< of every hole, mm (1..6)
-  double spacing_mm = 10.0;  ///< between the pattern's holes, mm (4..40)
-  double edge_distance_mm =
-      5.0;  ///< pattern holes' centres at least this far from the edge, mm (1..20)
-  /// Pattern holes only where the implant is at least this thick plus 1 mm, mm (0.3..10; the
-  /// material's minimum thickness when built with one): the rim of a hole through thinner
-  /// material is thinner still where the surface curves.
+  bool pattern = false;
+  double diameter_mm = 2.0;
+  double spacing_mm = 10.0;
+  double edge_distance_mm = 5.0;
+  /// Pattern holes only where the implant is at least this thick plus 1 mm (the material's
+  /// minimum thickness when built with one): the rim of a hole through thinner material is
+  /// thinner still where the surface curves.
   double min_thickness_mm = 1.0;
   /// Single holes at these points (each moved onto the implant's surface); a pattern hole
   /// within half the spacing of one gives way to it.
   std::vector<Eigen::Vector3d> added;
   /// Pattern holes within half the spacing of these points are left out.
   std::vector<Eigen::Vector3d> removed;
-  double voxel_mm = 0.2;      ///< grid of the drilling, mm (0.05..1; at most a quarter diameter)
+  double voxel_mm = 0.2;      ///< at most a quarter of the diameter
   double max_voxels = 1.2e7;  ///< a large implant's grid is coarsened to this many voxels
   /// Field values within 1e-3 of the meshing's iso-level are moved that far off it (no sliver
   /// triangles); false: only a value exactly at it, as plans saved before this were meshed (set
@@ -52,6 +53,31 @@ struct PerforationParams {
   bool sound_rims = true;
   bool any() const { return pattern || !added.empty(); }
 };
+/// PerforationParams' fields, each declared once (ParamSpec), in the order a session writes
+/// them.
+template <class Visit>
+void for_each_field(Visit&& visit, PerforationParams& p) {
+  visit(field("pattern").with_option(
+            "perforate",
+            "drill holes on a hexagonal pattern through the implant (drainage, dura suspension)"),
+        p.pattern);
+  visit(length_mm("diameter_mm", "diameter", 1, 6)
+            .with_option("hole-diameter", "diameter of the holes"),
+        p.diameter_mm);
+  visit(length_mm("spacing_mm", "spacing", 4, 40)
+            .with_option("hole-spacing", "between the pattern's holes"),
+        p.spacing_mm);
+  visit(length_mm("edge_distance_mm", "distance from the edge", 1, 20)
+            .with_option("hole-edge-distance",
+                         "the pattern's holes at least this far from the implant's edge"),
+        p.edge_distance_mm);
+  visit(length_mm("min_thickness_mm", "minimum thickness around them", 0.3, 10),
+        p.min_thickness_mm);
+  visit(length_mm("voxel_mm", "grid", 0.05, 1), p.voxel_mm);
+  visit(number("max_voxels", "number of grid voxels", 1e5, 5e7), p.max_voxels);
+  visit(field("added"), p.added);
+  visit(field("removed"), p.removed);
+}
 /// Why the parameters cannot be used (a value out of its range), or empty.
 std::string perforation_problem(const PerforationParams& p);
 
