@@ -776,16 +776,9 @@ bool apply_proposal_result(PlanState& s, const Json& j, const std::string& where
 // SHA-256 (a SessionError naming the file when it changed), and how it was fitted and weighed:
 // version 7 recorded neither and is read with what it was made with (weight 0.5, 10 mm margin,
 // 1 mm noise, a poor fit over 1.0 mm or under half paired).
-ShapeModel recorded_shape_model(const ParamReader& r, const ApplyContext& ctx,
-                                ProposeParams& params, ShapePriorParams& prior) {
+// How the model a propose_markers command names was fitted and weighed, as recorded.
+void recorded_prior(const ParamReader& r, ProposeParams& params, ShapePriorParams& prior) {
   const ParamReader model(r.value("shape_model"), r.where() + " shape_model");
-  const std::string path = resolve_input(model.string("path"), ctx, "shape model");
-  const std::string bytes = read_file_bytes(path);
-  const std::string sha = sha256_hex(bytes), expected = model.string("sha256");
-  if (sha != expected)
-    throw SessionError(path, "the shape model changed since this plan was made (SHA-256 " +
-                                 sha.substr(0, 12) + "… now, " + expected.substr(0, 12) +
-                                 "… recorded)");
   auto number_or = [&](const char* name, double version7) {
     return model.has(name) ? model.number(name) : version7;
   };
@@ -794,19 +787,32 @@ ShapeModel recorded_shape_model(const ParamReader& r, const ApplyContext& ctx,
   prior.fit.noise_mm = number_or("noise_mm", 1.0);
   prior.fit.max_rms_mm = number_or("max_rms_mm", 1.0);
   prior.fit.min_paired = number_or("min_paired", 0.5);
+}
+
+ShapeModel recorded_shape_model(const ParamReader& r, const ApplyContext& ctx) {
+  const ParamReader model(r.value("shape_model"), r.where() + " shape_model");
+  const std::string path = resolve_input(model.string("path"), ctx, "shape model");
+  const std::string bytes = read_file_bytes(path);
+  const std::string sha = sha256_hex(bytes), expected = model.string("sha256");
+  if (sha != expected)
+    throw SessionError(path, "the shape model changed since this plan was made (SHA-256 " +
+                                 sha.substr(0, 12) + "… now, " + expected.substr(0, 12) +
+                                 "… recorded)");
   return parse_shape_model(bytes, path);
 }
 
 void apply_propose(PlanState& s, const ParamReader& r, const ApplyContext& ctx, Json& record) {
   ProposeParams params;
   params_from_json(ParamReader(r.value("params"), r.where() + " params"), params);
+  ShapePriorParams prior;
+  if (r.has("shape_model")) recorded_prior(r, params, prior);
+  const ProposeParams asked = params;
   if (!r.has("result")) {
     take_scan_borders(params.detect, s.skull->surface->loaded.report);
     const SurfaceLocator& bone = s.skull->surface->locator;
     const SurfaceLocator& mirror = s.mirrored ? s.mirrored->locator : bone;
     if (r.has("shape_model")) {
-      ShapePriorParams prior;
-      const ShapeModel model = recorded_shape_model(r, ctx, params, prior);
+      const ShapeModel model = recorded_shape_model(r, ctx);
       const DefectRegion defect =
           detect_defect_near_plane(s.skull->surface->mesh, bone, *s.plane, params.detect);
       record["result"] = proposal_result(propose_markers_with_model(
@@ -818,6 +824,8 @@ void apply_propose(PlanState& s, const ParamReader& r, const ApplyContext& ctx, 
   }
   const Json& result = r.has("result") ? r.value("result") : record["result"];
   if (!apply_proposal_result(s, result, r.where() + " result")) return;
+  s.proposal_params = asked;
+  s.proposal_prior = prior;
   // Where the replay finds it (beside the session when moved with it); as recorded when gone.
   s.proposal_shape_model.clear();
   if (r.has("shape_model")) {

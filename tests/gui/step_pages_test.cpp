@@ -226,9 +226,19 @@ TEST(StepPages, AReopenedPlanShowsTheModelItsProposalUsed) {
   EXPECT_TRUE(use->isChecked());
   EXPECT_EQ(child<QLabel>(page, "shapeModelFile")->text(), "cranioplan_plan_model.cpsm");
   EXPECT_FALSE(QSettings().value("shapeModel/use").toBool());
+  // Proposed again as the plan's proposal was asked: its model's weight and fit as recorded.
+  host.state.proposal_params.shape_model_weight = 1.0;
+  host.state.proposal_params.surface_spacing_mm = 5.0;
+  host.state.proposal_prior.margin_mm = 15.0;
+  host.state.proposal_prior.fit.max_rms_mm = 0.8;
   click(page, "propose");
   ASSERT_EQ(host.pushed.back().type, CommandType::ProposeMarkers);
-  EXPECT_EQ(host.pushed.back().params["shape_model"]["path"], model.string());
+  const Json& asked = host.pushed.back().params;
+  EXPECT_EQ(asked["shape_model"]["path"], model.string());
+  EXPECT_EQ(asked["shape_model"]["weight"], 1.0);
+  EXPECT_EQ(asked["shape_model"]["margin_mm"], 15.0);
+  EXPECT_EQ(asked["shape_model"]["max_rms_mm"], 0.8);
+  EXPECT_EQ(asked["params"]["surface_spacing_mm"], 5.0);
   // Unticked by the user: the same proposal shown again leaves it so.
   use->setChecked(false);
   page.show_state(host.state);

@@ -112,6 +112,18 @@ TEST(AutoplanSession, AShapeModelIsRecordedAsAnInputAndVerified) {
     const Json by_half = markers_of(half);
     EXPECT_EQ(markers_of(seven), by_half);
     EXPECT_NE(markers_of(whole), by_half);
+    // The plan keeps what its proposal was asked (the wizard proposes again with it), read from
+    // the recorded command without the model's file.
+    Command recorded = s.effective_commands()[*at];
+    recorded.params["shape_model"]["weight"] = 0.75;
+    recorded.params["shape_model"]["margin_mm"] = 12.0;
+    recorded.params["params"]["surface_spacing_mm"] = 5.0;
+    const ApplyOutcome out = apply_command(s.state_at(*at), recorded);
+    ASSERT_TRUE(out.accepted) << out.message;
+    EXPECT_EQ(out.state.proposal_params.shape_model_weight, 0.75);
+    EXPECT_EQ(out.state.proposal_params.surface_spacing_mm, 5.0);
+    EXPECT_EQ(out.state.proposal_prior.margin_mm, 12.0);
+    EXPECT_EQ(out.state.proposal_prior.fit.noise_mm, ShapePriorParams{}.fit.noise_mm);
   }
 
   // The model changed after the plan: verify says so, naming it.

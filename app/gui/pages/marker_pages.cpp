@@ -67,10 +67,14 @@ EdgeMarkersPage::EdgeMarkersPage(PageHost& host)
     : MarkersPage(kEdgeMarkersStep, host, MarkerType::OuterEdge, MarkerType::InnerEdge) {
   QPushButton* propose = add_button(tr("Propose markers automatically"), "propose");
   connect(propose, &QPushButton::clicked, this, [this] {
-    // With several openings in the skull, the one where the user has put edge markers is
-    // meant (otherwise the largest).
-    ProposeParams params;
-    params.detect.near = edge_marker_centre(host_.plan().markers);
+    // Proposed again, as the last proposal was asked (its model weighed and fitted as
+    // recorded); with several openings in the skull, the one where the user has put edge
+    // markers is meant (otherwise the largest).
+    const PlanState& plan = host_.plan();
+    const bool again = !plan.proposal_message.empty();
+    ProposeParams params = again ? plan.proposal_params : ProposeParams{};
+    const ShapePriorParams prior = again ? plan.proposal_prior : ShapePriorParams{};
+    params.detect.near = edge_marker_centre(plan.markers);
     const std::string model = shape_model_path();
     if (!model.empty() && !QFileInfo::exists(QString::fromStdString(model))) {
       proposal_note_->setText(tr("The shape model %1 is missing: choose it again, or untick "
@@ -81,7 +85,7 @@ EdgeMarkersPage::EdgeMarkersPage(PageHost& host)
     }
     Command propose;
     try {
-      propose = commands::propose_markers(params, model);  // hashes the model's file
+      propose = commands::propose_markers(params, model, "", prior);  // hashes the model's file
     } catch (const Error& e) {
       proposal_note_->setText(tr("The shape model could not be read: %1").arg(e.what()));
       proposal_note_->setVisible(true);

@@ -148,6 +148,11 @@ struct PlanState {
   std::string proposal_message;
   /// From the last proposal: the shape model file it was guided by, as recorded (empty: none).
   std::string proposal_shape_model;
+  /// From the last proposal: the parameters it was made with, and how its shape model was
+  /// fitted and weighed (the defaults without one), as recorded: a proposal made again in the
+  /// wizard asks the same.
+  ProposeParams proposal_params;
+  ShapePriorParams proposal_prior;
   /// From the last proposal: stretches of the rim no ray saw, where the outline between the
   /// edge markers is interpolated (the view draws them for the surgeon to check).
   std::vector<RimStretch> unseen_rim;
