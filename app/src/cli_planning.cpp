@@ -64,19 +64,14 @@ void add_material_options(CLI::App* cmd, MaterialOptions& o, bool for_check) {
                   "what the implant is made of: " + presets +
                       " or custom (its thickness, minimum thickness, edge clearance, "
                       "under-contour and density; the values below change them)");
-  cmd->add_option("--clearance", o.clearance, "gap between the implant's edge and the bone (mm)")
-      ->check(CLI::Range(0.0, 3.0));
+  // Each changes the preset's value only when given.
+  add_declared_option(cmd, spec_of<Material>("edge_clearance_mm"), o.clearance);
   if (!for_check) {
-    cmd->add_option("--under-contour", o.under_contour,
-                    "outer surface set this far below the skull's (mm)")
-        ->check(CLI::Range(0.0, 1.0));
-    cmd->add_option("--min-thickness", o.min_thickness, "the material's thinnest wall (mm)")
-        ->check(CLI::Range(0.3, 10.0));
-    cmd->add_option("--plate-thickness", o.plate_thickness,
-                    "a plate of this thickness instead of the bone's (mm)")
-        ->check(CLI::Range(0.3, 15.0));
+    add_declared_option(cmd, spec_of<Material>("under_contour_mm"), o.under_contour);
+    add_declared_option(cmd, spec_of<Material>("min_thickness_mm"), o.min_thickness);
+    add_declared_option(cmd, spec_of<Material>("thickness_mm"), o.plate_thickness);
   }
-  cmd->add_option("--density", o.density, "for the mass (g/cm³)")->check(CLI::Range(0.1, 25.0));
+  add_declared_option(cmd, spec_of<Material>("density_g_cm3"), o.density);
   cmd->add_option("--clearance-zone", o.zones,
                   "X,Y,Z,RADIUS,MM: the rim within RADIUS mm of the point held MM off the bone "
                   "(repeatable)");
@@ -149,6 +144,11 @@ void add_declared_option(CLI::App* cmd, const ParamSpec& s, int& value, const st
 void add_declared_option(CLI::App* cmd, const ParamSpec& s, bool& value,
                          const std::string& prefix) {
   cmd->add_flag("--" + prefix + s.option, value, s.help);
+}
+
+void add_declared_option(CLI::App* cmd, const ParamSpec& s, std::optional<double>& value) {
+  cmd->add_option("--" + std::string(s.option), value, declared_help(s))
+      ->check(CLI::Range(s.min, s.max));
 }
 
 void add_hole_options(CLI::App* cmd, HoleOptions& o) {

@@ -41,6 +41,8 @@ void add_declared_option(CLI::App* cmd, const ParamSpec& s, double& value,
                          const std::string& prefix);
 void add_declared_option(CLI::App* cmd, const ParamSpec& s, int& value, const std::string& prefix);
 void add_declared_option(CLI::App* cmd, const ParamSpec& s, bool& value, const std::string& prefix);
+/// An option that changes `s`'s value only when given (a material preset's).
+void add_declared_option(CLI::App* cmd, const ParamSpec& s, std::optional<double>& value);
 /// The options `params`' type declares (for_each_field), bound to its fields.
 template <class P>
 void add_declared_options(CLI::App* cmd, P& params, const std::string& prefix = "") {

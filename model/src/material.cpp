@@ -28,14 +28,6 @@ std::string lower(std::string s) {
   return s;
 }
 
-bool within(double v, double lo, double hi) { return std::isfinite(v) && v >= lo && v <= hi; }
-
-std::string range_problem(const char* what, double v, double lo, double hi, const char* unit) {
-  char buf[160];
-  std::snprintf(buf, sizeof(buf), "%s must be %g to %g %s (%g given)", what, lo, hi, unit, v);
-  return buf;
-}
-
 }  // namespace
 
 const std::vector<Material>& material_presets() {
@@ -59,22 +51,15 @@ std::optional<Material> material_preset(const std::string& id_or_name) {
 }
 
 std::string material_problem(const Material& m) {
-  if (!std::isnan(m.thickness_mm) && !within(m.thickness_mm, 0.3, 15.0))
-    return range_problem("the thickness", m.thickness_mm, 0.3, 15.0, "mm");
-  if (!within(m.min_thickness_mm, 0.3, 10.0))
-    return range_problem("the minimum thickness", m.min_thickness_mm, 0.3, 10.0, "mm");
+  if (std::string problem = range_problems("the", m); !problem.empty()) return problem;
   if (!std::isnan(m.thickness_mm) && m.thickness_mm < m.min_thickness_mm)
-    return range_problem("the thickness", m.thickness_mm, m.min_thickness_mm, 15.0,
-                         "mm (not below the minimum thickness)");
-  if (!within(m.edge_clearance_mm, 0.0, 3.0))
-    return range_problem("the edge clearance", m.edge_clearance_mm, 0.0, 3.0, "mm");
-  if (!within(m.under_contour_mm, 0.0, 1.0))
-    return range_problem("the under-contour", m.under_contour_mm, 0.0, 1.0, "mm");
-  if (!within(m.density_g_cm3, 0.1, 25.0))
-    return range_problem("the density", m.density_g_cm3, 0.1, 25.0, "g/cm³");
+    return spec_of<Material>("thickness_mm")
+               .problem("the", m.thickness_mm, m.min_thickness_mm,
+                        spec_of<Material>("thickness_mm").max) +
+           " (not below the minimum thickness)";
   if (m.onlay_mm != 0.0) {
-    if (!within(m.onlay_mm, 3.0, 20.0))
-      return range_problem("the onlay's overlap", m.onlay_mm, 3.0, 20.0, "mm");
+    const ParamSpec onlay = spec_of<Material>("onlay_mm");
+    if (m.onlay_mm < 3.0) return onlay.problem("the", m.onlay_mm, 3.0, onlay.max);
     if (std::isnan(m.thickness_mm)) return "a plate laid on the bone needs a thickness";
     if (m.edge_clearance_mm > 0.0 || m.under_contour_mm > 0.0)
       return "a plate laid on the bone has no edge clearance or under-contour";
@@ -102,11 +87,7 @@ std::string describe(const Material& m) {
 
 std::string zone_problem(const ClearanceZone& z) {
   if (!z.center.allFinite()) return "the zone's centre is not a point";
-  if (!within(z.radius_mm, 1.0, 100.0))
-    return range_problem("the zone's radius", z.radius_mm, 1.0, 100.0, "mm");
-  if (!within(z.clearance_mm, 0.0, 3.0))
-    return range_problem("the zone's clearance", z.clearance_mm, 0.0, 3.0, "mm");
-  return {};
+  return range_problems("the", z);
 }
 
 double clearance_at(const Eigen::Vector3d& p, double base_mm,

@@ -351,6 +351,8 @@ struct DeclaredWriter {
   void operator()(const ParamSpec& s, const double& v) { j[s.key] = number_or_null(v); }
   void operator()(const ParamSpec& s, const int& v) { j[s.key] = v; }
   void operator()(const ParamSpec& s, const bool& v) { j[s.key] = v; }
+  void operator()(const ParamSpec& s, const std::string& v) { j[s.key] = v; }
+  void operator()(const ParamSpec& s, const Eigen::Vector3d& v) { j[s.key] = to_json(v); }
   void operator()(const ParamSpec& s, const std::vector<Eigen::Vector3d>& points) {
     Json list = Json::array();
     for (const auto& v : points) list.push_back(to_json(v));
@@ -368,6 +370,8 @@ struct DeclaredReader {
   void operator()(const ParamSpec& s, double& v) { v = r.number(s.key); }
   void operator()(const ParamSpec& s, int& v) { v = r.integer(s.key); }
   void operator()(const ParamSpec& s, bool& v) { v = r.boolean(s.key); }
+  void operator()(const ParamSpec& s, std::string& v) { v = r.string(s.key); }
+  void operator()(const ParamSpec& s, Eigen::Vector3d& v) { v = r.vector3(s.key); }
   void operator()(const ParamSpec& s, std::vector<Eigen::Vector3d>& points) {
     const Json& list = r.value(s.key);
     if (!list.is_array()) throw SessionError(r.where(), std::string(s.key) + " must be a list");
@@ -413,45 +417,20 @@ PerforationParams perforations_from_json(const ParamReader& r) {
   return declared_from_json(r, &perforation_problem);
 }
 
-Json to_json(const Material& m) {
-  return Json{{"id", m.id},
-              {"name", m.name},
-              {"thickness_mm", std::isnan(m.thickness_mm) ? Json(nullptr) : Json(m.thickness_mm)},
-              {"min_thickness_mm", m.min_thickness_mm},
-              {"edge_clearance_mm", m.edge_clearance_mm},
-              {"under_contour_mm", m.under_contour_mm},
-              {"density_g_cm3", m.density_g_cm3},
-              {"onlay_mm", m.onlay_mm}};
-}
+Json to_json(const Material& m) { return declared_to_json(m); }
 
-Json to_json(const ClearanceZone& z) {
-  return Json{
-      {"center", to_json(z.center)}, {"radius_mm", z.radius_mm}, {"clearance_mm", z.clearance_mm}};
-}
+Json to_json(const ClearanceZone& z) { return declared_to_json(z); }
 
 Material material_from_json(const ParamReader& r) {
   Material m;
-  m.id = r.string("id");
-  m.name = r.string("name");
-  m.thickness_mm = r.number("thickness_mm");  // null: follows the bone
-  m.min_thickness_mm = r.number("min_thickness_mm");
-  m.edge_clearance_mm = r.number("edge_clearance_mm");
-  m.under_contour_mm = r.number("under_contour_mm");
-  m.density_g_cm3 = r.number("density_g_cm3");
-  m.onlay_mm = r.number("onlay_mm");
+  for_each_field(DeclaredReader{r}, m);
   if (const std::string problem = material_problem(m); !problem.empty())
     throw SessionError(r.where(), "material " + m.name + ": " + problem);
   return m;
 }
 
 ClearanceZone clearance_zone_from_json(const ParamReader& r) {
-  ClearanceZone z;
-  z.center = r.vector3("center");
-  z.radius_mm = r.number("radius_mm");
-  z.clearance_mm = r.number("clearance_mm");
-  if (const std::string problem = zone_problem(z); !problem.empty())
-    throw SessionError(r.where(), problem);
-  return z;
+  return declared_from_json(r, &zone_problem);
 }
 
 void params_from_json(const ParamReader& r, ExtractBoneSurfaceParams& p) {

@@ -309,6 +309,11 @@ TEST(Commands, ManufacturingParametersAreWrittenAndCheckedAsDeclared) {
   expect_written_as_declared<PerforationParams>(to_json(holes), &options);
   std::set<std::string> mould_options;
   expect_written_as_declared<MouldParams>(to_json(MouldParams{}), &mould_options);
+  expect_written_as_declared<Material>(to_json(*material_preset("peek")), &options);
+  expect_written_as_declared<ClearanceZone>(to_json(ClearanceZone{}), &options);
+  for (const Material& m : material_presets()) EXPECT_EQ(material_problem(m), "") << m.name;
+  EXPECT_EQ(to_json(material_from_json(ParamReader(to_json(*material_preset("titanium")), "t"))),
+            to_json(*material_preset("titanium")));
 
   const TabParams tabs_back = tabs_from_json(ParamReader(to_json(tabs), "test"));
   EXPECT_EQ(to_json(tabs_back), to_json(tabs));

@@ -22,6 +22,13 @@ const ImplantParams& automatic_implant() {
   return p;
 }
 
+// A declared parameter's help as a tooltip: a sentence.
+QString tooltip(const ParamSpec& s) {
+  QString text = QString::fromUtf8(s.help);
+  if (!text.isEmpty()) text[0] = text[0].toUpper();
+  return text;
+}
+
 // A field for a declared parameter: its range, unit and meaning from its ParamSpec.
 QDoubleSpinBox* declared_spin(QWidget* parent, const char* name, const ParamSpec& s, double value,
                               double step) {
@@ -30,7 +37,7 @@ QDoubleSpinBox* declared_spin(QWidget* parent, const char* name, const ParamSpec
   b->setRange(s.min, s.max);
   b->setSingleStep(step);
   if (*s.unit) b->setSuffix(QStringLiteral(" ") + QString::fromUtf8(s.unit));
-  b->setToolTip(QString::fromUtf8(s.help));
+  b->setToolTip(tooltip(s));
   b->setValue(value);
   return b;
 }
@@ -39,7 +46,7 @@ QSpinBox* declared_count(QWidget* parent, const char* name, const ParamSpec& s, 
   auto* b = new QSpinBox(parent);
   b->setObjectName(name);
   b->setRange(static_cast<int>(s.min), static_cast<int>(s.max));
-  b->setToolTip(QString::fromUtf8(s.help));
+  b->setToolTip(tooltip(s));
   b->setValue(value);
   return b;
 }
@@ -54,16 +61,6 @@ BuildPage::BuildPage(PageHost& host) : StepPage(kBuildStep, host) {
   add_perforation_controls();
   add_tab_controls();
   watch_controls();
-}
-
-QDoubleSpinBox* BuildPage::spin(const char* name, double lo, double hi, double step,
-                                const QString& suffix) {
-  auto* b = new QDoubleSpinBox(this);
-  b->setObjectName(name);
-  b->setRange(lo, hi);
-  b->setSingleStep(step);
-  b->setSuffix(suffix);
-  return b;
 }
 
 void BuildPage::add_build_and_result() {
@@ -132,14 +129,22 @@ void BuildPage::add_material_controls() {
   material_->addItem(tr("None (the plan's surfaces)"));
   for (const Material& m : material_presets()) material_->addItem(QString::fromStdString(m.name));
   material_->addItem(tr("Custom"));
-  clearance_ = spin("materialClearance", 0, 3, 0.1, " mm");
-  clearance_->setToolTip(tr("Gap left between the implant's edge and the bone's cut edge"));
-  under_contour_ = spin("materialUnderContour", 0, 1, 0.1, " mm");
-  under_contour_->setToolTip(tr("The outer surface set this far below the skull's"));
-  min_thickness_ = spin("materialMinThickness", 0.3, 10, 0.1, " mm");
-  plate_ = spin("materialPlate", 0, 15, 0.1, " mm");
+  const Material custom;
+  clearance_ = declared_spin(this, "materialClearance", spec_of<Material>("edge_clearance_mm"),
+                             custom.edge_clearance_mm, 0.1);
+  under_contour_ =
+      declared_spin(this, "materialUnderContour", spec_of<Material>("under_contour_mm"),
+                    custom.under_contour_mm, 0.1);
+  min_thickness_ =
+      declared_spin(this, "materialMinThickness", spec_of<Material>("min_thickness_mm"),
+                    custom.min_thickness_mm, 0.1);
+  // Left unset (its lowest value, 0) the implant follows the bone.
+  plate_ = declared_spin(this, "materialPlate", spec_of<Material>("thickness_mm"), 0.0, 0.1);
+  plate_->setMinimum(0.0);
+  plate_->setValue(0.0);
   plate_->setSpecialValueText(tr("follows the bone"));
-  density_ = spin("materialDensity", 0.1, 25, 0.01, " g/cm³");
+  density_ = declared_spin(this, "materialDensity", spec_of<Material>("density_g_cm3"),
+                           custom.density_g_cm3, 0.01);
   form_->addRow(tr("Material"), material_);
   form_->addRow(tr("Edge clearance"), clearance_);
   form_->addRow(tr("Under-contour"), under_contour_);
@@ -160,10 +165,11 @@ void BuildPage::add_zone_controls() {
   mark_zone_->setToolTip(
       tr("Then click the rim: the stretch within the radius keeps the zone's "
          "clearance (e.g. 3 mm under the temporalis muscle)"));
-  zone_radius_ = spin("zoneRadius", 1, 100, 1, " mm");
-  zone_radius_->setValue(15);
-  zone_clearance_ = spin("zoneClearance", 0, 3, 0.1, " mm");
-  zone_clearance_->setValue(3);
+  const ClearanceZone zone;
+  zone_radius_ =
+      declared_spin(this, "zoneRadius", spec_of<ClearanceZone>("radius_mm"), zone.radius_mm, 1);
+  zone_clearance_ = declared_spin(this, "zoneClearance", spec_of<ClearanceZone>("clearance_mm"),
+                                  zone.clearance_mm, 0.1);
   remove_zone_ = make_button(tr("Remove the last zone"), "removeZone");
   connect(remove_zone_, &QPushButton::clicked, this, [this] {
     if (zones_.empty()) return;

@@ -162,7 +162,6 @@ class BuildPage : public StepPage {
   void add_tab_controls();
   /// Any control changed after a build marks the implant shown as not what the controls say.
   void watch_controls();
-  QDoubleSpinBox* spin(const char* name, double lo, double hi, double step, const QString& suffix);
   ImplantParams params() const;
   /// The chosen preset's values into the fields (none: the fields off).
   void show_material(int index);

@@ -9,25 +9,51 @@
 #include <string>
 #include <vector>
 
+#include "cranioplan/model/param_spec.h"
+
 namespace cranioplan {
 
+// The fields' ranges, units and meanings are declared in for_each_field below.
 struct Material {
   std::string id = "custom";    ///< preset id ("peek", "pmma", "titanium") or "custom"
   std::string name = "custom";  ///< as shown and printed ("PEEK", …)
-  /// The implant's thickness, mm (0.3..15); NaN: it follows the bone (the inner surface of the
-  /// plan, from the inner markers or the bone's thickness around the rim).
+  /// NaN: the implant follows the bone (the inner surface of the plan, from the inner markers or
+  /// the bone's thickness around the rim).
   double thickness_mm = std::numeric_limits<double>::quiet_NaN();
-  double min_thickness_mm = 1.0;  ///< thinner is not printable, mm (0.3..10)
-  /// The implant's edge is held this far back from the bone's cut edge, mm (0..3).
+  double min_thickness_mm = 1.0;
   double edge_clearance_mm = 0.0;
-  /// The outer surface is set this far below the skull's outer surface, mm (0..1).
   double under_contour_mm = 0.0;
-  double density_g_cm3 = 1.0;  ///< for the implant's mass, g/cm³ (0.1..25)
+  double density_g_cm3 = 1.0;
   /// A plate laid on the bone (onlay): it covers the opening at the skull's outer surface and
-  /// reaches this far beyond the rim over the outer table, mm (3..20; needs a thickness, and no
-  /// clearance or under-contour). 0: the implant fills the opening (inlay).
+  /// reaches this far beyond the rim over the outer table (3 mm or more; needs a thickness, and
+  /// no clearance or under-contour). 0: the implant fills the opening (inlay).
   double onlay_mm = 0.0;
 };
+
+/// Material's fields, each declared once (ParamSpec), in the order a session writes them.
+template <class Visit>
+void for_each_field(Visit&& visit, Material& m) {
+  visit(field("id"), m.id);
+  visit(field("name"), m.name);
+  visit(length_mm("thickness_mm", "thickness", 0.3, 15)
+            .with_option("plate-thickness", "a plate of this thickness instead of the bone's")
+            .unset_derived(),
+        m.thickness_mm);
+  visit(
+      length_mm("min_thickness_mm", "minimum thickness", 0.3, 10)
+          .with_option("min-thickness", "the material's thinnest wall (thinner is not printable)"),
+      m.min_thickness_mm);
+  visit(length_mm("edge_clearance_mm", "edge clearance", 0, 3)
+            .with_option("clearance", "gap between the implant's edge and the bone's cut edge"),
+        m.edge_clearance_mm);
+  visit(length_mm("under_contour_mm", "under-contour", 0, 1)
+            .with_option("under-contour", "outer surface set this far below the skull's"),
+        m.under_contour_mm);
+  visit(ParamSpec{"density_g_cm3", "density", 0.1, 25, "g/cm³"}.with_option("density",
+                                                                            "for the mass"),
+        m.density_g_cm3);
+  visit(length_mm("onlay_mm", "onlay's overlap", 0, 20), m.onlay_mm);
+}
 
 /// The presets, in the order a user is offered them: PEEK, PMMA, titanium plate.
 const std::vector<Material>& material_presets();
@@ -43,9 +69,16 @@ std::string describe(const Material& m);
 /// off the bone wherever the bone it faces lies within `radius_mm` of `center`.
 struct ClearanceZone {
   Eigen::Vector3d center = Eigen::Vector3d::Zero();  ///< a point on the rim, mm
-  double radius_mm = 15.0;                           ///< 1..100 mm
-  double clearance_mm = 3.0;                         ///< 0..3 mm
+  double radius_mm = 15.0;
+  double clearance_mm = 3.0;
 };
+/// ClearanceZone's fields, each declared once (ParamSpec), in the order a session writes them.
+template <class Visit>
+void for_each_field(Visit&& visit, ClearanceZone& z) {
+  visit(field("center"), z.center);
+  visit(length_mm("radius_mm", "zone's radius", 1, 100), z.radius_mm);
+  visit(length_mm("clearance_mm", "zone's clearance", 0, 3), z.clearance_mm);
+}
 /// Why the zone cannot be used, or empty.
 std::string zone_problem(const ClearanceZone& z);
 /// A zone's clearance blends into the one around it over this distance beyond its radius, mm:
