@@ -1,8 +1,9 @@
 // The programs' first start (cranioplan, cranioplan-cli): sets malloc's tunables (huge pages,
 // one arena: huge_pages.h) and starts the program itself, ../libexec/cranioplan/NAME from
 // where this file lies, with the same arguments. Its libraries (VTK, Qt) are then loaded once:
-// a program started directly loads them, sets the tunables and starts itself again (0.07 s
-// more for the CLI, docs/BENCHMARKS.md). Links nothing but the C++ runtime.
+// a program started directly loads them, sets the tunables and starts itself again (what that
+// costs: docs/decisions/0030-memory-huge-pages-one-arena-no-copies.md). Links nothing but the
+// C++ runtime.
 #include <unistd.h>
 
 #include <cerrno>

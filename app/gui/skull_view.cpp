@@ -102,8 +102,8 @@ vtkSmartPointer<vtkPolyData> to_polydata(const SkullMesh& mesh) {
 // The same points and normals with every triangle wound the other way, for drawing with a
 // reflection: the reflection turns the winding back, so OpenGL's front faces and VTK's two-sided
 // lighting agree again (with the skull's own winding the reflected mirror was lit from behind).
-// Only the triangles are new: about 70 MB on a skull of two million triangles, where the mirror
-// used to be a mesh and a polydata of its own (about 400 MB).
+// Only the triangles are new: the mirror has no mesh or polydata of its own, which would cost
+// several times as much (docs/decisions/0030-memory-huge-pages-one-arena-no-copies.md).
 vtkSmartPointer<vtkPolyData> reversed_winding(vtkPolyData* source) {
   vtkCellArray* polys = source->GetPolys();
   vtkNew<vtkCellArray> cells;
@@ -154,8 +154,8 @@ struct MeshLayer {
   vtkNew<vtkPolyDataMapper> mapper;
   vtkNew<vtkActor> actor;
   // Picking: the plan's own locator of the shown mesh (kept alive with it by `keep`), so the
-  // view builds no second search structure (a VTK cell locator of a 2-million-triangle skull
-  // is about 300 MB).
+  // view builds no second search structure (a VTK cell locator of a skull takes several times
+  // the plan's own: docs/BENCHMARKS.md, "Where the memory goes, and what bounds it").
   const SurfaceLocator* locator = nullptr;
 
   MeshLayer() {
@@ -226,9 +226,9 @@ struct MeshLayer {
   // While the camera moves, a mesh of more than kCoarseAbove triangles is drawn from a coarse
   // copy (coarse_copy, given by set_coarse when made on a worker, else made at the first move
   // after the mesh changed; a reflection of another layer's mesh reverses that layer's copy,
-  // as the mesh itself is shared): under Mesa's software renderer the sample's skull and
-  // translucent mirror take 0.3–0.5 s a frame, their coarse copies (about 60,000 triangles
-  // each) a quarter of that.
+  // as the mesh itself is shared): under Mesa's software renderer a frame of the whole skull
+  // and translucent mirror takes several times one of their coarse copies (docs/USER_GUIDE.md,
+  // "The window"; docs/BENCHMARKS.md).
   static constexpr vtkIdType kCoarseAbove = 150000;
   static constexpr double kCoarseCellMm = 3.0;
   vtkNew<vtkPolyDataMapper> coarse_mapper;
@@ -483,9 +483,9 @@ SkullView::SkullView(QWidget* parent) : QOpenGLWidget(parent), d_(std::make_uniq
 void SkullView::Impl::set_up_layers() {
   // Depth peeling for the translucent mirror and plane: order-independent transparency
   // (VTK's default without it) draws wrong colours under Mesa's llvmpipe. Four peels, stopping
-  // once fewer than 5 % of the pixels change: on the sample's step 8, 8 of the view's 513,000
-  // pixels differ by more than 40 from six exact peels, and a frame takes 0.8–1.1 s instead of
-  // 2 s under llvmpipe (cranioplan --pauses).
+  // once fewer than 5 % of the pixels change: hardly a pixel differs from six exact peels, and
+  // a frame under llvmpipe takes about half as long (measured with cranioplan --pauses:
+  // docs/decisions/0028-speed-history.md).
   window->SetAlphaBitPlanes(1);
   window->SetMultiSamples(0);
   renderer->SetUseDepthPeeling(1);
@@ -823,7 +823,8 @@ void SkullView::set_moving(bool moving) {
   Impl& d = *d_;
   // The implant, what the plan is about, is always drawn whole. Depth peeling (the translucent
   // mirror's true colours) is left for the frames at rest: under llvmpipe it doubles a coarse
-  // frame (125 against 60 ms); blended without it the mirror shows paler while moving.
+  // frame (docs/BENCHMARKS.md, "Turning the view"); blended without it the mirror shows paler
+  // while moving.
   d.skull.draw_coarse(moving);
   d.mirror.draw_coarse(moving, &d.skull);
   for (MeshLayer* half : {&d.mould_outer, &d.mould_inner}) half->draw_coarse(moving);

@@ -39,7 +39,8 @@ namespace cranioplan::cli {
 namespace {
 
 // Skulls are used where load_skull put them (`const LoadedSkull loaded = ...; loaded.mesh`), never
-// copied out: OpenMesh meshes have no move constructor, and a copy of a SkullFix skull is 300 MB.
+// copied out: OpenMesh meshes have no move constructor, and every copy of a skull costs its whole
+// size again (docs/BENCHMARKS.md, "Where the memory goes, and what bounds it").
 
 Json implant_json(const ImplantResult& r) {
   Json holes = Json::array();

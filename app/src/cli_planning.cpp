@@ -126,12 +126,26 @@ std::string declared_help(const ParamSpec& s) {
   return *s.unit ? std::string(s.help) + " (" + s.unit + ")" : std::string(s.help);
 }
 
+// A number the declaration allows: in its range (or 0 where 0 means none).
+CLI::Validator declared_check(const ParamSpec& s) {
+  std::string shown = "[" + std::string(s.zero_means_none ? "0, " : "") +
+                      CLI::detail::to_string(s.min) + " - " + CLI::detail::to_string(s.max) + "]";
+  return CLI::Validator(
+      [s](std::string& text) -> std::string {
+        double v = 0.0;
+        if (!CLI::detail::lexical_cast(text, v)) return "Value " + text + " is not a number";
+        if (!s.allows(v)) return "Value " + text + " not in range " + s.range_text();
+        return {};
+      },
+      shown);
+}
+
 }  // namespace
 
 void add_declared_option(CLI::App* cmd, const ParamSpec& s, double& value,
                          const std::string& prefix) {
-  auto* option = cmd->add_option("--" + prefix + s.option, value, declared_help(s))
-                     ->check(CLI::Range(s.min, s.max));
+  auto* option =
+      cmd->add_option("--" + prefix + s.option, value, declared_help(s))->check(declared_check(s));
   if (!s.unset_allowed) option->capture_default_str();
 }
 
@@ -147,8 +161,7 @@ void add_declared_option(CLI::App* cmd, const ParamSpec& s, bool& value,
 }
 
 void add_declared_option(CLI::App* cmd, const ParamSpec& s, std::optional<double>& value) {
-  cmd->add_option("--" + std::string(s.option), value, declared_help(s))
-      ->check(CLI::Range(s.min, s.max));
+  cmd->add_option("--" + std::string(s.option), value, declared_help(s))->check(declared_check(s));
 }
 
 void add_hole_options(CLI::App* cmd, HoleOptions& o) {

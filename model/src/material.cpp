@@ -58,8 +58,6 @@ std::string material_problem(const Material& m) {
                         spec_of<Material>("thickness_mm").max) +
            " (not below the minimum thickness)";
   if (m.onlay_mm != 0.0) {
-    const ParamSpec onlay = spec_of<Material>("onlay_mm");
-    if (m.onlay_mm < 3.0) return onlay.problem("the", m.onlay_mm, 3.0, onlay.max);
     if (std::isnan(m.thickness_mm)) return "a plate laid on the bone needs a thickness";
     if (m.edge_clearance_mm > 0.0 || m.under_contour_mm > 0.0)
       return "a plate laid on the bone has no edge clearance or under-contour";

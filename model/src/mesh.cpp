@@ -108,8 +108,7 @@ void add_face_or_split(SkullMesh& mesh, const std::array<Eigen::Vector3d, 3>& p,
 // exponent is the next power of two, as it should be. Zeros, subnormals, infinities and NaNs
 // (none reach here from a file: the readers refuse non-finite coordinates) go through frexp.
 // Not static_cast<double>(static_cast<float>(x)): GCC 12's SLP vectorizer at -O2/-O3 drops
-// that round trip over Eigen vectors (measured on this machine: the coordinates came back
-// unrounded).
+// that round trip over Eigen vectors: the coordinates come back unrounded.
 double round_to_single(double x) {
   uint64_t bits = 0;
   std::memcpy(&bits, &x, sizeof bits);

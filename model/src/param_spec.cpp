@@ -21,7 +21,13 @@ std::string bound(double v) {
 
 bool ParamSpec::allows(double v) const {
   if (std::isnan(v)) return unset_allowed;
+  if (zero_means_none && v == 0.0) return true;
   return std::isfinite(v) && v >= min && v <= max;
+}
+
+std::string ParamSpec::range_text() const {
+  return std::string(zero_means_none ? "0, or " : "") + bound(min) + " to " + bound(max) +
+         (*unit ? std::string(" ") + unit : std::string());
 }
 
 std::string ParamSpec::problem(const char* whose, double v) const {
@@ -29,9 +35,11 @@ std::string ParamSpec::problem(const char* whose, double v) const {
 }
 
 std::string ParamSpec::problem(const char* whose, double v, double lo, double hi) const {
-  std::string s = std::string(whose) + " " + (noun ? noun : key) + " must be " + bound(lo) +
-                  " to " + bound(hi) + (*unit ? std::string(" ") + unit : std::string());
-  return s + " (" + bound(v) + " given)";
+  ParamSpec bounds = *this;
+  bounds.min = lo;
+  bounds.max = hi;
+  return std::string(whose) + " " + (noun ? noun : key) + " must be " + bounds.range_text() + " (" +
+         bound(v) + " given)";
 }
 
 }  // namespace cranioplan

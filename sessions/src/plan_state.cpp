@@ -769,14 +769,9 @@ bool apply_proposal_result(PlanState& s, const Json& j, const std::string& where
   return true;
 }
 
-// Proposes markers, or applies the proposal the command recorded when it was first done; both
-// go through the recorded form, so a replay is the live command. A proposal replaces the
-// markers; a failed one leaves them as they were.
-// The shape model a propose_markers command names, read once and checked against its recorded
-// SHA-256 (a SessionError naming the file when it changed), and how it was fitted and weighed:
-// version 7 recorded neither and is read with what it was made with (weight 0.5, 10 mm margin,
-// 1 mm noise, a poor fit over 1.0 mm or under half paired).
-// How the model a propose_markers command names was fitted and weighed, as recorded.
+// How the model a propose_markers command names was fitted and weighed, as recorded: version 7
+// recorded neither and is read with what it was made with (weight 0.5, 10 mm margin, 1 mm
+// noise, a poor fit over 1.0 mm or under half paired).
 void recorded_prior(const ParamReader& r, ProposeParams& params, ShapePriorParams& prior) {
   const ParamReader model(r.value("shape_model"), r.where() + " shape_model");
   auto number_or = [&](const char* name, double version7) {
@@ -789,6 +784,8 @@ void recorded_prior(const ParamReader& r, ProposeParams& params, ShapePriorParam
   prior.fit.min_paired = number_or("min_paired", 0.5);
 }
 
+// The shape model a propose_markers command names, read once and checked against its recorded
+// SHA-256 (a SessionError naming the file when it changed).
 ShapeModel recorded_shape_model(const ParamReader& r, const ApplyContext& ctx) {
   const ParamReader model(r.value("shape_model"), r.where() + " shape_model");
   const std::string path = resolve_input(model.string("path"), ctx, "shape model");
@@ -801,12 +798,26 @@ ShapeModel recorded_shape_model(const ParamReader& r, const ApplyContext& ctx) {
   return parse_shape_model(bytes, path);
 }
 
-void apply_propose(PlanState& s, const ParamReader& r, const ApplyContext& ctx, Json& record) {
+// What a proposal made again is asked: the recorded parameters of a proposal of this version;
+// of an earlier version (read with the switches that replay it as it was made), today's, with
+// its model's weight.
+ProposeParams asked_again(const ProposeParams& recorded, int version) {
+  if (version == current_version(CommandType::ProposeMarkers)) return recorded;
+  ProposeParams today;
+  today.shape_model_weight = recorded.shape_model_weight;
+  return today;
+}
+
+// Proposes markers, or applies the proposal the command recorded when it was first done; both
+// go through the recorded form, so a replay is the live command. A proposal replaces the
+// markers; a failed one leaves them as they were.
+void apply_propose(PlanState& s, const ParamReader& r, int version, const ApplyContext& ctx,
+                   Json& record) {
   ProposeParams params;
   params_from_json(ParamReader(r.value("params"), r.where() + " params"), params);
   ShapePriorParams prior;
   if (r.has("shape_model")) recorded_prior(r, params, prior);
-  const ProposeParams asked = params;
+  const ProposeParams asked = asked_again(params, version);
   if (!r.has("result")) {
     take_scan_borders(params.detect, s.skull->surface->loaded.report);
     const SurfaceLocator& bone = s.skull->surface->locator;
@@ -1067,7 +1078,7 @@ ApplyOutcome apply_command(const PlanState& before, const Command& command,
         apply_marker_edit(s, command.type, r);
         break;
       case CommandType::ProposeMarkers:
-        apply_propose(s, r, context, out.record);
+        apply_propose(s, r, command.version, context, out.record);
         break;
       case CommandType::SmoothMarkers:
         apply_smooth(s, r);

@@ -33,6 +33,16 @@ TEST(ParamSpec, UnsetIsAllowedOnlyWhereTheValueIsDerived) {
   EXPECT_FALSE(field("positions").ranged());
 }
 
+TEST(ParamSpec, ZeroCanMeanNoneBelowTheRange) {
+  const ParamSpec onlay = length_mm("onlay_mm", "onlay's overlap", 3, 20).zero_for_none();
+  EXPECT_TRUE(onlay.allows(0.0));
+  EXPECT_FALSE(onlay.allows(2.0));
+  EXPECT_FALSE(onlay.allows(-1.0));
+  EXPECT_TRUE(onlay.allows(3.0));
+  EXPECT_EQ(onlay.problem("the", 2.0), "the onlay's overlap must be 0, or 3 to 20 mm (2 given)");
+  EXPECT_EQ(onlay.range_text(), "0, or 3 to 20 mm");
+}
+
 // A Params struct of the test's own, declared as the product's are.
 struct Toy {
   double length = 5.0;
@@ -56,7 +66,6 @@ TEST(ParamSpec, TheFirstFieldOutOfItsRangeIsNamed) {
   const ParamSpec s = spec_of<Toy>("length_mm");
   EXPECT_STREQ(s.option, "length");
   EXPECT_STREQ(s.help, "how long");
-  EXPECT_EQ(spec_of<Toy>("nothing").key, std::string());
 }
 
 }  // namespace

@@ -124,6 +124,19 @@ TEST(AutoplanSession, AShapeModelIsRecordedAsAnInputAndVerified) {
     EXPECT_EQ(out.state.proposal_params.surface_spacing_mm, 5.0);
     EXPECT_EQ(out.state.proposal_prior.margin_mm, 12.0);
     EXPECT_EQ(out.state.proposal_prior.fit.noise_mm, ShapePriorParams{}.fit.noise_mm);
+    // A proposal of an earlier version (read with the switches that replay it as it was made:
+    // the rays' rim, support markers on every layer) is made again with today's parameters and
+    // its model's weight.
+    Command older = recorded;
+    older.version = 7;
+    older.params["params"]["detect"].erase("trace_rim_on_bone");
+    older.params["params"].erase("max_support_layers");
+    const ApplyOutcome old_out = apply_command(s.state_at(*at), older);
+    ASSERT_TRUE(old_out.accepted) << old_out.message;
+    EXPECT_TRUE(old_out.state.proposal_params.detect.trace_rim_on_bone);
+    EXPECT_EQ(old_out.state.proposal_params.max_support_layers, ProposeParams{}.max_support_layers);
+    EXPECT_EQ(old_out.state.proposal_params.surface_spacing_mm, ProposeParams{}.surface_spacing_mm);
+    EXPECT_EQ(old_out.state.proposal_params.shape_model_weight, 0.75);
   }
 
   // The model changed after the plan: verify says so, naming it.

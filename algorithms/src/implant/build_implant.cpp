@@ -945,8 +945,8 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
   const std::vector<Marker>& used = plate ? outer_only : markers;
   // The shell, then the fit to the bone, the tabs and the holes, each meshed anew: each stage
   // meshes into the next one's input and the last into the result (OpenMesh meshes are
-  // copied, not moved: up to 25 ms for the sample's implant, most of it faulting in fresh
-  // pages).
+  // copied, not moved, and a copy costs mostly the faulting in of fresh pages:
+  // docs/decisions/0030-memory-huge-pages-one-arena-no-copies.md).
   const bool fitted = params.method == ImplantMethod::Shell && params.fit_to_bone_mm > 0.0 &&
                       skull && skull->n_faces() > 0;
   const bool tabbed = params.tabs.any(), drilled = params.perforations.any();

@@ -64,8 +64,9 @@ vtkSmartPointer<vtkDataArray> fill_padded(const Volume& volume, float pad, float
   T* dst = array->GetPointer(0);
   const T padding = static_cast<T>(scale * pad);
   const size_t slice = static_cast<size_t>(nx) * ny;
-  // Slice by slice on all threads: the copy's pages (240 MB as floats for a SkullFix volume)
-  // are first touched here, and faulting them in costs more than copying.
+  // Slice by slice on all threads: the copy, a sample for each of the volume's, is first
+  // touched here, and faulting its pages in costs more than copying
+  // (docs/decisions/0028-speed-history.md).
   parallel_for(
       static_cast<size_t>(nz),
       [&](size_t begin, size_t end) {
@@ -119,8 +120,9 @@ void extract(const Volume& volume, const ExtractBoneSurfaceParams& params,
 
   // Pad by one sample below the threshold on every side so the surface is closed where bone
   // touches the edge of the scan. Index space: sample (i,j,k) of the volume sits at (i,j,k).
-  // The padded copy of the volume and VTK's output are let go as soon as the triangles are out
-  // (a SkullFix volume is 240 MB as floats): they are not needed while the mesh is built.
+  // The padded copy of the volume and VTK's output are let go as soon as the triangles are out:
+  // they are large, and not needed while the mesh is built (docs/BENCHMARKS.md, "Where the
+  // memory goes, and what bounds it").
   TriangleSoup soup;
   {
     const float pad = static_cast<float>(std::min<double>(range.lo, threshold - 1.0));

@@ -75,7 +75,7 @@ size_t gunzip_each(const std::string& path, const char* data, size_t size, size_
 
 std::string gunzip(const std::string& path, const char* data, size_t size, size_t expected_size) {
   // Grown as the data comes, from four times its size (or the announced size, if smaller): a
-  // header may announce terabytes over a few bytes of data (a fuzzed NRRD asked for 600 GB).
+  // header may announce terabytes over a few bytes of data (docs/FUZZING.md).
   const size_t guess = std::max<size_t>(size * 4, 1 << 16);
   std::string out;
   out.reserve(expected_size > 0 ? std::min(expected_size, guess) : guess);

@@ -154,9 +154,10 @@ std::vector<BoundaryLoop> boundary_loops(const TriangleSoup& welded,
 // within this angle (degrees), and as wide as a cut through the head along both of its plane's
 // principal axes (mm): a scan's end crosses the head's shell in a ring, 60 mm across at the
 // least; a skull's own curve keeps a disc of only 38 mm within 2 mm of its end (at a 90 mm
-// radius), and a defect's flat cut face is a band as narrow as the bone is thick. Measured
-// (docs/AUTOPLAN.md): scans' lower ends cover 18-32 % of their outline, 6,000-8,000 mm² of it
-// open; the sample's sides, shaved by the field of view, 95 % (90-100 mm² open).
+// radius), and a defect's flat cut face is a band as narrow as the bone is thick. A scan's end
+// covers a small part of its outline and leaves the head's inside open through it; a field of
+// view that shaves the head's side across solid bone covers nearly all of its outline
+// (measured: docs/AUTOPLAN.md).
 constexpr double kCapMinAreaMm2 = 200.0;
 constexpr double kCapFacingDeg = 30.0;
 constexpr double kCapMajorMm = 60.0, kCapMinorMm = 30.0;

@@ -293,8 +293,8 @@ void read_nrrd_samples(const std::string& path, const NrrdHeader& h, const std::
       if (held < need)  // throws the message for too few bytes, converting nothing
         convert_samples(path, data, held, v.size(), type, big_endian, v.data);
     }
-    // Converted as it is inflated: the inflated samples are never held whole (a SkullFix mask
-    // of int32 is 250 MB of them).
+    // Converted as it is inflated: the inflated samples are never held whole, only the floats
+    // they become (docs/decisions/0028-speed-history.md).
     SampleStream samples(path, v.size(), type, big_endian, v.data);
     gunzip_each(path, data, available, need,
                 [&](const char* piece, size_t n) { samples.add(piece, n); });

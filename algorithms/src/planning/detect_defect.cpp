@@ -220,8 +220,9 @@ std::optional<Eigen::Vector3d> vault_center(const SurfaceLocator& locator, const
 }
 
 namespace {
-// The vault's rays lean one way by at least this (mean of unit directions; 0.22–0.32 on real
-// skulls, about 0 on a shell closed all round).
+// The vault's rays lean one way by at least this (mean of unit directions): a real skull's
+// lean well beyond it, a shell closed all round's hardly at all (docs/AUTOPLAN.md, "The skull
+// base").
 constexpr double kVaultDirected = 0.1;
 }  // namespace
 
@@ -272,9 +273,9 @@ struct RayFan {
 // Casts the rays (laid out in `frame`) and finds the vault: rays through a regular shell, both
 // tables facing the ray within 45°. The skull base, the face and the orbits are bone met
 // obliquely or several times; the vault is the dome above them. The mean direction of these
-// rays and of the openings' rays (a defect is vault too) is the skull's superior direction:
-// tilted back on a skull with a face (37° on the sample), 0–14° on SkullFix's crania; on a
-// shell closed all round it is no direction.
+// rays and of the openings' rays (a defect is vault too) is the skull's superior direction,
+// tilted back on a skull with a face (docs/AUTOPLAN.md, "The skull base"); on a shell closed
+// all round it is no direction.
 RayFan cast_fan(const RayCaster& cast, int n, const Eigen::Matrix3d& frame, bool framed) {
   RayFan fan;
   fan.dirs = fibonacci_sphere(n);
@@ -359,21 +360,21 @@ Openings find_openings(const RayFan& fan, const Eigen::Vector3d& center,
 
 // The skull base (or the scan's cut): the rank (in `o.order`) of the largest opening whose mean
 // direction points away from the vault, more than 105° from its direction; o.order.size() for
-// none. Seen from the rays' start (detect_defect_near_plane) the sample's foramen magnum lies
-// at 130° and its frontal defect at 100°, within 0.4° on copies decimated to 250,000-60,000
-// triangles (seen from the vertex centroid: the foramen 113-124°, the defect 82-96°, as the
-// thin bone around them opens up on the decimated copies); SkullFix's bases 125–154°, their
-// defects 26–53°. The orbits lie further still (120–150°) but are smaller than the foramen (a
-// limit of 114° took an orbit of a 60,000-triangle copy for the base, and planned the foramen
-// magnum as the defect). Where the surface is open along a cut that faces away from the vault
+// none. Seen from the rays' start (detect_defect_near_plane) a skull's foramen magnum lies well
+// beyond that limit and its defect within it, on coarse copies of the skull too (seen from the
+// vertex centroid the angles shift as the thin bone around the openings opens up on a coarse
+// copy). The orbits lie further still but are smaller than the foramen; a
+// limit too near the foramen's angle can miss the foramen on a coarse copy, take an orbit for
+// the base and plan the foramen magnum as the defect (the angles measured: docs/AUTOPLAN.md,
+// "The skull base"). Where the surface is open along a cut that faces away from the vault
 // (`borders`), the base must face it too (its mean direction within 60° of the cut's outward
 // normal): the cut blocks the base's own rays, and a defect seen far from the vault is then
 // not taken for the base. With the skull's frame (its third axis the midsagittal plane's normal),
-// the base must also lie within 30° of the plane, as the foramen magnum and a scan's cut do (on the
-// sample 0°, and 17–27° for its orbits): a large one-sided defect low on the side of the head (a
-// decompressive hemicraniectomy, 8,000 mm² and more) is larger than the foramen magnum and
-// would otherwise be taken for the base if it reached 105°. Without such an opening, or without
-// a vault direction, the skull is closed below.
+// the base must also lie within 30° of the plane, as the foramen magnum and a scan's cut do: a
+// large one-sided defect low on the side of the head (a decompressive hemicraniectomy,
+// 8,000 mm² and more) is larger than the foramen magnum and would otherwise be taken for the
+// base if it reached 105°. Without such an opening, or without a vault direction, the skull is
+// closed below.
 size_t skull_base(const Openings& o, const Eigen::Vector3d& up, const Eigen::Matrix3d& frame,
                   bool framed, const std::vector<ScanBorder>& borders) {
   constexpr double kBaseAwayFromVault = -0.2588;  // cos 105°

@@ -51,11 +51,10 @@ struct Sample {
 // Rim-only, the outer radius is fitted either as it is (the spline's quadratic trend keeps the
 // ring's curvature) or as its excess over the sphere that fits the ring (the vault keeps
 // bending as around the opening): whichever predicts the ring's band next to the opening
-// better from the rest of the ring. A quadratic trend sags over wide openings (a synthetic
-// 100 mm cut: Dice 0.82 against 0.89 over the sphere); a sphere bulges where the vault
-// flattens (SkullFix 003 planned with a quadratic trend: Dice 0.917, over a sphere 0.875), and
-// the band tells them apart. `uv` projects a ray's direction as the fit does; `distance` is
-// each ray's distance from the opening.
+// better from the rest of the ring. A quadratic trend sags over wide openings; a sphere bulges
+// where the vault flattens; the band tells them apart (docs/decisions/0001-ring-and-fit.md).
+// `uv` projects a ray's direction as the fit does; `distance` is each ray's distance from the
+// opening.
 std::optional<VaultSphere> choose_vault(
     const std::vector<Sample>& ring, const std::vector<Eigen::Vector3d>& outer,
     const std::vector<double>& distance, const Eigen::Vector3d& center,
@@ -309,8 +308,8 @@ struct DefectSurfaceFit {
       const double dist = 2.0 * std::asin(std::min(1.0, 0.5 * std::sqrt(chord2))) * r_out;
       if (dist < clearance || dist > clearance + width) continue;
       // Near an oblique cut face a ray enters or leaves through the cut instead of a table: its
-      // thickness is too small, so it does not inform the thickness (measured on SkullFix: the
-      // fitted bone 2.5 mm too thin across the opening).
+      // thickness is too small, so it does not inform the thickness (a spline carries it
+      // across the opening, and the fitted bone comes out too thin: docs/AUTOPLAN.md, "The ring").
       const bool parallel = params.max_table_angle_deg <= 0 ||
                             -o.inner_normal.dot(o.outer_normal) >=
                                 std::cos(params.max_table_angle_deg * M_PI / 180.0);
@@ -334,9 +333,9 @@ struct DefectSurfaceFit {
   }
 
   // Rim-only, only bone that continues from the rim: past an orbit the rays meet the orbital
-  // roof 30-40 mm nearer the centre than the frontal bone, and a ring holding it bent the fitted
-  // surfaces and the support markers down to it (the sample from its STL: a bay 6.8 mm deep in
-  // the implant's edge above the orbit). Mirror-guided, the fit takes the mismatch with the
+  // roof 30-40 mm nearer the centre than the frontal bone, and a ring holding it bends the fitted
+  // surfaces and the support markers down to it (a bay in the implant's edge above the orbit:
+  // docs/AUTOPLAN.md, "Rim-only"). Mirror-guided, the fit takes the mismatch with the
   // mirror, which meets the same roof on the other side: that bone fits as well as any.
   static void keep_continuing(DefectSurfaces& s, std::vector<Sample>& ring,
                               const DefectRegion& defect, const DefectSurfaceParams& params) {
@@ -366,9 +365,9 @@ struct DefectSurfaceFit {
   // Fitting sites: the ring's rays averaged over square cells of the site spacing on the
   // fitting plane (uv, millimetres at the rim's radius). Averages, not one ray picked per site:
   // which rays a centre a millimetre away sends through the ring changes, and a spline through
-  // single picked rays followed their noise across the opening (the same skull, its rays'
-  // centre moved 1 mm: Dice 0.91-0.94 against its own plan; the averages move with the bone,
-  // not with the rays). The number of sites, 0 when the spline could not be fitted.
+  // single picked rays follows their noise across the opening, where the averages move with the
+  // bone, not with the rays (docs/AUTOPLAN.md, "The fit"). The number of sites, 0 when the
+  // spline could not be fitted.
   static int fit_sites(const DefectSurfaces& s, ThinPlateSpline& tps, bool outer,
                        const std::vector<Sample>& ring, const std::vector<size_t>& use,
                        const DefectSurfaceParams& params) {
@@ -440,8 +439,9 @@ struct DefectSurfaceFit {
     s.sites = sites;
     // The residual over the ring's rays that the fit describes. Rays farther off than the
     // outlier limit are counted apart: mirror-guided, a ray past an orbit meets the orbital roof
-    // on one side and the frontal bone on the other, 30-50 mm apart, and a few of those made the
-    // sample's residual read 3 mm where the rest of the ring fits to 0.2 mm.
+    // on one side and the frontal bone on the other, 30-50 mm apart, and a few of those would
+    // make the residual read many times what the rest of the ring fits to (docs/AUTOPLAN.md,
+    // "The fit").
     double sum = 0.0;
     size_t count = 0;
     int off = 0;

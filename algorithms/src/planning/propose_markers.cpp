@@ -110,15 +110,17 @@ std::vector<size_t> by_bearing(const DefectRegion& defect, double spacing) {
 
 // Where the rays start. The vault's centre (vault_center, found from the skull's vertex
 // centroid on the plane: any start in the cavity converges to it within 0.05 mm) is a property
-// of the bone: no meshing moves it by more than 0.3 mm and a crop of the face by a few
-// millimetres (docs/AUTOPLAN.md). A small opening seen from it is seen narrow and its rim at a
-// grazing angle, so the start moves from there towards the opening until the opening is seen
-// 50° wide (at most half the vault's radius). An opening seen that wide from the vault's
-// centre already (SkullFix's large defects) keeps the surface centroid, where those plans were
-// measured best, unless it sees the opening less than half as large as the vault's centre does
-// (the vault's centre then). The surface centroid too when there is no vault to fit or no
-// opening seen from it. Not the vertex centroid: decimation moved it 7-12 mm, on a SkullFix skull
-// into the bone of its base, where no ray from it crosses one table.
+// of the bone: meshing hardly moves it, and a crop of the face only a little (docs/AUTOPLAN.md).
+// A small opening seen from it is seen narrow and its rim at a grazing angle, so the start
+// moves from there towards the opening until the opening is seen 50° wide (at most half the
+// vault's radius). An opening seen that wide from the vault's centre already (large cut-out
+// defects) keeps the surface centroid, where those plans measure best
+// (docs/decisions/0010-other-starts-from-the-vault-centre.md), unless it sees the opening less
+// than half as large as the vault's centre does (the vault's centre then). The surface centroid
+// too when there is no vault to fit or no opening seen from it. Not the vertex centroid: it
+// follows wherever the triangles are dense, and a decimation can move it into the bone of the
+// skull's base, where no ray from it crosses one table
+// (docs/decisions/0017-the-rays-start-not-the-vertex-centroid.md).
 Eigen::Vector3d rays_start(const SkullMesh& skull, const SurfaceLocator& bone, const Plane& plane,
                            const DetectDefectParams& params) {
   constexpr double kSeenWide = 25.0 * M_PI / 180.0;
@@ -326,17 +328,18 @@ std::vector<FittedPoints> fitted_along_ring(const DefectRegion& defect,
 // not (the rim runs along an orbit or the skull base), rim-only the fit only extrapolates
 // there: at the last bone. Mirror-guided, the fitted surface there is the mirror's own outer
 // table (where the mirror has bone), and the marker stands on it too: the rim's rays meet the
-// rounded edge of the bone above an orbit at a grazing angle, and where they met it moved by
-// 2-3 mm when the rays' start moved by a fraction of a millimetre (the sample's brow: its
-// lower wall held most of what differed between such plans; docs/AUTOPLAN.md). No inner edge
+// rounded edge of the bone above an orbit at a grazing angle, and where they meet it moves by
+// millimetres when the rays' start moves by a fraction of a millimetre, the brow's lower wall
+// with it (docs/decisions/0012-what-moves-the-brows-lower-wall.md). No inner edge
 // markers: the inner rim is the outer one set in by the thickness field of the inner markers
 // (docs/IMPLANT.md).
 // The ring is probed by direction from the centre, not by position (at an oblique cut face
 // the rim's last bone is the cut's inner corner, a table's thickness below the ring's outer
 // table), 5 and 7 mm out, with the ring's bone up to 15 mm out (the rays that leave through
-// such a face are not in the ring, so it may begin several millimetres beyond the rim; probing
-// further out found bone across the sample's orbit: rim gap 3 mm). Only ring bone on the
-// fitted outer surface counts: bone met far below it is not the outer table going on.
+// such a face are not in the ring, so it may begin several millimetres beyond the rim; further
+// out the probes find bone across an orbit: docs/decisions/0004-marker-rules.md). Only ring
+// bone on the fitted outer surface counts: bone met far below it is not the outer table going
+// on.
 constexpr double kEdgeRingReach = 12.0;  // beyond the rim clearance, mm
 
 // Along the scan's end the rim is where the table would cross the border's plane
@@ -427,13 +430,11 @@ void add_edge_markers(const DefectRegion& defect, const DefectSurfaces& surfaces
     }
     // At the rim's last bone: rim-only where no intact bone continues beyond the rim, and where
     // it does but no fitted surface says where (mirror-guided, the mirror has no bone there: a
-    // rim point left out there left the outline to cut straight across that stretch, and an
-    // export of the sample smoothed as Slicer does lost one next to the frontal sinus). Not
+    // rim point left out there leaves the outline to cut straight across that stretch). Not
     // where that bone lies below the fitted bone altogether (rim-only), or, without a fitted
     // surface there, more than one layer of bone below its neighbours on the rim: its ray met other
     // bone past the vault's edge (an orbital roof, a sinus wall), and a marker there pulls the
-    // implant's outer surface down into a funnel (the sample: a rim point 18 mm below the
-    // surface; decimated, two 20-30 mm below their neighbours, rim gap 7 mm).
+    // implant's outer surface down into a funnel (docs/decisions/0004-marker-rules.md).
     const double radius = (rim - c).norm();
     if (fitted ? radius < (fitted->second - c).norm() - 1.0
                : radius < neighbours_radius(i) - params.detect.max_thickness_mm)
@@ -446,10 +447,10 @@ void add_edge_markers(const DefectRegion& defect, const DefectSurfaces& surfaces
 // where the ray's first bone is the inner table (it faces the ray), also where the ray did
 // not meet both tables squarely: next to a real defect's rim the bone thins and bends, and
 // the implant meets it only if its inner surface follows it (inner ones only where both
-// tables are parallel open a 4 mm gap at the rim of the sample's defect planned rim-only).
+// tables are parallel leave a gap at the rim: docs/decisions/0004-marker-rules.md).
 // Not where the first bone is a cut face met side-on: it lies above where the inner table
 // goes on, and the implant's inner surface would rise to it and leave the wedge of bone under
-// the cut empty (SkullFix: median Dice 0.904 -> 0.910, boundary Dice 0.901 -> 0.924).
+// the cut empty (docs/decisions/0004-marker-rules.md).
 
 void add_support_markers(const DefectSurfaces& surfaces, const std::vector<FittedPoints>& ring_fit,
                          const ProposeParams& params, int& id, std::vector<Marker>& out) {

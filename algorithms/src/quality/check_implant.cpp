@@ -115,8 +115,8 @@ std::vector<double> thickness_samples(const SkullMesh& implant, const SurfaceLoc
     n.normalize();
     if (across_plate(n, axis)) {
       if (!measure) continue;
-      // Where the plate curves, a normal can leave it at a grazing angle and run along it (on
-      // the sample's frontal implant up to 27 mm through a plate 8 mm at its thickest): the
+      // Where the plate curves, a normal can leave it at a grazing angle and run along it, far
+      // further than the plate is thick (docs/IMPLANT.md, the quality report's thickness): the
       // thickness there is at most the diameter of the deepest ball the ray passes.
       rays.emplace_back((f.p[0] + f.p[1] + f.p[2]) / 3.0, n);
     } else {

@@ -74,6 +74,7 @@ EdgeMarkersPage::EdgeMarkersPage(PageHost& host)
     const bool again = !plan.proposal_message.empty();
     ProposeParams params = again ? plan.proposal_params : ProposeParams{};
     const ShapePriorParams prior = again ? plan.proposal_prior : ShapePriorParams{};
+    params.detect.center.reset();  // a start given to the last proposal: found again
     params.detect.near = edge_marker_centre(plan.markers);
     const std::string model = shape_model_path();
     if (!model.empty() && !QFileInfo::exists(QString::fromStdString(model))) {

@@ -25,8 +25,8 @@ struct Material {
   double under_contour_mm = 0.0;
   double density_g_cm3 = 1.0;
   /// A plate laid on the bone (onlay): it covers the opening at the skull's outer surface and
-  /// reaches this far beyond the rim over the outer table (3 mm or more; needs a thickness, and
-  /// no clearance or under-contour). 0: the implant fills the opening (inlay).
+  /// reaches this far beyond the rim over the outer table (needs a thickness, and no clearance
+  /// or under-contour). 0: the implant fills the opening (inlay).
   double onlay_mm = 0.0;
 };
 
@@ -52,7 +52,7 @@ void for_each_field(Visit&& visit, Material& m) {
   visit(ParamSpec{"density_g_cm3", "density", 0.1, 25, "g/cm³"}.with_option("density",
                                                                             "for the mass"),
         m.density_g_cm3);
-  visit(length_mm("onlay_mm", "onlay's overlap", 0, 20), m.onlay_mm);
+  visit(length_mm("onlay_mm", "onlay's overlap", 3, 20).zero_for_none(), m.onlay_mm);
 }
 
 /// The presets, in the order a user is offered them: PEEK, PMMA, titanium plate.

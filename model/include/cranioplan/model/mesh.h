@@ -58,7 +58,7 @@ struct BuildMeshStats {
 /// lexicographic order of position, each triangle starting at its smallest vertex (its
 /// orientation kept) and the triangles in lexicographic order. The same surface read from a CT,
 /// from an STL of it or from a PLY in another vertex order then gives the same soup, and so the
-/// same plan: sampling by vertex index no longer depends on how the file listed them.
+/// same plan: sampling by vertex index does not depend on how the file listed them.
 void make_canonical(TriangleSoup& soup);
 
 /// Builds a mesh from an indexed soup. Triangles with a repeated index or zero area are dropped;
@@ -66,8 +66,8 @@ void make_canonical(TriangleSoup& soup);
 /// do), so that no triangle of the input is lost. Unused vertices are not added.
 SkullMesh build_mesh(const TriangleSoup& soup, BuildMeshStats* stats = nullptr);
 /// The same, built in `into` (whatever it held is cleared). OpenMesh meshes cannot be moved:
-/// assigning build_mesh's result to a mesh that already exists copies it (about 0.4 s and
-/// 250 MB for a SkullFix skull).
+/// assigning build_mesh's result to a mesh that already exists copies it, in time and memory
+/// (docs/decisions/0030-memory-huge-pages-one-arena-no-copies.md).
 void build_mesh(const TriangleSoup& soup, SkullMesh& into, BuildMeshStats* stats = nullptr);
 
 /// The mesh as an indexed soup (vertex order = vertex handle order, garbage collected).
@@ -81,8 +81,8 @@ Eigen::Matrix3Xd vertex_matrix(const SkullMesh& mesh);
 /// holes, a point inside it keeps the open parts' share small).
 double signed_volume(const SkullMesh& mesh);
 /// The mean of the mesh's vertices, mm (zero for a mesh without vertices). It moves towards
-/// wherever the triangles are dense: decimation moved skulls' by up to 12 mm, one's into the
-/// bone of its base.
+/// wherever the triangles are dense: a decimation moves it by millimetres, even into the bone
+/// of the skull's base (docs/decisions/0017-the-rays-start-not-the-vertex-centroid.md).
 Eigen::Vector3d vertex_centroid(const SkullMesh& mesh);
 /// The centroid of the surface, each triangle weighted by its area, mm: the same for the same
 /// surface however it is triangulated (the vertex centroid when no face has an area).

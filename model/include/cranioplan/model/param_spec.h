@@ -4,6 +4,7 @@
 // lists its fields with their declarations in one `for_each_field(visit, params)` next to the
 // struct; the session's JSON, the CLI's options, the GUI's fields and the range checks are all
 // made from that list (docs/ARCHITECTURE.md "Parameters").
+#include <cassert>
 #include <cstring>
 #include <string>
 #include <type_traits>
@@ -18,6 +19,7 @@ struct ParamSpec {
   const char* option = nullptr;  ///< its command-line option without "--"; nullptr: none
   const char* help = "";         ///< what it is: the option's help, the GUI field's tooltip
   bool unset_allowed = false;    ///< NaN allowed: the value is then derived (from the material)
+  bool zero_means_none = false;  ///< 0 allowed below the range: none (no countersink, no onlay)
 
   bool ranged() const { return noun != nullptr; }
   /// Whether `v` may be given: NaN where unset is allowed, else a number in the range.
@@ -39,6 +41,13 @@ struct ParamSpec {
     s.unset_allowed = true;
     return s;
   }
+  ParamSpec zero_for_none() const {
+    ParamSpec s = *this;
+    s.zero_means_none = true;
+    return s;
+  }
+  /// "1 to 6 mm", "0, or 3 to 20 mm": the values allowed, as a message says them.
+  std::string range_text() const;
 };
 
 /// A length in mm from `lo` to `hi`.
@@ -62,6 +71,7 @@ ParamSpec spec_of(const char* key) {
         if (std::strcmp(s.key, key) == 0) out = s;
       },
       p);
+  assert(*out.key && "spec_of: P declares no field of that name");
   return out;
 }
 

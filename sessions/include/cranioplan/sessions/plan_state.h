@@ -28,8 +28,8 @@ namespace cranioplan {
 
 /// A skull loaded from a file with its locator, built once and shared by every state that uses
 /// it. The loaded skull is built in place: OpenMesh meshes have no move constructor, so
-/// std::move copies them (on a skull of two million triangles each copy is about 300 MB, and
-/// taking a loaded mesh into this structure used to peak at three of them).
+/// std::move copies them, and each copy of a skull costs its whole size again
+/// (docs/BENCHMARKS.md, "Where the memory goes, and what bounds it").
 struct SharedSurface {
   SharedSurface(const std::string& path, const ExtractBoneSurfaceParams& import);
   SharedSurface(const SharedSurface&) = delete;
@@ -43,9 +43,9 @@ struct SharedSurface {
 
 /// The mirrored skull where the plan has put it: not a mesh of its own but the skull itself,
 /// moved by `placement` (the reflection across the plane, then the registration and any hand
-/// moves: an improper motion). On a skull of two million triangles a mirrored copy is about
-/// 300 MB, too much to keep one per registration in the session's history. The view draws the
-/// skull's mesh moved by `placement`; the locator answers in place (the skull's own tree, moved).
+/// moves: an improper motion). A mirrored copy is as large as the skull, too much to keep one
+/// per registration in the session's history. The view draws the skull's mesh moved by
+/// `placement`; the locator answers in place (the skull's own tree, moved).
 struct MovedSurface {
   std::shared_ptr<const SharedSurface> skull;  ///< the skull's mesh and tree
   RigidTransform placement;                    ///< skull → the mirror where the plan has put it

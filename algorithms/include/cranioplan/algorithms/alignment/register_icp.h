@@ -53,9 +53,10 @@ RegisterResult register_icp(const SkullMesh& moving, const SkullMesh& fixed,
                             const VertexCloud* moving_cloud = nullptr);
 
 /// Registers the skull's mirror image across `plane` onto the skull without building the mirrored
-/// mesh (on a skull of two million triangles it is about 300 MB): the skull is registered onto
-/// itself starting from `params.initial` after the reflection. The result carries the mirror
-/// (mirror_mesh(skull, plane)) onto the skull, as register_icp(mirror, skull, params) does.
+/// mesh (a copy as large as the skull: docs/BENCHMARKS.md, "Where the memory goes, and what
+/// bounds it"): the skull is registered onto itself starting from `params.initial` after the
+/// reflection. The result carries the mirror (mirror_mesh(skull, plane)) onto the skull, as
+/// register_icp(mirror, skull, params) does.
 RegisterResult register_mirror(const SkullMesh& skull, const Plane& plane,
                                const RegisterParams& params = {},
                                const VertexCloud* cloud = nullptr);

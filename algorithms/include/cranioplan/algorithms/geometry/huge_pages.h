@@ -1,17 +1,17 @@
 #pragma once
 // Malloc tuned for the planning's large arrays. The planning allocates large arrays (a SkullFix
 // CT as floats, its surface, grids of millions of voxels) and touches each page once: with 4 KB
-// pages the kernel serves a page fault per 4 KB, and on virtual machines those are dear (a third
-// of a SkullFix import's time). glibc's malloc asks for transparent huge pages (2 MB) when its
-// tunable glibc.malloc.hugetlb=1 is set (the kernel takes the advice unless its mode is
-// "never"). With glibc.malloc.arena_max=1 the worker threads allocate from the main heap, whose
-// memory is kept and reused, instead of arenas of their own that are given back to the kernel
-// and faulted in again at the next parallel loop (the sample's autoplan 5 % faster, the same
-// peak; docs/BENCHMARKS.md). Tunables are read when a process starts, so the programs start
-// themselves once more with them. The allocations change, not the arithmetic: the same implant
-// bytes either way (tested). The installed programs are small launchers (app/launcher.cpp) that
-// set the tunables before the program and its libraries are loaded; run directly, a program
-// starts itself again.
+// pages the kernel serves a page fault per 4 KB, and on virtual machines those are dear
+// (docs/decisions/0030-memory-huge-pages-one-arena-no-copies.md). glibc's malloc asks for
+// transparent huge pages (2 MB) when its tunable glibc.malloc.hugetlb=1 is set (the kernel
+// takes the advice unless its mode is "never"). With glibc.malloc.arena_max=1 the worker
+// threads allocate from the main heap, whose memory is kept and reused, instead of arenas of
+// their own that are given back to the kernel and faulted in again at the next parallel loop
+// (what each gains: docs/BENCHMARKS.md, "Memory in huge pages, one malloc arena"). Tunables are
+// read when a process starts, so the programs start themselves once more with them. The
+// allocations change, not the arithmetic: the same implant bytes either way (tested). The
+// installed programs are small launchers (app/launcher.cpp) that set the tunables before the
+// program and its libraries are loaded; run directly, a program starts itself again.
 #include <optional>
 #include <string>
 

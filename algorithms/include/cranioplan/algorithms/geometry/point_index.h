@@ -33,7 +33,7 @@ std::vector<size_t> thin_points(const std::vector<Eigen::Vector3d>& points, doub
 
 /// A mesh's vertices with their normals (all_vertex_samples) and a search tree over them, made
 /// once and shared by the stages that each need them (the plane fit, the registrations): on a
-/// SkullFix skull each costs about half a second to make.
+/// large skull each is dear to make (docs/decisions/0028-speed-history.md).
 struct VertexCloud {
   explicit VertexCloud(const SkullMesh& mesh);
   SurfaceSamples samples;

@@ -139,7 +139,7 @@ ImplantResult build_implant(const std::vector<Marker>& markers, const SkullMesh*
 /// The parameters of a quick preview of the same implant, for the view while a marker is being
 /// dragged: the same method, surfaces and thickness, without the fit to the bone and what needs
 /// it (edge clearance, clearance zones, under-contour, onlay) or comes after it (tabs, holes).
-/// On the sample: about 15 ms where the fitted implant takes a second.
+/// It takes a small fraction of the fitted implant's time (docs/BENCHMARKS.md).
 ImplantParams live_preview_params(ImplantParams params);
 
 }  // namespace cranioplan

@@ -104,8 +104,9 @@ void for_each_field(Visit&& visit, TabParams& p) {
             .with_option("screw-diameter", "the screw holes'"),
         p.screw_diameter_mm);
   visit(
-      length_mm("countersink_diameter_mm", "countersinks' diameter", 0, 8)
-          .with_option("countersink", "the countersinks' diameter at the tab's top, 90° (0: none)"),
+      length_mm("countersink_diameter_mm", "countersinks' diameter", 1.2, 8)
+          .with_option("countersink", "the countersinks' diameter at the tab's top, 90° (0: none)")
+          .zero_for_none(),
       p.countersink_diameter_mm);
   visit(length_mm("midline_distance_mm", "distance from the midline", 0, 40)
             .with_option("tab-midline-distance",

@@ -21,10 +21,9 @@ struct TrimToBoneParams {
   double max_voxels = 6e6;
   /// Parts thinner than this (slivers on the bone, filaments between bone fragments) go, mm
   /// (≥ 0). Half a millimetre above the quality report's 1 mm minimum: the surface is then
-  /// blurred (and, without a clearance, kept a voxel off the bone), which thins what is left.
-  /// With 1.25 mm the sample's plans keep edges under 1 mm up to 3.8 mm wide between the
-  /// crushed bone fragments above the orbit (over other readings and poses, 2 plans not
-  /// printable and 2 more with a rim gap over 0.5 mm with 1.25 mm and 1 mm bridges).
+  /// blurred (and, without a clearance, kept a voxel off the bone), which thins what is left:
+  /// a smaller width keeps edges under 1 mm between crushed bone fragments (docs/IMPLANT.md;
+  /// docs/decisions/0005-the-trim.md).
   double min_feature_mm = 1.5;
   double smoothing_mm = 0.3;  ///< Gaussian blur of the mask before meshing (σ), mm (≥ 0)
   /// Cracks narrower than twice this between the implant and the bone (the implant on one side,

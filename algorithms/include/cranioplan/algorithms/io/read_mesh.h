@@ -31,8 +31,8 @@ struct ReadMeshParams {
   bool orient_outward = false;
   /// The repairs of a skull's soup (repair_soup), each with a warning (MeshFile::
   /// repeated_dropped, triangles_turned, holes_closed): triangles with the same three corners as
-  /// another dropped (a surface written twice doubles every crossing there: the sample with its
-  /// rim's patch written twice planned at Dice 0.86 against its own plan); patches that wind
+  /// another dropped (a surface written twice doubles every crossing there, and the plan moves:
+  /// docs/ARCHITECTURE.md, "Errors, in three tiers"); patches that wind
   /// against their neighbours turned to agree with the larger part of their piece (a halfedge
   /// mesh cannot join two triangles that run a shared edge alike: read as they came, such seams
   /// are split into holes and reported as non-manifold); small holes closed, wound as their

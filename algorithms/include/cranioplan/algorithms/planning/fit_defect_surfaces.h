@@ -43,8 +43,8 @@ struct DefectSurfaceParams {
   /// mirror's corrections: fields that vary gently, so it rides over the bone's roughness.
   double smoothing = 0.03;
   /// The same for the outer radius itself (rim-only): the shape of the surroundings is the
-  /// only guide across the opening, and smoothing it flattens the vault (on SkullFix the
-  /// middle of the openings came out 0.3–1 mm low with 0.03).
+  /// only guide across the opening, and smoothing it as much as the corrections flattens the
+  /// vault: the middle of an opening comes out low (docs/AUTOPLAN.md, "Rim-only").
   double outer_smoothing = 0.003;
   /// Rim-only: the outer radius as it is, with the spline's quadratic trend (Quadratic), or as
   /// its excess over the sphere fitted to the ring (Sphere); Best: whichever predicts the

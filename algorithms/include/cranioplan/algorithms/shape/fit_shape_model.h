@@ -28,13 +28,12 @@ struct ShapeFitParams {
   double noise_mm = 1.0;
   /// A fit whose residual on the intact bone (RMS over the pairs) exceeds this is poor, mm: a
   /// model that does not describe the skull where it is seen does not know the missing part.
-  /// The library's model on SkullFix 000-003 and on 6 of 14 flaps: 0.30-0.67 mm, pairing 95-99 %
-  /// of the vertices; on SkullFix 004 0.86 mm at 76 % (used, it made the plan worse); on the
-  /// other flaps 0.76-1.24 mm, those over 0.8 mm pairing 67-89 % (docs/SHAPE_MODEL.md).
+  /// The limit lies between the fits that lay the model on the bone and those that made a plan
+  /// worse (the fits it was drawn from: docs/SHAPE_MODEL.md, "Fallback").
   double max_rms_mm = 0.8;
-  /// A fit that pairs fewer of the model's vertices left in than this share is poor (a model
-  /// reaching past the scan's bone pairs less without fitting worse: a synthetic shell cut
-  /// lower than the template pairs 82 % at 0.45 mm).
+  /// A fit that pairs fewer of the model's vertices left in than this share is poor. Pairing
+  /// alone does not judge a fit: a model reaching past the scan's bone pairs less without
+  /// fitting worse (docs/SHAPE_MODEL.md, "Fallback").
   double min_paired = 0.75;
 };
 
