@@ -52,10 +52,9 @@ std::optional<Material> material_preset(const std::string& id_or_name) {
 
 std::string material_problem(const Material& m) {
   if (std::string problem = range_problems("the", m); !problem.empty()) return problem;
+  const ParamSpec thickness = spec_of<Material>("thickness_mm");
   if (!std::isnan(m.thickness_mm) && m.thickness_mm < m.min_thickness_mm)
-    return spec_of<Material>("thickness_mm")
-               .problem("the", m.thickness_mm, m.min_thickness_mm,
-                        spec_of<Material>("thickness_mm").max) +
+    return thickness.problem("the", m.thickness_mm, m.min_thickness_mm, thickness.max) +
            " (not below the minimum thickness)";
   if (m.onlay_mm != 0.0) {
     if (std::isnan(m.thickness_mm)) return "a plate laid on the bone needs a thickness";

@@ -61,120 +61,150 @@ const TypeInfo& info(CommandType type) {
 
 Json number_or_null(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
 
-// Visitors over a Params struct's fields: one list of fields per struct serves both directions.
-struct Writer {
+// Visitors over a Params struct's fields, both directions: the fields a struct declares
+// (for_each_field, ParamSpec) and the lists below of those not declared yet (field(name)).
+struct DeclaredWriter {
   Json& j;
-  void operator()(const char* name, const double& v) { j[name] = number_or_null(v); }
-  void operator()(const char* name, const int& v) { j[name] = v; }
-  void operator()(const char* name, const long long& v) { j[name] = v; }
-  void operator()(const char* name, const bool& v) { j[name] = v; }
+  void operator()(const ParamSpec& s, const double& v) { j[s.key] = number_or_null(v); }
+  void operator()(const ParamSpec& s, const int& v) { j[s.key] = v; }
+  void operator()(const ParamSpec& s, const long long& v) { j[s.key] = v; }
+  void operator()(const ParamSpec& s, const bool& v) { j[s.key] = v; }
+  void operator()(const ParamSpec& s, const std::string& v) { j[s.key] = v; }
+  void operator()(const ParamSpec& s, const Eigen::Vector3d& v) { j[s.key] = to_json(v); }
+  void operator()(const ParamSpec& s, const std::vector<Eigen::Vector3d>& points) {
+    Json list = Json::array();
+    for (const auto& v : points) list.push_back(to_json(v));
+    j[s.key] = list;
+  }
+  void operator()(const ParamSpec& s, const std::optional<Plane>& plane) {
+    j[s.key] =
+        plane ? Json{{"normal", to_json(plane->normal)}, {"offset", plane->offset}} : Json(nullptr);
+  }
 };
 
-struct Reader {
+struct DeclaredReader {
+  static constexpr size_t kMaxPoints = 1000;
   const ParamReader& r;
-  void operator()(const char* name, double& v) { v = r.number(name); }
-  void operator()(const char* name, int& v) { v = r.integer(name); }
-  void operator()(const char* name, long long& v) {
-    v = static_cast<long long>(std::llround(r.number(name)));
+  void operator()(const ParamSpec& s, double& v) { v = r.number(s.key); }
+  void operator()(const ParamSpec& s, int& v) { v = r.integer(s.key); }
+  void operator()(const ParamSpec& s, long long& v) {
+    v = static_cast<long long>(std::llround(r.number(s.key)));
   }
-  void operator()(const char* name, bool& v) { v = r.boolean(name); }
+  void operator()(const ParamSpec& s, bool& v) { v = r.boolean(s.key); }
+  void operator()(const ParamSpec& s, std::string& v) { v = r.string(s.key); }
+  void operator()(const ParamSpec& s, Eigen::Vector3d& v) { v = r.vector3(s.key); }
+  void operator()(const ParamSpec& s, std::vector<Eigen::Vector3d>& points) {
+    const Json& list = r.value(s.key);
+    if (!list.is_array()) throw SessionError(r.where(), std::string(s.key) + " must be a list");
+    if (list.size() > kMaxPoints)
+      throw SessionError(r.where(),
+                         "more than " + format_count(kMaxPoints) + " points in " + s.key);
+    for (const Json& v : list)
+      points.push_back(vector_from_json(v, r.where(), std::string("a point in ") + s.key));
+  }
+  void operator()(const ParamSpec& s, std::optional<Plane>& plane) {
+    plane.reset();
+    if (r.value(s.key).is_null()) return;
+    const ParamReader m(r.value(s.key), r.where() + " " + s.key);
+    plane = Plane{m.vector3("normal"), m.number("offset")};
+  }
 };
 
 template <class V, class P>
 void extract_fields(V& v, P& p) {
-  v("threshold", p.threshold);
-  v("largest_piece_only", p.largest_piece_only);
-  v("min_piece_triangles", p.min_piece_triangles);
-  v("target_triangles", p.target_triangles);
+  v(field("threshold"), p.threshold);
+  v(field("largest_piece_only"), p.largest_piece_only);
+  v(field("min_piece_triangles"), p.min_piece_triangles);
+  v(field("target_triangles"), p.target_triangles);
 }
 
 template <class V, class P>
 void plane_fields(V& v, P& p) {
-  v("refine", p.refine);
-  v("use_surface_symmetry", p.use_surface_symmetry);
-  v("sample_count", p.sample_count);
-  v("outer_iterations", p.outer_iterations);
-  v("robust_scale_mm", p.robust_scale_mm);
-  v("coarse_robust_scale_mm", p.coarse_robust_scale_mm);
-  v("coarse_iterations", p.coarse_iterations);
-  v("max_correspondence_mm", p.max_correspondence_mm);
-  v("inlier_threshold_mm", p.inlier_threshold_mm);
-  v("landmark_weight", p.landmark_weight);
-  v("convergence_deg", p.convergence_deg);
-  v("convergence_mm", p.convergence_mm);
+  v(field("refine"), p.refine);
+  v(field("use_surface_symmetry"), p.use_surface_symmetry);
+  v(field("sample_count"), p.sample_count);
+  v(field("outer_iterations"), p.outer_iterations);
+  v(field("robust_scale_mm"), p.robust_scale_mm);
+  v(field("coarse_robust_scale_mm"), p.coarse_robust_scale_mm);
+  v(field("coarse_iterations"), p.coarse_iterations);
+  v(field("max_correspondence_mm"), p.max_correspondence_mm);
+  v(field("inlier_threshold_mm"), p.inlier_threshold_mm);
+  v(field("landmark_weight"), p.landmark_weight);
+  v(field("convergence_deg"), p.convergence_deg);
+  v(field("convergence_mm"), p.convergence_mm);
 }
 
 template <class V, class P>
 void register_fields(V& v, P& p) {
-  v("sample_count", p.sample_count);
-  v("max_iterations", p.max_iterations);
-  v("max_correspondence_mm", p.max_correspondence_mm);
-  v("trim_fraction", p.trim_fraction);
-  v("huber_mm", p.huber_mm);
-  v("convergence_mm", p.convergence_mm);
+  v(field("sample_count"), p.sample_count);
+  v(field("max_iterations"), p.max_iterations);
+  v(field("max_correspondence_mm"), p.max_correspondence_mm);
+  v(field("trim_fraction"), p.trim_fraction);
+  v(field("huber_mm"), p.huber_mm);
+  v(field("convergence_mm"), p.convergence_mm);
 }
 
 template <class V, class P>
 void smooth_fields(V& v, P& p) {
-  v("radius_mm", p.radius_mm);
-  v("edge_weight", p.edge_weight);
-  v("iterations", p.iterations);
+  v(field("radius_mm"), p.radius_mm);
+  v(field("edge_weight"), p.edge_weight);
+  v(field("iterations"), p.iterations);
 }
 
 template <class V, class P>
 void detect_fields(V& v, P& p) {
-  v("directions", p.directions);
-  v("min_area_mm2", p.min_area_mm2);
-  v("support_width_mm", p.support_width_mm);
-  v("max_thickness_mm", p.max_thickness_mm);
-  v("min_thickness_mm", p.min_thickness_mm);
+  v(field("directions"), p.directions);
+  v(field("min_area_mm2"), p.min_area_mm2);
+  v(field("support_width_mm"), p.support_width_mm);
+  v(field("max_thickness_mm"), p.max_thickness_mm);
+  v(field("min_thickness_mm"), p.min_thickness_mm);
 }
 
 template <class V, class P>
 void propose_fields(V& v, P& p) {
-  v("min_mirror_coverage", p.min_mirror_coverage);
-  v("edge_spacing_mm", p.edge_spacing_mm);
-  v("surface_spacing_mm", p.surface_spacing_mm);
+  v(field("min_mirror_coverage"), p.min_mirror_coverage);
+  v(field("edge_spacing_mm"), p.edge_spacing_mm);
+  v(field("surface_spacing_mm"), p.surface_spacing_mm);
 }
 
 // propose_markers version 2: how the defect's surfaces are fitted to the intact ring.
 template <class V, class P>
 void surface_fit_fields(V& v, P& p) {
-  v("ring_width_mm", p.ring_width_mm);
-  v("rim_clearance_mm", p.rim_clearance_mm);
-  v("ray_spacing_mm", p.ray_spacing_mm);
-  v("site_spacing_mm", p.site_spacing_mm);
-  v("smoothing", p.smoothing);
-  v("outlier_sigmas", p.outlier_sigmas);
+  v(field("ring_width_mm"), p.ring_width_mm);
+  v(field("rim_clearance_mm"), p.rim_clearance_mm);
+  v(field("ray_spacing_mm"), p.ray_spacing_mm);
+  v(field("site_spacing_mm"), p.site_spacing_mm);
+  v(field("smoothing"), p.smoothing);
+  v(field("outlier_sigmas"), p.outlier_sigmas);
 }
 
 // build_implant 3: how the shell is fitted to the bone ("trim").
 template <class V, class P>
 void trim_fields(V& v, P& p) {
-  v("voxel_mm", p.voxel_mm);
-  v("max_voxels", p.max_voxels);
-  v("min_feature_mm", p.min_feature_mm);
-  v("smoothing_mm", p.smoothing_mm);
-  v("bridge_mm", p.bridge_mm);
+  v(field("voxel_mm"), p.voxel_mm);
+  v(field("max_voxels"), p.max_voxels);
+  v(field("min_feature_mm"), p.min_feature_mm);
+  v(field("smoothing_mm"), p.smoothing_mm);
+  v(field("bridge_mm"), p.bridge_mm);
 }
 
 template <class V, class P>
 void implant_fields(V& v, P& p) {
-  v("resolution_mm", p.resolution_mm);
-  v("thickness_mm", p.thickness_mm);
-  v("snap_rim_to_skull", p.snap_rim_to_skull);
-  v("surface_smoothing", p.surface_smoothing);
-  v("max_rim_snap_mm", p.max_rim_snap_mm);
-  v("fit_to_bone_mm", p.fit_to_bone_mm);
-  v("delaunay_alpha", p.delaunay_alpha);
-  v("delaunay_tolerance", p.delaunay_tolerance);
-  v("delaunay_offset", p.delaunay_offset);
+  v(field("resolution_mm"), p.resolution_mm);
+  v(field("thickness_mm"), p.thickness_mm);
+  v(field("snap_rim_to_skull"), p.snap_rim_to_skull);
+  v(field("surface_smoothing"), p.surface_smoothing);
+  v(field("max_rim_snap_mm"), p.max_rim_snap_mm);
+  v(field("fit_to_bone_mm"), p.fit_to_bone_mm);
+  v(field("delaunay_alpha"), p.delaunay_alpha);
+  v(field("delaunay_tolerance"), p.delaunay_tolerance);
+  v(field("delaunay_offset"), p.delaunay_offset);
 }
 
 template <class Fields, class P>
 Json write_fields(Fields fields, const P& p) {
   Json j = Json::object();
-  Writer w{j};
+  DeclaredWriter w{j};
   fields(w, p);
   return j;
 }
@@ -345,50 +375,6 @@ Json params_to_json(const ImplantParams& p) {
 
 namespace {
 
-// Writes and reads the fields a Params struct declares (for_each_field, ParamSpec).
-struct DeclaredWriter {
-  Json& j;
-  void operator()(const ParamSpec& s, const double& v) { j[s.key] = number_or_null(v); }
-  void operator()(const ParamSpec& s, const int& v) { j[s.key] = v; }
-  void operator()(const ParamSpec& s, const bool& v) { j[s.key] = v; }
-  void operator()(const ParamSpec& s, const std::string& v) { j[s.key] = v; }
-  void operator()(const ParamSpec& s, const Eigen::Vector3d& v) { j[s.key] = to_json(v); }
-  void operator()(const ParamSpec& s, const std::vector<Eigen::Vector3d>& points) {
-    Json list = Json::array();
-    for (const auto& v : points) list.push_back(to_json(v));
-    j[s.key] = list;
-  }
-  void operator()(const ParamSpec& s, const std::optional<Plane>& plane) {
-    j[s.key] =
-        plane ? Json{{"normal", to_json(plane->normal)}, {"offset", plane->offset}} : Json(nullptr);
-  }
-};
-
-struct DeclaredReader {
-  static constexpr size_t kMaxPoints = 1000;
-  const ParamReader& r;
-  void operator()(const ParamSpec& s, double& v) { v = r.number(s.key); }
-  void operator()(const ParamSpec& s, int& v) { v = r.integer(s.key); }
-  void operator()(const ParamSpec& s, bool& v) { v = r.boolean(s.key); }
-  void operator()(const ParamSpec& s, std::string& v) { v = r.string(s.key); }
-  void operator()(const ParamSpec& s, Eigen::Vector3d& v) { v = r.vector3(s.key); }
-  void operator()(const ParamSpec& s, std::vector<Eigen::Vector3d>& points) {
-    const Json& list = r.value(s.key);
-    if (!list.is_array()) throw SessionError(r.where(), std::string(s.key) + " must be a list");
-    if (list.size() > kMaxPoints)
-      throw SessionError(r.where(),
-                         "more than " + format_count(kMaxPoints) + " points in " + s.key);
-    for (const Json& v : list)
-      points.push_back(vector_from_json(v, r.where(), std::string("a point in ") + s.key));
-  }
-  void operator()(const ParamSpec& s, std::optional<Plane>& plane) {
-    plane.reset();
-    if (r.value(s.key).is_null()) return;
-    const ParamReader m(r.value(s.key), r.where() + " " + s.key);
-    plane = Plane{m.vector3("normal"), m.number("offset")};
-  }
-};
-
 template <class P>
 Json declared_to_json(const P& p) {
   Json j = Json::object();
@@ -434,7 +420,7 @@ ClearanceZone clearance_zone_from_json(const ParamReader& r) {
 }
 
 void params_from_json(const ParamReader& r, ExtractBoneSurfaceParams& p) {
-  Reader v{r};
+  DeclaredReader v{r};
   extract_fields(v, p);
   // load_skull 1 has no "canonical": the skull as the file gave it, so that
   // those plans replay to the implants they exported.
@@ -464,16 +450,16 @@ void params_from_json(const ParamReader& r, ExtractBoneSurfaceParams& p) {
   p.dicom_series = r.has("dicom_series") ? r.string("dicom_series") : std::string();
 }
 void params_from_json(const ParamReader& r, PlaneFitParams& p) {
-  Reader v{r};
+  DeclaredReader v{r};
   plane_fields(v, p);
 }
 void params_from_json(const ParamReader& r, SmoothParams& p) {
-  Reader v{r};
+  DeclaredReader v{r};
   smooth_fields(v, p);
 }
 
 void params_from_json(const ParamReader& r, RegisterParams& p) {
-  Reader v{r};
+  DeclaredReader v{r};
   register_fields(v, p);
   p.initial = transform_from_json(r.value("initial"), r.where());
   const Json& roi = r.value("roi");
@@ -494,13 +480,13 @@ void params_from_json(const ParamReader& r, RegisterParams& p) {
 }
 
 void params_from_json(const ParamReader& r, ProposeParams& p) {
-  Reader v{r};
+  DeclaredReader v{r};
   propose_fields(v, p);
   const std::string method = r.string("method");
   if (!plan_method_from_string(method, p.method))
     throw SessionError(r.where(), "unknown planning method \"" + method + "\"");
   const ParamReader detect(r.value("detect"), r.where() + " detect");
-  Reader dv{detect};
+  DeclaredReader dv{detect};
   detect_fields(dv, p.detect);
   p.detect.near.reset();
   if (detect.has("near") && !detect.value("near").is_null()) p.detect.near = detect.vector3("near");
@@ -521,7 +507,7 @@ void params_from_json(const ParamReader& r, ProposeParams& p) {
   p.surfaces.weigh_sites_by_rays = false;
   if (r.has("surfaces")) {
     const ParamReader surfaces(r.value("surfaces"), r.where() + " surfaces");
-    Reader sv{surfaces};
+    DeclaredReader sv{surfaces};
     surface_fit_fields(sv, p.surfaces);
     if (surfaces.has("mirror_footprint_mm"))
       p.surfaces.mirror_footprint_mm = surfaces.number("mirror_footprint_mm");
@@ -536,7 +522,7 @@ void params_from_json(const ParamReader& r, ProposeParams& p) {
 }
 
 void params_from_json(const ParamReader& r, ImplantParams& p) {
-  Reader v{r};
+  DeclaredReader v{r};
   implant_fields(v, p);
   const std::string method = r.string("method");
   if (method == to_string(ImplantMethod::Shell))
@@ -558,7 +544,7 @@ void params_from_json(const ParamReader& r, ImplantParams& p) {
   p.trim = TrimToBoneParams{};
   if (r.has("trim")) {
     const ParamReader trim(r.value("trim"), r.where() + " trim");
-    Reader tv{trim};
+    DeclaredReader tv{trim};
     trim_fields(tv, p.trim);
     // build_implant 3 has no "clearance_mm": the bone grown by a voxel kept out,
     // and fills kept as made.
