@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <functional>
+#include <future>
 #include <limits>
 #include <map>
 #include <string>
@@ -16,6 +17,7 @@
 #include "cranioplan/algorithms/geometry/point_index.h"
 #include "cranioplan/algorithms/geometry/surface_locator.h"
 #include "cranioplan/algorithms/geometry/surface_samples.h"
+#include "cranioplan/model/parallel.h"
 
 namespace cranioplan {
 namespace {
@@ -403,8 +405,10 @@ struct DefectSurfaceFit {
 
   // One surface's spline (the outer radius, or the thickness from rays through both tables),
   // with one round of outlier removal, and its residual; false when the ring lies on a line.
+  // `sites`: the number of sites it was fitted to. The outer and the inner fit read `s`'s frame
+  // and write their own members only, so they may run side by side.
   static bool fit(DefectSurfaces& s, bool outer, const std::vector<Sample>& ring,
-                  const DefectSurfaceParams& params) {
+                  const DefectSurfaceParams& params, int& fitted_sites) {
     std::vector<size_t> all_rays, through_tables;
     for (size_t i = 0; i < ring.size(); ++i) {
       all_rays.push_back(i);
@@ -436,7 +440,7 @@ struct DefectSurfaceFit {
       const int refit = fit_sites(s, tps, outer, ring, kept, params);
       if (refit > 0) sites = refit;
     }
-    s.sites = sites;
+    fitted_sites = sites;
     // The residual over the ring's rays that the fit describes. Rays farther off than the
     // outlier limit are counted apart: mirror-guided, a ray past an orbit meets the orbital roof
     // on one side and the frontal bone on the other, 30-50 mm apart, and a few of those would
@@ -505,11 +509,15 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
     return s;
   }
   if (!mirror) DefectSurfaceFit::vault(s, ring, params);
-  for (bool outer : {true, false})
-    if (!DefectSurfaceFit::fit(s, outer, ring, params)) {
-      s.message = "the intact bone around the opening lies on a line: no surface can be fitted";
-      return s;
-    }
+  int outer_sites = 0, inner_sites = 0;
+  std::future<bool> outer_fitted = std::async(
+      beside(), [&] { return DefectSurfaceFit::fit(s, true, ring, params, outer_sites); });
+  const bool inner_fitted = DefectSurfaceFit::fit(s, false, ring, params, inner_sites);
+  if (!outer_fitted.get() || !inner_fitted) {
+    s.message = "the intact bone around the opening lies on a line: no surface can be fitted";
+    return s;
+  }
+  s.sites = inner_sites;
   s.status = DefectSurfaces::Status::Fitted;
   s.message = DefectSurfaceFit::describe(s);
   return s;

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <limits>
 #include <numeric>
 #include <optional>
@@ -768,11 +769,22 @@ TracedRim trace_rim_on_bone(const SkullMesh& skull, const SurfaceLocator& bone,
   }
   const Projection project{axis, e1, axis.cross(e1)};
   const double band_angle = std::clamp(params.band_deg, 5.0, 90.0) * kDeg;
+  std::future<std::vector<Eigen::Vector3d>> normals =
+      std::async(beside(), [&skull] { return smooth_vertex_normals(skull); });
   std::vector<int> faces = band_faces(skull, center, hole_directions, band_angle);
   FacesAround around = faces_around(skull, faces);
   const Band band{std::move(faces), std::move(around), hole_directions, band_angle};
   r.faces_examined = band.faces.size();
-  const std::vector<Eigen::Vector3d> vn = smooth_vertex_normals(skull);
+  const std::vector<Eigen::Vector3d> vn = normals.get();
+  // The two tables are traced independently, the inner beside the outer (its edge is only
+  // used when the outer one is found).
+  const bool trace_inner = !inner_seeds.empty() && !seen_inner_rim.empty();
+  std::future<TableEdge> inner_edge;
+  if (trace_inner)
+    inner_edge = std::async(beside(), [&] {
+      return trace_table(skull, bone, vn, project, center, band, inner_seeds, seen_inner_rim,
+                         borders, false, params);
+    });
   const TableEdge outer = trace_table(skull, bone, vn, project, center, band, outer_seeds, seen_rim,
                                       borders, true, params);
   if (!covers_enough(outer.sector)) {
@@ -799,9 +811,8 @@ TracedRim trace_rim_on_bone(const SkullMesh& skull, const SurfaceLocator& bone,
               r.at_scan_border.end());
 
   // The inner table's edge; each outer point paired with the inner one nearest it.
-  if (!inner_seeds.empty() && !seen_inner_rim.empty()) {
-    const TableEdge inner = trace_table(skull, bone, vn, project, center, band, inner_seeds,
-                                        seen_inner_rim, borders, false, params);
+  if (trace_inner) {
+    const TableEdge inner = inner_edge.get();
     if (inner.loop.size() >= 3) {
       const PointIndex index(inner.loop);
       for (const Eigen::Vector3d& p : r.outer) r.inner.push_back(inner.loop[index.nearest(p)]);
