@@ -225,14 +225,7 @@ Subcommand add_smooth(CLI::App& app, const bool& json) {
   auto o = std::make_shared<Opts>();
   auto* cmd = app.add_subcommand("smooth", "The paper's Laplacian smoother on surface markers");
   cmd->add_option("MARKERS", o->markers, "markers (.json, .csv or Slicer .mrk.json)")->required();
-  cmd->add_option("--radius", o->params.radius_mm, "neighbourhood radius (mm)")
-      ->required()
-      ->check(CLI::PositiveNumber);
-  cmd->add_option("--edge-weight", o->params.edge_weight, "weight of edge markers (>= 1)")
-      ->required()
-      ->check(CLI::Range(1.0, 1e6));
-  cmd->add_option("--iterations", o->params.iterations, "iterations (default 1)")
-      ->check(CLI::Range(1, 1000));
+  add_declared_options(cmd, o->params);
   cmd->add_option("--project-onto", o->mirrored,
                   "put smoothed surface markers back onto this mesh (the mirrored skull)");
   cmd->add_option("-o,--output", o->output, "markers to write (.json, .csv or Slicer .mrk.json)")
@@ -275,20 +268,9 @@ Subcommand add_implant(CLI::App& app, const bool& json) {
   cmd->add_option("--markers", o->markers, "markers (.json, .csv or Slicer .mrk.json)")->required();
   cmd->add_option("--method", o->method, "shell (default) or delaunay3d")
       ->check(CLI::IsMember({"shell", "delaunay3d"}));
-  cmd->add_option("--resolution", o->params.resolution_mm, "shell edge length (mm)")
-      ->check(CLI::Range(0.2, 10.0));
-  cmd->add_option("--thickness", o->params.thickness_mm,
-                  "thickness without inner markers (mm; default: bone around the rim)")
-      ->check(CLI::Range(0.5, 30.0));
+  add_declared_options(cmd, o->params);
   cmd->add_flag("--no-rim-snap", o->no_snap,
                 "keep the rim between markers where the spline puts it");
-  cmd->add_option("--alpha", o->params.delaunay_alpha, "delaunay3d alpha (mm; 0 = convex hull)");
-  cmd->add_option("--tolerance", o->params.delaunay_tolerance, "delaunay3d tolerance");
-  cmd->add_option("--offset", o->params.delaunay_offset, "delaunay3d offset");
-  cmd->add_option("--fit-to-bone", o->params.fit_to_bone_mm,
-                  "build the shell this far over the bone and subtract the skull (mm; 0: off; "
-                  "a clearance or under-contour needs it)")
-      ->check(CLI::Range(0.0, 10.0));
   add_material_options(cmd, o->material);
   add_hole_options(cmd, o->holes);
   add_tab_options(cmd, o->tabs);

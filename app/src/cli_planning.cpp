@@ -47,10 +47,8 @@ void refuse_if_in_model(const ShapeModel& model, const std::string& skull_path) 
 
 // --fit-to-bone MM: the automatic planner's implant built beyond the rim and trimmed by the bone.
 void add_fit_option(CLI::App* cmd, AutoplanParams& params) {
-  cmd->add_option("--fit-to-bone", params.implant.fit_to_bone_mm,
-                  "build the implant this far over the bone and subtract the skull (mm; 0: off)")
-      ->capture_default_str()
-      ->check(CLI::Range(0.0, 10.0));
+  add_declared_option(cmd, spec_of<ImplantParams>("fit_to_bone_mm"), params.implant.fit_to_bone_mm,
+                      "");
   cmd->add_option("--local-registration", params.local_registration_mm,
                   "register the mirror again within this margin of the opening (mm; 0: off)")
       ->capture_default_str()

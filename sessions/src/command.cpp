@@ -145,13 +145,6 @@ void register_fields(V& v, P& p) {
 }
 
 template <class V, class P>
-void smooth_fields(V& v, P& p) {
-  v(field("radius_mm"), p.radius_mm);
-  v(field("edge_weight"), p.edge_weight);
-  v(field("iterations"), p.iterations);
-}
-
-template <class V, class P>
 void detect_fields(V& v, P& p) {
   v(field("directions"), p.directions);
   v(field("min_area_mm2"), p.min_area_mm2);
@@ -188,25 +181,28 @@ void trim_fields(V& v, P& p) {
   v(field("bridge_mm"), p.bridge_mm);
 }
 
-template <class V, class P>
-void implant_fields(V& v, P& p) {
-  v(field("resolution_mm"), p.resolution_mm);
-  v(field("thickness_mm"), p.thickness_mm);
-  v(field("snap_rim_to_skull"), p.snap_rim_to_skull);
-  v(field("surface_smoothing"), p.surface_smoothing);
-  v(field("max_rim_snap_mm"), p.max_rim_snap_mm);
-  v(field("fit_to_bone_mm"), p.fit_to_bone_mm);
-  v(field("delaunay_alpha"), p.delaunay_alpha);
-  v(field("delaunay_tolerance"), p.delaunay_tolerance);
-  v(field("delaunay_offset"), p.delaunay_offset);
-}
-
 template <class Fields, class P>
 Json write_fields(Fields fields, const P& p) {
   Json j = Json::object();
   DeclaredWriter w{j};
   fields(w, p);
   return j;
+}
+
+template <class P>
+Json declared_to_json(const P& p) {
+  Json j = Json::object();
+  for_each_field(DeclaredWriter{j}, const_cast<P&>(p));  // the writer only reads
+  return j;
+}
+
+// The fields `P` declares, read and checked by `problem` (the operation's own rules).
+template <class P>
+P declared_from_json(const ParamReader& r, std::string (*problem)(const P&)) {
+  P p;
+  for_each_field(DeclaredReader{r}, p);
+  if (const std::string why = problem(p); !why.empty()) throw SessionError(r.where(), why);
+  return p;
 }
 
 Command make(CommandType type, Json params, int step = 0) {
@@ -315,9 +311,7 @@ Json params_to_json(const ExtractBoneSurfaceParams& p) {
 Json params_to_json(const PlaneFitParams& p) {
   return write_fields([](auto& v, auto& q) { plane_fields(v, q); }, p);
 }
-Json params_to_json(const SmoothParams& p) {
-  return write_fields([](auto& v, auto& q) { smooth_fields(v, q); }, p);
-}
+Json params_to_json(const SmoothParams& p) { return declared_to_json(p); }
 
 Json params_to_json(const RegisterParams& p) {
   Json j = write_fields([](auto& v, auto& q) { register_fields(v, q); }, p);
@@ -356,7 +350,7 @@ Json params_to_json(const ProposeParams& p) {
 }
 
 Json params_to_json(const ImplantParams& p) {
-  Json j = write_fields([](auto& v, auto& q) { implant_fields(v, q); }, p);
+  Json j = declared_to_json(p);
   j["method"] = to_string(p.method);
   j["frame"] = p.frame == ImplantFrame::Radial ? "radial" : "planar";
   j["radial_center"] = p.radial_center ? to_json(*p.radial_center) : Json(nullptr);
@@ -372,26 +366,6 @@ Json params_to_json(const ImplantParams& p) {
   j["scan_ends"] = to_json(p.scan_ends);
   return j;
 }
-
-namespace {
-
-template <class P>
-Json declared_to_json(const P& p) {
-  Json j = Json::object();
-  for_each_field(DeclaredWriter{j}, const_cast<P&>(p));  // the writer only reads
-  return j;
-}
-
-// The fields `P` declares, read and checked by `problem` (the operation's own rules).
-template <class P>
-P declared_from_json(const ParamReader& r, std::string (*problem)(const P&)) {
-  P p;
-  for_each_field(DeclaredReader{r}, p);
-  if (const std::string why = problem(p); !why.empty()) throw SessionError(r.where(), why);
-  return p;
-}
-
-}  // namespace
 
 Json to_json(const TabParams& p) { return declared_to_json(p); }
 Json to_json(const MouldParams& p) { return declared_to_json(p); }
@@ -454,8 +428,7 @@ void params_from_json(const ParamReader& r, PlaneFitParams& p) {
   plane_fields(v, p);
 }
 void params_from_json(const ParamReader& r, SmoothParams& p) {
-  DeclaredReader v{r};
-  smooth_fields(v, p);
+  p = declared_from_json(r, &smooth_problem);
 }
 
 void params_from_json(const ParamReader& r, RegisterParams& p) {
@@ -522,8 +495,9 @@ void params_from_json(const ParamReader& r, ProposeParams& p) {
 }
 
 void params_from_json(const ParamReader& r, ImplantParams& p) {
-  DeclaredReader v{r};
-  implant_fields(v, p);
+  for_each_field(DeclaredReader{r}, p);
+  if (const std::string why = range_problems("the implant's", p); !why.empty())
+    throw SessionError(r.where(), why);
   const std::string method = r.string("method");
   if (method == to_string(ImplantMethod::Shell))
     p.method = ImplantMethod::Shell;

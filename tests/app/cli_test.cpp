@@ -368,7 +368,11 @@ TEST(Cli, DeclaredOptionsCarryTheirRangeOnEverySubcommand) {
   const std::pair<const char*, const char*> refused[] = {
       {" mould i.stl --skull s.stl -o m.3mf --wall 3", "--wall"},
       {" export s.json -o m.3mf --mould --mould-vent-diameter 7", "--mould-vent-diameter"},
-      {" implant s.stl --tab-screws 3 -o i.stl", "--tab-screws"}};
+      {" implant s.stl --tab-screws 3 -o i.stl", "--tab-screws"},
+      {" smooth m.json --radius 0.5 -o o.json", "--radius"},
+      {" smooth m.json --iterations 1000 -o o.json", "--iterations"},
+      {" implant --skull s.stl --markers m.json --resolution 20 -o i.stl", "--resolution"},
+      {" autoplan s.stl --fit-to-bone 11 -o i.stl", "--fit-to-bone"}};
   for (const auto& [args, option] : refused) {
     EXPECT_EQ(test::run_command("sh -c '" + kCli + args + " 2>&1'", &out), 2) << args;
     EXPECT_NE(out.find(option), std::string::npos) << out;

@@ -336,6 +336,61 @@ TEST(Commands, ManufacturingParametersAreWrittenAndCheckedAsDeclared) {
   EXPECT_THROW(perforations_from_json(ParamReader(not_a_list, "plan.json")), SessionError);
 }
 
+// The smoothing's and the implant's own parameters are declared as well: written as declared,
+// and a session whose values are out of range (a smoothing of a billion rounds would never end)
+// is refused by the reader naming the parameter, before anything is computed.
+TEST(Commands, SmoothingAndShellParametersAreWrittenAndCheckedAsDeclared) {
+  std::set<std::string> smooth_options, implant_options;
+  expect_written_as_declared<SmoothParams>(params_to_json(SmoothParams{}), &smooth_options);
+  EXPECT_EQ(smooth_options, (std::set<std::string>{"radius", "edge-weight", "iterations"}));
+  const Json implant = params_to_json(ImplantParams{});
+  Json own = Json::object();  // the scalar fields; the groups each declare their own
+  for (auto it = implant.begin(); it != implant.end(); ++it)
+    if (!it.value().is_object() && !it.value().is_array() && it.key() != "method" &&
+        it.key() != "frame" && it.key() != "radial_center" && it.key() != "material")
+      own[it.key()] = it.value();
+  expect_written_as_declared<ImplantParams>(own, &implant_options);
+  EXPECT_TRUE(implant_options.count("fit-to-bone"));
+  EXPECT_TRUE(implant.at("thickness_mm").is_null()) << "unset: the bone's thickness";
+
+  const auto refused = [](const auto& read, const std::string& words) {
+    try {
+      read();
+      ADD_FAILURE() << "read: " << words;
+    } catch (const SessionError& e) {
+      EXPECT_NE(std::string(e.what()).find(words), std::string::npos) << e.what();
+      EXPECT_NE(std::string(e.what()).find("plan.json"), std::string::npos) << e.what();
+    }
+  };
+  Json smooth = params_to_json(SmoothParams{});
+  smooth["iterations"] = 1000000000;
+  refused(
+      [&] {
+        SmoothParams p;
+        params_from_json(ParamReader(smooth, "plan.json"), p);
+      },
+      "the smoothing's iterations must be 1 to 100 (1,000,000,000 given)");
+  Json shell = params_to_json(ImplantParams{});
+  shell["resolution_mm"] = 0.01;
+  refused(
+      [&] {
+        ImplantParams p;
+        params_from_json(ParamReader(shell, "plan.json"), p);
+      },
+      "the implant's resolution must be 0.2 to 10 mm (0.01 given)");
+  SmoothParams back;
+  params_from_json(ParamReader(params_to_json(SmoothParams{3.5, 4.0, 7}), "plan.json"), back);
+  EXPECT_EQ(params_to_json(back), params_to_json(SmoothParams{3.5, 4.0, 7}));
+  // The build refuses the same values given directly, in the same words.
+  ImplantParams coarse;
+  coarse.resolution_mm = 12.0;
+  const ImplantResult r = build_implant({}, nullptr, coarse);
+  EXPECT_FALSE(r.usable());
+  EXPECT_NE(r.message.find("the implant's resolution must be 0.2 to 10 mm (12 given)"),
+            std::string::npos)
+      << r.message;
+}
+
 // A mesh's length unit is part of the load: recorded, replayed, and read as millimetres from
 // a load_skull 1 or 2, which had none (nor turned a skull that winds inward outward). A unit that
 // is no length is refused.

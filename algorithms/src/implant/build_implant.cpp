@@ -820,8 +820,10 @@ ImplantResult refused(const std::string& why) {
   return r;
 }
 
-// Why the material or the clearance zones cannot be applied, or empty.
+// Why the parameters, the material or the clearance zones cannot be applied, or empty.
 std::string finishing_problem(const ImplantParams& params, const SkullMesh* skull) {
+  if (std::string problem = range_problems("the implant's", params); !problem.empty())
+    return problem;
   if (params.material) {
     const std::string problem = material_problem(*params.material);
     if (!problem.empty()) return params.material->name + ": " + problem;

@@ -10,9 +10,11 @@ namespace {
 constexpr double kCoincident2 = 1e-18;  // (1 nm)², in mm²
 }  // namespace
 
+std::string smooth_problem(const SmoothParams& p) { return range_problems("the smoothing's", p); }
+
 SmoothResult smooth_markers(const std::vector<Marker>& markers, const SmoothParams& params,
                             const SurfaceLocator* project_onto) {
-  assert(params.radius_mm > 0 && params.edge_weight >= 1 && params.iterations >= 1);
+  assert(smooth_problem(params).empty());
   SmoothResult result;
   result.markers = markers;
   if (markers.size() < 3) {

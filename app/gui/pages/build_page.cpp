@@ -10,6 +10,7 @@
 #include <cmath>
 
 #include "cranioplan/algorithms/planning/autoplan.h"
+#include "declared_fields.h"
 #include "step_pages.h"
 
 namespace cranioplan::gui {
@@ -22,34 +23,6 @@ const ImplantParams& automatic_implant() {
   return p;
 }
 
-// A declared parameter's help as a tooltip: a sentence.
-QString tooltip(const ParamSpec& s) {
-  QString text = QString::fromUtf8(s.help);
-  if (!text.isEmpty()) text[0] = text[0].toUpper();
-  return text;
-}
-
-// A field for a declared parameter: its range, unit and meaning from its ParamSpec.
-QDoubleSpinBox* declared_spin(QWidget* parent, const char* name, const ParamSpec& s, double value,
-                              double step) {
-  auto* b = new QDoubleSpinBox(parent);
-  b->setObjectName(name);
-  b->setRange(s.min, s.max);
-  b->setSingleStep(step);
-  if (*s.unit) b->setSuffix(QStringLiteral(" ") + QString::fromUtf8(s.unit));
-  b->setToolTip(tooltip(s));
-  b->setValue(value);
-  return b;
-}
-
-QSpinBox* declared_count(QWidget* parent, const char* name, const ParamSpec& s, int value) {
-  auto* b = new QSpinBox(parent);
-  b->setObjectName(name);
-  b->setRange(static_cast<int>(s.min), static_cast<int>(s.max));
-  b->setToolTip(tooltip(s));
-  b->setValue(value);
-  return b;
-}
 }  // namespace
 
 BuildPage::BuildPage(PageHost& host) : StepPage(kBuildStep, host) {
@@ -91,26 +64,17 @@ void BuildPage::add_shell_controls() {
   method_ = new QComboBox(this);
   method_->setObjectName("implantMethod");
   method_->addItems({tr("Shell (fitted surfaces)"), tr("Delaunay 3D (Egger et al. 2017)")});
-  resolution_ = new QDoubleSpinBox(this);
-  resolution_->setRange(0.3, 5);
-  resolution_->setValue(1.0);
-  resolution_->setSingleStep(0.1);
-  resolution_->setSuffix(" mm");
-  thickness_ = new QDoubleSpinBox(this);
-  thickness_->setRange(0, 15);
-  thickness_->setValue(0);
+  resolution_ = declared_spin(this, "implantResolution", spec_of<ImplantParams>("resolution_mm"),
+                              automatic_implant().resolution_mm, 0.1);
+  // Left unset (its lowest value, 0) the thickness is the bone's around the rim.
+  thickness_ =
+      declared_spin(this, "implantThickness", spec_of<ImplantParams>("thickness_mm"), 0.0, 0.1);
+  thickness_->setMinimum(0.0);
+  thickness_->setValue(0.0);
   thickness_->setSpecialValueText(tr("measured at the rim"));
-  thickness_->setSuffix(" mm");
-  fit_ = new QDoubleSpinBox(this);
-  fit_->setObjectName("implantFit");
-  fit_->setRange(0, 8);
-  fit_->setSingleStep(0.5);
-  fit_->setValue(automatic_implant().fit_to_bone_mm);
+  fit_ = declared_spin(this, "implantFit", spec_of<ImplantParams>("fit_to_bone_mm"),
+                       automatic_implant().fit_to_bone_mm, 0.5);
   fit_->setSpecialValueText(tr("off"));
-  fit_->setSuffix(" mm");
-  fit_->setToolTip(
-      tr("Build the shell this far over the bone and subtract the skull: the implant meets "
-         "the cut face all around and never enters the bone (about 1 s per rebuild)"));
   form_->addRow(tr("Method"), method_);
   form_->addRow(tr("Resolution"), resolution_);
   form_->addRow(tr("Thickness without inner markers"), thickness_);

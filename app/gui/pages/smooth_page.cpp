@@ -6,21 +6,20 @@
 #include <QSlider>
 #include <QSpinBox>
 
+#include "cranioplan/algorithms/implant/smooth_markers.h"
+#include "declared_fields.h"
 #include "step_pages.h"
 
 namespace cranioplan::gui {
 
 SmoothPage::SmoothPage(PageHost& host) : StepPage(kSmoothStep, host) {
-  radius_ = new QSlider(Qt::Horizontal, this);
-  radius_->setObjectName("smoothRadius");
-  radius_->setRange(2, 40);
-  radius_->setValue(10);
-  weight_ = new QSlider(Qt::Horizontal, this);
-  weight_->setObjectName("smoothWeight");
-  weight_->setRange(1, 10);
-  weight_->setValue(2);
-  iterations_ = new QSpinBox(this);
-  iterations_->setRange(1, 20);
+  const SmoothParams defaults;
+  radius_ = declared_slider(this, "smoothRadius", spec_of<SmoothParams>("radius_mm"),
+                            static_cast<int>(defaults.radius_mm));
+  weight_ = declared_slider(this, "smoothWeight", spec_of<SmoothParams>("edge_weight"),
+                            static_cast<int>(defaults.edge_weight));
+  iterations_ = declared_count(this, "smoothIterations", spec_of<SmoothParams>("iterations"),
+                               defaults.iterations);
   project_ = new QCheckBox(tr("Put smoothed markers back on the mirror"), this);
   project_->setChecked(true);
   info_ = new QLabel(this);
@@ -32,7 +31,7 @@ SmoothPage::SmoothPage(PageHost& host) : StepPage(kSmoothStep, host) {
   const auto with_value = [this](QSlider* slider, QLabel*& value, const char* name) {
     value = new QLabel(this);
     value->setObjectName(name);
-    value->setMinimumWidth(value->fontMetrics().horizontalAdvance(QStringLiteral("40 mm")));
+    value->setMinimumWidth(value->fontMetrics().horizontalAdvance(QStringLiteral("100 mm")));
     auto* row = new QHBoxLayout;
     row->addWidget(slider, 1);
     row->addWidget(value);

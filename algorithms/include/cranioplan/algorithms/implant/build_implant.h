@@ -11,6 +11,7 @@
 #include "cranioplan/model/marker.h"
 #include "cranioplan/model/material.h"
 #include "cranioplan/model/mesh.h"
+#include "cranioplan/model/param_spec.h"
 #include "cranioplan/model/plane.h"
 
 namespace cranioplan {
@@ -21,12 +22,13 @@ enum class ImplantMethod { Shell, Delaunay3D };
 enum class ImplantFrame { Radial, Planar };
 const char* to_string(ImplantMethod m);
 
+// The scalar fields' ranges, units and meanings are declared in for_each_field below.
 struct ImplantParams {
   ImplantMethod method = ImplantMethod::Shell;
   // shell
-  double resolution_mm = 1.0;  ///< target edge length of the shell, mm (0.2..10)
-  /// Thickness when there are no inner markers, mm; NaN: the bone thickness measured around
-  /// the rim (6 mm when no skull is given).
+  double resolution_mm = 1.0;  ///< target edge length of the shell
+  /// Thickness when there are no inner markers; NaN: the bone thickness measured around the
+  /// rim (6 mm when no skull is given).
   double thickness_mm = std::numeric_limits<double>::quiet_NaN();
   bool snap_rim_to_skull = true;  ///< rim points between edge markers are put onto the bone
   /// Surface markers are approximated rather than interpolated with this spline smoothing
@@ -88,6 +90,40 @@ struct ImplantParams {
   double delaunay_tolerance = 0.001;  ///< point merge tolerance, fraction of the bounding box
   double delaunay_offset = 2.5;       ///< bounding triangulation size multiplier
 };
+
+/// ImplantParams' own scalar fields, each declared once (ParamSpec), in the order a session
+/// writes them. Its trim, material, clearance zones, perforations and tabs declare theirs beside
+/// their own structs.
+template <class Visit>
+void for_each_field(Visit&& visit, ImplantParams& p) {
+  visit(length_mm("resolution_mm", "resolution", 0.2, 10)
+            .with_option("resolution", "the shell's edge length"),
+        p.resolution_mm);
+  visit(length_mm("thickness_mm", "thickness", 0.5, 30)
+            .unset_derived()
+            .with_option("thickness",
+                         "the implant's thickness where no inner markers are set (default: the "
+                         "bone's, measured around the rim)"),
+        p.thickness_mm);
+  visit(field("snap_rim_to_skull"), p.snap_rim_to_skull);
+  visit(number("surface_smoothing", "surface smoothing", 0, 1), p.surface_smoothing);
+  visit(length_mm("max_rim_snap_mm", "largest rim snap", 0, 20), p.max_rim_snap_mm);
+  visit(length_mm("fit_to_bone_mm", "fit to the bone", 0, 10)
+            .with_option("fit-to-bone",
+                         "build the shell this far over the bone and subtract the skull (0: off; "
+                         "a clearance or under-contour needs it)"),
+        p.fit_to_bone_mm);
+  visit(length_mm("delaunay_alpha", "Delaunay alpha", 0, 1000)
+            .with_option("alpha", "delaunay3d: the alpha shape's radius (0: the convex hull)"),
+        p.delaunay_alpha);
+  visit(number("delaunay_tolerance", "Delaunay tolerance", 0, 1)
+            .with_option("tolerance",
+                         "delaunay3d: points closer than this share of the bounding box merge"),
+        p.delaunay_tolerance);
+  visit(number("delaunay_offset", "Delaunay offset", 2.5, 100)
+            .with_option("offset", "delaunay3d: the first triangulation's size, times the points'"),
+        p.delaunay_offset);
+}
 
 struct ImplantResult {
   enum class Status { Built, TooFewMarkers, Failed };

@@ -1,0 +1,48 @@
+#include "declared_fields.h"
+
+#include <QDoubleSpinBox>
+#include <QSlider>
+#include <QSpinBox>
+#include <cmath>
+
+#include "cranioplan/model/param_spec.h"
+
+namespace cranioplan::gui {
+
+QString declared_tooltip(const ParamSpec& s) {
+  QString text = QString::fromUtf8(s.help);
+  if (!text.isEmpty()) text[0] = text[0].toUpper();
+  return text;
+}
+
+QDoubleSpinBox* declared_spin(QWidget* parent, const char* name, const ParamSpec& s, double value,
+                              double step) {
+  auto* b = new QDoubleSpinBox(parent);
+  b->setObjectName(name);
+  b->setRange(s.min, s.max);
+  b->setSingleStep(step);
+  if (*s.unit) b->setSuffix(QStringLiteral(" ") + QString::fromUtf8(s.unit));
+  b->setToolTip(declared_tooltip(s));
+  b->setValue(value);
+  return b;
+}
+
+QSpinBox* declared_count(QWidget* parent, const char* name, const ParamSpec& s, int value) {
+  auto* b = new QSpinBox(parent);
+  b->setObjectName(name);
+  b->setRange(static_cast<int>(s.min), static_cast<int>(s.max));
+  b->setToolTip(declared_tooltip(s));
+  b->setValue(value);
+  return b;
+}
+
+QSlider* declared_slider(QWidget* parent, const char* name, const ParamSpec& s, int value) {
+  auto* b = new QSlider(Qt::Horizontal, parent);
+  b->setObjectName(name);
+  b->setRange(static_cast<int>(std::ceil(s.min)), static_cast<int>(std::floor(s.max)));
+  b->setToolTip(declared_tooltip(s));
+  b->setValue(value);
+  return b;
+}
+
+}  // namespace cranioplan::gui
