@@ -304,6 +304,35 @@ TEST(StepPages, BuildPushesTheParametersTheControlsShow) {
   EXPECT_DOUBLE_EQ(p.at("fit_to_bone_mm").get<double>(), 4.0);
 }
 
+// The shell's fields take the declared ranges: a plan made on the command line (fitted 10 mm
+// over the bone, a 20 mm thickness, a 9 mm resolution) shows and rebuilds with its own values,
+// not clamped ones; a field that may be left unset steps from unset straight to the least value
+// allowed (a plate of 0.1 mm would be refused) and back.
+TEST(StepPages, TheShellsFieldsTakeTheDeclaredRanges) {
+  RecordingHost host;
+  BuildPage page(host);
+  ImplantParams built;
+  built.resolution_mm = 9.0;
+  built.thickness_mm = 20.0;
+  built.fit_to_bone_mm = 10.0;
+  host.state.implant_params = built;
+  page.show_state(host.state);
+  click(page, "build");
+  ASSERT_EQ(host.pushed.back().type, CommandType::BuildImplant);
+  const Json& p = host.pushed.back().params.at("params");
+  EXPECT_DOUBLE_EQ(p.at("resolution_mm").get<double>(), 9.0);
+  EXPECT_DOUBLE_EQ(p.at("thickness_mm").get<double>(), 20.0);
+  EXPECT_DOUBLE_EQ(p.at("fit_to_bone_mm").get<double>(), 10.0);
+  auto* plate = child<QDoubleSpinBox>(page, "materialPlate");
+  ASSERT_EQ(plate->value(), 0.0);
+  plate->stepUp();
+  EXPECT_DOUBLE_EQ(plate->value(), spec_of<Material>("thickness_mm").min) << "unset, then 0.3 mm";
+  plate->stepDown();
+  EXPECT_DOUBLE_EQ(plate->value(), 0.0) << "back to unset";
+  EXPECT_EQ(child<QDoubleSpinBox>(page, "implantResolution")->maximum(),
+            spec_of<ImplantParams>("resolution_mm").max);
+}
+
 // An implant fitted from another margin than the one asked: the field keeps the margin asked,
 // the panel says which one was used and why.
 TEST(StepPages, AFitFromAnotherMarginIsSaid) {

@@ -4,6 +4,7 @@
 #include <QSlider>
 #include <QSpinBox>
 #include <cmath>
+#include <memory>
 
 #include "cranioplan/model/param_spec.h"
 
@@ -25,6 +26,21 @@ QDoubleSpinBox* declared_spin(QWidget* parent, const char* name, const ParamSpec
   b->setToolTip(declared_tooltip(s));
   b->setValue(value);
   return b;
+}
+
+void allow_unset(QDoubleSpinBox* box, const ParamSpec& s, const QString& text) {
+  box->setMinimum(0.0);
+  box->setSpecialValueText(text);
+  box->setValue(0.0);
+  auto previous = std::make_shared<double>(0.0);
+  QObject::connect(box, &QDoubleSpinBox::valueChanged, box,
+                   [box, least = s.min, previous](double v) {
+                     if (v > 0.0 && v < least) {
+                       box->setValue(v > *previous ? least : 0.0);
+                       return;
+                     }
+                     *previous = v;
+                   });
 }
 
 QSpinBox* declared_count(QWidget* parent, const char* name, const ParamSpec& s, int value) {

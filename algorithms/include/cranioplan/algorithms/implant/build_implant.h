@@ -99,7 +99,7 @@ void for_each_field(Visit&& visit, ImplantParams& p) {
   visit(length_mm("resolution_mm", "resolution", 0.2, 10)
             .with_option("resolution", "the shell's edge length"),
         p.resolution_mm);
-  visit(length_mm("thickness_mm", "thickness", 0.5, 30)
+  visit(length_mm("thickness_mm", "thickness", 0.1, 30)
             .unset_derived()
             .with_option("thickness",
                          "the implant's thickness where no inner markers are set (default: the "
