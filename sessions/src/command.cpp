@@ -119,32 +119,6 @@ void extract_fields(V& v, P& p) {
 }
 
 template <class V, class P>
-void plane_fields(V& v, P& p) {
-  v(field("refine"), p.refine);
-  v(field("use_surface_symmetry"), p.use_surface_symmetry);
-  v(field("sample_count"), p.sample_count);
-  v(field("outer_iterations"), p.outer_iterations);
-  v(field("robust_scale_mm"), p.robust_scale_mm);
-  v(field("coarse_robust_scale_mm"), p.coarse_robust_scale_mm);
-  v(field("coarse_iterations"), p.coarse_iterations);
-  v(field("max_correspondence_mm"), p.max_correspondence_mm);
-  v(field("inlier_threshold_mm"), p.inlier_threshold_mm);
-  v(field("landmark_weight"), p.landmark_weight);
-  v(field("convergence_deg"), p.convergence_deg);
-  v(field("convergence_mm"), p.convergence_mm);
-}
-
-template <class V, class P>
-void register_fields(V& v, P& p) {
-  v(field("sample_count"), p.sample_count);
-  v(field("max_iterations"), p.max_iterations);
-  v(field("max_correspondence_mm"), p.max_correspondence_mm);
-  v(field("trim_fraction"), p.trim_fraction);
-  v(field("huber_mm"), p.huber_mm);
-  v(field("convergence_mm"), p.convergence_mm);
-}
-
-template <class V, class P>
 void detect_fields(V& v, P& p) {
   v(field("directions"), p.directions);
   v(field("min_area_mm2"), p.min_area_mm2);
@@ -203,6 +177,14 @@ P declared_from_json(const ParamReader& r, std::string (*problem)(const P&)) {
   for_each_field(DeclaredReader{r}, p);
   if (const std::string why = problem(p); !why.empty()) throw SessionError(r.where(), why);
   return p;
+}
+
+// The fields `p`'s type declares, read into `p` and refused out of their ranges.
+template <class P>
+void read_declared(const ParamReader& r, const char* whose, P& p) {
+  for_each_field(DeclaredReader{r}, p);
+  if (const std::string why = range_problems(whose, p); !why.empty())
+    throw SessionError(r.where(), why);
 }
 
 Command make(CommandType type, Json params, int step = 0) {
@@ -308,13 +290,11 @@ Json params_to_json(const ExtractBoneSurfaceParams& p) {
   j["dicom_series"] = p.dicom_series;
   return j;
 }
-Json params_to_json(const PlaneFitParams& p) {
-  return write_fields([](auto& v, auto& q) { plane_fields(v, q); }, p);
-}
+Json params_to_json(const PlaneFitParams& p) { return declared_to_json(p); }
 Json params_to_json(const SmoothParams& p) { return declared_to_json(p); }
 
 Json params_to_json(const RegisterParams& p) {
-  Json j = write_fields([](auto& v, auto& q) { register_fields(v, q); }, p);
+  Json j = declared_to_json(p);
   j["initial"] = to_json(p.initial);
   if (p.roi) {
     Json roi;
@@ -424,16 +404,14 @@ void params_from_json(const ParamReader& r, ExtractBoneSurfaceParams& p) {
   p.dicom_series = r.has("dicom_series") ? r.string("dicom_series") : std::string();
 }
 void params_from_json(const ParamReader& r, PlaneFitParams& p) {
-  DeclaredReader v{r};
-  plane_fields(v, p);
+  read_declared(r, "the plane fit's", p);
 }
 void params_from_json(const ParamReader& r, SmoothParams& p) {
   p = declared_from_json(r, &smooth_problem);
 }
 
 void params_from_json(const ParamReader& r, RegisterParams& p) {
-  DeclaredReader v{r};
-  register_fields(v, p);
+  read_declared(r, "the registration's", p);
   p.initial = transform_from_json(r.value("initial"), r.where());
   const Json& roi = r.value("roi");
   if (roi.is_null()) {
@@ -495,9 +473,7 @@ void params_from_json(const ParamReader& r, ProposeParams& p) {
 }
 
 void params_from_json(const ParamReader& r, ImplantParams& p) {
-  for_each_field(DeclaredReader{r}, p);
-  if (const std::string why = range_problems("the implant's", p); !why.empty())
-    throw SessionError(r.where(), why);
+  read_declared(r, "the implant's", p);
   const std::string method = r.string("method");
   if (method == to_string(ImplantMethod::Shell))
     p.method = ImplantMethod::Shell;

@@ -391,6 +391,45 @@ TEST(Commands, SmoothingAndShellParametersAreWrittenAndCheckedAsDeclared) {
       << r.message;
 }
 
+// The plane fit's and the registration's parameters too: written as declared (the starting
+// transform and the region after the registration's), and a count out of range in a session is
+// refused naming it rather than clamped without a word.
+TEST(Commands, PlaneAndRegistrationParametersAreWrittenAndCheckedAsDeclared) {
+  std::set<std::string> none;
+  expect_written_as_declared<PlaneFitParams>(params_to_json(PlaneFitParams{}), &none);
+  Json reg = params_to_json(RegisterParams{});
+  EXPECT_TRUE(reg.contains("initial") && reg.contains("roi"));
+  reg.erase("initial");
+  reg.erase("roi");
+  expect_written_as_declared<RegisterParams>(reg, &none);
+  EXPECT_TRUE(none.empty()) << "no CLI option declared yet";
+
+  Json plane = params_to_json(PlaneFitParams{});
+  plane["outer_iterations"] = 5000;
+  try {
+    PlaneFitParams p;
+    params_from_json(ParamReader(plane, "plan.json"), p);
+    ADD_FAILURE() << "5,000 updates were read";
+  } catch (const SessionError& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "the plane fit's number of updates must be 1 to 50 (5000 given)"),
+              std::string::npos)
+        << e.what();
+  }
+  Json trimmed = params_to_json(RegisterParams{});
+  trimmed["trim_fraction"] = 0.0;
+  try {
+    RegisterParams p;
+    params_from_json(ParamReader(trimmed, "plan.json"), p);
+    ADD_FAILURE() << "a registration keeping no pair was read";
+  } catch (const SessionError& e) {
+    EXPECT_NE(std::string(e.what()).find(
+                  "the registration's share of pairs kept must be 0.05 to 1 (0 given)"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
 // A mesh's length unit is part of the load: recorded, replayed, and read as millimetres from
 // a load_skull 1 or 2, which had none (nor turned a skull that winds inward outward). A unit that
 // is no length is refused.

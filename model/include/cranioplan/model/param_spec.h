@@ -58,6 +58,10 @@ inline ParamSpec length_mm(const char* key, const char* noun, double lo, double 
 inline ParamSpec number(const char* key, const char* noun, double lo, double hi) {
   return ParamSpec{key, noun, lo, hi, ""};
 }
+/// An angle in degrees from `lo` to `hi`.
+inline ParamSpec angle_deg(const char* key, const char* noun, double lo, double hi) {
+  return ParamSpec{key, noun, lo, hi, "deg"};
+}
 /// A field without a range: a flag, a list of points, an optional plane.
 inline ParamSpec field(const char* key) { return ParamSpec{key}; }
 

@@ -5,6 +5,7 @@
 
 #include "cranioplan/model/landmarks.h"
 #include "cranioplan/model/mesh.h"
+#include "cranioplan/model/param_spec.h"
 #include "cranioplan/model/plane.h"
 
 namespace cranioplan {
@@ -12,23 +13,43 @@ namespace cranioplan {
 struct SurfaceSamples;
 struct VertexCloud;
 
+// The fields' ranges and units are declared in for_each_field below.
 struct PlaneFitParams {
   bool refine = true;                ///< run the Ceres refinement after the initial plane
   bool use_surface_symmetry = true;  ///< add the surface-symmetry residuals (needs a mesh)
-  int sample_count = 4000;           ///< surface samples for symmetry, 100..100000
-  int outer_iterations = 40;         ///< correspondence updates (k-d tree), 1..50
-  double robust_scale_mm = 1.0;      ///< Cauchy loss scale for symmetry residuals, mm (>0)
+  int sample_count = 4000;           ///< surface samples for symmetry
+  int outer_iterations = 40;         ///< correspondence updates (k-d tree)
+  double robust_scale_mm = 1.0;      ///< Cauchy loss scale for symmetry residuals
   /// The first `coarse_iterations` updates use this wider scale (graduated: the cost is smoother
   /// there, so starts a fraction of a degree apart reach the same optimum instead of stopping
-  /// in different shallow minima of the nearest-point correspondences), mm (>0).
+  /// in different shallow minima of the nearest-point correspondences).
   double coarse_robust_scale_mm = 4.0;
-  int coarse_iterations = 8;  ///< updates at the coarse scale (not checked for convergence), ≥ 0
-  double max_correspondence_mm = 10;  ///< reflected samples farther than this are ignored, mm
-  double inlier_threshold_mm = 1.5;   ///< |residual| below this counts as an inlier, mm
-  double landmark_weight = 1.0;       ///< weight of each landmark residual (≥ 0)
-  double convergence_deg = 1e-2;      ///< stop outer iterations when the normal turns less, deg
-  double convergence_mm = 1e-2;       ///< ... and the offset moves less than this, mm
+  int coarse_iterations = 8;          ///< updates at the coarse scale (not checked for convergence)
+  double max_correspondence_mm = 10;  ///< reflected samples farther than this are ignored
+  double inlier_threshold_mm = 1.5;   ///< |residual| below this counts as an inlier
+  double landmark_weight = 1.0;       ///< weight of each landmark residual
+  double convergence_deg = 1e-2;      ///< stop outer iterations when the normal turns less
+  double convergence_mm = 1e-2;       ///< ... and the offset moves less than this
 };
+
+/// PlaneFitParams' fields, each declared once (ParamSpec), in the order a session writes them.
+template <class Visit>
+void for_each_field(Visit&& visit, PlaneFitParams& p) {
+  visit(field("refine"), p.refine);
+  visit(field("use_surface_symmetry"), p.use_surface_symmetry);
+  visit(number("sample_count", "number of samples", 100, 100000), p.sample_count);
+  visit(number("outer_iterations", "number of updates", 1, 50), p.outer_iterations);
+  visit(length_mm("robust_scale_mm", "robust scale", 0.01, 50), p.robust_scale_mm);
+  visit(length_mm("coarse_robust_scale_mm", "coarse robust scale", 0.01, 50),
+        p.coarse_robust_scale_mm);
+  visit(number("coarse_iterations", "number of coarse updates", 0, 50), p.coarse_iterations);
+  visit(length_mm("max_correspondence_mm", "largest pairing distance", 0.1, 100),
+        p.max_correspondence_mm);
+  visit(length_mm("inlier_threshold_mm", "inlier threshold", 0.01, 50), p.inlier_threshold_mm);
+  visit(number("landmark_weight", "landmarks' weight", 0, 1000), p.landmark_weight);
+  visit(angle_deg("convergence_deg", "convergence angle", 0, 10), p.convergence_deg);
+  visit(length_mm("convergence_mm", "convergence distance", 0, 10), p.convergence_mm);
+}
 
 struct PlaneFit {
   enum class Status { Converged, MaxIterations, Failed };

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "cranioplan/model/mesh.h"
+#include "cranioplan/model/param_spec.h"
 #include "cranioplan/model/plane.h"
 #include "cranioplan/model/rigid_transform.h"
 
@@ -20,16 +21,30 @@ struct RegionOfInterest {
   bool contains(const Eigen::Vector3d& p) const;
 };
 
+// The scalar fields' ranges and units are declared in for_each_field below.
 struct RegisterParams {
   RigidTransform initial;               ///< starting transform of MOVING
-  int sample_count = 6000;              ///< moving samples used, 100..200000
-  int max_iterations = 60;              ///< 1..500
-  double max_correspondence_mm = 8.0;   ///< pairs farther apart are ignored, mm (>0)
-  double trim_fraction = 0.85;          ///< keep this best fraction of pairs, (0, 1]
-  double huber_mm = 1.0;                ///< Huber weight scale for residuals, mm (>0)
-  double convergence_mm = 0.01;         ///< stop when an update moves no sample more than this, mm
+  int sample_count = 6000;              ///< moving samples used
+  int max_iterations = 60;              ///< updates at most
+  double max_correspondence_mm = 8.0;   ///< pairs farther apart are ignored
+  double trim_fraction = 0.85;          ///< keep this best fraction of pairs
+  double huber_mm = 1.0;                ///< Huber weight scale for residuals
+  double convergence_mm = 0.01;         ///< stop when an update moves no sample more than this
   std::optional<RegionOfInterest> roi;  ///< only moving samples inside it (after transform)
 };
+
+/// RegisterParams' scalar fields, each declared once (ParamSpec), in the order a session writes
+/// them (the starting transform and the region follow them).
+template <class Visit>
+void for_each_field(Visit&& visit, RegisterParams& p) {
+  visit(number("sample_count", "number of samples", 100, 200000), p.sample_count);
+  visit(number("max_iterations", "number of updates", 1, 500), p.max_iterations);
+  visit(length_mm("max_correspondence_mm", "largest pairing distance", 0.1, 100),
+        p.max_correspondence_mm);
+  visit(number("trim_fraction", "share of pairs kept", 0.05, 1), p.trim_fraction);
+  visit(length_mm("huber_mm", "Huber scale", 0.01, 50), p.huber_mm);
+  visit(length_mm("convergence_mm", "convergence distance", 0, 10), p.convergence_mm);
+}
 
 struct RegisterResult {
   enum class Status { Converged, MaxIterations, Failed };
