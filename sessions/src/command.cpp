@@ -170,21 +170,24 @@ Json declared_to_json(const P& p) {
   return j;
 }
 
-// The fields `P` declares, read and checked by `problem` (the operation's own rules).
+// The fields `p`'s type declares, read into `p` and refused when `problem` (the operation's
+// rules, or only the declared ranges) finds one.
+template <class P, class Problem>
+void read_declared(const ParamReader& r, P& p, Problem problem) {
+  for_each_field(DeclaredReader{r}, p);
+  if (const std::string why = problem(p); !why.empty()) throw SessionError(r.where(), why);
+}
+
+// The same into `P`s of their own; `whose`: the ranges only ("the plane fit's").
 template <class P>
 P declared_from_json(const ParamReader& r, std::string (*problem)(const P&)) {
   P p;
-  for_each_field(DeclaredReader{r}, p);
-  if (const std::string why = problem(p); !why.empty()) throw SessionError(r.where(), why);
+  read_declared(r, p, problem);
   return p;
 }
-
-// The fields `p`'s type declares, read into `p` and refused out of their ranges.
 template <class P>
 void read_declared(const ParamReader& r, const char* whose, P& p) {
-  for_each_field(DeclaredReader{r}, p);
-  if (const std::string why = range_problems(whose, p); !why.empty())
-    throw SessionError(r.where(), why);
+  read_declared(r, p, [whose](const P& q) { return range_problems(whose, q); });
 }
 
 Command make(CommandType type, Json params, int step = 0) {

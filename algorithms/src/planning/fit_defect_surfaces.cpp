@@ -404,11 +404,11 @@ struct DefectSurfaceFit {
   }
 
   // One surface's spline (the outer radius, or the thickness from rays through both tables),
-  // with one round of outlier removal, and its residual; false when the ring lies on a line.
-  // `sites`: the number of sites it was fitted to. The outer and the inner fit read `s`'s frame
-  // and write their own members only, so they may run side by side.
-  static bool fit(DefectSurfaces& s, bool outer, const std::vector<Sample>& ring,
-                  const DefectSurfaceParams& params, int& fitted_sites) {
+  // with one round of outlier removal, and its residual; the number of sites it was fitted to,
+  // 0 when the ring lies on a line. The outer and the inner fit read `s`'s frame and write
+  // their own members only, so they may run side by side.
+  static int fit(DefectSurfaces& s, bool outer, const std::vector<Sample>& ring,
+                 const DefectSurfaceParams& params) {
     std::vector<size_t> all_rays, through_tables;
     for (size_t i = 0; i < ring.size(); ++i) {
       all_rays.push_back(i);
@@ -428,7 +428,7 @@ struct DefectSurfaceFit {
     // stays calm where the ring is open on one side (next to an orbit).
     tps.set_quadratic_trend(outer && !s.mirror_guided);
     int sites = fit_sites(s, tps, outer, ring, rays, params);
-    if (sites == 0) return false;
+    if (sites == 0) return 0;
     // One round of outlier removal: rays far off the first fit.
     std::vector<double> abs_res;
     for (size_t i : rays) abs_res.push_back(std::abs(residual(tps, i)));
@@ -440,7 +440,6 @@ struct DefectSurfaceFit {
       const int refit = fit_sites(s, tps, outer, ring, kept, params);
       if (refit > 0) sites = refit;
     }
-    fitted_sites = sites;
     // The residual over the ring's rays that the fit describes. Rays farther off than the
     // outlier limit are counted apart: mirror-guided, a ray past an orbit meets the orbital roof
     // on one side and the frontal bone on the other, 30-50 mm apart, and a few of those would
@@ -463,7 +462,7 @@ struct DefectSurfaceFit {
         count > 0 ? std::sqrt(sum / static_cast<double>(count)) : 0.0;
     (outer ? s.outer_off_rays : s.thickness_off_rays) = off;
     (outer ? s.outer_off_limit_mm : s.thickness_off_limit_mm) = limit;
-    return true;
+    return sites;
   }
 
   // What was fitted, and how well.
@@ -509,11 +508,10 @@ DefectSurfaces fit_defect_surfaces(const DefectRegion& defect, const SurfaceLoca
     return s;
   }
   if (!mirror) DefectSurfaceFit::vault(s, ring, params);
-  int outer_sites = 0, inner_sites = 0;
-  std::future<bool> outer_fitted = std::async(
-      beside(), [&] { return DefectSurfaceFit::fit(s, true, ring, params, outer_sites); });
-  const bool inner_fitted = DefectSurfaceFit::fit(s, false, ring, params, inner_sites);
-  if (!outer_fitted.get() || !inner_fitted) {
+  std::future<int> outer_sites =
+      std::async(beside(), [&] { return DefectSurfaceFit::fit(s, true, ring, params); });
+  const int inner_sites = DefectSurfaceFit::fit(s, false, ring, params);
+  if (outer_sites.get() == 0 || inner_sites == 0) {
     s.message = "the intact bone around the opening lies on a line: no surface can be fitted";
     return s;
   }

@@ -69,7 +69,7 @@ void BuildPage::add_shell_controls() {
   // Left unset (its lowest value, 0) the thickness is the bone's around the rim.
   thickness_ =
       declared_spin(this, "implantThickness", spec_of<ImplantParams>("thickness_mm"), 0.0, 0.1);
-  allow_unset(thickness_, spec_of<ImplantParams>("thickness_mm"), tr("measured at the rim"));
+  allow_unset(thickness_, tr("measured at the rim"));
   fit_ = declared_spin(this, "implantFit", spec_of<ImplantParams>("fit_to_bone_mm"),
                        automatic_implant().fit_to_bone_mm, 0.5);
   fit_->setSpecialValueText(tr("off"));
@@ -102,7 +102,7 @@ void BuildPage::add_material_controls() {
                     custom.min_thickness_mm, 0.1);
   // Left unset (its lowest value, 0) the implant follows the bone.
   plate_ = declared_spin(this, "materialPlate", spec_of<Material>("thickness_mm"), 0.0, 0.1);
-  allow_unset(plate_, spec_of<Material>("thickness_mm"), tr("follows the bone"));
+  allow_unset(plate_, tr("follows the bone"));
   density_ = declared_spin(this, "materialDensity", spec_of<Material>("density_g_cm3"),
                            custom.density_g_cm3, 0.01);
   form_->addRow(tr("Material"), material_);

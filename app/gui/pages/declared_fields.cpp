@@ -28,19 +28,19 @@ QDoubleSpinBox* declared_spin(QWidget* parent, const char* name, const ParamSpec
   return b;
 }
 
-void allow_unset(QDoubleSpinBox* box, const ParamSpec& s, const QString& text) {
+void allow_unset(QDoubleSpinBox* box, const QString& text) {
+  const double least = box->minimum();
   box->setMinimum(0.0);
   box->setSpecialValueText(text);
   box->setValue(0.0);
   auto previous = std::make_shared<double>(0.0);
-  QObject::connect(box, &QDoubleSpinBox::valueChanged, box,
-                   [box, least = s.min, previous](double v) {
-                     if (v > 0.0 && v < least) {
-                       box->setValue(v > *previous ? least : 0.0);
-                       return;
-                     }
-                     *previous = v;
-                   });
+  QObject::connect(box, &QDoubleSpinBox::valueChanged, box, [box, least, previous](double v) {
+    if (v > 0.0 && v < least) {
+      box->setValue(v > *previous ? least : 0.0);
+      return;
+    }
+    *previous = v;
+  });
 }
 
 QSpinBox* declared_count(QWidget* parent, const char* name, const ParamSpec& s, int value) {

@@ -22,9 +22,9 @@ QDoubleSpinBox* declared_spin(QWidget* parent, const char* name, const ParamSpec
                               double step);
 /// A field for a declared count.
 QSpinBox* declared_count(QWidget* parent, const char* name, const ParamSpec& s, int value);
-/// Lets `box` (a declared_spin for `s`) be left unset: its lowest value 0 reads `text`, and a
-/// value between 0 and the least allowed steps to the least allowed going up, to 0 going down.
-void allow_unset(QDoubleSpinBox* box, const ParamSpec& s, const QString& text);
+/// Lets `box` (a declared_spin) be left unset: below its least value it takes 0, which reads
+/// `text`; a value between 0 and the least steps to the least going up, to 0 going down.
+void allow_unset(QDoubleSpinBox* box, const QString& text);
 /// A slider over a declared parameter's range in whole units.
 QSlider* declared_slider(QWidget* parent, const char* name, const ParamSpec& s, int value);
 

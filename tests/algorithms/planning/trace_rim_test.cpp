@@ -11,6 +11,7 @@
 #include "cranioplan/algorithms/io/extract_bone_surface.h"
 #include "cranioplan/algorithms/planning/detect_defect.h"
 #include "cranioplan/algorithms/quality/inject_defect.h"
+#include "cranioplan/model/parallel.h"
 #include "support/synthetic.h"
 
 namespace cranioplan {
@@ -149,6 +150,27 @@ TEST(TraceRim, FindsTheEdgeTheRaysCannotSee) {
   // Rays seen every ~1.5° of the rim; the rim points about a millimetre apart.
   EXPECT_GT(found.outer_rim.size(), 300u);
   EXPECT_GT(found.area_mm2, seen.area_mm2);
+}
+
+// The two tables are traced side by side: the rim is the same on one thread and on two.
+TEST(TraceRim, TheTracedRimIsTheSameOnOneThreadAndOnTwo) {
+  const ShelfedFlap& c = shelfed_flap();
+  const SurfaceLocator bone(c.defective);
+  DetectDefectParams traced;
+  traced.scan_borders = std::vector<ScanBorder>{};
+  std::vector<Eigen::Vector3d> outer[2], inner[2];
+  for (int threads : {1, 2}) {
+    set_thread_count(threads);
+    const DefectRegion found =
+        detect_defect(c.defective, bone, Eigen::Vector3d(0.0, 0.0, 5.0), traced);
+    set_thread_count(0);
+    ASSERT_TRUE(found.rim_traced) << found.message;
+    outer[threads - 1] = found.outer_rim;
+    inner[threads - 1] = found.inner_rim;
+  }
+  EXPECT_EQ(outer[0], outer[1]);
+  EXPECT_EQ(inner[0], inner[1]);
+  EXPECT_FALSE(inner[0].empty());
 }
 
 }  // namespace
